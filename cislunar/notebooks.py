@@ -1,0 +1,185 @@
+"""Execute the literate notebooks headless and gather their paper-vs-reproduction tables.
+
+Usage::
+
+    python -m cislunar.notebooks                 # every notebook at full fidelity (make reproduce)
+    python -m cislunar.notebooks --quick         # every notebook in quick mode (make test runs them via pytest)
+    python -m cislunar.notebooks --quick 01 02   # a selection, by number or name prefix
+
+Each ``notebooks/NN_topic.py`` (jupytext py:percent) is converted to ``.ipynb`` and executed with papermill on the
+``python3`` kernel with the parameters ``QUICK``, ``SEED`` and ``OUTPUT_DIR``.  Executed notebooks land in
+``<build>/notebooks/``, figures in ``<build>/figures/`` (written by the notebooks through
+:func:`cislunar.plotting.save_figure`), each notebook's closing table in ``<build>/report/NN_topic.md``, and all
+tables present are assembled into ``<build>/report.md``.  A failing cell fails the command, naming the notebook
+and the cell.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import paths
+from .report import REPORT_METADATA_KEY
+
+__all__ = ["NotebookFailure", "NotebookResult", "discover", "run_notebook", "assemble_report", "main"]
+
+
+class NotebookFailure(RuntimeError):
+    """A notebook cell raised; the message names the notebook, the cell and the error."""
+
+
+@dataclass(frozen=True)
+class NotebookResult:
+    """Outcome of one notebook run."""
+
+    name: str
+    seconds: float
+    executed_path: Path
+    report_markdown: str
+
+
+def notebooks_dir() -> Path:
+    """``notebooks/`` in the repository."""
+    return paths.repo_root() / "notebooks"
+
+
+def discover(selection=None) -> list[Path]:
+    """Notebook sources ``notebooks/NN_*.py`` in order, optionally filtered by name prefixes (``"01"``, ``"02_mut"``)."""
+    found = sorted(p for p in notebooks_dir().glob("[0-9][0-9]_*.py"))
+    if not selection:
+        return found
+    chosen = []
+    for key in selection:
+        match = [p for p in found if p.stem.startswith(key) or p.name == key]
+        if not match:
+            raise ValueError(f"no notebook matches {key!r}; available: {[p.stem for p in found]}")
+        chosen.extend(m for m in match if m not in chosen)
+    return chosen
+
+
+def _extract_report(nb) -> str:
+    parts = []
+    for cell in nb.cells:
+        for out in cell.get("outputs", []):
+            if out.get("metadata", {}).get(REPORT_METADATA_KEY):
+                parts.append(out["data"]["text/markdown"])
+    return "\n\n".join(parts)
+
+
+def run_notebook(source: Path, *, quick: bool, seed: int = 0, output_dir=None, kernel: str = "python3",
+                 extra_parameters: dict | None = None) -> NotebookResult:
+    """Convert ``source`` with jupytext, execute it with papermill and collect its report table.
+
+    Parameters
+    ----------
+    source : Path
+        ``notebooks/NN_topic.py``.
+    quick : bool
+        Passed as the ``QUICK`` parameter (smaller sizes, same science).
+    seed : int
+        Passed as ``SEED``.
+    output_dir : path-like, optional
+        Build directory (default ``build/``), passed as ``OUTPUT_DIR``.
+    kernel : str
+        Jupyter kernel name.
+    extra_parameters : dict, optional
+        Further papermill parameters.
+
+    Raises
+    ------
+    NotebookFailure
+        When a cell raises; the message names the notebook and the cell.
+    """
+    import jupytext
+    import nbformat
+    import papermill as pm
+
+    os.environ.setdefault("JUPYTER_PREFER_ENV_PATH", "1")
+    build = paths.build_dir(output_dir)
+    src_dir = build / "notebooks" / "_sources"
+    src_dir.mkdir(parents=True, exist_ok=True)
+    name = source.stem
+    nb = jupytext.read(source)
+    tags = [c.metadata.get("tags", []) for c in nb.cells]
+    if sum("parameters" in t for t in tags) != 1:
+        raise NotebookFailure(f"{name}: needs exactly one cell tagged 'parameters'")
+    ipynb = src_dir / f"{name}.ipynb"
+    nbformat.write(nb, ipynb)
+    executed = build / "notebooks" / f"{name}.ipynb"
+    params = {"QUICK": bool(quick), "SEED": int(seed), "OUTPUT_DIR": str(build)}
+    params.update(extra_parameters or {})
+    start = time.perf_counter()
+    try:
+        pm.execute_notebook(str(ipynb), str(executed), parameters=params, kernel_name=kernel,
+                            cwd=str(build / "notebooks"), progress_bar=False, log_output=False)
+    except pm.PapermillExecutionError as exc:
+        done = nbformat.read(executed, as_version=4)
+        cell = done.cells[exc.cell_index] if exc.cell_index < len(done.cells) else None
+        head = (cell.source.strip().splitlines() or [""])[0] if cell is not None else ""
+        raise NotebookFailure(
+            f"{name}: cell {exc.cell_index} (execution count {exc.exec_count}, starting {head!r}) raised "
+            f"{exc.ename}: {exc.evalue}"
+        ) from None
+    seconds = time.perf_counter() - start
+    done = nbformat.read(executed, as_version=4)
+    report = _extract_report(done)
+    if not report:
+        raise NotebookFailure(f"{name}: no paper-vs-reproduction table was displayed (ComparisonTable.display())")
+    rep_dir = build / "report"
+    rep_dir.mkdir(parents=True, exist_ok=True)
+    mode = "quick" if quick else "full"
+    (rep_dir / f"{name}.md").write_text(f"## {name} ({mode} mode, {seconds:.0f} s)\n\n{report}\n")
+    assemble_report(output_dir)
+    return NotebookResult(name, seconds, executed, report)
+
+
+def assemble_report(output_dir=None) -> Path:
+    """Concatenate ``<build>/report/*.md`` into ``<build>/report.md``."""
+    build = paths.build_dir(output_dir)
+    parts = sorted((build / "report").glob("*.md"))
+    text = ["# Paper versus reproduction", "",
+            "Generated by `python -m cislunar.notebooks`; one section per executed notebook. Status words: "
+            "*reproduced* (agrees within the stated tolerance), *differs* (with the reason), *derived* (the paper "
+            "gives no number; computed here), *beyond paper*.", ""]
+    text += [p.read_text() for p in parts]
+    out = build / "report.md"
+    out.write_text("\n".join(text))
+    return out
+
+
+def main(argv=None) -> int:
+    """Command-line entry point; returns the process exit status."""
+    parser = argparse.ArgumentParser(prog="python -m cislunar.notebooks", description=__doc__.split("\n\n")[0])
+    parser.add_argument("names", nargs="*", help="notebook number or name prefixes (default: all)")
+    parser.add_argument("--quick", action="store_true", help="quick mode: smaller sizes, same science")
+    parser.add_argument("--seed", type=int, default=0, help="random seed passed to every notebook")
+    parser.add_argument("--output-dir", default=None, help="build directory (default: <repo>/build)")
+    args = parser.parse_args(argv)
+    try:
+        sources = discover(args.names)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    failures = 0
+    total = time.perf_counter()
+    for src in sources:
+        print(f"[{src.stem}] running ({'quick' if args.quick else 'full'})...", flush=True)
+        try:
+            res = run_notebook(src, quick=args.quick, seed=args.seed, output_dir=args.output_dir)
+        except NotebookFailure as exc:
+            failures += 1
+            print(f"[{src.stem}] FAILED: {exc}", file=sys.stderr, flush=True)
+            continue
+        print(f"[{src.stem}] done in {res.seconds:.1f} s -> {res.executed_path}", flush=True)
+    report = assemble_report(args.output_dir)
+    print(f"report: {report}; total {time.perf_counter() - total:.1f} s; {failures} failed", flush=True)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    raise SystemExit(main())

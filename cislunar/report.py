@@ -1,0 +1,95 @@
+"""Paper-vs-reproduction tables.
+
+Every notebook ends with a :class:`ComparisonTable`.  ``table.display()`` renders it as Markdown in the notebook
+and tags the output so that the notebook runner (:mod:`cislunar.notebooks`) can gather all tables into
+``build/report.md`` without parsing prose.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+__all__ = ["ComparisonTable", "Row", "REPORT_METADATA_KEY", "STATUSES", "fmt"]
+
+#: Key placed in the display metadata of a rendered table.
+REPORT_METADATA_KEY = "cislunar_report"
+#: Allowed status words; "differs" and "not in paper" need a reason.
+STATUSES = ("reproduced", "differs", "derived", "not in paper", "beyond paper")
+
+
+def fmt(value, digits: int = 6) -> str:
+    """Format numbers compactly for tables (strings pass through)."""
+    if value is None:
+        return "-"
+    if isinstance(value, str):
+        return value
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return str(value)
+    if v == 0:
+        return "0"
+    if 1e-3 <= abs(v) < 1e6:
+        return f"{v:.{digits}g}"
+    return f"{v:.{max(digits - 2, 2)}e}"
+
+
+@dataclass
+class Row:
+    """One comparison: what the paper says, what we computed, and whether they agree (with the reason if not)."""
+
+    quantity: str
+    paper: str
+    reproduced: str
+    status: str
+    note: str = ""
+
+
+@dataclass
+class ComparisonTable:
+    """Paper value, reproduced value and status for each checked quantity of one notebook.
+
+    Parameters
+    ----------
+    title : str
+        Usually the notebook name and the paper section it follows.
+    """
+
+    title: str
+    rows: list = field(default_factory=list)
+
+    def add(self, quantity: str, paper, reproduced, status: str, note: str = "") -> "ComparisonTable":
+        """Append a row.
+
+        ``status`` must start with one of :data:`STATUSES`; a ``differs`` or ``not in paper`` row needs a ``note``
+        that says why.
+        """
+        head = status.split(":")[0].strip()
+        if head not in STATUSES:
+            raise ValueError(f"status must start with one of {STATUSES}; got {status!r}")
+        if head in ("differs", "not in paper") and not note and ":" not in status:
+            raise ValueError(f"a {head!r} row needs a note saying why (quantity {quantity!r})")
+        self.rows.append(Row(quantity, fmt(paper), fmt(reproduced), status, note))
+        return self
+
+    def to_markdown(self) -> str:
+        """The table as GitHub-flavoured Markdown."""
+        lines = [f"**{self.title}**", "", "| quantity | paper | reproduced | status | note |",
+                 "|---|---|---|---|---|"]
+        for r in self.rows:
+            cells = [r.quantity, r.paper, r.reproduced, r.status, r.note]
+            lines.append("| " + " | ".join(str(c).replace("|", "\\|").replace("\n", " ") for c in cells) + " |")
+        return "\n".join(lines)
+
+    def _repr_markdown_(self):
+        return self.to_markdown()
+
+    def display(self) -> None:
+        """Show the table in a notebook, tagged for the report gatherer (falls back to printing)."""
+        md = self.to_markdown()
+        try:
+            from IPython.display import display
+        except ImportError:  # pragma: no cover - IPython is a notebook dependency
+            print(md)
+            return
+        display({"text/markdown": md, "text/plain": md}, raw=True, metadata={REPORT_METADATA_KEY: True})
