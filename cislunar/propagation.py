@@ -430,7 +430,7 @@ def find_events(system: CR3BP, x0, t_end: float, events=("y_crossing",), *, t0: 
             rows.append((tt, label, sgn))
     rows.sort(key=lambda r: r[0] if t_end > t0 else -r[0])
     times = np.array([r[0] for r in rows])
-    xs = np.array([np.asarray(c_out(tt))[:6] for tt in times]).reshape(-1, 6)
+    xs = np.array([np.array(c_out(tt)[:6], copy=True) for tt in times]).reshape(-1, 6)  # c_out reuses its buffer
     return EventRecord(t=times, x=xs, kind=[r[1] for r in rows], direction=np.array([r[2] for r in rows], dtype=int))
 
 
