@@ -269,3 +269,495 @@ class CR3BPLPV:
         s = _checks.as_array(state, "state", last=4)
         r = self.rho(s) if rho is None else rho
         return np.einsum("...ij,...j->...i", self.C(r), s) + self.d(r)
+
+
+# ------------------------------------------------------------------------------------------- polytope
+@dataclass(frozen=True)
+class ParameterBox:
+    """Axis-aligned box (a convex polytope) bounding the scheduling parameters.
+
+    Parameters
+    ----------
+    lower, upper : array_like, shape (k,)
+        Bounds of each parameter (same units as :meth:`CR3BPLPV.rho`), ``lower <= upper``.
+    names : tuple of str
+        Parameter names (default :data:`RHO_NAMES`).
+    source : str
+        Where the bounds come from (e.g. the trajectory they were taken from).
+    """
+
+    lower: np.ndarray
+    upper: np.ndarray
+    names: tuple = RHO_NAMES
+    source: str = ""
+
+    def __post_init__(self):
+        lo = _checks.as_array(self.lower, "lower", ndim=(1,))
+        hi = _checks.as_array(self.upper, "upper", shape=lo.shape)
+        if np.any(hi < lo):
+            raise ValueError(f"upper must be >= lower componentwise; got lower={lo}, upper={hi}")
+        if len(self.names) != lo.size:
+            raise ValueError(f"names must have {lo.size} entries; got {len(self.names)}")
+        object.__setattr__(self, "lower", lo)
+        object.__setattr__(self, "upper", hi)
+
+    @classmethod
+    def from_samples(cls, rho, *, margin: float = 0.0, source: str = "") -> "ParameterBox":
+        """Smallest box containing the samples ``rho`` (n, k), widened by ``margin`` times each range."""
+        r = _checks.as_array(rho, "rho", ndim=(2,))
+        if r.shape[0] < 1:
+            raise ValueError("rho must hold at least one sample")
+        margin = _checks.positive(margin, "margin", allow_zero=True)
+        lo, hi = r.min(axis=0), r.max(axis=0)
+        w = (hi - lo) * margin
+        return cls(lo - w, hi + w, source=source)
+
+    @property
+    def dim(self) -> int:
+        """Number of parameters."""
+        return self.lower.size
+
+    @property
+    def centre(self) -> np.ndarray:
+        """Box centre."""
+        return 0.5 * (self.lower + self.upper)
+
+    def vertices(self, free=None) -> np.ndarray:
+        """Polytope vertices, shape (2^k, dim).
+
+        Parameters
+        ----------
+        free : sequence of int, optional
+            Indices of the parameters allowed to vary (default: all with ``upper > lower``); the others are
+            held at the box centre (used by the benchmark to scale the number of vertices).
+        """
+        if free is None:
+            free = [i for i in range(self.dim) if self.upper[i] > self.lower[i]]
+        free = [int(i) for i in free]
+        if any(i < 0 or i >= self.dim for i in free) or len(set(free)) != len(free):
+            raise ValueError(f"free must hold distinct indices in [0, {self.dim}); got {free}")
+        out = np.tile(self.centre, (2 ** len(free), 1))
+        for row, corner in enumerate(product((0, 1), repeat=len(free))):
+            for i, c in zip(free, corner):
+                out[row, i] = self.upper[i] if c else self.lower[i]
+        return out
+
+    def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
+        """``n`` points drawn uniformly in the box (n, dim), with the generator ``rng``."""
+        if not isinstance(rng, np.random.Generator):
+            raise ValueError(f"rng must be a numpy.random.Generator; got {type(rng).__name__}")
+        n = int(_checks.positive(n, "n"))
+        return self.lower + (self.upper - self.lower) * rng.random((n, self.dim))
+
+    def contains(self, rho, *, rtol: float = 1e-12) -> np.ndarray:
+        """Whether points (..., dim) lie in the box (with a relative tolerance)."""
+        r = _checks.as_array(rho, "rho", last=self.dim)
+        tol = rtol * np.maximum(np.abs(self.lower), np.abs(self.upper))
+        return np.all((r >= self.lower - tol) & (r <= self.upper + tol), axis=-1)
+
+
+# ------------------------------------------------------------------------------------- resonant orbit
+def _planar_shoot(system: CR3BP, x0: np.ndarray, tau: float, *, tol: float = 1e-11, max_iter: int = 30):
+    """Minimal fixed-x0 single shooting for an x-axis symmetric planar orbit (fallback if cislunar.orbits
+    is unavailable): unknowns (vy0, tau), residual (y, vx) at tau."""
+    from .propagation import propagate_stm
+
+    vy0 = float(x0[4])
+    for _ in range(max_iter):
+        s0 = np.array([x0[0], 0.0, 0.0, 0.0, vy0, 0.0])
+        tr = propagate_stm(system, s0, np.array([0.0, tau]))
+        xf, phi = tr.x[-1], tr.stm[-1]
+        G = xf[[1, 3]]
+        if np.linalg.norm(G) < tol:
+            return s0, 2.0 * tau
+        fd = system.eom(xf)
+        J = np.array([[phi[1, 4], fd[1]], [phi[3, 4], fd[3]]])
+        step = np.linalg.solve(J, -G)
+        step *= min(1.0, 0.1 / max(np.max(np.abs(step)), 1e-300))
+        vy0, tau = vy0 + step[0], tau + step[1]
+    raise RuntimeError(f"planar shooting did not converge: |G| = {np.linalg.norm(G):.3e}")
+
+
+@dataclass(frozen=True)
+class ResonantOrbit:
+    """A planar Earth-Moon p:q resonant periodic orbit (x-axis symmetric).
+
+    Attributes
+    ----------
+    p, q : int
+        The spacecraft makes about ``p`` revolutions about the Earth while the Moon makes ``q``.
+    x0 : ndarray, shape (6,)
+        State at the perpendicular x-axis crossing on the far side of the Earth (LU, LU/TU, rotating frame).
+    period : float
+        Period in the rotating frame, TU (close to :math:`2\\pi q`).
+    perigee_radius : float
+        Distance from the Earth at ``x0``, LU (the requested design value).
+    """
+
+    system: CR3BP
+    p: int
+    q: int
+    x0: np.ndarray
+    period: float
+    perigee_radius: float
+
+    def sample(self, n: int, periods: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+        """Times (n,) and states (n, 6) over ``periods`` periods, propagated with :func:`propagate`."""
+        from .propagation import propagate
+
+        n = int(_checks.positive(n, "n"))
+        t = np.linspace(0.0, _checks.positive(periods, "periods") * self.period, max(n, 2))
+        return t, propagate(self.system, self.x0, t).x
+
+
+def resonant_orbit(system: CR3BP = EARTH_MOON, p: int = 3, q: int = 1, perigee_radius: float = 0.2) -> ResonantOrbit:
+    r"""Planar p:q Earth-Moon resonant orbit by single shooting from a Keplerian guess.
+
+    The guess is the Earth-centred Keplerian ellipse of semi-major axis :math:`a = (q/p)^{2/3}` LU (mean motion
+    p/q times the Moon's) with perigee ``perigee_radius`` on the far side of the Earth, converted to the rotating
+    frame (:math:`v_y = -(v_p - r_p)`); the CR3BP orbit is then corrected at fixed :math:`x_0` with free
+    :math:`(\dot y_0, T/2)` (half-period guess :math:`\pi q`).  The planar resonant orbits are the
+    surveillance orbits of Frueh et al. (2021) cited in the paper's introduction; p, q and the perigee radius
+    are this reproduction's choice (the paper does not state its orbit).
+
+    Parameters
+    ----------
+    system : CR3BP
+    p, q : int
+        Resonance (positive, ``p > q``).
+    perigee_radius : float
+        Distance from the Earth of the initial x-axis crossing, LU, in (0.05, 0.9).
+
+    Returns
+    -------
+    ResonantOrbit
+    """
+    if not isinstance(system, CR3BP):
+        raise ValueError(f"system must be a cislunar.dynamics.CR3BP; got {type(system).__name__}")
+    if int(p) != p or int(q) != q or p < 1 or q < 1 or p <= q:
+        raise ValueError(f"p and q must be positive integers with p > q; got p={p}, q={q}")
+    rp = _checks.in_range(perigee_radius, "perigee_radius", 0.05, 0.9)
+    mu = system.mu
+    a = (q / p) ** (2.0 / 3.0)
+    if rp >= 2 * a:
+        raise ValueError(f"perigee_radius must be below 2a = {2 * a:.3f} LU for a {p}:{q} resonance; got {rp}")
+    vp = np.sqrt((1.0 - mu) * (2.0 / rp - 1.0 / a))
+    guess = np.array([-mu - rp, 0.0, 0.0, 0.0, -(vp - rp), 0.0])
+    try:
+        from .orbits import correct_symmetric
+    except ImportError:  # pragma: no cover - shared module not present
+        x0, period = _planar_shoot(system, guess, np.pi * q)
+    else:
+        orbit = correct_symmetric(system, guess, np.pi * q, fix="x0", label=f"{p}:{q} resonant")
+        x0, period = orbit.x0, orbit.period
+    return ResonantOrbit(system, int(p), int(q), np.asarray(x0, dtype=float), float(period), rp)
+
+
+# ----------------------------------------------------------------------------------------- precisions
+def precision_to_noise_deg(kappa) -> np.ndarray:
+    r"""Allowable angle noise (deg) from the precision of a sine or cosine sensor, paper Eq. 24:
+    :math:`\delta\theta = \sin^{-1}(1/\kappa)` (equivalently :math:`\pi/2 - \cos^{-1}(1/\kappa)`).
+
+    For :math:`\kappa \le 1` the sine/cosine noise may exceed 1 and the angle is unconstrained: 90 deg.
+    """
+    k = _checks.as_array(kappa, "kappa", finite=False)
+    if np.any(np.isnan(k)) or np.any(k < 0):
+        raise ValueError("kappa must be non-negative")
+    with np.errstate(divide="ignore"):
+        inv = np.where(k > 0, 1.0 / np.where(k > 0, k, 1.0), np.inf)
+    return np.degrees(np.arcsin(np.minimum(inv, 1.0)))
+
+
+def noise_deg_to_precision(noise_deg) -> np.ndarray:
+    """Inverse of :func:`precision_to_noise_deg`: :math:`\\kappa = 1/\\sin(\\delta\\theta)`, noise in (0, 90] deg."""
+    n = _checks.as_array(noise_deg, "noise_deg")
+    if np.any(n <= 0) or np.any(n > 90):
+        raise ValueError("noise_deg must lie in (0, 90] degrees")
+    return 1.0 / np.sin(np.radians(n))
+
+
+def default_disturbance(sigma_acc: float = 1e-3):
+    r"""Disturbance channel used in this reproduction (the paper never states :math:`B_d, S_d, D_d`).
+
+    Unmodelled accelerations of size ``sigma_acc`` (LU/TU^2 per unit normalised input) on both velocity
+    components: :math:`B_d = [0; I_2]`, :math:`S_d = \sigma_{acc} I_2`, :math:`D_d = 0` (the disturbance does not
+    enter the sensors).
+
+    Returns
+    -------
+    tuple of ndarray
+        ``(Bd (4, 2), Sd (2, 2), Dd (6, 2))``.
+    """
+    s = _checks.positive(sigma_acc, "sigma_acc", allow_zero=True)
+    Bd = np.vstack([np.zeros((2, 2)), np.eye(2)])
+    return Bd, s * np.eye(2), np.zeros((6, 2))
+
+
+class InfeasibleLMIError(RuntimeError):
+    """The precision LMI has no solution (or the solver failed); the message names gamma and the status."""
+
+    def __init__(self, message: str, gamma: float, status: str):
+        super().__init__(message)
+        self.gamma = gamma
+        self.status = status
+
+
+@dataclass(frozen=True)
+class ObserverDesign:
+    """Result of :class:`PrecisionLMI` (Theorem 1 or 2).
+
+    Attributes
+    ----------
+    norm : str
+        ``"h2"`` or ``"hinf"``.
+    gamma : float
+        Performance bound on the position error, LU.
+    L : ndarray (4, 6)
+        Observer gain :math:`L = X^{-1}Y` of Eq. 3a (sign convention of the paper: the observer is
+        :math:`\\dot{\\hat x} = (A + LC)\\hat x - Ly + b + Ld`).
+    X : ndarray (4, 4)
+        Lyapunov matrix (:math:`P^{-1}`).
+    beta : ndarray (6,)
+        :math:`\\beta_i = \\kappa_i^2`.
+    kappa : ndarray (6,)
+        Precision of each sensor (inverse of its admissible noise, :math:`\\kappa_i = \\sqrt{\\beta_i}`).
+    noise_deg : ndarray (6,)
+        Eq. 24 applied to each :math:`\\kappa_i` (meaningful for the four angle sensors), deg.
+    used : ndarray of bool (6,)
+        Sensors whose :math:`\\beta_i` exceeds ``sparsity_tol`` times the largest (the others can be removed).
+    status, solver : str
+        Solver status and name.
+    solve_time : float
+        Wall-clock seconds of the solve (including canonicalisation on the first call).
+    objective : float
+        Optimal :math:`\\|\\beta\\|_p`.
+    """
+
+    norm: str
+    gamma: float
+    L: np.ndarray
+    X: np.ndarray
+    beta: np.ndarray
+    kappa: np.ndarray
+    noise_deg: np.ndarray
+    used: np.ndarray
+    status: str
+    solver: str
+    solve_time: float
+    objective: float
+    Bw: np.ndarray = None
+    Dd: np.ndarray = None
+
+    def noise_std(self) -> np.ndarray:
+        """Admissible noise level of each sensor :math:`1/\\kappa_i` (inf for removed sensors)."""
+        with np.errstate(divide="ignore"):
+            return np.where(self.used, 1.0 / self.kappa, np.inf)
+
+    def gain(self, *, drop_unused: bool = True) -> np.ndarray:
+        """Observer gain (4, 6); with ``drop_unused`` the columns of removed sensors are set to zero."""
+        L = self.L.copy()
+        if drop_unused:
+            L[:, ~self.used] = 0.0
+        return L
+
+
+_SOLVERS = ("CLARABEL", "SCS")
+_NORMS = ("h2", "hinf")
+_OBJECTIVES = {"l1": 1, "l2": 2, "linf": np.inf}
+
+
+class PrecisionLMI:
+    r"""Theorem 1 (H2) or Theorem 2 (H-infinity) of the paper as a cvxpy problem, built once.
+
+    Decision variables :math:`X = X^T \succ 0` (4x4), :math:`Y` (4x6), :math:`\beta \ge 0` (6) and, for H2,
+    :math:`Q = Q^T` (2x2).  At every vertex :math:`\rho_v` of the parameter polytope (the LMIs are affine in
+    :math:`\rho` because :math:`A, C` are and :math:`X, Y` are constant, so the vertices suffice):
+
+    H2 (Eq. 12-13, derived from the Gramian form :math:`(A+LC)P + P(A+LC)^T + B_{\bar w}B_{\bar w}^T \prec 0`,
+    :math:`\mathrm{tr}(C_z P C_z^T) < \gamma^2`, with :math:`X = P^{-1}, Y = XL`):
+
+    .. math:: \begin{bmatrix} \mathrm{sym}(XA_v + YC_v) & (XB_d + YD_d)S_d & Y\\ \star & -I & 0\\
+              \star & 0 & -\mathrm{diag}(\beta)\end{bmatrix} \prec 0,\quad
+              \begin{bmatrix} -Q & C_z\\ C_z^T & -X\end{bmatrix} \prec 0,\quad \mathrm{tr}\,Q < \gamma^2 .
+
+    H-infinity (Eq. 14/19, from the bounded-real lemma
+    :math:`\mathrm{sym}(X(A+LC)) + C_z^TC_z + \gamma^{-2}XB_{\bar w}B_{\bar w}^TX \prec 0`):
+
+    .. math:: \begin{bmatrix} \mathrm{sym}(XA_v + YC_v) & (XB_d + YD_d)S_d & C_z^T & Y\\ \star & -\gamma^2 I & 0 & 0\\
+              \star & 0 & -I & 0\\ \star & 0 & 0 & -\gamma^2\mathrm{diag}(\beta)\end{bmatrix} \prec 0 ,
+
+    which is solved in the equivalent, better-conditioned form obtained with :math:`X = \gamma^2X'`,
+    :math:`Y = \gamma^2 Y'` (same :math:`L = X'^{-1}Y'`, same :math:`\beta`): the :math:`C_z` blocks become
+    :math:`C_z/\gamma` and the :math:`-\gamma^2` factors become 1 (with :math:`\gamma = 0.0013`,
+    :math:`\gamma^2\beta` spans twelve orders of magnitude and Clarabel fails on the printed form).
+
+    In both, the noise enters through :math:`S_n = \mathrm{diag}(1/\kappa_i)` (the scaling from the normalised
+    to the physical noise; the paper's text writes :math:`S_n = \mathrm{diag}(\kappa_i)`, which contradicts its
+    own definition :math:`\kappa_i = 1/\|n_i\|`) so :math:`(S_nS_n^T)^{-1} = \mathrm{diag}(\beta)` and the
+    precision is :math:`\kappa_i = \sqrt{\beta_i}` for *both* theorems (the printed H-infinity formula
+    :math:`\sqrt{\beta_i/\gamma}` does not follow from Eq. 18-19).  Strict inequalities are imposed with a margin
+    ``eps`` (:math:`\preceq -\epsilon I`).  :math:`\gamma^2` is a ``cp.Parameter`` so sweeps reuse the
+    canonicalised problem.
+
+    Parameters
+    ----------
+    model : CR3BPLPV
+    vertices : array_like (n_v, 6)
+        Polytope vertices of :math:`\rho`.
+    norm : {"h2", "hinf"}
+    disturbance : tuple, optional
+        ``(Bd (4, nd), Sd (nd, nd), Dd (6, nd))``; default :func:`default_disturbance`.
+    Cz : array_like (nz, 4), optional
+        Performance output; default position ``[I2 0]``.
+    objective : {"l1", "l2", "linf"}
+        Norm of :math:`\beta` minimised (``"l1"`` promotes sparse sensor selection).
+    eps : float
+        Margin for the strict LMIs.
+    sensors : sequence of int, optional
+        Subset of sensors offered to the design (others get zero gain); default all six.
+    """
+
+    def __init__(self, model: CR3BPLPV, vertices, norm: str = "h2", *, disturbance=None, Cz=None,
+                 objective: str = "l1", eps: float = 1e-8, sensors=None):
+        import cvxpy as cp
+
+        if not isinstance(model, CR3BPLPV):
+            raise ValueError(f"model must be a CR3BPLPV; got {type(model).__name__}")
+        if norm not in _NORMS:
+            raise ValueError(f"norm must be one of {_NORMS}; got {norm!r}")
+        if objective not in _OBJECTIVES:
+            raise ValueError(f"objective must be one of {tuple(_OBJECTIVES)}; got {objective!r}")
+        V = _checks.as_array(vertices, "vertices", ndim=(2,), last=model.n_rho)
+        if V.shape[0] < 1:
+            raise ValueError("vertices must hold at least one vertex")
+        self.eps = _checks.positive(eps, "eps")
+        Bd, Sd, Dd = default_disturbance() if disturbance is None else disturbance
+        Bd = _checks.as_array(Bd, "disturbance Bd", ndim=(2,))
+        nd = Bd.shape[1]
+        if Bd.shape[0] != model.n_x:
+            raise ValueError(f"disturbance Bd must have {model.n_x} rows; got shape {Bd.shape}")
+        Sd = _checks.as_array(Sd, "disturbance Sd", shape=(nd, nd))
+        Dd = _checks.as_array(Dd, "disturbance Dd", shape=(model.n_y, nd))
+        Cz = np.hstack([np.eye(2), np.zeros((2, 2))]) if Cz is None else _checks.as_array(Cz, "Cz", ndim=(2,),
+                                                                                           last=model.n_x)
+        sensors = list(range(model.n_y)) if sensors is None else sorted(int(i) for i in sensors)
+        if not sensors or any(i < 0 or i >= model.n_y for i in sensors) or len(set(sensors)) != len(sensors):
+            raise ValueError(f"sensors must be distinct indices in [0, {model.n_y}); got {sensors}")
+        self.model, self.vertices, self.norm, self.objective = model, V, norm, objective
+        self.Bd, self.Sd, self.Dd, self.Cz, self.sensors = Bd, Sd, Dd, Cz, sensors
+        nx, ns, nz = model.n_x, len(sensors), Cz.shape[0]
+        A_v = model.A(V)
+        C_v = model.C(V)[:, sensors, :]
+        Dd_s = Dd[sensors]
+
+        X = cp.Variable((nx, nx), symmetric=True, name="X")
+        Y = cp.Variable((nx, ns), name="Y")
+        beta = cp.Variable(ns, nonneg=True, name="beta")
+        self.gamma2 = cp.Parameter(nonneg=True, name="gamma2", value=1.0)
+        self.inv_gamma = cp.Parameter(nonneg=True, name="inv_gamma", value=1.0)
+        eps = self.eps
+        cons = [X >> eps * np.eye(nx)]
+        Ind = np.eye(nd)
+        for Av, Cv in zip(A_v, C_v):
+            M11 = X @ Av + Y @ Cv
+            M11 = M11 + M11.T
+            M12 = (X @ Bd + Y @ Dd_s) @ Sd
+            if norm == "h2":
+                blk = cp.bmat([[M11, M12, Y],
+                               [M12.T, -Ind, np.zeros((nd, ns))],
+                               [Y.T, np.zeros((ns, nd)), -cp.diag(beta)]])
+            else:
+                blk = cp.bmat([[M11, M12, self.inv_gamma * Cz.T, Y],
+                               [M12.T, -Ind, np.zeros((nd, nz)), np.zeros((nd, ns))],
+                               [self.inv_gamma * Cz, np.zeros((nz, nd)), -np.eye(nz), np.zeros((nz, ns))],
+                               [Y.T, np.zeros((ns, nd)), np.zeros((ns, nz)), -cp.diag(beta)]])
+            size = blk.shape[0]
+            cons.append(0.5 * (blk + blk.T) << -eps * np.eye(size))
+        Q = None
+        if norm == "h2":
+            Q = cp.Variable((nz, nz), symmetric=True, name="Q")
+            cons.append(cp.bmat([[Q, Cz], [Cz.T, X]]) >> eps * np.eye(nz + nx))
+            cons.append(cp.trace(Q) <= self.gamma2)
+        self._X, self._Y, self._beta, self._Q = X, Y, beta, Q
+        self.problem = cp.Problem(cp.Minimize(cp.norm(beta, _OBJECTIVES[objective])), cons)
+
+    def solve(self, gamma: float, *, solver: str = "CLARABEL", sparsity_tol: float = 1e-4,
+              **solver_options) -> ObserverDesign:
+        """Solve for the bound ``gamma`` (LU) and return the design.
+
+        Parameters
+        ----------
+        gamma : float
+            Bound on the H2 or H-infinity norm from the normalised exogenous input to the position error, LU.
+        solver : {"CLARABEL", "SCS"}
+        sparsity_tol : float
+            A sensor is reported unused when its :math:`\\beta_i` is below this fraction of the largest.
+        **solver_options
+            Passed to ``cvxpy.Problem.solve``.
+
+        Raises
+        ------
+        ValueError
+            Non-positive gamma or unknown solver.
+        InfeasibleLMIError
+            The solver reports infeasibility or fails; the message names gamma and the status.
+        """
+        import cvxpy as cp
+
+        gamma = _checks.positive(gamma, "gamma")
+        solver = str(solver).upper()
+        if solver not in _SOLVERS:
+            raise ValueError(f"solver must be one of {_SOLVERS}; got {solver!r}")
+        sparsity_tol = _checks.in_range(sparsity_tol, "sparsity_tol", 0.0, 1.0)
+        if solver == "SCS":
+            solver_options = {"eps_abs": 1e-9, "eps_rel": 1e-9, "max_iters": 200000, **solver_options}
+        self.gamma2.value = gamma**2
+        self.inv_gamma.value = 1.0 / gamma
+        t0 = time.perf_counter()
+        try:
+            self.problem.solve(solver=solver, **solver_options)
+        except cp.error.SolverError as exc:
+            raise InfeasibleLMIError(f"{self.norm} precision LMI: solver {solver} failed at gamma = {gamma:g} "
+                                     f"({exc})", gamma, "solver_error") from exc
+        elapsed = time.perf_counter() - t0
+        status = self.problem.status
+        if status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or self._X.value is None:
+            raise InfeasibleLMIError(
+                f"{self.norm} precision LMI infeasible or unsolved at gamma = {gamma:g}: solver {solver} status "
+                f"{status!r} ({self.vertices.shape[0]} vertices)", gamma, str(status))
+        Xv = 0.5 * (self._X.value + self._X.value.T)
+        Ls = np.linalg.solve(Xv, self._Y.value)
+        L = np.zeros((self.model.n_x, self.model.n_y))
+        L[:, self.sensors] = Ls
+        beta = np.zeros(self.model.n_y)
+        beta[self.sensors] = np.maximum(self._beta.value, 0.0)
+        kappa = np.sqrt(beta)
+        used = np.zeros(self.model.n_y, dtype=bool)
+        used[self.sensors] = beta[self.sensors] > sparsity_tol * beta.max()
+        return ObserverDesign(norm=self.norm, gamma=gamma, L=L, X=Xv, beta=beta, kappa=kappa,
+                              noise_deg=precision_to_noise_deg(kappa), used=used, status=str(status),
+                              solver=solver, solve_time=elapsed, objective=float(self.problem.value),
+                              Bw=self.Bd @ self.Sd, Dd=self.Dd @ self.Sd)
+
+
+def design_observer(model: CR3BPLPV, vertices, gamma: float, norm: str = "h2", *, solver: str = "CLARABEL",
+                    **kwargs) -> ObserverDesign:
+    """One-shot :class:`PrecisionLMI` build and solve (keyword arguments go to the constructor).
+
+    Returns
+    -------
+    ObserverDesign
+    """
+    return PrecisionLMI(model, vertices, norm, **kwargs).solve(gamma, solver=solver)
+
+
+def gamma_sweep(lmi: PrecisionLMI, gammas, *, solver: str = "CLARABEL") -> list:
+    """Solve ``lmi`` for each gamma (re-using the canonicalised problem); infeasible points give ``None``."""
+    g = _checks.as_array(gammas, "gammas", ndim=(1,))
+    out = []
+    for gamma in g:
+        try:
+            out.append(lmi.solve(float(gamma), solver=solver))
+        except InfeasibleLMIError:
+            out.append(None)
+    return out

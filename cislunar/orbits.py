@@ -177,7 +177,7 @@ class PeriodicOrbit:
             raise ValueError(f"n must be at least 2; got {n}")
         _checks.positive(periods, "periods")
         t = np.linspace(0.0, periods * self.period, n)
-        return t, propagate(self.system, self.x0, t).x
+        return t, propagate(self.system, self.x0, t, impact=False).x
 
     @cached_property
     def apses(self):
@@ -215,7 +215,7 @@ def _residual_jacobian(system: CR3BP, X: np.ndarray, planar: bool, tol: float):
     x0, tau = _unpack(X, planar)
     if not tau > 0:
         raise ValueError(f"half period must be positive; got {tau}")
-    tr = propagate_stm(system, x0, np.array([0.0, tau]), tol=tol)
+    tr = propagate_stm(system, x0, np.array([0.0, tau]), tol=tol, impact=False)  # iterates may graze the Moon
     xf, phi = tr.x[-1], tr.stm[-1]
     f = system.eom(xf)
     rows = [1, 3] if planar else [1, 3, 5]
@@ -273,7 +273,7 @@ def half_period_guess(system: CR3BP, x0, *, max_time: float = 20.0, tol: float =
 
 def _finish(system, X, planar, history, label, int_tol) -> PeriodicOrbit:
     x0, tau = _unpack(X, planar)
-    tr = propagate_stm(system, x0, np.array([0.0, 2.0 * tau]), tol=int_tol)
+    tr = propagate_stm(system, x0, np.array([0.0, 2.0 * tau]), tol=int_tol, impact=False)
     closure = float(np.linalg.norm(tr.x[-1] - x0))
     return PeriodicOrbit(system=system, x0=x0, period=2.0 * tau, monodromy=tr.stm[-1], closure=closure,
                          residuals=tuple(history), label=label)

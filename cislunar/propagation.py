@@ -97,13 +97,19 @@ def _template(order: int, batch: int, tol: float, events: tuple = ()):
             kind, hy.event_direction.any
         )
         nt_events.append(hy.nt_event(expr, callback=_EventCallback(kind), direction=direction))
+    # terminal events: impact on the surface of either primary (radii in par[1] (Moon) and par[2] (Earth), LU)
+    x, y, z = variables[:3]
+    impact = [((x - 1.0 + hy.par[0]) ** 2 + y**2 + z**2) - hy.par[1] ** 2,
+              ((x + hy.par[0]) ** 2 + y**2 + z**2) - hy.par[2] ** 2]
     kwargs = dict(tol=tol, compact_mode=True)
-    if nt_events:
-        kwargs["nt_events"] = nt_events
     if batch == 1:
-        return hy.taylor_adaptive(sys, [0.5, 0, 0, 0, 0.5, 0], pars=[0.01], **kwargs)
+        kwargs["t_events"] = [hy.t_event(e, direction=hy.event_direction.negative) for e in impact]
+        if nt_events:
+            kwargs["nt_events"] = nt_events
+        return hy.taylor_adaptive(sys, [0.5, 0, 0, 0, 0.5, 0], pars=[0.01, 0.0, 0.0], **kwargs)
+    kwargs["t_events"] = [hy.t_event_batch(e, direction=hy.event_direction.negative) for e in impact]
     return hy.taylor_adaptive_batch(sys, np.tile(np.array([0.5, 0, 0, 0, 0.5, 0])[:, None], (1, batch)),
-                                    pars=np.full((1, batch), 0.01), **kwargs)
+                                    pars=np.zeros((3, batch)), **kwargs)
 
 
 class _EventCallback:
@@ -186,7 +192,7 @@ def _grid_from(t) -> np.ndarray:
 
 
 def _propagate_chunk(system: CR3BP, x0_chunk: np.ndarray, grid: np.ndarray, order: int, tol: float,
-                     batch: int) -> np.ndarray:
+                     batch: int, impact: bool = True) -> np.ndarray:
     """Propagate ``x0_chunk`` (k <= batch states) on ``grid``; returns raw variational states (k, m, n_vars)."""
     ta = copy.copy(_template(order, batch, tol))
     n_vars = len(ta.state) if batch == 1 else ta.state.shape[0]
@@ -194,7 +200,7 @@ def _propagate_chunk(system: CR3BP, x0_chunk: np.ndarray, grid: np.ndarray, orde
     k = x0_chunk.shape[0]
     if batch == 1:
         out = np.empty((1, grid.size, n_vars))
-        ta.pars[0] = system.mu
+        ta.pars[:] = _pars(system, impact)
         ta.time = grid[0]
         ta.state[:6] = x0_chunk[0]
         ta.state[6:] = vic
@@ -203,7 +209,7 @@ def _propagate_chunk(system: CR3BP, x0_chunk: np.ndarray, grid: np.ndarray, orde
         out[0] = res[-1]
         return out
     padded = np.concatenate([x0_chunk, np.repeat(x0_chunk[-1:], batch - k, axis=0)], axis=0)
-    ta.pars[0, :] = system.mu
+    ta.pars[:, :] = _pars(system, impact)[:, None]
     ta.set_time(np.full(batch, grid[0]))
     ta.state[:6, :] = padded.T
     ta.state[6:, :] = vic[:, None]
@@ -214,16 +220,24 @@ def _propagate_chunk(system: CR3BP, x0_chunk: np.ndarray, grid: np.ndarray, orde
     return np.transpose(arr, (2, 0, 1))[:k]
 
 
+def _pars(system: CR3BP, impact: bool = True) -> np.ndarray:
+    """Runtime parameters: mu, Moon radius and Earth radius (LU); zero radii switch impact detection off."""
+    if not impact:
+        return np.array([system.mu, 0.0, 0.0])
+    return np.array([system.mu, system.secondary_radius, system.primary_radius])
+
+
 def _check_outcome(outcome, t_target, t_reached):
     hy = _heyoka()
-    if outcome not in (hy.taylor_outcome.time_limit,) or not np.isclose(t_reached, t_target, rtol=0, atol=1e-12):
-        raise RuntimeError(
-            f"heyoka propagation stopped early: outcome {outcome}, reached t = {t_reached} TU, wanted {t_target} TU"
-            " (a collision with a primary or a non-finite state?)"
-        )
+    if outcome == hy.taylor_outcome.time_limit and np.isclose(t_reached, t_target, rtol=0, atol=1e-12):
+        return
+    code = int(outcome)
+    why = {0: "impact on the Moon's surface", 1: "impact on the Earth's surface"}.get(
+        code, f"outcome {outcome} (non-finite state or step-size collapse)")
+    raise RuntimeError(f"heyoka propagation stopped early at t = {t_reached} TU (wanted {t_target} TU): {why}")
 
 
-def _propagate(system: CR3BP, x0, t, order: int, tol: float, threads: int | None) -> Trajectory:
+def _propagate(system: CR3BP, x0, t, order: int, tol: float, threads: int | None, impact: bool = True) -> Trajectory:
     if not isinstance(system, CR3BP):
         raise ValueError(f"system must be a cislunar.dynamics.CR3BP; got {type(system).__name__}")
     x0 = _checks.as_state(x0, "x0", batch=True)
@@ -241,12 +255,12 @@ def _propagate(system: CR3BP, x0, t, order: int, tol: float, threads: int | None
     if threads < 1:
         raise ValueError(f"threads must be a positive integer; got {threads}")
     if threads == 1 or len(chunks) == 1:
-        raw = [_propagate_chunk(system, c, grid, order, tol, batch) for c in chunks]
+        raw = [_propagate_chunk(system, c, grid, order, tol, batch, impact) for c in chunks]
     else:
         from concurrent.futures import ThreadPoolExecutor  # heyoka releases the GIL while integrating
 
         with ThreadPoolExecutor(max_workers=min(threads, len(chunks))) as pool:
-            raw = list(pool.map(lambda c: _propagate_chunk(system, c, grid, order, tol, batch), chunks))
+            raw = list(pool.map(lambda c: _propagate_chunk(system, c, grid, order, tol, batch, impact), chunks))
     raw = np.concatenate(raw, axis=0)  # (n, m, n_vars)
     x = raw[..., :6]
     stm = stt = None
@@ -262,7 +276,8 @@ def _propagate(system: CR3BP, x0, t, order: int, tol: float, threads: int | None
     return Trajectory(t=grid, x=x, stm=stm, stt=stt)
 
 
-def propagate(system: CR3BP, x0, t, *, tol: float = DEFAULT_TOL, threads: int | None = None) -> Trajectory:
+def propagate(system: CR3BP, x0, t, *, tol: float = DEFAULT_TOL, threads: int | None = None,
+              impact: bool = True) -> Trajectory:
     """Propagate one state or a batch of states through the CR3BP.
 
     Parameters
@@ -278,6 +293,9 @@ def propagate(system: CR3BP, x0, t, *, tol: float = DEFAULT_TOL, threads: int | 
         Integrator tolerance (relative and absolute), in [1e-16, 1e-3].
     threads : int, optional
         Number of threads over which batch chunks are spread (heyoka releases the GIL); default 1.
+    impact : bool
+        Stop with ``RuntimeError`` when a trajectory reaches the Moon's or the Earth's surface (default).  Set
+        False for purely mathematical trajectories, e.g. intermediate iterates of a differential corrector.
 
     Returns
     -------
@@ -289,26 +307,28 @@ def propagate(system: CR3BP, x0, t, *, tol: float = DEFAULT_TOL, threads: int | 
     ValueError
         Wrong shapes, NaN, a non-monotonic grid or an out-of-range tolerance.
     RuntimeError
-        The integration stopped before the final time.
+        The integration stopped before the final time (impact on a primary, non-finite state).
     """
-    return _propagate(system, x0, t, 0, tol, threads)
+    return _propagate(system, x0, t, 0, tol, threads, impact)
 
 
-def propagate_stm(system: CR3BP, x0, t, *, tol: float = DEFAULT_TOL, threads: int | None = None) -> Trajectory:
+def propagate_stm(system: CR3BP, x0, t, *, tol: float = DEFAULT_TOL, threads: int | None = None,
+                  impact: bool = True) -> Trajectory:
     """Propagate state(s) and the STM :math:`\\Phi(t_k, t_0)` (first-order variational equations).
 
     Same arguments as :func:`propagate`; the result has ``stm`` of shape ``(m, 6, 6)`` or ``(n, m, 6, 6)``.
     """
-    return _propagate(system, x0, t, 1, tol, threads)
+    return _propagate(system, x0, t, 1, tol, threads, impact)
 
 
-def propagate_stt(system: CR3BP, x0, t, *, tol: float = DEFAULT_TOL, threads: int | None = None) -> Trajectory:
+def propagate_stt(system: CR3BP, x0, t, *, tol: float = DEFAULT_TOL, threads: int | None = None,
+                  impact: bool = True) -> Trajectory:
     """Propagate state(s), STM and the second-order STT :math:`\\Psi_{ijk}=\\partial^2x_i/\\partial x_{0j}\\partial x_{0k}`.
 
     Same arguments as :func:`propagate`; the result has ``stt`` of shape ``(m, 6, 6, 6)`` (or with a leading
     batch axis), symmetric in its last two indices.
     """
-    return _propagate(system, x0, t, 2, tol, threads)
+    return _propagate(system, x0, t, 2, tol, threads, impact)
 
 
 def propagate_scipy(system: CR3BP, x0, t, *, stm: bool = False, rtol: float = 1e-13, atol: float = 1e-13,
@@ -413,7 +433,7 @@ def find_events(system: CR3BP, x0, t_end: float, events=("y_crossing",), *, t0: 
     callbacks = [ev.callback for ev in ta.nt_events]
     for cb in callbacks:
         cb.records = []
-    ta.pars[0] = system.mu
+    ta.pars[:] = _pars(system)
     ta.time = t0
     ta.state[:] = x0
     res = ta.propagate_until(t_end, c_output=True)
