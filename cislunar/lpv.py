@@ -586,10 +586,26 @@ class PrecisionLMI:
     .. math:: \begin{bmatrix} \mathrm{sym}(XA_v + YC_v) & (XB_d + YD_d)S_d & C_z^T & Y\\ \star & -\gamma^2 I & 0 & 0\\
               \star & 0 & -I & 0\\ \star & 0 & 0 & -\gamma^2\mathrm{diag}(\beta)\end{bmatrix} \prec 0 ,
 
-    which is solved in the equivalent, better-conditioned form obtained with :math:`X = \gamma^2X'`,
-    :math:`Y = \gamma^2 Y'` (same :math:`L = X'^{-1}Y'`, same :math:`\beta`): the :math:`C_z` blocks become
-    :math:`C_z/\gamma` and the :math:`-\gamma^2` factors become 1 (with :math:`\gamma = 0.0013`,
-    :math:`\gamma^2\beta` spans twelve orders of magnitude and Clarabel fails on the printed form).
+    Scaling.  With :math:`\gamma = 0.0013` the printed forms mix entries from :math:`\gamma^2 \sim 10^{-6}` to
+    :math:`\beta \sim 10^{6}`; Clarabel then fails (H-infinity) or returns "optimal" points that violate
+    :math:`\mathrm{tr}\,Q < \gamma^2` by a factor of two (H2).  Both problems are therefore solved in the
+    equivalent variables :math:`\tilde X = \gamma^2 X`, :math:`\tilde Y = \gamma^2 Y` (same
+    :math:`L = \tilde X^{-1}\tilde Y`), :math:`\tilde\beta = \gamma^2\beta`, :math:`\tilde Q = Q/\gamma^2`
+    (congruence transformations with :math:`\mathrm{diag}(\gamma I, I, \gamma I)`), in which :math:`\gamma`
+    only scales the disturbance, :math:`S_d \to S_d/\gamma`, and :math:`\mathrm{tr}\,\tilde Q < 1`:
+
+    .. math:: \begin{bmatrix} \mathrm{sym}(\tilde XA_v + \tilde YC_v) & (\tilde XB_d + \tilde YD_d)S_d/\gamma &
+              [C_z^T] & \tilde Y\\ \star & -I & & 0\\ & & [-I] & \\ \star & 0 & & -\mathrm{diag}
+              (\tilde\beta)\end{bmatrix} \prec 0
+
+    (bracketed blocks for H-infinity only).  A consequence worth knowing: without disturbance
+    (:math:`S_d = 0`) the optimal precision scales exactly as :math:`\kappa \propto 1/\gamma`.
+
+    Optional pole region (beyond the paper).  The H-infinity optimum is approached only as the gain grows
+    without bound (the observer then simply inverts the :math:`\theta_1` measurement); ``pole_radius`` R adds
+    at each vertex :math:`\begin{bmatrix}-R\tilde X & \tilde X A_{cl}\\ \star & -R\tilde X\end{bmatrix}
+    \prec 0`, i.e. the eigenvalues of :math:`A+LC` inside the disc :math:`|\lambda| < R` with the same
+    Lyapunov matrix, which bounds the gain so that the observer can be integrated.
 
     In both, the noise enters through :math:`S_n = \mathrm{diag}(1/\kappa_i)` (the scaling from the normalised
     to the physical noise; the paper's text writes :math:`S_n = \mathrm{diag}(\kappa_i)`, which contradicts its
@@ -618,7 +634,7 @@ class PrecisionLMI:
     """
 
     def __init__(self, model: CR3BPLPV, vertices, norm: str = "h2", *, disturbance=None, Cz=None,
-                 objective: str = "l1", eps: float = 1e-8, sensors=None):
+                 objective: str = "l1", eps: float = 1e-8, sensors=None, pole_radius: float | None = None):
         import cvxpy as cp
 
         if not isinstance(model, CR3BPLPV):
@@ -631,6 +647,7 @@ class PrecisionLMI:
         if V.shape[0] < 1:
             raise ValueError("vertices must hold at least one vertex")
         self.eps = _checks.positive(eps, "eps")
+        self.pole_radius = None if pole_radius is None else _checks.positive(pole_radius, "pole_radius")
         Bd, Sd, Dd = default_disturbance() if disturbance is None else disturbance
         Bd = _checks.as_array(Bd, "disturbance Bd", ndim=(2,))
         nd = Bd.shape[1]
@@ -650,34 +667,39 @@ class PrecisionLMI:
         C_v = model.C(V)[:, sensors, :]
         Dd_s = Dd[sensors]
 
+        # scaled variables (see class notes): X~ = gamma^2 X, Y~ = gamma^2 Y, beta~ = gamma^2 beta, Q~ = Q/gamma^2
         X = cp.Variable((nx, nx), symmetric=True, name="X")
         Y = cp.Variable((nx, ns), name="Y")
-        beta = cp.Variable(ns, nonneg=True, name="beta")
-        self.gamma2 = cp.Parameter(nonneg=True, name="gamma2", value=1.0)
+        beta = cp.Variable(ns, nonneg=True, name="beta_scaled")
         self.inv_gamma = cp.Parameter(nonneg=True, name="inv_gamma", value=1.0)
         eps = self.eps
         cons = [X >> eps * np.eye(nx)]
         Ind = np.eye(nd)
         for Av, Cv in zip(A_v, C_v):
             M11 = X @ Av + Y @ Cv
+            XAcl = M11
             M11 = M11 + M11.T
-            M12 = (X @ Bd + Y @ Dd_s) @ Sd
+            M12 = self.inv_gamma * ((X @ Bd + Y @ Dd_s) @ Sd)
             if norm == "h2":
                 blk = cp.bmat([[M11, M12, Y],
                                [M12.T, -Ind, np.zeros((nd, ns))],
                                [Y.T, np.zeros((ns, nd)), -cp.diag(beta)]])
             else:
-                blk = cp.bmat([[M11, M12, self.inv_gamma * Cz.T, Y],
+                blk = cp.bmat([[M11, M12, Cz.T, Y],
                                [M12.T, -Ind, np.zeros((nd, nz)), np.zeros((nd, ns))],
-                               [self.inv_gamma * Cz, np.zeros((nz, nd)), -np.eye(nz), np.zeros((nz, ns))],
+                               [Cz, np.zeros((nz, nd)), -np.eye(nz), np.zeros((nz, ns))],
                                [Y.T, np.zeros((ns, nd)), np.zeros((ns, nz)), -cp.diag(beta)]])
             size = blk.shape[0]
             cons.append(0.5 * (blk + blk.T) << -eps * np.eye(size))
+            if self.pole_radius is not None:
+                R = self.pole_radius
+                disk = cp.bmat([[-R * X, XAcl], [XAcl.T, -R * X]])
+                cons.append(0.5 * (disk + disk.T) << -eps * np.eye(2 * nx))
         Q = None
         if norm == "h2":
-            Q = cp.Variable((nz, nz), symmetric=True, name="Q")
+            Q = cp.Variable((nz, nz), symmetric=True, name="Q_scaled")
             cons.append(cp.bmat([[Q, Cz], [Cz.T, X]]) >> eps * np.eye(nz + nx))
-            cons.append(cp.trace(Q) <= self.gamma2)
+            cons.append(cp.trace(Q) <= 1.0)
         self._X, self._Y, self._beta, self._Q = X, Y, beta, Q
         self.problem = cp.Problem(cp.Minimize(cp.norm(beta, _OBJECTIVES[objective])), cons)
 
@@ -711,7 +733,6 @@ class PrecisionLMI:
         sparsity_tol = _checks.in_range(sparsity_tol, "sparsity_tol", 0.0, 1.0)
         if solver == "SCS":
             solver_options = {"eps_abs": 1e-9, "eps_rel": 1e-9, "max_iters": 200000, **solver_options}
-        self.gamma2.value = gamma**2
         self.inv_gamma.value = 1.0 / gamma
         t0 = time.perf_counter()
         try:
@@ -730,13 +751,13 @@ class PrecisionLMI:
         L = np.zeros((self.model.n_x, self.model.n_y))
         L[:, self.sensors] = Ls
         beta = np.zeros(self.model.n_y)
-        beta[self.sensors] = np.maximum(self._beta.value, 0.0)
+        beta[self.sensors] = np.maximum(self._beta.value, 0.0) / gamma**2
         kappa = np.sqrt(beta)
         used = np.zeros(self.model.n_y, dtype=bool)
         used[self.sensors] = beta[self.sensors] > sparsity_tol * beta.max()
         return ObserverDesign(norm=self.norm, gamma=gamma, L=L, X=Xv, beta=beta, kappa=kappa,
                               noise_deg=precision_to_noise_deg(kappa), used=used, status=str(status),
-                              solver=solver, solve_time=elapsed, objective=float(self.problem.value),
+                              solver=solver, solve_time=elapsed, objective=float(self.problem.value) / gamma**2,
                               Bw=self.Bd @ self.Sd, Dd=self.Dd @ self.Sd)
 
 
@@ -761,3 +782,172 @@ def gamma_sweep(lmi: PrecisionLMI, gammas, *, solver: str = "CLARABEL") -> list:
         except InfeasibleLMIError:
             out.append(None)
     return out
+
+
+# ------------------------------------------------------------------------------------------ verification
+def h2_norm(A, B, C) -> float:
+    r"""H2 norm of :math:`C(sI-A)^{-1}B` from the controllability Gramian (Lyapunov equation).
+
+    :math:`AP + PA^T + BB^T = 0`, :math:`\|G\|_2 = \sqrt{\mathrm{tr}(CPC^T)}`; ``inf`` if A is not Hurwitz.
+    """
+    from scipy.linalg import solve_continuous_lyapunov
+
+    A = _checks.as_array(A, "A", ndim=(2,))
+    B = _checks.as_array(B, "B", ndim=(2,))
+    C = _checks.as_array(C, "C", ndim=(2,))
+    if A.shape[0] != A.shape[1] or B.shape[0] != A.shape[0] or C.shape[1] != A.shape[0]:
+        raise ValueError(f"A must be square and conform with B and C; got {A.shape}, {B.shape}, {C.shape}")
+    if np.max(np.linalg.eigvals(A).real) >= 0:
+        return np.inf
+    P = solve_continuous_lyapunov(A, -B @ B.T)
+    return float(np.sqrt(max(np.trace(C @ P @ C.T), 0.0)))
+
+
+def _sigma_max(A, B, C, w):
+    n = A.shape[0]
+    G = C @ np.linalg.solve(1j * w * np.eye(n) - A, B)
+    return np.linalg.norm(G, 2)
+
+
+def hinf_norm(A, B, C, *, rtol: float = 1e-9, max_iter: int = 50) -> float:
+    r"""H-infinity norm of :math:`C(sI-A)^{-1}B` (no feedthrough) by the Hamiltonian level-set iteration.
+
+    Boyd-Balakrishnan / Bruinsma-Steinbuch: starting from a lower bound (largest singular value over a
+    frequency grid and the modal frequencies), the level :math:`\gamma(1+2\,\mathrm{rtol})` is tested with
+    :math:`H = [[A, BB^T/\gamma^2], [-C^TC, -A^T]]`; its imaginary eigenvalues :math:`j\omega_i` bracket the
+    frequencies where :math:`\sigma_{max} > \gamma`, whose midpoints give the next lower bound.  Returns
+    ``inf`` if A is not Hurwitz.
+    """
+    A = _checks.as_array(A, "A", ndim=(2,))
+    B = _checks.as_array(B, "B", ndim=(2,))
+    C = _checks.as_array(C, "C", ndim=(2,))
+    eig = np.linalg.eigvals(A)
+    if np.max(eig.real) >= 0:
+        return np.inf
+    scale = max(np.max(np.abs(eig)), 1e-12)
+    freqs = np.concatenate([[0.0], np.abs(eig.imag), scale * np.logspace(-4, 2, 60)])
+    lb = max(_sigma_max(A, B, C, w) for w in freqs)
+    if lb == 0:
+        return 0.0
+    n = A.shape[0]
+    BB, CC = B @ B.T, C.T @ C
+    for _ in range(max_iter):
+        g = lb * (1.0 + 2.0 * rtol)
+        H = np.block([[A, BB / g**2], [-CC, -A.T]])
+        ev = np.linalg.eigvals(H)
+        tol_im = 1e-8 * max(np.max(np.abs(ev)), 1.0)
+        w = np.sort(np.abs(ev[np.abs(ev.real) < tol_im].imag))
+        w = np.unique(np.round(w / tol_im) * tol_im)
+        if w.size == 0:
+            return float(lb)
+        if w.size == 1:
+            cand = [w[0]]
+        else:
+            cand = 0.5 * (w[:-1] + w[1:])
+        new = max(_sigma_max(A, B, C, x) for x in cand)
+        if new <= lb * (1.0 + rtol):
+            return float(lb)
+        lb = new
+    return float(lb)  # pragma: no cover
+
+
+@dataclass(frozen=True)
+class Verification:
+    """Independent check of an observer gain over the parameter polytope.
+
+    Attributes
+    ----------
+    n_vertices, n_samples : int
+        Frozen parameter values checked (vertices and uniform random interior samples).
+    max_real_eig : float
+        Largest real part of the eigenvalues of :math:`A(\\rho)+LC(\\rho)` over all checked points, 1/TU.
+    worst_h2, worst_hinf : float
+        Largest frozen-parameter H2 and H-infinity norms from the normalised input to the position error, LU.
+    worst_rho_h2, worst_rho_hinf : ndarray (6,)
+        Parameter values where the worst norms occur.
+    gamma : float
+        Design bound.
+    norm : str
+        Norm the design bounds (``"h2"`` or ``"hinf"``).
+    """
+
+    n_vertices: int
+    n_samples: int
+    max_real_eig: float
+    worst_h2: float
+    worst_hinf: float
+    worst_rho_h2: np.ndarray
+    worst_rho_hinf: np.ndarray
+    gamma: float
+    norm: str
+
+    @property
+    def hurwitz(self) -> bool:
+        """A+LC Hurwitz at every checked point."""
+        return bool(self.max_real_eig < 0)
+
+    @property
+    def worst(self) -> float:
+        """Worst norm of the designed kind."""
+        return self.worst_h2 if self.norm == "h2" else self.worst_hinf
+
+    @property
+    def passed(self) -> bool:
+        """Hurwitz everywhere and the designed norm below gamma everywhere."""
+        return self.hurwitz and self.worst < self.gamma
+
+
+def error_system(model: CR3BPLPV, design: ObserverDesign, rho, *, L=None):
+    r"""Frozen-parameter error system :math:`(A+LC,\ [B_dS_d + LD_dS_d,\ LS_n],\ C_z)` at ``rho`` (6,).
+
+    :math:`S_n = \mathrm{diag}(1/\kappa_i)` (zero for sensors whose gain column is zero).
+    """
+    r = _checks.as_array(rho, "rho", shape=(model.n_rho,))
+    L = design.gain() if L is None else _checks.as_array(L, "L", shape=(model.n_x, model.n_y))
+    with np.errstate(divide="ignore"):
+        sn = np.where(design.kappa > 0, 1.0 / np.where(design.kappa > 0, design.kappa, 1.0), 0.0)
+    sn = np.where(np.any(L != 0, axis=0), sn, 0.0)
+    Acl = model.A(r) + L @ model.C(r)
+    B = np.hstack([design.Bw + L @ design.Dd, L * sn[None, :]])
+    Cz = np.hstack([np.eye(2), np.zeros((2, 2))])
+    return Acl, B, Cz
+
+
+def verify_observer(model: CR3BPLPV, design: ObserverDesign, box: ParameterBox, n_samples: int,
+                    rng: np.random.Generator, *, L=None) -> Verification:
+    """Check a design without trusting the solver: Hurwitz and frozen-parameter H2 / H-infinity norms at every
+    vertex of ``box`` and at ``n_samples`` uniform random points inside it.
+
+    Parameters
+    ----------
+    model : CR3BPLPV
+    design : ObserverDesign
+    box : ParameterBox
+    n_samples : int
+        Interior samples (>= 1).
+    rng : numpy.random.Generator
+    L : array_like (4, 6), optional
+        Gain to check (default ``design.gain()``, unused sensors removed).
+
+    Returns
+    -------
+    Verification
+    """
+    if not isinstance(box, ParameterBox):
+        raise ValueError(f"box must be a ParameterBox; got {type(box).__name__}")
+    V = box.vertices()
+    S = box.sample(n_samples, rng)
+    pts = np.vstack([V, S])
+    max_eig, worst2, worstinf = -np.inf, -np.inf, -np.inf
+    r2 = rinf = pts[0]
+    for r in pts:
+        Acl, B, Cz = error_system(model, design, r, L=L)
+        max_eig = max(max_eig, float(np.max(np.linalg.eigvals(Acl).real)))
+        h2 = h2_norm(Acl, B, Cz)
+        hi = hinf_norm(Acl, B, Cz)
+        if h2 > worst2:
+            worst2, r2 = h2, r
+        if hi > worstinf:
+            worstinf, rinf = hi, r
+    return Verification(V.shape[0], S.shape[0], max_eig, worst2, worstinf, r2.copy(), rinf.copy(),
+                        design.gamma, design.norm)
