@@ -182,7 +182,7 @@ class PeriodicOrbit:
     @cached_property
     def apses(self):
         """Moon-relative periapsis/apoapsis passages over one period (:class:`cislunar.propagation.EventRecord`)."""
-        return find_events(self.system, self.x0, self.period * (1.0 + 1e-9), ("apse",))
+        return find_events(self.system, self.x0, self.period * (1.0 + 1e-9), ("apse",), impact=False)
 
     @property
     def perilune_radius_km(self) -> float:
@@ -265,7 +265,7 @@ def _newton(system, X, planar, fixed: int | None, arclength=None, *, tol=1e-12, 
 
 def half_period_guess(system: CR3BP, x0, *, max_time: float = 20.0, tol: float = DEFAULT_TOL) -> float:
     """Time of the first return to the x-z plane (a half-period guess for a symmetric orbit), TU."""
-    ev = find_events(system, x0, max_time, ("y_crossing",), tol=tol)
+    ev = find_events(system, x0, max_time, ("y_crossing",), tol=tol, impact=False)
     if ev.t.size == 0:
         raise ValueError(f"x0 does not return to the x-z plane within max_time = {max_time} TU")
     return float(ev.t[0])
@@ -486,7 +486,7 @@ def nrho_9_2(system: CR3BP) -> PeriodicOrbit:
 
 
 def l2_southern_halo_family(system: CR3BP, *, step: float = 0.01, n_moonward: int = 40, n_l2ward: int = 200,
-                            min_perilune_km: float = 2.0 * 1737.4, progress: bool = False) -> list:
+                            min_perilune_km: float = 1800.0, progress: bool = False) -> list:
     """Members of the southern L2 halo family, from the NRHOs near the Moon out to the planar-bifurcation end.
 
     Pseudo-arclength continuation starts at the 9:2 NRHO and runs both ways: towards the Moon until the perilune

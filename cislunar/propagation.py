@@ -40,6 +40,9 @@ __all__ = [
     "propagate_scipy",
     "find_events",
     "EventRecord",
+    "stm_finite_difference",
+    "stt_finite_difference",
+    "default_threads",
 ]
 
 #: Default heyoka tolerance (relative and absolute); machine precision is 2.2e-16.
@@ -232,8 +235,9 @@ def _check_outcome(outcome, t_target, t_reached):
     if outcome == hy.taylor_outcome.time_limit and np.isclose(t_reached, t_target, rtol=0, atol=1e-12):
         return
     code = int(outcome)
+    event = -(code + 1) if -3 <= code < 0 else code  # heyoka: terminal event i without callback -> -(i + 1)
     why = {0: "impact on the Moon's surface", 1: "impact on the Earth's surface"}.get(
-        code, f"outcome {outcome} (non-finite state or step-size collapse)")
+        event, f"outcome {outcome} (non-finite state or step-size collapse)")
     raise RuntimeError(f"heyoka propagation stopped early at t = {t_reached} TU (wanted {t_target} TU): {why}")
 
 
@@ -396,7 +400,7 @@ class EventRecord:
 
 
 def find_events(system: CR3BP, x0, t_end: float, events=("y_crossing",), *, t0: float = 0.0,
-                tol: float = DEFAULT_TOL) -> EventRecord:
+                tol: float = DEFAULT_TOL, impact: bool = True) -> EventRecord:
     """Locate x-z plane crossings and apse passages (w.r.t. the Moon) along a trajectory.
 
     Parameters
@@ -413,6 +417,8 @@ def find_events(system: CR3BP, x0, t_end: float, events=("y_crossing",), *, t0: 
         Initial time, TU.
     tol : float
         Integrator tolerance; event times are located to about the same precision.
+    impact : bool
+        Raise ``RuntimeError`` if the trajectory reaches a primary's surface (see :func:`propagate`).
 
     Returns
     -------
@@ -433,7 +439,7 @@ def find_events(system: CR3BP, x0, t_end: float, events=("y_crossing",), *, t0: 
     callbacks = [ev.callback for ev in ta.nt_events]
     for cb in callbacks:
         cb.records = []
-    ta.pars[:] = _pars(system)
+    ta.pars[:] = _pars(system, impact)
     ta.time = t0
     ta.state[:] = x0
     res = ta.propagate_until(t_end, c_output=True)
@@ -459,3 +465,25 @@ def default_threads() -> int:
     env = os.environ.get("CISLUNAR_THREADS")
     return int(env) if env else (os.cpu_count() or 1)
 
+
+
+def stm_finite_difference(system: CR3BP, x0, t_final: float, h: float, *, tol: float = DEFAULT_TOL) -> np.ndarray:
+    """Central-difference STM :math:`[x(t; x_0 + h e_j) - x(t; x_0 - h e_j)] / 2h` (one batch of 12 states).
+
+    Used to verify :func:`propagate_stm`; the error versus ``h`` shows truncation (``h^2``) and round-off
+    (``eps/h``) regimes.
+    """
+    x0 = _checks.as_state(x0, "x0", batch=False)
+    h = _checks.positive(h, "h")
+    E = h * np.eye(6)
+    out = propagate(system, np.vstack([x0 + E, x0 - E]), np.array([0.0, float(t_final)]), tol=tol).x[:, -1]
+    return (out[:6] - out[6:]).T / (2.0 * h)
+
+
+def stt_finite_difference(system: CR3BP, x0, t_final: float, h: float, *, tol: float = DEFAULT_TOL) -> np.ndarray:
+    """Central-difference STT :math:`\\Psi_{:,:,k} = [\\Phi(x_0 + h e_k) - \\Phi(x_0 - h e_k)] / 2h`."""
+    x0 = _checks.as_state(x0, "x0", batch=False)
+    h = _checks.positive(h, "h")
+    E = h * np.eye(6)
+    phis = propagate_stm(system, np.vstack([x0 + E, x0 - E]), np.array([0.0, float(t_final)]), tol=tol).stm[:, -1]
+    return np.moveaxis((phis[:6] - phis[6:]) / (2.0 * h), 0, -1)

@@ -25,7 +25,7 @@ from . import _checks
 from .dynamics import CR3BP
 
 __all__ = ["SurfaceStation", "surface_station_position", "station_elevation", "line_of_sight_clear",
-           "DEFAULT_STATIONS", "l2_observer_state"]
+           "DEFAULT_STATIONS", "l2_observer_state", "dro_observer_orbit", "surface_coverage", "DRO_OBSERVER_X0"]
 
 
 @dataclass(frozen=True)
@@ -48,13 +48,13 @@ class SurfaceStation:
         return surface_station_position(system, self.latitude_deg, self.longitude_deg)
 
 
-#: Three stations chosen so that together they see the whole southern 9:2 NRHO (checked in notebook 01):
-#: one at the north pole (under perilune), one on the far side at the equator (facing L2 and the apolune region)
-#: and one at 60 deg south on the far side.
+#: Three stations chosen so that together they see the whole southern 9:2 NRHO (checked in notebook 01 and the
+#: tests; found by a grid search over mirror-symmetric layouts): the south pole, under the apolune region, and two
+#: stations at 30 deg N, 60 deg E and W, which see the fast perilune passage over the north pole from either side.
 DEFAULT_STATIONS = (
-    SurfaceStation("north pole", 90.0, 0.0),
-    SurfaceStation("far-side equator", 0.0, 180.0),
-    SurfaceStation("far-side south", -60.0, 180.0),
+    SurfaceStation("south pole", -90.0, 0.0),
+    SurfaceStation("30N 60E", 30.0, 60.0),
+    SurfaceStation("30N 60W", 30.0, -60.0),
 )
 
 
@@ -107,3 +107,27 @@ def line_of_sight_clear(system: CR3BP, observer_positions, target_positions, *, 
 def l2_observer_state(system: CR3BP) -> np.ndarray:
     """State of the L2 observer: at rest at L2, shape (6,)."""
     return np.r_[system.libration_points()[1], np.zeros(3)]
+
+
+#: x-axis crossing of the DRO observer (Wolf & Jones test case 1 target, Table 2), LU.
+DRO_OBSERVER_X0 = 0.778008526
+
+
+def dro_observer_orbit(system: CR3BP):
+    """The DRO observer's orbit: the periodic DRO through ``x0 = 0.778008526`` LU (about 16.2 days)."""
+    from .orbits import correct_symmetric
+
+    return correct_symmetric(system, [DRO_OBSERVER_X0, 0, 0, 0, 0.556190606, 0], fix="x0", label="DRO observer")
+
+
+def surface_coverage(system: CR3BP, target_positions, stations=DEFAULT_STATIONS, *, min_elevation_deg: float = 0.0):
+    """Visibility of targets ``(m, >=3)`` from each surface station (elevation above ``min_elevation_deg``).
+
+    Returns
+    -------
+    ndarray of bool, shape (len(stations), m)
+    """
+    t = _checks.as_array(target_positions, "target_positions", ndim=(2,))
+    _checks.in_range(min_elevation_deg, "min_elevation_deg", -90.0, 90.0)
+    return np.array([station_elevation(system, s.position(system), t) > np.deg2rad(min_elevation_deg)
+                     for s in stations])

@@ -1,0 +1,339 @@
+# ---
+# jupyter:
+#   jupytext:
+#     formats: py:percent
+#   kernelspec:
+#     display_name: Python 3
+#     language: python
+#     name: python3
+# ---
+
+# %% [markdown]
+# # 01 · The CR3BP and the reference orbits of all four papers
+#
+# **What you will learn.** How the circular restricted three-body problem (CR3BP) is written in the rotating
+# frame; how its state transition matrix (STM) and second-order state transition tensor (STT) are computed and
+# checked; how symmetric periodic orbits are found by single shooting and continued into families; and how every
+# reference orbit the four papers use is *computed and verified* rather than pasted:
+#
+# * the distant retrograde orbits (DROs) of Wolf & Jones, test cases 1 and 2 (their Tables 2 and 4);
+# * the southern L2 halo family down into the near-rectilinear halo orbits (NRHOs), with the Gateway 9:2 NRHO
+#   derived from its period and the stable NRHO of stability index 1 (Greaves & Scheeres 2021, "Dynamics",
+#   Table 1 and Fig. 2; the informed-station-keeping paper uses the same 9:2 NRHO);
+# * the optical observer sites of the maneuver-detection paper (its "Measurements" section, Fig. 3).
+#
+# **Paper sections followed.** Greaves & Scheeres, *Observation and Maneuver Detection for Cislunar Vehicles*
+# (JAS 2021), "Modeling Definitions: Dynamics" and "Measurements"; Wolf & Jones (arXiv 2408.17435),
+# "Dynamics" (their Eq. for the CR3BP and the unit definitions) and "Test Case #1/#2" (Tables 2 and 4).
+#
+# All computation lives in the `cislunar` package; this notebook calls it and plots.
+
+# %% tags=["parameters"]
+QUICK = False
+SEED = 0
+OUTPUT_DIR = ""
+
+# %%
+# Sizes derived from QUICK: quick mode samples more coarsely, but computes every orbit and every check.
+FD_STEPS = 8 if QUICK else 15  # finite-difference steps in the STM/STT error-versus-step study
+HALO_STEP = 0.03 if QUICK else 0.01  # pseudo-arclength step along the halo family
+DRO_MEMBERS = 13 if QUICK else 51  # members of the DRO family drawn
+SAMPLES = 1500 if QUICK else 8000  # points per orbit for visibility checks
+
+import numpy as np
+import matplotlib.pyplot as plt
+
+from cislunar import orbits, plotting, propagation, reference, sites
+from cislunar.dynamics import EARTH_MOON as em, SYNODIC_MONTH_DAYS
+from cislunar.report import ComparisonTable
+
+plotting.use_style()
+out = OUTPUT_DIR or None
+table = ComparisonTable("01 CR3BP and reference orbits (Greaves & Scheeres 2021 §Dynamics, Wolf & Jones Tables 2 and 4)")
+
+# %% [markdown]
+# ## 1 · The CR3BP in the rotating frame
+#
+# Two primaries (Earth, mass $1-\mu$; Moon, mass $\mu$) move on circles about their barycentre. In the frame that
+# rotates with them (x from Earth to Moon, z along their angular momentum), with the Earth-Moon distance as length
+# unit and the inverse mean motion as time unit, a spacecraft obeys
+#
+# $$\ddot x - 2\dot y = \frac{\partial U}{\partial x},\qquad \ddot y + 2\dot x = \frac{\partial U}{\partial y},\qquad
+# \ddot z = \frac{\partial U}{\partial z},\qquad U = \tfrac12(x^2+y^2) + \frac{1-\mu}{r_1} + \frac{\mu}{r_2},$$
+#
+# where $r_1, r_2$ are the distances to the Earth at $(-\mu,0,0)$ and the Moon at $(1-\mu,0,0)$. This is the
+# *velocity* form (Greaves & Scheeres' Eq. 2 in dimensional form; Wolf & Jones' dynamics section). The Jacobi
+# constant $C = 2U - v^2$ is conserved. The constants, with their sources, are in `cislunar.dynamics`:
+
+# %%
+print(f"mu = {em.mu}")
+print(f"length unit = {em.length_unit_km} km, time unit = {em.time_unit_s} s = {em.time_unit_days:.6f} d")
+print(f"velocity unit = {em.velocity_unit_km_s:.6f} km/s, 2*pi TU = {2*np.pi*em.time_unit_days:.4f} d")
+L = em.libration_points()
+for k, p in enumerate(L, 1):
+    print(f"L{k}: ({p[0]:+.10f}, {p[1]:+.10f})  C = {em.jacobi(np.r_[p, 0, 0, 0]):.10f}")
+
+# %% [markdown]
+# Wolf & Jones define the time unit as $P_{synodic}/2\pi$ with $P_{synodic}$ "the period of the system around
+# the barycenter". The period of the primaries about their barycentre is the *sidereal* month; with the constants
+# used here $2\pi$ TU = 27.28 d (the sidereal month is 27.32 d), whereas the synodic month (new moon to new moon,
+# 29.53 d) is what defines the 9:2 NRHO resonance. We use the standard time unit
+# $\sqrt{L^3/G(M_E+M_M)}$ and note the naming difference in the closing table.
+#
+# ## 2 · STM and second-order STT, checked against finite differences
+#
+# Linearising about a trajectory gives $\dot\Phi = A(t)\Phi$ with $A = \partial f/\partial x$; the second-order
+# tensor obeys $\dot\Psi_{ijk} = A_{il}\Psi_{ljk} + f_{i,lm}\Phi_{lj}\Phi_{mk}$. heyoka.py generates these
+# variational equations symbolically and integrates them with the state by its Taylor method, so
+# $\delta x(t) \approx \Phi\,\delta x_0 + \tfrac12 \Psi\,\delta x_0\,\delta x_0$. We compare with central
+# differences over one full 9:2 NRHO period (through perilune, the hardest stretch): the error first falls as
+# $h^2$ (truncation) and then rises as $\varepsilon/h$ (round-off). The bottom of the V is the finite-difference
+# accuracy; agreement there to ~1e-9 (STM) and ~1e-8 (STT) says the variational equations are right.
+
+# %%
+nrho = orbits.nrho_9_2(em)
+exact = propagation.propagate_stt(em, nrho.x0, nrho.period)
+steps = np.logspace(-9, -2.5, FD_STEPS)
+stm_err, stt_err = [], []
+for h in steps:
+    fd1 = propagation.stm_finite_difference(em, nrho.x0, nrho.period, h)
+    fd2 = propagation.stt_finite_difference(em, nrho.x0, nrho.period, h)
+    stm_err.append(np.max(np.abs(fd1 - exact.stm[-1])) / np.max(np.abs(exact.stm[-1])))
+    stt_err.append(np.max(np.abs(fd2 - exact.stt[-1])) / np.max(np.abs(exact.stt[-1])))
+fig, ax = plt.subplots()
+ax.loglog(steps, stm_err, "o-", label="STM  (central differences of the state)")
+ax.loglog(steps, stt_err, "s-", label="STT  (central differences of the STM)")
+ax.loglog(steps, 3 * np.max(np.abs(exact.stm[-1])) * steps**2 / 1e2, "k:", lw=1, label=r"$\propto h^2$")
+ax.set_xlabel("finite-difference step h [LU, LU/TU]")
+ax.set_ylabel("max relative error vs heyoka")
+ax.set_title("Variational equations vs finite differences, one 9:2 NRHO period")
+ax.legend()
+plotting.save_figure(fig, "01_stm_stt_vs_finite_differences", output_dir=out)
+best_stm, best_stt = min(stm_err), min(stt_err)
+print(f"best agreement: STM {best_stm:.1e}, STT {best_stt:.1e}")
+
+# %% [markdown]
+# ## 3 · Symmetric periodic orbits by single shooting
+#
+# An orbit that crosses the x-z plane perpendicularly twice is symmetric. Start at a crossing,
+# $x_0 = [x_0, 0, z_0, 0, \dot y_0, 0]$, and ask that after the half period $\tau$ the orbit crosses again
+# perpendicularly: $G = [y(\tau), \dot x(\tau), \dot z(\tau)] = 0$. Newton's method needs
+# $\partial G/\partial(x_0, z_0, \dot y_0, \tau)$, which is three rows of the STM plus the vector field:
+# three equations, four unknowns, hence a one-parameter family. Fixing $x_0$ gives one member (used for the DROs);
+# fixing $\tau$ gives the member of prescribed period (the 9:2 NRHO); pseudo-arclength continuation walks the
+# family along the null vector of $\partial G/\partial X$.
+#
+# ### The DROs of Wolf & Jones (Tables 2 and 4)
+#
+# Each printed state is propagated as printed for one period of the periodic orbit through the same $x_0$. Rows
+# printed to nine digits should close to about $10^{-8}$.
+
+# %%
+checks = [reference.verify_table_row(em, row) for row in reference.load_wolf_jones_table()]
+print(f"{'table':>5} {'row':>12} {'printed vy0':>12} {'corrected vy0':>14} {'closure as printed':>19} "
+      f"{'period [d]':>10} {'Jacobi C':>12}")
+for c in checks:
+    print(f"{c.table:>5} {c.label:>12} {c.vy0:12.9f} {c.corrected.x0[4]:14.9f} {c.raw_closure:19.2e} "
+          f"{c.corrected.period_days:10.4f} {c.corrected.jacobi:12.9f}")
+
+# %% [markdown]
+# Every row closes to the printed precision **except the observer's initial state** $x_S(t_0)$ (the same in both
+# tables), whose $\dot y_0 = 0.528996986$ does not give a periodic orbit: propagated for a period it misses its
+# start by about 1 LU. Holding the printed $x_0 = 0.778185828$, the periodic DRO has
+# $\dot y_0 \approx 0.5559319$. The text says the observer starts on a DRO "adjacent" to the targets' (similar
+# Jacobi constant and period), which the corrected state satisfies and the printed one does not (its Jacobi
+# constant, printed below, lies far from the family's). We therefore use the **corrected** observer state in
+# notebooks 05 and 06, and flag the row in the closing table. A plausible cause is a transcription error in the
+# second and third significant digits ("0.529" for "0.556").
+
+# %%
+obs = [c for c in checks if c.label == "observer_t0"][0]
+print(f"printed observer state: C = {em.jacobi(np.array([obs.x0, 0, 0, 0, obs.vy0, 0])):.6f}; "
+      f"corrected: C = {obs.corrected.jacobi:.6f}; targets: C in "
+      f"[{min(c.corrected.jacobi for c in checks):.6f}, {max(c.corrected.jacobi for c in checks):.6f}]")
+
+dro_x0 = np.linspace(0.95, 0.70, DRO_MEMBERS)
+dros = orbits.dro_family(em, dro_x0)
+fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 5))
+for orb in dros[:: max(1, len(dros) // 12)]:
+    _, xs = orb.sample(400)
+    plotting.plot_rotating(ax1, xs, em, "xy", units="km", moon_centred=True, color="0.6", lw=0.8)
+for c in checks:
+    _, xs = c.corrected.sample(400)
+    plotting.plot_rotating(ax1, xs, em, "xy", units="km", moon_centred=True, lw=1.2)
+_, bad = (lambda s: (None, propagation.propagate(em, s, np.linspace(0, obs.corrected.period, 400)).x))(
+    np.array([obs.x0, 0, 0, 0, obs.vy0, 0]))
+plotting.plot_rotating(ax1, bad, em, "xy", units="km", moon_centred=True, color="C1", ls="--",
+                       label="observer state as printed (not periodic)")
+plotting.plot_primaries(ax1, em, "xy", moon_centred=True, units="km", earth=False)
+ax1.set_title("DRO family (grey) and the Wolf & Jones orbits (Moon-centred)")
+ax1.locator_params(axis="x", nbins=5)
+ax1.legend(loc="lower left")
+ax2.plot([o.x0[0] for o in dros], [o.period_days for o in dros], "-", color="0.5", label="DRO family")
+ax2.plot([c.x0 for c in checks], [c.corrected.period_days for c in checks], "o", label="Tables 2 and 4 (corrected)")
+ax2.set_xlabel("x-axis crossing x0 [LU]")
+ax2.set_ylabel("period [days]")
+ax2.legend()
+plotting.save_figure(fig, "01_dro_family_wolf_jones", output_dir=out)
+
+# %% [markdown]
+# ## 4 · The southern L2 halo family and the NRHOs
+#
+# The Gateway NRHO is defined by a resonance: nine revolutions in two synodic months, so its period is
+# $T = \tfrac{2}{9}\times 29.530589$ d $= 6.5624$ d. We therefore *derive* it by shooting from apolune with
+# $\tau = T/2$ held fixed (the commonly quoted apolune state only seeds Newton's method). Continuing that orbit
+# both ways with pseudo-arclength gives the southern L2 halo family, from the NRHOs close to the Moon out to where
+# the family bifurcates from the planar Lyapunov orbits ($z_0 \to 0$).
+#
+# **Stability.** The monodromy matrix $M = \Phi(T, 0)$ has eigenvalues in reciprocal pairs. Greaves & Scheeres'
+# stability index is $\nu = (|\lambda_{max}| + 1/|\lambda_{max}|)/2$, equal to 1 when every eigenvalue lies on the
+# unit circle. Along the family we also track the signed Broucke indices $(\lambda + 1/\lambda)/2$ of the two
+# non-trivial pairs, computed from ${\rm tr}\,M$ and ${\rm tr}\,M^2$ (no eigenvector pairing, so they stay smooth
+# through bifurcations). The 9:2 NRHO's hyperbolic pair has index $\approx -1.32$; continuing Moonward, that
+# index rises through $-1$ (a period-doubling boundary) and the orbits become linearly stable. The **stable NRHO**
+# is the member on that boundary, located by root finding on the half period, so its stability index is 1.
+
+# %%
+stable = orbits.stable_nrho(em)
+family = orbits.l2_southern_halo_family(em, step=HALO_STEP)
+rp = np.array([o.perilune_radius_km for o in family])
+nu = np.array([o.stability_index for o in family])
+for name, o in (("9:2 NRHO", nrho), ("stable NRHO", stable)):
+    print(f"{name:12s} x0 = [{o.x0[0]:.10f}, 0, {o.x0[2]:+.10f}, 0, {o.x0[4]:+.10f}, 0]  T = {o.period_days:.6f} d"
+          f"  rp = {o.perilune_radius_km:8.1f} km  ra = {o.apolune_radius_km:8.1f} km  nu = {o.stability_index:.6f}"
+          f"  C = {o.jacobi:.8f}  closure = {o.closure:.1e}")
+print(f"{len(family)} family members; worst closure {max(o.closure for o in family):.1e}")
+
+fig, ax = plt.subplots()
+ax.semilogy(rp, nu, "-", color="0.3", label="southern L2 halo family")
+ax.semilogy(nrho.perilune_radius_km, nrho.stability_index, "o", color="C0", ms=8, label="9:2 NRHO")
+ax.semilogy(stable.perilune_radius_km, stable.stability_index, "o", color="C1", ms=8, label="stable NRHO (nu = 1)")
+ax.axvline(em.secondary_radius_km, color="0.6", ls=":", lw=1)
+ax.text(em.secondary_radius_km * 1.05, 2, "lunar radius", color="0.4", rotation=90)
+ax.set_xscale("log")
+ax.set_xticks([2000, 3000, 5000, 10000, 20000, 50000])
+ax.xaxis.set_major_formatter(plt.matplotlib.ticker.ScalarFormatter())
+ax.xaxis.set_minor_formatter(plt.matplotlib.ticker.NullFormatter())
+ax.set_xlabel("perilune radius [km]")
+ax.set_ylabel(r"stability index $\nu$")
+ax.set_title("Stability along the southern L2 halo family")
+ax.legend()
+plotting.save_figure(fig, "01_halo_stability_vs_perilune", output_dir=out)
+
+# %% [markdown]
+# The analogue of Greaves & Scheeres' Fig. 2: NRHO members about the Moon with the two reference orbits
+# highlighted (Moon-centred axes, as in the paper).
+
+# %%
+fig, axes = plotting.three_plane_axes(figsize=(13, 4.5))
+nrho_like = [o for o in family if o.perilune_radius_km < 20000]
+for o in nrho_like[:: max(1, len(nrho_like) // 10)]:
+    _, xs = o.sample(600)
+    plotting.plot_three_planes(axes, xs, em, moon_centred=True, units="km", color="0.7", lw=0.7)
+for o, colour, lab in ((nrho, "C0", "9:2 NRHO"), (stable, "C1", "stable NRHO")):
+    _, xs = o.sample(1500)
+    plotting.plot_three_planes(axes, xs, em, moon_centred=True, units="km", color=colour, lw=1.6, label=lab)
+for plane, ax in axes.items():
+    plotting.plot_primaries(ax, em, plane, moon_centred=True, units="km", earth=False)
+axes["xy"].legend(loc="upper left")
+fig.suptitle("Southern L2 NRHO family (grey) with the 9:2 (blue) and stable (red) reference orbits")
+plotting.save_figure(fig, "01_nrho_family_fig2", output_dir=out)
+
+# %% [markdown]
+# ## 5 · Observer sites (maneuver-detection paper, Fig. 3)
+#
+# The paper's observer states are not given in its text (the table is missing), so the sites are documented
+# choices in `cislunar.sites`: an observer at rest at L2, one on a DRO, and three lunar-surface stations, fixed in
+# the rotating frame because the Moon is tidally locked. We then check the three statements the paper makes about
+# them: the L2 observer's line of sight is never interrupted; the DRO observer suffers short, infrequent lunar
+# occultations; and three surface stations are needed to see the whole 9:2 orbit.
+
+# %%
+l2_state = sites.l2_observer_state(em)
+dro_obs = sites.dro_observer_orbit(em)
+stations = sites.DEFAULT_STATIONS
+span = np.linspace(0.0, 5 * nrho.period, 5 * SAMPLES // 2)  # five NRHO periods, DRO observer running alongside
+visibility = {}
+for name, o in (("9:2", nrho), ("stable", stable)):
+    xt = propagation.propagate(em, o.x0, span).x
+    xd = propagation.propagate(em, dro_obs.x0, span).x
+    cov = sites.surface_coverage(em, o.sample(SAMPLES)[1], stations)
+    pairs = [cov[[i, j]].any(axis=0).mean() for i in range(3) for j in range(i + 1, 3)]
+    visibility[name] = dict(
+        l2=sites.line_of_sight_clear(em, l2_state, xt).mean(),
+        dro=sites.line_of_sight_clear(em, xd, xt).mean(),
+        single=cov.mean(axis=1), best_pair=max(pairs), all3=cov.any(axis=0).mean(),
+    )
+    v = visibility[name]
+    print(f"{name:7s} NRHO: L2 line of sight clear {100*v['l2']:.2f}% | DRO observer clear {100*v['dro']:.2f}% | "
+          f"stations alone {np.round(100*v['single'], 1)}% | best pair {100*v['best_pair']:.1f}% | "
+          f"all three {100*v['all3']:.2f}%")
+
+fig, axes = plotting.three_plane_axes(figsize=(13, 4.5))
+for o in (nrho, stable):
+    plotting.plot_three_planes(axes, o.sample(1200)[1], em, moon_centred=True, units="km", color="C0", lw=1)
+plotting.plot_three_planes(axes, dro_obs.sample(800)[1], em, moon_centred=True, units="km", color="C1", lw=1.2,
+                           label="DRO observer")
+for plane, ax in axes.items():
+    plotting.plot_primaries(ax, em, plane, moon_centred=True, units="km", earth=False)
+    i, j = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}[plane]
+    p = (l2_state[:3] - em.secondary_position) * em.length_unit_km
+    ax.plot(p[i], p[j], "*", color="C1", ms=12, label="L2 observer")
+    for s in stations:
+        q = (s.position(em) - em.secondary_position) * em.length_unit_km
+        ax.plot(q[i], q[j], "^", color="C1", ms=6)
+axes["xy"].legend(loc="lower left")
+fig.suptitle("Observer sites (red) and the NRHOs (blue), Moon-centred; triangles: surface stations")
+plotting.save_figure(fig, "01_observer_sites_fig3", output_dir=out)
+
+# %% [markdown]
+# ## 6 · Paper versus reproduction
+#
+# Greaves & Scheeres' Table 1 (their NRHO states, stability indices and perilune radii) is missing from the
+# paper's text, so their two NRHOs are compared with what the text and the public facts in
+# `shared/reference-notes.md` say. Every Wolf & Jones row is verified.
+
+# %%
+T92 = 2 / 9 * SYNODIC_MONTH_DAYS
+table.add("9:2 NRHO period [d]", f"2/9 synodic month = {T92:.6f}", nrho.period_days,
+          "reproduced" if abs(nrho.period_days - T92) / T92 < 1e-8 else "differs: period constraint not met",
+          "derived by shooting with the half period fixed")
+table.add("9:2 NRHO perilune radius [km]", "about 3200-3300 (reference notes)", nrho.perilune_radius_km,
+          "reproduced" if 3200 <= nrho.perilune_radius_km <= 3300 else "differs: outside the quoted range")
+table.add("9:2 NRHO apolune radius [km]", "about 71000 (reference notes)", nrho.apolune_radius_km,
+          "reproduced" if abs(nrho.apolune_radius_km - 71000) < 1000 else "differs: outside the quoted range")
+table.add("9:2 NRHO apolune state [x0, z0, vy0]", "about [1.0219, -0.182, -0.1030] (reference notes)",
+          f"[{nrho.x0[0]:.5f}, {nrho.x0[2]:.5f}, {nrho.x0[4]:.5f}]", "reproduced", "same orbit, more digits")
+table.add("9:2 NRHO stability index", "Table 1 missing", nrho.stability_index, "not in paper",
+          "Table 1 absent from the text; computed here")
+table.add("stable NRHO stability index", 1.0, stable.stability_index,
+          "reproduced" if abs(stable.stability_index - 1) < 1e-3 else "differs: root finding failed",
+          "member at the period-doubling boundary nearest the 9:2 NRHO (documented choice)")
+table.add("stable NRHO perilune radius [km] / period [d]", "Table 1 missing",
+          f"{stable.perilune_radius_km:.1f} / {stable.period_days:.4f}", "not in paper",
+          "Table 1 absent; any member of the stable band has index 1, we take its boundary")
+for c in checks:
+    ok = c.periodic_as_printed
+    table.add(f"W&J Table {c.table} {c.label}: closure of printed state", "periodic DRO", f"{c.raw_closure:.1e}",
+              "reproduced" if ok else "differs: printed vy0 is not periodic",
+              f"T = {c.corrected.period_days:.4f} d, C = {c.corrected.jacobi:.8f}" +
+              ("" if ok else f"; corrected vy0 = {c.corrected.x0[4]:.9f} used instead of {c.vy0}"))
+P = obs.corrected.period_days
+table.add("W&J test case 1 observation window [d]", "12 to 23", f"{0.75 * P:.1f} to {1.5 * P:.1f}",
+          "differs: the text's 23 d end is not 3P/2",
+          f"window [3P/4, 3P/2] with P = {P:.2f} d (corrected observer DRO) ends at {1.5 * P:.1f} d")
+table.add("W&J time unit", "P_synodic / 2 pi", f"{em.time_unit_days:.5f} d (2 pi TU = {2*np.pi*em.time_unit_days:.2f} d)",
+          "differs: naming only", "the primaries' period about the barycentre is the sidereal, not synodic, month")
+table.add("STM vs central differences (9:2 period)", "-", f"{best_stm:.1e}", "beyond paper", "relative, best step")
+table.add("STT vs central differences of the STM", "-", f"{best_stt:.1e}", "beyond paper", "relative, best step")
+v = visibility["9:2"]
+table.add("L2 observer line of sight to the 9:2 NRHO", "never interrupted", f"{100 * v['l2']:.2f}% clear",
+          "reproduced" if v["l2"] == 1 else "differs: occultations found", "observer at rest at L2 (choice)")
+table.add("DRO observer outages (9:2 NRHO)", "limited, infrequent and short", f"{100 * (1 - v['dro']):.2f}% of time",
+          "reproduced" if 0 < 1 - v["dro"] < 0.05 else "differs: see the visibility printout",
+          "DRO through x0 = 0.778 LU (choice)")
+table.add("surface stations needed for the full 9:2 orbit", 3,
+          f"all three {100 * v['all3']:.1f}%, best pair {100 * v['best_pair']:.1f}%",
+          "reproduced" if v["all3"] == 1 and v["best_pair"] < 1 else "differs: coverage incomplete or a pair suffices",
+          "stations: south pole, 30N 60E, 30N 60W (choice, horizon mask 0 deg)")
+table.display()
