@@ -108,6 +108,8 @@ def run_notebook(source: Path, *, quick: bool, seed: int = 0, output_dir=None, k
     tags = [c.metadata.get("tags", []) for c in nb.cells]
     if sum("parameters" in t for t in tags) != 1:
         raise NotebookFailure(f"{name}: needs exactly one cell tagged 'parameters'")
+    nb.metadata.setdefault("kernelspec", {"name": kernel, "display_name": "Python 3", "language": "python"})
+    nb.metadata.setdefault("language_info", {"name": "python"})
     ipynb = src_dir / f"{name}.ipynb"
     nbformat.write(nb, ipynb)
     executed = build / "notebooks" / f"{name}.ipynb"
