@@ -1,0 +1,688 @@
+r"""Augmented observer/target covariances: SPD helpers, process noise, EKF covariance analysis (CRLB).
+
+Augmented state (Wolf & Jones Eq. 7)
+------------------------------------
+:math:`\mathbf x_{\mathcal A} = [\mathbf x_{\mathcal S}; \mathbf x^{(1)}_{\mathcal T}; \dots;
+\mathbf x^{(N_{\mathcal T})}_{\mathcal T}]`, 6 (N_T + 1) components, each a CR3BP state in LU, LU/TU (rotating
+frame).  Objects are uncorrelated a priori and move independently, so the initial covariance, the transition
+matrix :math:`\Phi_{\mathcal A}` (Eq. 22) and the process noise :math:`Q_{\mathcal A}` are block diagonal.  The
+augmented measurement Jacobian :math:`H_{\mathcal A}` (Eq. 21) couples the observer to each target.
+
+Process noise
+-------------
+A continuous white-noise acceleration :math:`\mathbf w(t)` with power spectral density (PSD) :math:`q` per axis
+enters as :math:`\dot{\delta\mathbf x} = A(t)\delta\mathbf x + G\mathbf w`, :math:`G = [0; I_3]`.  Its exact
+discretisation along the reference trajectory between :math:`t_k` and :math:`t_{k+1}` is
+
+.. math:: Q_k = \int_{t_k}^{t_{k+1}} \Phi(t_{k+1},\tau)\,G\,q\,G^T\,\Phi(t_{k+1},\tau)^T\,d\tau ,
+
+the time-varying generalisation of Van Loan's formula (it solves the Lyapunov differential equation
+:math:`\dot Q = AQ + QA^T + qGG^T`, :math:`Q(t_k)=0`).  :func:`process_noise` evaluates the integral by
+Gauss-Legendre quadrature with STMs from heyoka (:math:`\Phi(t_{k+1},\tau) = \Phi(t_{k+1},t_k)
+\Phi(\tau,t_k)^{-1}`, both propagated from :math:`t_k` so the inverse is of a short-arc STM);
+:func:`process_noise_lyapunov` integrates the Lyapunov equation with scipy (independent check) and
+:func:`van_loan` is the classical matrix-exponential form for a constant :math:`A`.
+
+Units of the PSD.  The PSD of an acceleration has units (km/s^2)^2 / Hz = km^2/s^3.  Wolf & Jones print
+"Q [km/s^3] = 1e-11" (Tables 3 and 5); we read it as :math:`q = 10^{-11}` km^2/s^3 (the only dimensionally
+consistent reading) and convert with :func:`psd_to_nondimensional`:
+:math:`q_{nd} = q\,T^3/L^2` (LU^2/TU^3), i.e. 1e-11 km^2/s^3 = 3.574e-6 LU^2/TU^3 for the Earth-Moon units.
+Over one day this gives a velocity standard deviation of about :math:`\sqrt{q\Delta t}` = 0.93 m/s per axis.
+
+EKF covariance analysis (Performance Evaluation section)
+--------------------------------------------------------
+The CRLB of a nonlinear system with Gaussian noise is obtained from the EKF covariance recursion linearised about
+the *true* trajectory (Taylor 1978):
+
+.. math:: \bar P_{k+1} = \Phi_k\hat P_k\Phi_k^T + Q_k,\quad K_k = \bar P_k H_k^T(H_k\bar P_kH_k^T + R_k)^{-1},\quad
+          \hat P_k = (I-K_kH_k)\bar P_k(I-K_kH_k)^T + K_kR_kK_k^T
+
+(the Joseph form, algebraically equal to the paper's :math:`(I-KH)\bar P` and better conditioned; identical to
+``filterpy.kalman.KalmanFilter.predict/update``, checked in the tests).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import scipy.linalg
+from scipy.integrate import solve_ivp
+
+from . import _checks
+from .dynamics import CR3BP
+from .measurements import MeasurementModel
+
+__all__ = [
+    "WOLF_JONES_SIGMA_POS_KM",
+    "WOLF_JONES_SIGMA_VEL_KM_S",
+    "WOLF_JONES_PSD_KM2_S3",
+    "symmetrize",
+    "check_spd",
+    "cholesky_spd",
+    "logdet_spd",
+    "block_diag",
+    "state_covariance",
+    "augment_states",
+    "augmented_covariance",
+    "psd_to_nondimensional",
+    "van_loan",
+    "process_noise",
+    "process_noise_lyapunov",
+    "ekf_predict",
+    "ekf_update",
+    "CovarianceHistory",
+    "covariance_analysis",
+    "position_sigma_km",
+    "AugmentedLinearization",
+    "linearize_augmented",
+]
+
+#: Wolf & Jones Tables 3 and 5: initial 1-sigma position per axis, km.
+WOLF_JONES_SIGMA_POS_KM = 100.0
+#: Wolf & Jones Tables 3 and 5: initial 1-sigma velocity per axis, km/s.
+WOLF_JONES_SIGMA_VEL_KM_S = 1e-2
+#: Wolf & Jones Tables 3 and 5: process-noise PSD, read as km^2/s^3 (printed "km/s^3").
+WOLF_JONES_PSD_KM2_S3 = 1e-11
+
+
+# --------------------------------------------------------------------------------------------------------------
+# SPD helpers
+# --------------------------------------------------------------------------------------------------------------
+def symmetrize(P) -> np.ndarray:
+    """Symmetric part :math:`(P + P^T)/2` of square matrices ``(..., n, n)``."""
+    P = np.asarray(P, dtype=float)
+    return 0.5 * (P + np.swapaxes(P, -1, -2))
+
+
+def _square(P, name):
+    P = _checks.as_array(P, name)
+    if P.ndim < 2 or P.shape[-1] != P.shape[-2]:
+        raise ValueError(f"{name} must be a square matrix (..., n, n); got shape {P.shape}")
+    return P
+
+
+def cholesky_spd(P, name: str = "P", *, rtol: float = 1e-8) -> np.ndarray:
+    """Lower Cholesky factor of symmetric positive-definite matrices ``(..., n, n)``.
+
+    Parameters
+    ----------
+    P : array_like, shape (..., n, n)
+    name : str
+        Argument name for error messages.
+    rtol : float
+        Allowed asymmetry :math:`\\max|P-P^T|` relative to :math:`\\max|P|`.
+
+    Raises
+    ------
+    ValueError
+        Not square, NaN, asymmetric beyond ``rtol`` or not positive definite (names ``name``).
+    """
+    P = _square(P, name)
+    scale = np.max(np.abs(P)) if P.size else 0.0
+    if scale == 0.0:
+        raise ValueError(f"{name} must be positive definite; got a zero matrix")
+    if np.max(np.abs(P - np.swapaxes(P, -1, -2))) > rtol * scale:
+        raise ValueError(f"{name} must be symmetric (max asymmetry {np.max(np.abs(P - np.swapaxes(P, -1, -2))):.3g})")
+    try:
+        return np.linalg.cholesky(symmetrize(P))
+    except np.linalg.LinAlgError as exc:
+        raise ValueError(f"{name} must be positive definite (Cholesky factorisation failed)") from exc
+
+
+def check_spd(P, name: str = "P", *, rtol: float = 1e-8) -> np.ndarray:
+    """Check that ``P`` (..., n, n) is symmetric positive definite; return its symmetric part.
+
+    Raises ``ValueError`` naming ``name`` otherwise (see :func:`cholesky_spd`).
+    """
+    cholesky_spd(P, name, rtol=rtol)
+    return symmetrize(P)
+
+
+def logdet_spd(P, name: str = "P") -> np.ndarray:
+    """:math:`\\ln|P|` of SPD matrices ``(..., n, n)`` from the Cholesky factor, :math:`2\\sum_i \\ln L_{ii}`."""
+    L = cholesky_spd(P, name)
+    return 2.0 * np.sum(np.log(np.diagonal(L, axis1=-2, axis2=-1)), axis=-1)
+
+
+def block_diag(blocks) -> np.ndarray:
+    """Block-diagonal matrix from a sequence of square blocks, or from an array ``(..., k, n, n)`` (per leading index).
+
+    With an array input the leading axes are kept: ``(..., k, n, n) -> (..., k n, k n)``.
+    """
+    if isinstance(blocks, np.ndarray) and blocks.ndim >= 3:
+        k, n = blocks.shape[-3], blocks.shape[-1]
+        out = np.zeros(blocks.shape[:-3] + (k * n, k * n))
+        for i in range(k):
+            out[..., i * n:(i + 1) * n, i * n:(i + 1) * n] = blocks[..., i, :, :]
+        return out
+    return scipy.linalg.block_diag(*[np.atleast_2d(np.asarray(b, dtype=float)) for b in blocks])
+
+
+# --------------------------------------------------------------------------------------------------------------
+# augmented state and initial covariances
+# --------------------------------------------------------------------------------------------------------------
+def _check_system(system):
+    if not isinstance(system, CR3BP):
+        raise ValueError(f"system must be a cislunar.dynamics.CR3BP; got {type(system).__name__}")
+    return system
+
+
+def state_covariance(sigma_pos_km: float, sigma_vel_km_s: float, system: CR3BP) -> np.ndarray:
+    """Diagonal 6x6 covariance in LU^2 and (LU/TU)^2 from 1-sigma position (km) and velocity (km/s) per axis.
+
+    Wolf & Jones Tables 3 and 5: 100 km and 1e-2 km/s for every object.
+    """
+    sp = _checks.positive(sigma_pos_km, "sigma_pos_km")
+    sv = _checks.positive(sigma_vel_km_s, "sigma_vel_km_s")
+    _check_system(system)
+    d = np.r_[np.full(3, sp / system.length_unit_km), np.full(3, sv / system.velocity_unit_km_s)]
+    return np.diag(d**2)
+
+
+def augment_states(observer, targets) -> np.ndarray:
+    """Augmented state of Eq. 7: ``observer`` (..., 6) and ``targets`` (N_T, ..., 6) -> (..., 6 (N_T+1))."""
+    xs = _checks.as_array(observer, "observer", last=6)
+    xt = _checks.as_array(targets, "targets", last=6)
+    if xt.ndim != xs.ndim + 1:
+        raise ValueError(f"targets must have shape (N_T,) + observer.shape; got {xt.shape} for observer {xs.shape}")
+    return np.concatenate([xs] + [xt[i] for i in range(xt.shape[0])], axis=-1)
+
+
+def augmented_covariance(P_observer, P_targets) -> np.ndarray:
+    """Block-diagonal :math:`P_{\\mathcal A,0} = \\mathrm{diag}(P_{\\mathcal S}, P^{(1)}_{\\mathcal T}, \\dots)`.
+
+    ``P_observer`` (6, 6); ``P_targets`` (N_T, 6, 6), or (6, 6) for a single target.  Each block must be SPD
+    (``ValueError`` names the argument).
+    """
+    Ps = check_spd(_checks.as_array(P_observer, "P_observer", shape=(6, 6)), "P_observer")
+    Pt = _checks.as_array(P_targets, "P_targets")
+    if Pt.ndim == 2:
+        Pt = Pt[None]
+    if Pt.ndim != 3 or Pt.shape[1:] != (6, 6):
+        raise ValueError(f"P_targets must have shape (N_T, 6, 6) or (6, 6); got {Pt.shape}")
+    Pt = check_spd(Pt, "P_targets")
+    return block_diag(np.concatenate([Ps[None], Pt], axis=0))
+
+
+# --------------------------------------------------------------------------------------------------------------
+# process noise
+# --------------------------------------------------------------------------------------------------------------
+def psd_to_nondimensional(q_km2_s3: float, system: CR3BP) -> float:
+    """Convert an acceleration PSD from km^2/s^3 to LU^2/TU^3: :math:`q_{nd} = q\\,T^3/L^2`.
+
+    Raises ``ValueError`` for a negative or non-finite ``q_km2_s3`` (zero is allowed: no process noise).
+    """
+    q = _checks.positive(q_km2_s3, "q_km2_s3", allow_zero=True)
+    _check_system(system)
+    return q * system.time_unit_s**3 / system.length_unit_km**2
+
+
+def van_loan(A, q: float, dt: float):
+    """Van Loan discretisation for a constant ``A`` (6x6) and white acceleration noise of PSD ``q`` on :math:`G=[0;I_3]`.
+
+    .. math:: \\exp\\left(\\begin{bmatrix}-A & GqG^T\\\\ 0 & A^T\\end{bmatrix}\\Delta t\\right)
+              = \\begin{bmatrix}\\cdot & \\Phi^{-1}Q\\\\ 0 & \\Phi^T\\end{bmatrix}
+
+    Returns
+    -------
+    Phi : ndarray (6, 6)
+    Q : ndarray (6, 6)
+    """
+    A = _checks.as_array(A, "A", shape=(6, 6))
+    q = _checks.positive(q, "q", allow_zero=True)
+    dt = _checks.positive(dt, "dt")
+    W = np.zeros((6, 6))
+    W[3:, 3:] = q * np.eye(3)
+    M = np.zeros((12, 12))
+    M[:6, :6] = -A
+    M[:6, 6:] = W
+    M[6:, 6:] = A.T
+    E = scipy.linalg.expm(M * dt)
+    Phi = E[6:, 6:].T
+    return Phi, symmetrize(Phi @ E[:6, 6:])
+
+
+def _interval_transitions(system: CR3BP, starts: np.ndarray, dts: np.ndarray, q: float | None, n_nodes: int,
+                          order: int):
+    """Per-interval STM (and STT) over ``dts`` from ``starts`` (K, 6), and the process noise by quadrature."""
+    from .propagation import propagate_stm, propagate_stt
+
+    K = starts.shape[0]
+    F = np.empty((K, 6, 6))
+    Qd = np.empty((K, 6, 6)) if q is not None else None
+    Psi = np.empty((K, 6, 6, 6)) if order == 2 else None
+    nodes, weights = np.polynomial.legendre.leggauss(n_nodes)
+    # group equal interval lengths so that each group is one batch propagation on a shared grid
+    keys = np.round(dts / np.max(np.abs(dts)), 12)
+    for key in np.unique(keys):
+        idx = np.flatnonzero(keys == key)
+        dt = float(dts[idx[0]])
+        taus = 0.5 * dt * (nodes + 1.0)
+        grid = np.r_[0.0, taus, dt] if q is not None else np.array([0.0, dt])
+        prop = propagate_stt if order == 2 else propagate_stm
+        tr = prop(system, starts[idx], grid)
+        stm = tr.stm if tr.stm.ndim == 4 else tr.stm[None]
+        F[idx] = stm[:, -1]
+        if order == 2:
+            stt = tr.stt if tr.stt.ndim == 5 else tr.stt[None]
+            Psi[idx] = stt[:, -1]
+        if q is not None:
+            phi_end = stm[:, -1]  # (k, 6, 6)
+            phi_nodes = stm[:, 1:-1]  # (k, n_nodes, 6, 6)
+            # Phi(t_end, tau) = Phi(t_end, t_k) Phi(tau, t_k)^{-1}; only its last three columns are needed
+            M = np.linalg.solve(np.swapaxes(phi_nodes, -1, -2), np.swapaxes(phi_end, -1, -2)[:, None])
+            M = np.swapaxes(M, -1, -2)[..., :, 3:6]  # (k, n_nodes, 6, 3)
+            integrand = M @ np.swapaxes(M, -1, -2)
+            Qd[idx] = symmetrize(q * 0.5 * dt * np.einsum("j,kjab->kab", weights, integrand))
+    return F, Qd, Psi
+
+
+def process_noise(system: CR3BP, x, t, q: float, *, n_nodes: int = 12) -> np.ndarray:
+    """Exact discrete process noise :math:`Q_k` between consecutive grid times along reference trajectories.
+
+    Parameters
+    ----------
+    system : CR3BP
+    x : array_like, shape (m, 6) or (n, m, 6)
+        Reference states at the grid times ``t`` (LU, LU/TU), e.g. ``propagate(...).x``.
+    t : array_like, shape (m,)
+        Strictly increasing times, TU.
+    q : float
+        Acceleration PSD per axis in LU^2/TU^3 (see :func:`psd_to_nondimensional`).
+    n_nodes : int
+        Gauss-Legendre nodes per interval (12 reaches ~1e-14 relative accuracy for one-day arcs in cislunar
+        space; compare :func:`process_noise_lyapunov`).
+
+    Returns
+    -------
+    ndarray, shape (m-1, 6, 6) or (n, m-1, 6, 6)
+        :math:`Q_k` in LU^2, LU^2/TU, (LU/TU)^2 blocks.
+    """
+    _check_system(system)
+    x = _checks.as_array(x, "x", ndim=(2, 3), last=6)
+    t = _checks.time_grid(t, "t")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("t must be strictly increasing")
+    if x.shape[-2] != t.size:
+        raise ValueError(f"x must hold one state per time of t ({t.size}); got shape {x.shape}")
+    q = _checks.positive(q, "q", allow_zero=True)
+    if int(n_nodes) < 2:
+        raise ValueError(f"n_nodes must be at least 2; got {n_nodes}")
+    single = x.ndim == 2
+    xs = x[None] if single else x
+    n, m = xs.shape[0], xs.shape[1]
+    starts = xs[:, :-1].reshape(-1, 6)
+    dts = np.tile(np.diff(t), n)
+    _, Qd, _ = _interval_transitions(system, starts, dts, q, int(n_nodes), 1)
+    Qd = Qd.reshape(n, m - 1, 6, 6)
+    return Qd[0] if single else Qd
+
+
+def process_noise_lyapunov(system: CR3BP, x0, dt: float, q: float, *, rtol: float = 1e-12,
+                           atol: float = 1e-16) -> np.ndarray:
+    """Reference :math:`Q` over one interval by integrating :math:`\\dot Q = A(t)Q + QA(t)^T + qGG^T` with scipy.
+
+    ``x0`` (6,) is the reference state at the start, ``dt`` (TU) the interval, ``q`` the PSD in LU^2/TU^3.
+    Independent of heyoka: DOP853 on the state and the full 6x6 Q (42 equations).
+    """
+    _check_system(system)
+    x0 = _checks.as_state(x0, "x0", batch=False)
+    dt = _checks.positive(dt, "dt")
+    q = _checks.positive(q, "q", allow_zero=True)
+    W = np.zeros((6, 6))
+    W[3:, 3:] = q * np.eye(3)
+
+    def rhs(_t, y):
+        xs = y[:6]
+        Q = y[6:].reshape(6, 6)
+        A = system.jacobian(xs)
+        return np.concatenate([system.eom(xs), (A @ Q + Q @ A.T + W).ravel()])
+
+    sol = solve_ivp(rhs, (0.0, dt), np.r_[x0, np.zeros(36)], method="DOP853", rtol=rtol, atol=atol)
+    if not sol.success:  # pragma: no cover
+        raise RuntimeError(f"solve_ivp failed: {sol.message}")
+    return symmetrize(sol.y[6:, -1].reshape(6, 6))
+
+
+# --------------------------------------------------------------------------------------------------------------
+# EKF covariance recursion
+# --------------------------------------------------------------------------------------------------------------
+def ekf_predict(P, F, Q) -> np.ndarray:
+    """Covariance time update :math:`\\bar P = F P F^T + Q` (broadcast over leading axes)."""
+    P = _square(P, "P")
+    F = _checks.as_array(F, "F")
+    Q = _square(Q, "Q")
+    n = P.shape[-1]
+    if F.shape[-2:] != (n, n) or Q.shape[-1] != n:
+        raise ValueError(f"F and Q must be ({n}, {n}) to match P; got F {F.shape}, Q {Q.shape}")
+    return symmetrize(F @ P @ np.swapaxes(F, -1, -2) + Q)
+
+
+def ekf_update(P, H, R):
+    """Joseph-form covariance measurement update.
+
+    Parameters
+    ----------
+    P : array_like, shape (..., n, n)
+        Prior covariance (SPD).
+    H : array_like, shape (..., m, n)
+        Measurement Jacobian.
+    R : array_like, shape (..., m, m)
+        Measurement noise covariance (SPD).
+
+    Returns
+    -------
+    P_post : ndarray (..., n, n)
+        :math:`(I-KH)P(I-KH)^T + KRK^T`.
+    K : ndarray (..., n, m)
+        Kalman gain :math:`PH^TS^{-1}`.
+    S : ndarray (..., m, m)
+        Innovation covariance :math:`HPH^T + R`.
+    """
+    P = _square(P, "P")
+    H = _checks.as_array(H, "H")
+    R = _square(R, "R")
+    n = P.shape[-1]
+    if H.ndim < 2 or H.shape[-1] != n:
+        raise ValueError(f"H must have shape (..., m, {n}) to match P; got {H.shape}")
+    m = H.shape[-2]
+    if R.shape[-1] != m:
+        raise ValueError(f"R must be ({m}, {m}) to match H; got {R.shape}")
+    cholesky_spd(R, "R")
+    HT = np.swapaxes(H, -1, -2)
+    S = symmetrize(H @ P @ HT + R)
+    L = cholesky_spd(S, "S (innovation covariance)")
+    # K^T = S^{-1} H P via two triangular solves
+    HP = H @ P
+    KT = np.linalg.solve(np.swapaxes(L, -1, -2), np.linalg.solve(L, HP))
+    K = np.swapaxes(KT, -1, -2)
+    IKH = np.eye(n) - K @ H
+    P_post = symmetrize(IKH @ P @ np.swapaxes(IKH, -1, -2) + K @ R @ np.swapaxes(K, -1, -2))
+    return P_post, K, S
+
+
+@dataclass(frozen=True)
+class CovarianceHistory:
+    """Output of :func:`covariance_analysis`.
+
+    Attributes
+    ----------
+    prior : ndarray (N, n, n)
+        :math:`\\bar P_k` before the measurement at :math:`t_k` (``prior[0]`` is the initial covariance).
+    posterior : ndarray (N, n, n)
+        :math:`\\hat P_k` after it: the CRLB of the augmented state at :math:`t_k`.
+    innovation : ndarray (N, M, M)
+        :math:`S_k = H_k\\bar P_kH_k^T + R_k`.
+    """
+
+    prior: np.ndarray
+    posterior: np.ndarray
+    innovation: np.ndarray
+
+
+def _as_sequence(arr, name, count, shape):
+    a = _checks.as_array(arr, name)
+    if a.shape == shape:
+        return np.broadcast_to(a, (count,) + shape)
+    if a.shape != (count,) + shape:
+        raise ValueError(f"{name} must have shape {(count,) + shape} or {shape}; got {a.shape}")
+    return a
+
+
+def covariance_analysis(P0, F, Q, H, R) -> CovarianceHistory:
+    """EKF covariance recursion (CRLB along a given linearisation), measurements at every time ``t_0..t_{N-1}``.
+
+    Parameters
+    ----------
+    P0 : array_like (n, n)
+        Covariance at the first measurement time (SPD).
+    F : array_like (N-1, n, n)
+        Transition matrices :math:`\\Phi(t_{k+1}, t_k)`.
+    Q : array_like (N-1, n, n) or (n, n)
+        Process noise over each interval (symmetric positive semi-definite).
+    H : array_like (N, M, n)
+        Measurement Jacobians.
+    R : array_like (N, M, M) or (M, M)
+        Measurement noise covariances (SPD).
+
+    Returns
+    -------
+    CovarianceHistory
+    """
+    P0, F, Q, H, R = _check_linear_system(P0, F, Q, H, R)
+    N = H.shape[0]
+    prior = np.empty((N,) + P0.shape)
+    post = np.empty_like(prior)
+    S = np.empty((N, H.shape[1], H.shape[1]))
+    P = P0
+    for k in range(N):
+        if k > 0:
+            P = ekf_predict(P, F[k - 1], Q[k - 1])
+        prior[k] = P
+        P, _, S[k] = ekf_update(P, H[k], R[k])
+        post[k] = P
+    return CovarianceHistory(prior, post, S)
+
+
+def _check_linear_system(P0, F, Q, H, R, *, chol_R: bool = False):
+    """Validate the matrices of a linear-Gaussian measurement sequence (shared with :mod:`cislunar.information`).
+
+    Returns ``(P0, F, Q, H, R)`` as float arrays (Q, R broadcast to sequences), plus the Cholesky factors of R
+    when ``chol_R``.
+    """
+    P0 = check_spd(_square(P0, "P0"), "P0")
+    if P0.ndim != 2:
+        raise ValueError(f"P0 must be a single (n, n) matrix; got {P0.shape}")
+    n = P0.shape[0]
+    H = _checks.as_array(H, "H", ndim=(3,))
+    if H.shape[-1] != n:
+        raise ValueError(f"H must have shape (N, M, {n}) to match P0; got {H.shape}")
+    N, M = H.shape[0], H.shape[1]
+    if N < 1:
+        raise ValueError("H must hold at least one measurement time")
+    F = _checks.as_array(F, "F")
+    if N == 1 and F.size == 0:
+        F = np.zeros((0, n, n))
+    F = _as_sequence(F, "F", N - 1, (n, n))
+    Q = _as_sequence(Q, "Q", N - 1, (n, n)) if np.size(Q) else np.zeros((0, n, n))
+    if N > 1:
+        Qs = symmetrize(Q)
+        if np.max(np.abs(Q - Qs)) > 1e-8 * max(np.max(np.abs(Q)), 1e-300):
+            raise ValueError("Q must be symmetric")
+        # PSD test: Q + jitter I must admit a Cholesky factor (jitter 1e-10 of the largest diagonal entry)
+        d = np.diagonal(Qs, axis1=-2, axis2=-1)
+        if np.any(d < 0):
+            raise ValueError("Q must be positive semi-definite (negative diagonal entry)")
+        jitter = 1e-10 * np.maximum(np.max(d, axis=-1), 1e-300)
+        try:
+            np.linalg.cholesky(Qs + jitter[:, None, None] * np.eye(n))
+        except np.linalg.LinAlgError as exc:
+            raise ValueError("Q must be positive semi-definite") from exc
+        Q = Qs
+    R = _as_sequence(R, "R", N, (M, M))
+    LR = cholesky_spd(R, "R")
+    R = symmetrize(R)
+    return (P0, F, Q, H, R, LR) if chol_R else (P0, F, Q, H, R)
+
+
+def position_sigma_km(P, index: int, system: CR3BP) -> np.ndarray:
+    """RMS position error :math:`\\sqrt{\\mathrm{tr} P_{rr}}` (km) of object ``index`` (0 = observer) in augmented covariances ``(..., n, n)``."""
+    P = _square(P, "P")
+    _check_system(system)
+    i = int(index)
+    if i < 0 or 6 * (i + 1) > P.shape[-1]:
+        raise ValueError(f"index must select an object in 0..{P.shape[-1] // 6 - 1}; got {index}")
+    blk = P[..., 6 * i:6 * i + 3, 6 * i:6 * i + 3]
+    return np.sqrt(np.trace(blk, axis1=-2, axis2=-1)) * system.length_unit_km
+
+
+# --------------------------------------------------------------------------------------------------------------
+# linearisation of an observer / N-target measurement sequence along true trajectories
+# --------------------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class AugmentedLinearization:
+    """Linear-Gaussian description of an observation window (Wolf & Jones Eqs. 19-23 ingredients).
+
+    Measurements of every target are taken at every time ``t[k]``, k = 0..N-1 (``t[0]`` is the start of the
+    observation window, where ``P0`` applies).
+
+    Attributes
+    ----------
+    t : ndarray (N,)
+        Measurement times, TU.
+    observer : ndarray (N, 6)
+        Observer states at ``t``.
+    targets : ndarray (N_T, N, 6)
+        Target states at ``t``.
+    P0 : ndarray (n, n)
+        Augmented covariance at ``t[0]``, n = 6 (N_T + 1).
+    F : ndarray (N-1, n, n)
+        :math:`\\Phi_{\\mathcal A}(t_{k+1}, t_k)` (block diagonal, Eq. 22).
+    Q : ndarray (N-1, n, n)
+        :math:`Q_{\\mathcal A,k+1}` (block diagonal).
+    H : ndarray (N, M, n)
+        :math:`H_{\\mathcal A,k}` (Eq. 21), M = m N_T.
+    R : ndarray (N, M, M)
+        :math:`R_{\\mathcal A,k}` (block diagonal).
+    dF : ndarray (N-1, n, n, 6) or None
+        :math:`\\partial F_k/\\partial\\mathbf x_{\\mathcal S}(t_0)` (from the observer's second-order STT).
+    dH : ndarray (N, M, n, 6) or None
+        :math:`\\partial H_k/\\partial\\mathbf x_{\\mathcal S}(t_0)` (measurement Hessians times the STM).
+    observer_stm : ndarray (N, 6, 6)
+        :math:`\\Phi_{\\mathcal S}(t_k, t_0)`.
+    """
+
+    t: np.ndarray
+    observer: np.ndarray
+    targets: np.ndarray
+    P0: np.ndarray
+    F: np.ndarray
+    Q: np.ndarray
+    H: np.ndarray
+    R: np.ndarray
+    dF: np.ndarray | None
+    dH: np.ndarray | None
+    observer_stm: np.ndarray
+
+    @property
+    def n_targets(self) -> int:
+        return self.targets.shape[0]
+
+    @property
+    def arrays(self):
+        """``(P0, F, Q, H, R)`` for the functions of :mod:`cislunar.information`."""
+        return self.P0, self.F, self.Q, self.H, self.R
+
+
+def linearize_augmented(system: CR3BP, observer_x0, targets_x0, t, model: MeasurementModel, noise, P0, *,
+                        q: float | None = None, Q=None, derivatives: bool = False,
+                        n_nodes: int = 12) -> AugmentedLinearization:
+    """Propagate observer and targets from ``t[0]`` and linearise the measurement sequence along them.
+
+    Parameters
+    ----------
+    system : CR3BP
+    observer_x0 : array_like (6,)
+        Observer state at ``t[0]`` (the start of the observation window), LU, LU/TU.
+    targets_x0 : array_like (N_T, 6)
+        Target states at ``t[0]``.
+    t : array_like (N,)
+        Strictly increasing measurement times, TU (N >= 2).
+    model : MeasurementModel
+        Measurement taken by the observer of each target at every time.
+    noise : array_like (m, m) or callable
+        Noise covariance of one measurement (non-dimensional), or ``noise(observer, target) -> (..., m, m)``
+        (e.g. a range-dependent angular model built on :func:`cislunar.measurements.angles_noise`).
+    P0 : array_like (n, n)
+        Augmented covariance at ``t[0]``.
+    q : float, optional
+        Acceleration PSD (LU^2/TU^3) of every object; :math:`Q_{\\mathcal A}` is computed along the trajectories
+        with :func:`process_noise`.  Exclusive with ``Q``.
+    Q : array_like (N-1, n, n), optional
+        Given augmented process noise (held fixed, e.g. when differentiating with respect to the observer, as in
+        Wolf & Jones who neglect the sensitivity of :math:`\\tilde P` to the observer state).
+    derivatives : bool
+        Also compute ``dF`` and ``dH`` with respect to the observer state at ``t[0]`` (second-order STT).
+    n_nodes : int
+        Quadrature nodes per interval for the process noise.
+
+    Returns
+    -------
+    AugmentedLinearization
+
+    Notes
+    -----
+    Transition matrices are propagated interval by interval from the reference states (no inversion of long-arc
+    STMs); :math:`\\Phi_{\\mathcal S}(t_k, t_0)` is their running product.  The noise covariance is treated as
+    independent of the states in ``dH`` (exact for constant noise; for range-dependent angular noise the
+    sensitivity of R is neglected, like that of :math:`\\tilde P` in the paper).
+    """
+    from .propagation import propagate
+
+    _check_system(system)
+    if not isinstance(model, MeasurementModel):
+        raise ValueError(f"model must be a cislunar.measurements.MeasurementModel; got {type(model).__name__}")
+    xs0 = _checks.as_state(observer_x0, "observer_x0", batch=False)
+    xt0 = _checks.as_array(targets_x0, "targets_x0", last=6)
+    if xt0.ndim == 1:
+        xt0 = xt0[None]
+    if xt0.ndim != 2 or xt0.shape[0] < 1:
+        raise ValueError(f"targets_x0 must have shape (N_T, 6); got {xt0.shape}")
+    t = _checks.time_grid(t, "t")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("t must be strictly increasing")
+    if (q is None) == (Q is None):
+        raise ValueError("give exactly one of q (process-noise PSD) and Q (discrete process noise)")
+    NT, N, m = xt0.shape[0], t.size, model.dim
+    n = 6 * (NT + 1)
+    P0 = check_spd(_checks.as_array(P0, "P0", shape=(n, n)), "P0")
+
+    # true trajectories on the measurement grid (batch: observer first)
+    tr = propagate(system, np.vstack([xs0, xt0]), t)
+    X = tr.x  # (NT+1, N, 6)
+    starts = X[:, :-1].reshape(-1, 6)
+    dts = np.tile(np.diff(t), NT + 1)
+    qq = None if q is None else _checks.positive(q, "q", allow_zero=True)
+    Fo, Qo, Psi = _interval_transitions(system, starts[:N - 1], dts[:N - 1], qq, n_nodes, 2 if derivatives else 1)
+    Ft, Qt, _ = _interval_transitions(system, starts[N - 1:], dts[N - 1:], qq, n_nodes, 1)
+    Fobj = np.concatenate([Fo[None], Ft.reshape(NT, N - 1, 6, 6)], axis=0)  # (NT+1, N-1, 6, 6)
+    F = block_diag(np.moveaxis(Fobj, 0, 1))
+    if Q is None:
+        Qobj = np.concatenate([Qo[None], Qt.reshape(NT, N - 1, 6, 6)], axis=0)
+        Qa = block_diag(np.moveaxis(Qobj, 0, 1))
+    else:
+        Qa = _as_sequence(Q, "Q", N - 1, (n, n))
+    # observer STM from t[0]
+    stm = np.empty((N, 6, 6))
+    stm[0] = np.eye(6)
+    for k in range(1, N):
+        stm[k] = Fo[k - 1] @ stm[k - 1]
+
+    obs, tgts = X[0], X[1:]
+    _, Hs, Ht = model.evaluate(obs[None], tgts)  # (NT, N, m, 6)
+    H = np.zeros((N, NT * m, n))
+    for i in range(NT):
+        H[:, i * m:(i + 1) * m, 0:6] = Hs[i]
+        H[:, i * m:(i + 1) * m, 6 * (i + 1):6 * (i + 2)] = Ht[i]
+    if callable(noise):
+        Rt = _checks.as_array(noise(obs[None], tgts), "noise(observer, target)", shape=(NT, N, m, m))
+    else:
+        Rt = np.broadcast_to(_checks.as_array(noise, "noise", shape=(m, m)), (NT, N, m, m))
+    R = block_diag(np.moveaxis(Rt, 0, 1))
+    check_spd(R, "noise")
+
+    dF = dH = None
+    if derivatives:
+        dF = np.zeros((N - 1, n, n, 6))
+        dF[:, 0:6, 0:6, :] = np.einsum("kabd,kdc->kabc", Psi, stm[:-1])
+        hess = model.hessian(obs[None], tgts)  # (NT, N, m, 6, 6): d2h/ddelta2
+        # dH_obs/dx_S = +hess, dH_tgt/dx_S = -hess (delta = x_T - x_S); chain with Phi_S(t_k, t_0)
+        dhx = np.einsum("ikabd,kdc->ikabc", hess, stm)
+        dH = np.zeros((N, NT * m, n, 6))
+        for i in range(NT):
+            dH[:, i * m:(i + 1) * m, 0:6, :] = dhx[i]
+            dH[:, i * m:(i + 1) * m, 6 * (i + 1):6 * (i + 2), :] = -dhx[i]
+    return AugmentedLinearization(t=t, observer=obs, targets=tgts, P0=P0, F=F, Q=Qa, H=H, R=R, dF=dF, dH=dH,
+                                  observer_stm=stm)
