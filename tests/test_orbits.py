@@ -119,3 +119,25 @@ def test_stability_index_conventions():
     assert np.allclose(orbits.broucke_indices(M), [(3 + 1 / 3) / 2, np.cos(1.0)], atol=1e-12)
     with pytest.raises(ValueError, match="monodromy"):
         orbits.stability_index(np.eye(5))
+
+
+def test_natural_and_pseudo_arclength_continuation_trace_the_same_family(nrho):
+    nat = orbits.continue_family(em, nrho, 3, -0.02, method="natural", parameter="half_period")
+    arc = orbits.continue_family(em, nrho, 6, -0.01, parameter="half_period")
+    # correct an arclength member's period with the natural method: same orbit
+    target = arc[-1]
+    again = orbits.correct_symmetric(em, nat[-1].x0, target.period / 2, fix="half_period")
+    assert np.max(np.abs(again.x0 - target.x0)) < 1e-9
+    for o in nat + arc:
+        assert o.closure < 1e-10
+    assert np.allclose(np.diff([o.period for o in nat]), -0.04, atol=1e-12)
+
+
+def test_integrators_are_compiled_once_per_process():
+    from cislunar import propagation
+
+    propagation.propagate_stm(em, [0.8, 0, 0, 0, 0.5, 0], 0.1)
+    before = propagation._template.cache_info()
+    propagation.propagate_stm(em, [0.8, 0, 0, 0, 0.5, 0], 0.2)
+    after = propagation._template.cache_info()
+    assert after.misses == before.misses and after.hits > before.hits
