@@ -395,13 +395,13 @@ def continue_family(system: CR3BP, orbit: PeriodicOrbit, n_steps: int, step: flo
         for attempt in range(4):
             try:
                 if method == "natural":
-                    Xg = X.copy()
-                    Xg[p_index] += ds
-                    if len(family) >= 2:  # secant predictor from the last two members
-                        Xq = _pack(family[-2].x0, family[-2].period / 2, planar)
-                        dp = X[p_index] - Xq[p_index]
-                        if dp != 0:
-                            Xg = X + (ds / dp) * (X - Xq)
+                    # first-order predictor: move along the family's tangent with the parameter advanced by ds
+                    _, DG = _residual_jacobian(system, X, planar, int_tol)
+                    keep = [i for i in range(X.size) if i != p_index]
+                    v = np.zeros(X.size)
+                    v[p_index] = 1.0
+                    v[keep] = np.linalg.lstsq(DG[:, keep], -DG[:, p_index], rcond=None)[0]
+                    Xg = X + ds * v
                     Xn, DG, hist = _newton(system, Xg, planar, p_index, tol=tol, max_iter=max_iter, int_tol=int_tol)
                 else:
                     _, DG = _residual_jacobian(system, X, planar, int_tol)
