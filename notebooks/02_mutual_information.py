@@ -1,0 +1,375 @@
+# ---
+# jupyter:
+#   jupytext:
+#     formats: py:percent
+#   kernelspec:
+#     display_name: Python 3
+#     language: python
+#     name: python3
+# ---
+
+# %% [markdown]
+# # 02 · Mutual information of an observation window and its gradient
+#
+# **What you will learn.** What the *mutual information* between the states of an observer and its targets and
+# the measurements it collects means (a expected KL divergence, in nats); how Wolf & Jones stack a whole
+# observation window into one linear-Gaussian model (their Eqs. 12-23) and get a closed form (Eq. 18); why the
+# same number can be computed measurement by measurement with a Kalman filter at a cost linear in the number of
+# measurements; how its gradient with respect to the observer's state (Eqs. 44-52) is built from the second-order
+# state transition tensor; and why a longer observer-target baseline makes inter-satellite measurements more
+# informative (the Markley / Psiaki argument of the paper's introduction).
+#
+# **Paper sections followed.** Wolf & Jones, *Information-Based Trajectory Planning for Autonomous Absolute
+# Tracking in Cislunar Space* (arXiv 2408.17435): "Problem Formulation: Information-Driven Objective" (Eqs. 9-23),
+# "Convex Objective Approximation" (Eqs. 44-52), "Performance Evaluation" (the CRLB by EKF covariance recursion)
+# and test case 2 (Tables 4 and 5). Measurement models also follow Greaves & Scheeres 2021 (Eqs. 6-13) and
+# their AMOS 2023 paper (Eqs. 15-20).
+#
+# All computation lives in `cislunar.measurements`, `cislunar.covariance` and `cislunar.information`.
+
+# %% tags=["parameters"]
+QUICK = False
+SEED = 0
+OUTPUT_DIR = ""
+
+# %%
+# Sizes derived from QUICK: quick mode uses fewer samples, baselines and timing sizes; every step still runs.
+MC_SAMPLES = 20000 if QUICK else 200000  # Monte Carlo samples for the KL check (Eq. 11)
+N_BASELINES = 5 if QUICK else 10  # observer phase offsets in the baseline study
+TIMING_SIZES = [5, 9, 17] if QUICK else [5, 9, 17, 33, 65]  # measurement times per window in the timing study
+TIMING_MIN_TIME = 0.02 if QUICK else 0.1  # seconds per timing run
+
+import numpy as np
+import matplotlib.pyplot as plt
+
+from cislunar import covariance as cov, information as info, measurements as meas, plotting
+from cislunar.dynamics import EARTH_MOON as em
+from cislunar.propagation import find_events, propagate
+from cislunar.report import ComparisonTable
+
+plotting.use_style()
+out = OUTPUT_DIR or None
+rng = np.random.default_rng(SEED)
+table = ComparisonTable("02 Mutual information (Wolf & Jones Eqs. 9-23, 44-52, Performance Evaluation)")
+
+# %% [markdown]
+# ## 1 · Mutual information as an expected KL divergence (Eqs. 9-11)
+#
+# For one state $x$ and one measurement $y$, the mutual information is the KL divergence (Eq. 10) between the
+# joint density and the product of the marginals (Eq. 9). Marginalising (Eq. 11) it is the *expected* divergence
+# between what the measurement says given the state, $p(y|x)$, and what we expect to measure before knowing the
+# state, $p(y)$:
+#
+# $$\mathcal I(x;y) = \mathbb E_x\left[D_{KL}\big(p(y|x)\,\|\,p(y)\big)\right].$$
+#
+# Worked example: a scalar $x\sim\mathcal N(0, p)$ measured as $y = hx + v$, $v\sim\mathcal N(0,r)$. Then
+# $p(y|x)=\mathcal N(hx, r)$, $p(y)=\mathcal N(0, h^2p+r)$ and the closed form is
+# $\mathcal I = \tfrac12\ln(1 + h^2p/r)$: the log of the ratio of prior to posterior standard deviation. We check
+# it three ways: closed form, the expected KL averaged over samples of $x$ (Eq. 10 for Gaussians), and the joint
+# Monte Carlo average of $\ln p(y|x) - \ln p(y)$ from `monte_carlo_mutual_information`.
+
+# %%
+p, h, r = 4.0, 1.0, 1.0
+closed = 0.5 * np.log(1 + h**2 * p / r)
+xs = rng.normal(0.0, np.sqrt(p), size=MC_SAMPLES)
+kl = info.gaussian_kl((h * xs)[:, None], [[r]], [0.0], [[h**2 * p + r]])  # KL(p(y|x) || p(y)) for each x
+mc, se = info.monte_carlo_mutual_information([[p]], np.zeros((0, 1, 1)), np.zeros((0, 1, 1)), [[[h]]], [[r]],
+                                             MC_SAMPLES, rng)
+print(f"closed form 0.5 ln(1 + h^2 p / r)  = {closed:.5f} nats")
+print(f"E_x[KL] over {MC_SAMPLES} samples    = {kl.mean():.5f} +- {kl.std(ddof=1) / np.sqrt(MC_SAMPLES):.5f}")
+print(f"joint Monte Carlo of log ratio       = {mc:.5f} +- {se:.5f}")
+print(f"posterior/prior std ratio: {np.sqrt(1 / (1 / p + h**2 / r)) / np.sqrt(p):.4f} = exp(-I) = {np.exp(-closed):.4f}")
+
+# %% [markdown]
+# ## 2 · The stacked window (Eqs. 12-23) on a toy problem
+#
+# Over a window the measurements at $t_0,\dots,t_{N-1}$ depend linearly (after linearisation) on the initial state
+# error and the process noises, $X=[x_0; w_1; \dots; w_{N-1}]$, with block-diagonal prior covariance
+# $\tilde P = \mathrm{diag}(P_0, Q_1, \dots)$ (Eq. 19). Row $j$ of the stacked Jacobian $\tilde H$ (Eq. 20) contains
+# $H_j\Phi(t_j,t_k)$ for every noise injected at $t_k\le t_j$ (Eqs. 21-22); $\tilde R$ is block diagonal (Eq. 23).
+# Then $Y\sim\mathcal N(\bar Y, \tilde H\tilde P\tilde H^T+\tilde R)$ and $Y|X\sim\mathcal N(\tilde HX, \tilde R)$
+# (Eqs. 16-17), so the expected KL divergence is Eq. 18:
+#
+# $$\mathcal I(X;Y) = \tfrac12\ln\frac{|\tilde H\tilde P\tilde H^T + \tilde R|}{|\tilde R|}.$$
+#
+# A 1-D constant-velocity toy (state: position, velocity; position measured at three times) shows the stacked
+# matrices. The block lower-triangular shape of $\tilde H$ is what makes the dense form cost $O(N^3)$.
+
+# %%
+dt = 1.0
+F_toy = np.tile([[1.0, dt], [0.0, 1.0]], (2, 1, 1))
+Q_toy = np.tile(0.01 * np.array([[dt**3 / 3, dt**2 / 2], [dt**2 / 2, dt]]), (2, 1, 1))  # Van Loan, PSD 0.01
+H_toy = np.tile([[[1.0, 0.0]]], (3, 1, 1))
+R_toy = np.tile([[[0.25]]], (3, 1, 1))
+P0_toy = np.diag([1.0, 0.5])
+Pt, Ht, Rt = info.stacked_matrices(P0_toy, F_toy, Q_toy, H_toy, R_toy)
+np.set_printoptions(precision=3, suppress=True)
+print("P~ (Eq. 19):\n", Pt, "\nH~ (Eq. 20):\n", Ht, "\nR~ (Eq. 23):\n", Rt)
+dense_toy = info.mutual_information_dense(P0_toy, F_toy, Q_toy, H_toy, R_toy)
+total_toy, terms_toy = info.mutual_information(P0_toy, F_toy, Q_toy, H_toy, R_toy, return_terms=True)
+print(f"Eq. 18 dense: {dense_toy:.12f} nats; chain rule: {total_toy:.12f} nats = sum of {np.round(terms_toy, 4)}")
+
+# %% [markdown]
+# **The chain rule.** $\mathcal I(X;Y) = \sum_k \mathcal I(X; y_k\,|\,y_{0:k-1})$. Given the earlier measurements,
+# $y_k = H_kx_k + v_k$ with $x_k\sim\mathcal N(\cdot, \bar P_k)$ — the Kalman filter's *prior* covariance — so each
+# term is the information gain of one Kalman update,
+# $\mathcal I_k = \tfrac12\ln|I + R_k^{-1/2}H_k\bar P_kH_k^TR_k^{-T/2}|$. The determinant of the stacked innovation
+# covariance factorises into the product of the per-step innovation covariances (block LDL), so the sum equals
+# Eq. 18 exactly, at a cost linear in $N$. The first measurement carries most information here (it collapses the
+# prior), later ones add less.
+
+# %% [markdown]
+# ## 3 · Measurement models and noise (test case 2; Greaves & Scheeres)
+#
+# Wolf & Jones test case 2 measures range $\rho = \|\Delta\mathbf r\|$ and range rate
+# $\dot\rho = \Delta\dot{\mathbf r}\cdot\Delta\mathbf r/\rho$ with $\Delta = x_{\mathcal T}-x_{\mathcal S}$, noise
+# 100 m and 10 m/s (Table 5). Their Jacobians with respect to the relative state are
+# $[\hat\rho^T\ 0]$ and $[(\Delta\dot{\mathbf r}-\dot\rho\hat\rho)^T/\rho\ \ \hat\rho^T]$; the observer's Jacobian
+# is the negative (Eq. 21 puts both in $H_{\mathcal A}$). Optical angles (G&S 2021 Eqs. 7-8, AMOS Eqs. 15-18) use
+# the RMS model $\sigma_\theta = \sqrt{\sigma_{min}^2 + D^2/\rho^2}$ (AMOS Eq. 20, $\sigma_{min}$ = 10 µrad,
+# $D$ = 4 m): resolution dominates below $D/\sigma_{min}$ = 400 m, pointing above.
+
+# %%
+rho_km = np.logspace(-2, 5, 200)
+sig = meas.angular_sigma(rho_km, meas.AMOS_SIGMA_MIN_RAD, meas.AMOS_RESOLUTION_KM)
+fig, ax = plt.subplots(figsize=(5.5, 3.5))
+ax.loglog(rho_km, sig * 1e6, label=r"$\sqrt{\sigma_{min}^2 + D^2/\rho^2}$ (AMOS Eq. 20)")
+ax.axvline(meas.AMOS_RESOLUTION_KM / meas.AMOS_SIGMA_MIN_RAD, color="0.5", ls=":", label=r"$\rho = D/\sigma_{min}$")
+ax.axvline(0.215, color="C3", ls="--", label="215 km: AMOS mean agent-target range")
+ax.set(xlabel="range [km]", ylabel=r"$\sigma_\theta$ [µrad]", title="Angular noise model")
+ax.legend(fontsize=8)
+plotting.save_figure(fig, "02_angular_noise_model", output_dir=out)
+print(f"sigma_theta at 215 km: {meas.angular_sigma(215.0, 1e-5, 0.004) * 1e6:.3f} µrad")
+
+# %% [markdown]
+# ## 4 · Test case 2: the observation window and its CRLB
+#
+# Three targets on the Table 4 DROs and an observer; window $[P_{ref}, 2P_{ref}]$ with one range/range-rate pair
+# per target per day, initial 100 km / 1 cm/s per axis (Table 5). **Choice:** the printed observer row
+# ($\dot y_0$ = 0.528996986) does not close as a periodic orbit (notebook 01), and the paper's optimised observer
+# trajectory is not published, so the observer here coasts on the `observer_tf` DRO of Table 4 (which closes) —
+# the un-manoeuvred reference, i.e. the paper's minimum-ΔV end of the trade. $P_{ref}$ is the period of that DRO.
+#
+# Process noise: Table 5 prints "$Q$ [km/s³] = $10^{-11}$"; the PSD of an acceleration has units km²/s³, so we read
+# $q = 10^{-11}$ km²/s³ $= q\,T^3/L^2$ LU²/TU³ and discretise it *exactly* along each reference trajectory,
+# $Q_k = \int\Phi(t_{k+1},\tau)GqG^T\Phi(t_{k+1},\tau)^Td\tau$ (time-varying Van Loan; Gauss-Legendre quadrature of
+# heyoka STMs, checked against the Lyapunov ODE in the tests).
+
+# %%
+observer_x0 = np.array([7.80136159e-1, 0, 0, 0, 5.53104815e-1, 0])
+targets_x0 = np.array([[7.78717734e-1, 0, 0, 0, 5.55157488e-1, 0],
+                       [7.79426943e-1, 0, 0, 0, 5.54128887e-1, 0],
+                       [7.81554639e-1, 0, 0, 0, 5.51070308e-1, 0]])
+P_ref = float(find_events(em, observer_x0, 10.0, ("y_crossing",)).t[1])
+start = propagate(em, np.vstack([observer_x0, targets_x0]), [0.0, P_ref]).x[:, -1]
+day = float(em.days_to_tu(1.0))
+t_win = P_ref + np.arange(0.0, P_ref + 1e-12, day)
+P_obj = cov.state_covariance(cov.WOLF_JONES_SIGMA_POS_KM, cov.WOLF_JONES_SIGMA_VEL_KM_S, em)
+R_rr = meas.range_range_rate_noise(meas.WOLF_JONES_RANGE_SIGMA_KM, meas.WOLF_JONES_RANGE_RATE_SIGMA_KM_S, em)
+q_nd = cov.psd_to_nondimensional(cov.WOLF_JONES_PSD_KM2_S3, em)
+lin = cov.linearize_augmented(em, start[0], start[1:], t_win, meas.RANGE_RANGE_RATE, R_rr,
+                              cov.block_diag([P_obj] * 4), q=q_nd, derivatives=True)
+print(f"P_ref = {em.tu_to_days(P_ref):.3f} d; window {em.tu_to_days(t_win[0]):.2f}-{em.tu_to_days(t_win[-1]):.2f} d, "
+      f"{t_win.size} measurement times, state dim {lin.P0.shape[0]}")
+print(f"q = {q_nd:.4e} LU^2/TU^3; one-day Q_S velocity sigma = "
+      f"{np.sqrt(lin.Q[0, 3, 3]) * em.velocity_unit_km_s * 1e3:.3f} m/s (sqrt(q dt) = {np.sqrt(1e-11 * 86400) * 1e3:.3f} m/s)")
+mi_dense = info.window_information(lin, method="dense")
+mi_struct, gains = info.mutual_information(*lin.arrays, return_terms=True)
+print(f"I(X;Y): dense Eq. 18 = {mi_dense:.9f} nats, chain rule = {mi_struct:.9f} nats "
+      f"(rel. diff {abs(mi_dense - mi_struct) / mi_dense:.1e})")
+
+# %% [markdown]
+# **Performance evaluation (CRLB).** Linearised about the true trajectories, the EKF covariance recursion
+# $\bar P_{k+1} = \Phi\hat P_k\Phi^T + Q$, $\hat P_k = (I-K_kH_k)\bar P_k$ (Joseph form here) gives the CRLB
+# (Taylor 1978), as in the paper's "Performance Evaluation". The same recursion produced the per-measurement
+# information gains above.
+
+# %%
+hist = cov.covariance_analysis(*lin.arrays)
+days = em.tu_to_days(t_win)
+fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.6))
+names = ["observer", "target 1", "target 2", "target 3"]
+sig_post = np.array([cov.position_sigma_km(hist.posterior, i, em) for i in range(4)])
+sig_prior = np.array([cov.position_sigma_km(hist.prior, i, em) for i in range(4)])
+for i, name in enumerate(names):
+    ax1.semilogy(days, sig_post[i], "o-", ms=3, label=name)
+ax1.set(xlabel="time [days]", ylabel="position RMS (CRLB) [km]", title="CRLB along the window (cf. Fig. 9)")
+ax1.legend(fontsize=8)
+ax2.bar(days, gains, width=0.6)
+ax2.set(xlabel="time [days]", ylabel="information gain [nats]", title=r"per-measurement $\mathcal{I}_k$ (chain rule)")
+plotting.save_figure(fig, "02_test_case_2_crlb_and_gains", output_dir=out)
+print("terminal position RMS [km]:", dict(zip(names, np.round(sig_post[:, -1], 3))))
+print("mean position RMS over the window [km]:", dict(zip(names, np.round(sig_post.mean(axis=1), 3))))
+transient = sig_post[:, 1] > sig_post[:, 0]
+
+# %% [markdown]
+# ## 5 · The gradient with respect to the observer (Eqs. 44-52)
+#
+# With the observer coasting through the window, every observer state is a function of its state at the window
+# start, $x_{\mathcal S,k^*}$, so $\tilde H$ depends on it through (i) the measurement Jacobians evaluated at the
+# propagated states (their Hessians times the STM, first term of Eq. 50) and (ii) the transition matrices inside
+# $\tilde H$ (the second-order STT, second term of Eq. 50, Eqs. 51-52). With the determinant derivative (Eq. 46):
+#
+# $$\frac{\partial\mathcal I}{\partial\xi} = \tfrac12\mathrm{tr}\Big(\tilde S^{-1}\big(\partial_\xi\tilde H\,
+# \tilde P\tilde H^T + \tilde H\tilde P\,\partial_\xi\tilde H^T\big)\Big)\quad\text{(Eqs. 47-48)}.$$
+#
+# As the paper says, $\tilde P$ (the process noise) is held fixed. The structured gradient differentiates the Kalman
+# recursion in reverse mode (adjoint), so its cost is a fixed multiple of one MI evaluation. Both are compared
+# with fourth-order central differences of the full re-propagated MI.
+
+# %%
+I0, g_struct = info.window_information(lin, gradient=True)
+_, g_dense = info.window_information(lin, gradient=True, method="dense")
+
+
+def mi_of_observer(x):
+    return info.window_information(cov.linearize_augmented(em, x, start[1:], t_win, meas.RANGE_RANGE_RATE, R_rr,
+                                                           lin.P0, Q=lin.Q))
+
+
+hfd = 1e-6
+g_fd = np.array([(8 * (mi_of_observer(start[0] + hfd * e) - mi_of_observer(start[0] - hfd * e))
+                  - (mi_of_observer(start[0] + 2 * hfd * e) - mi_of_observer(start[0] - 2 * hfd * e))) / (12 * hfd)
+                 for e in np.eye(6)])
+grad_err = np.max(np.abs(g_struct - g_fd)) / np.max(np.abs(g_fd))
+print("gradient [nats/LU, nats/(LU/TU)]\n structured:", g_struct, "\n dense:     ", g_dense, "\n central FD:", g_fd)
+print(f"max |structured - FD| / max |FD| = {grad_err:.1e}; structured vs dense {np.max(np.abs(g_struct - g_dense)) / np.max(np.abs(g_dense)):.1e}")
+
+# %% [markdown]
+# **How far does the linearisation of Eq. 44 hold?** Step the observer's initial state along the gradient
+# direction (position and velocity scaled separately to km and mm/s) and compare the true MI with
+# $\mathcal I + \nabla\mathcal I\cdot\delta x$. SCvx's trust region (Eq. 24f) has to keep steps in the range where
+# the two agree.
+
+# %%
+direction = g_struct / np.linalg.norm(g_struct)
+steps_km = np.array([1.0, 10.0, 100.0, 1000.0])
+true_mi, lin_mi = [], []
+for s_km in steps_km:
+    dx = direction * em.km_to_lu(s_km)
+    true_mi.append(mi_of_observer(start[0] + dx))
+    lin_mi.append(I0 + g_struct @ dx)
+lin_err = np.abs(np.array(true_mi) - np.array(lin_mi))
+for s_km, a, b in zip(steps_km, true_mi, lin_mi):
+    print(f"|dx| = {s_km:7.1f} km-equivalent: true {a:.4f}, Eq. 44 {b:.4f}, error {abs(a - b):.2e} nats")
+
+# %% [markdown]
+# ## 6 · Baseline and information (the Markley / Psiaki argument)
+#
+# Inter-satellite measurements inform *absolute* states only through the difference of the gravitational
+# accelerations the two spacecraft feel — like two accelerometers at a long baseline (Psiaki 1999). The longer the
+# baseline, the more the two dynamics differ, and the more observable the pair becomes. Test: a target on the
+# first Table 4 DRO and an observer on the *same* DRO, ahead by a phase $\tau$ (so no new orbit is needed and the
+# baseline grows with $\tau$); one period, daily measurements; relative position (test case 1, 100 m per axis)
+# and range/range-rate (test case 2). We report MI and the terminal CRLB. Expect a difference between the two:
+# relative position measures the full baseline vector, while in-plane range and range rate leave directions
+# unobserved — the paper notes that range needs out-of-plane observer motion (test case 2, Fig. 6).
+
+# %%
+tgt = targets_x0[0]
+P_tgt = float(find_events(em, tgt, 10.0, ("y_crossing",)).t[1])
+phases = np.geomspace(0.002, 0.5, N_BASELINES)  # fraction of the period the observer leads by
+obs_starts = propagate(em, tgt, np.r_[0.0, phases * P_tgt]).x[1:]
+t_base = np.arange(0.0, P_tgt + 1e-12, day)
+P0_pair = cov.block_diag([P_obj] * 2)
+models = {"relative position (100 m)": (meas.RELATIVE_POSITION, meas.relative_position_noise(0.1, em)),
+          "range + range rate": (meas.RANGE_RANGE_RATE, R_rr)}
+study = {name: {"baseline": [], "mi": [], "obs": [], "tgt": []} for name in models}
+for name, (model, noise) in models.items():
+    for xo in obs_starts:
+        lb = cov.linearize_augmented(em, xo, tgt[None], t_base, model, noise, P0_pair, q=q_nd)
+        hb = cov.covariance_analysis(*lb.arrays)
+        study[name]["baseline"].append(np.mean(np.linalg.norm(lb.targets[0, :, :3] - lb.observer[:, :3], axis=1)))
+        study[name]["mi"].append(info.mutual_information(*lb.arrays))
+        study[name]["obs"].append(cov.position_sigma_km(hb.posterior[-1], 0, em))
+        study[name]["tgt"].append(cov.position_sigma_km(hb.posterior[-1], 1, em))
+study = {k: {kk: np.array(vv) for kk, vv in v.items()} for k, v in study.items()}
+fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.6))
+for name, res in study.items():
+    b_km = em.lu_to_km(res["baseline"])
+    ax1.semilogx(b_km, res["mi"] - res["mi"][0], "o-", label=f"{name} (I at shortest = {res['mi'][0]:.1f} nats)")
+    ax2.loglog(b_km, res["obs"], "o-", label=f"observer, {name}")
+    ax2.loglog(b_km, res["tgt"], "s--", label=f"target, {name}")
+ax1.set(xlabel="mean baseline [km]", ylabel=r"$\mathcal{I} - \mathcal{I}_{shortest}$ [nats]", title="MI gain vs baseline")
+ax2.set(xlabel="mean baseline [km]", ylabel="terminal position RMS [km]", title="CRLB vs baseline")
+ax1.legend(fontsize=8)
+ax2.legend(fontsize=7)
+plotting.save_figure(fig, "02_baseline_study", output_dir=out)
+for name, res in study.items():
+    print(name, "\n  baseline [km]:", np.round(em.lu_to_km(res["baseline"])), "\n  MI [nats]:", np.round(res["mi"], 2),
+          "\n  observer RMS [km]:", np.round(res["obs"], 3))
+gain = {name: float(res["mi"].max() - res["mi"][0]) for name, res in study.items()}
+rms_drop = {name: float(res["obs"][0] / res["obs"].min()) for name, res in study.items()}
+peak = {name: float(em.lu_to_km(res["baseline"][np.argmax(res["mi"])])) for name, res in study.items()}
+
+# %% [markdown]
+# ## 7 · Cost: dense Eq. 18 versus the chain rule
+#
+# The same test-case-2 geometry, one DRO period, with the cadence changed so the window holds $N$ measurement
+# times. The dense form builds $\tilde H$ ($6N\times24N$) and factorises $\tilde S$: $O(N^3)$. The chain rule runs
+# $N$ Kalman steps on $24\times24$ matrices: $O(N)$. Times are best-of-3 wall clock on one BLAS thread (the
+# machine is shared, so absolute numbers vary by tens of percent).
+
+# %%
+timings = []
+for N in TIMING_SIZES:
+    t_n = np.linspace(P_ref, 2 * P_ref, N)
+    ln = cov.linearize_augmented(em, start[0], start[1:], t_n, meas.RANGE_RANGE_RATE, R_rr, lin.P0, q=q_nd,
+                                 derivatives=True)
+    timings.append(info.time_evaluations(*ln.arrays, ln.dF, ln.dH, repeat=3, min_time=TIMING_MIN_TIME))
+fig, ax = plt.subplots(figsize=(5.5, 3.8))
+ax.loglog(TIMING_SIZES, [1e3 * r.dense_value for r in timings], "o-", label="dense Eq. 18")
+ax.loglog(TIMING_SIZES, [1e3 * r.structured_value for r in timings], "s-", label="chain rule")
+ax.loglog(TIMING_SIZES, [1e3 * r.dense_gradient for r in timings], "o--", label="dense Eq. 18 + Eqs. 47-50")
+ax.loglog(TIMING_SIZES, [1e3 * r.structured_gradient for r in timings], "s--", label="chain rule + adjoint gradient")
+ax.set(xlabel="measurement times N", ylabel="time per evaluation [ms]", title="Evaluation cost")
+ax.legend(fontsize=8)
+plotting.save_figure(fig, "02_timing_dense_vs_structured", output_dir=out)
+for N, r in zip(TIMING_SIZES, timings):
+    print(f"N = {N:3d}: MI {r.ratio_value:5.1f}x, MI + gradient {r.ratio_gradient:5.1f}x faster structured "
+          f"(dense {1e3 * r.dense_gradient:.2f} ms, structured {1e3 * r.structured_gradient:.2f} ms)")
+r17 = timings[TIMING_SIZES.index(17)]
+
+# %% [markdown]
+# ## 8 · Paper versus reproduction
+
+# %%
+table.add("Eq. 11: I = E_X[KL(p(Y|X)||p(Y))] (scalar worked example)", f"{closed:.4f} nats (closed form)",
+          f"{mc:.4f} +- {se:.4f} (Monte Carlo)",
+          "reproduced" if abs(mc - closed) < 3 * se else "differs: Monte Carlo outside 3 standard errors")
+table.add("Eq. 18 on test case 2 window (dense)", "formula only", f"{mi_dense:.4f} nats", "derived",
+          "no numerical MI values are printed in the paper")
+table.add("Eq. 18 by chain rule (Kalman recursion)", "not in paper", f"rel. diff {abs(mi_dense - mi_struct) / mi_dense:.1e}",
+          "beyond paper", "same value at O(N) cost")
+table.add("Eqs. 44-52 gradient vs central differences", "formula only", f"max rel. err {grad_err:.1e}",
+          "reproduced" if grad_err < 1e-5 else "differs: gradient disagrees with finite differences",
+          "P~ held fixed as in the paper; dense Eq. 48 and the adjoint agree")
+table.add("Eq. 44 linearisation error at 10 km / 100 km steps", "not in paper",
+          f"{lin_err[1]:.2e} / {lin_err[2]:.2e} nats", "beyond paper", "scale for the SCvx trust region")
+table.add("Process-noise PSD (Table 5)", "1e-11 km/s^3", f"1e-11 km^2/s^3 = {q_nd:.4e} LU^2/TU^3", "derived",
+          "read as km^2/s^3, the units of an acceleration PSD")
+table.add("Reference DRO period / observation window", "window roughly 17-32 days",
+          f"P_ref = {em.tu_to_days(P_ref):.2f} d, window {days[0]:.1f}-{days[-1]:.1f} d", "reproduced",
+          "P_ref from the Table 4 observer_tf DRO")
+table.add("Observer trajectory in the window", "SCvx-optimised (not published)", "coasting on observer_tf DRO",
+          "differs: the optimised trajectory is not given; printed observer_t0 row is not periodic",
+          "corresponds to the un-manoeuvred end of the Pareto trade")
+table.add("RMS growth at the start of the window (Fig. 4 discussion)", "noticeable growth (diagonal P0)",
+          f"grows after first update for {int(transient.sum())} of 4 objects",
+          "reproduced" if transient.any() else "differs: no initial growth in this geometry")
+obs_better = sig_post[0].mean() < sig_post[1:].mean()
+table.add("Observer RMS below targets on average (Fig. 9)", "yes",
+          f"observer {sig_post[0].mean():.2f} km vs targets {sig_post[1:].mean():.2f} km (mean over window)",
+          "reproduced" if obs_better else "differs: observer is not better determined than the targets here",
+          "un-manoeuvred observer, so only qualitative")
+for name in study:
+    grows = gain[name] > 0 and rms_drop[name] > 1.5
+    table.add(f"MI and CRLB improve with baseline ({name})", "yes (Markley/Psiaki argument, qualitative)",
+              f"MI +{gain[name]:.2f} nats up to {peak[name]:.0f} km; observer RMS down {rms_drop[name]:.1f}x",
+              "reproduced" if grows else "differs: in-plane range/range-rate gains little from baseline alone",
+              "observer phase-shifted on the target's DRO; MI flattens once the pair is half an orbit apart"
+              if grows else "consistent with the paper's remark that range needs out-of-plane observer motion")
+table.add("Structured vs dense speed at test-case-2 size (N = 17)", "not in paper",
+          f"MI {r17.ratio_value:.1f}x, MI + gradient {r17.ratio_gradient:.1f}x", "beyond paper",
+          "target >= 10x; see the timing figure for the growth with N")
+table.display()
