@@ -28,9 +28,9 @@ Two evaluations
   .. math:: \mathcal I_k = \tfrac12\ln\left|I + R_k^{-1/2}H_k\bar P_kH_k^TR_k^{-T/2}\right|,
 
   with :math:`\bar P_k` the Kalman prior covariance (the determinant identity :math:`|S| = \prod_k |S_k|` of the
-  block-LDL factorisation of :math:`\tilde S`).  Cost is linear in N.  The gradient is the forward-mode
-  derivative of the same recursion (Cholesky factors of the whitened innovation covariances; no explicit
-  inverse).
+  block-LDL factorisation of :math:`\tilde S`).  Cost is linear in N.  The gradient is the reverse-mode
+  (adjoint) derivative of the same recursion: one forward and one backward sweep over the window, whatever the
+  number of parameters.
 
 Gradient (Eqs. 44-52)
 ---------------------

@@ -32,9 +32,8 @@ Degenerate geometry (documented behaviour, tested)
 --------------------------------------------------
 * **Zero range.**  When observer and target positions coincide (range below ``MIN_RANGE`` = 1e-12 in the state's
   length unit) the range rate, the angles, their rates and every Jacobian except that of ``relative_position`` are
-  undefined: a ``ValueError`` is raised.  The range itself is 0 and is returned by
-  :func:`range_range_rate` only when ``jacobian=False`` and ``range_rate`` is not needed: we raise anyway to keep
-  one rule (the pair is the measurement).
+  undefined: a ``ValueError`` is raised (also by :func:`range_range_rate`, whose range rate has no direction
+  to project on).  ``relative_position`` stays defined.
 * **Elevation at +-90 deg.**  When the line of sight is along the +-z axis (horizontal component
   :math:`\sqrt{\rho_x^2+\rho_y^2} \le 10^{-12}\rho`) the azimuth, its rate and the elevation Jacobian are undefined
   (AMOS Eq. 18 divides by :math:`\sqrt{\rho_x^2+\rho_y^2}`): a ``ValueError`` is raised.  The elevation value is
