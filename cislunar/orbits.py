@@ -184,21 +184,21 @@ class PeriodicOrbit:
         """Moon-relative periapsis/apoapsis passages over one period (:class:`cislunar.propagation.EventRecord`)."""
         return find_events(self.system, self.x0, self.period * (1.0 + 1e-9), ("apse",), impact=False)
 
+    @cached_property
+    def _apse_radii_km(self) -> np.ndarray:
+        """Distances to the Moon's centre at the initial point and at every apse over one period, km."""
+        points = np.vstack([self.x0[None, :3], self.apses.x[:, :3]])
+        return np.linalg.norm(points - self.system.secondary_position, axis=1) * self.system.length_unit_km
+
     @property
     def perilune_radius_km(self) -> float:
         """Smallest distance to the Moon's centre over one period, km (from apse events, or the initial point)."""
-        r = [np.linalg.norm(self.x0[:3] - self.system.secondary_position)]
-        if self.apses.t.size:
-            r += list(np.linalg.norm(self.apses.x[:, :3] - self.system.secondary_position, axis=1))
-        return float(min(r) * self.system.length_unit_km)
+        return float(self._apse_radii_km.min())
 
     @property
     def apolune_radius_km(self) -> float:
         """Largest distance to the Moon's centre over one period, km."""
-        r = [np.linalg.norm(self.x0[:3] - self.system.secondary_position)]
-        if self.apses.t.size:
-            r += list(np.linalg.norm(self.apses.x[:, :3] - self.system.secondary_position, axis=1))
-        return float(max(r) * self.system.length_unit_km)
+        return float(self._apse_radii_km.max())
 
 
 def _pack(x0: np.ndarray, tau: float, planar: bool) -> np.ndarray:
