@@ -46,7 +46,7 @@ def main() -> dict:
     args = (*lin.arrays, lin.dF, lin.dH)
     info_d, grad_d = I.mutual_information_gradient_dense(*args)
     info_s, grad_s = I.mutual_information_gradient(*args)
-    timing = I.time_evaluations(*args, repeat=5, min_time=0.2)
+    timing = I.time_evaluations(*args, repeat=9, min_time=0.1)
     N, M_, n = lin.H.shape
     out = {
         "n_measurement_times": int(N),
