@@ -5,6 +5,15 @@ Modules
 dynamics      CR3BP constants, units, vector field, Jacobian, Jacobi constant, libration points
 propagation   heyoka.py propagation of states, STMs and second-order STTs; events; scipy cross-check path
 orbits        symmetric periodic orbits: shooting, continuation, monodromy, stability; reference orbits
+reference     reference-orbit tables transcribed from the papers (``data/``), each row verified
+sites         observer sites: L2, DRO, lunar-surface stations; horizon and occultation geometry
+measurements  relative position, range / range-rate, azimuth / elevation (+ rates), Jacobians, noise models
+covariance    SPD helpers, process-noise discretisation, EKF covariance (CRLB) recursion, augmented states
+information   mutual information of an observation window (dense Eq. 18 and O(N) chain rule) and its gradient
+srif          square-root information filter and smoother (Householder)
+montecarlo    Monte Carlo trials and sweeps through any concurrent.futures-style executor
+lpv           LPV form of the planar CR3BP and H2 / H-infinity sensing-precision LMIs
+observers     LPV observer and EKF simulations on the nonlinear CR3BP
 plotting      packaged matplotlib style, ``save_figure``, rotating-frame plot helpers
 report        paper-vs-reproduction tables gathered into ``build/report.md``
 notebooks     command-line runner executing ``notebooks/NN_*.py`` with papermill
