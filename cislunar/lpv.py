@@ -78,6 +78,10 @@ __all__ = [
     "verify_observer",
     "gamma_sweep",
     "default_disturbance",
+    "error_system",
+    "ResonantOrbit",
+    "Scenario",
+    "paper_scenario",
 ]
 
 #: Names of the scheduling parameters rho_1..rho_6.
@@ -617,14 +621,15 @@ class PrecisionLMI:
 
     Parameters
     ----------
-    model : CR3BPLPV
-    vertices : array_like (n_v, 6)
-        Polytope vertices of :math:`\rho`.
+    A_vertices : array_like (n_v, nx, nx)
+        :math:`A(\rho_v)` at the polytope vertices (use :meth:`for_cr3bp` for the CR3BP model).
+    C_vertices : array_like (n_v, ny, nx)
+        :math:`C_y(\rho_v)`.
     norm : {"h2", "hinf"}
-    disturbance : tuple, optional
-        ``(Bd (4, nd), Sd (nd, nd), Dd (6, nd))``; default :func:`default_disturbance`.
-    Cz : array_like (nz, 4), optional
-        Performance output; default position ``[I2 0]``.
+    disturbance : tuple
+        ``(Bd (nx, nd), Sd (nd, nd), Dd (ny, nd))``; see :func:`default_disturbance`.
+    Cz : array_like (nz, nx), optional
+        Performance output; default the first two states (position ``[I2 0]`` for the CR3BP).
     objective : {"l1", "l2", "linf"}
         Norm of :math:`\beta` minimised (``"l1"`` promotes sparse sensor selection).
     eps : float
@@ -633,38 +638,42 @@ class PrecisionLMI:
         Subset of sensors offered to the design (others get zero gain); default all six.
     """
 
-    def __init__(self, model: CR3BPLPV, vertices, norm: str = "h2", *, disturbance=None, Cz=None,
+    def __init__(self, A_vertices, C_vertices, norm: str = "h2", *, disturbance, Cz=None,
                  objective: str = "l1", eps: float = 1e-8, sensors=None, pole_radius: float | None = None):
         import cvxpy as cp
 
-        if not isinstance(model, CR3BPLPV):
-            raise ValueError(f"model must be a CR3BPLPV; got {type(model).__name__}")
+        A_v = _checks.as_array(A_vertices, "A_vertices", ndim=(3,))
+        nx = A_v.shape[1]
+        if A_v.shape[0] < 1 or A_v.shape[2] != nx:
+            raise ValueError(f"A_vertices must have shape (n_v >= 1, nx, nx); got {A_v.shape}")
+        C_all = _checks.as_array(C_vertices, "C_vertices", ndim=(3,))
+        if C_all.shape[0] != A_v.shape[0] or C_all.shape[2] != nx:
+            raise ValueError(f"C_vertices must have shape ({A_v.shape[0]}, ny, {nx}); got {C_all.shape}")
+        ny = C_all.shape[1]
         if norm not in _NORMS:
             raise ValueError(f"norm must be one of {_NORMS}; got {norm!r}")
         if objective not in _OBJECTIVES:
             raise ValueError(f"objective must be one of {tuple(_OBJECTIVES)}; got {objective!r}")
-        V = _checks.as_array(vertices, "vertices", ndim=(2,), last=model.n_rho)
-        if V.shape[0] < 1:
-            raise ValueError("vertices must hold at least one vertex")
         self.eps = _checks.positive(eps, "eps")
         self.pole_radius = None if pole_radius is None else _checks.positive(pole_radius, "pole_radius")
-        Bd, Sd, Dd = default_disturbance() if disturbance is None else disturbance
+        if not isinstance(disturbance, tuple) or len(disturbance) != 3:
+            raise ValueError("disturbance must be a tuple (Bd, Sd, Dd)")
+        Bd, Sd, Dd = disturbance
         Bd = _checks.as_array(Bd, "disturbance Bd", ndim=(2,))
         nd = Bd.shape[1]
-        if Bd.shape[0] != model.n_x:
-            raise ValueError(f"disturbance Bd must have {model.n_x} rows; got shape {Bd.shape}")
+        if Bd.shape[0] != nx:
+            raise ValueError(f"disturbance Bd must have {nx} rows; got shape {Bd.shape}")
         Sd = _checks.as_array(Sd, "disturbance Sd", shape=(nd, nd))
-        Dd = _checks.as_array(Dd, "disturbance Dd", shape=(model.n_y, nd))
-        Cz = np.hstack([np.eye(2), np.zeros((2, 2))]) if Cz is None else _checks.as_array(Cz, "Cz", ndim=(2,),
-                                                                                           last=model.n_x)
-        sensors = list(range(model.n_y)) if sensors is None else sorted(int(i) for i in sensors)
-        if not sensors or any(i < 0 or i >= model.n_y for i in sensors) or len(set(sensors)) != len(sensors):
-            raise ValueError(f"sensors must be distinct indices in [0, {model.n_y}); got {sensors}")
-        self.model, self.vertices, self.norm, self.objective = model, V, norm, objective
+        Dd = _checks.as_array(Dd, "disturbance Dd", shape=(ny, nd))
+        Cz = np.eye(min(2, nx), nx) if Cz is None else _checks.as_array(Cz, "Cz", ndim=(2,), last=nx)
+        sensors = list(range(ny)) if sensors is None else sorted(int(i) for i in sensors)
+        if not sensors or any(i < 0 or i >= ny for i in sensors) or len(set(sensors)) != len(sensors):
+            raise ValueError(f"sensors must be distinct indices in [0, {ny}); got {sensors}")
+        self.n_x, self.n_y = nx, ny
+        self.A_vertices, self.C_vertices, self.norm, self.objective = A_v, C_all, norm, objective
         self.Bd, self.Sd, self.Dd, self.Cz, self.sensors = Bd, Sd, Dd, Cz, sensors
-        nx, ns, nz = model.n_x, len(sensors), Cz.shape[0]
-        A_v = model.A(V)
-        C_v = model.C(V)[:, sensors, :]
+        ns, nz = len(sensors), Cz.shape[0]
+        C_v = C_all[:, sensors, :]
         Dd_s = Dd[sensors]
 
         # scaled variables (see class notes): X~ = gamma^2 X, Y~ = gamma^2 Y, beta~ = gamma^2 beta, Q~ = Q/gamma^2
@@ -702,6 +711,22 @@ class PrecisionLMI:
             cons.append(cp.trace(Q) <= 1.0)
         self._X, self._Y, self._beta, self._Q = X, Y, beta, Q
         self.problem = cp.Problem(cp.Minimize(cp.norm(beta, _OBJECTIVES[objective])), cons)
+
+    @classmethod
+    def for_cr3bp(cls, model: CR3BPLPV, vertices, norm: str = "h2", *, disturbance=None, **kwargs) -> "PrecisionLMI":
+        """The LMI for the planar CR3BP LPV model at the polytope ``vertices`` (n_v, 6) of :math:`\rho`.
+
+        ``disturbance`` defaults to :func:`default_disturbance`; other keywords go to the constructor.
+        """
+        if not isinstance(model, CR3BPLPV):
+            raise ValueError(f"model must be a CR3BPLPV; got {type(model).__name__}")
+        V = _checks.as_array(vertices, "vertices", ndim=(2,), last=model.n_rho)
+        if V.shape[0] < 1:
+            raise ValueError("vertices must hold at least one vertex")
+        lmi = cls(model.A(V), model.C(V), norm, disturbance=default_disturbance() if disturbance is None
+                  else disturbance, **kwargs)
+        lmi.vertices = V
+        return lmi
 
     def solve(self, gamma: float, *, solver: str = "CLARABEL", sparsity_tol: float = 1e-4,
               **solver_options) -> ObserverDesign:
@@ -745,15 +770,15 @@ class PrecisionLMI:
         if status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or self._X.value is None:
             raise InfeasibleLMIError(
                 f"{self.norm} precision LMI infeasible or unsolved at gamma = {gamma:g}: solver {solver} status "
-                f"{status!r} ({self.vertices.shape[0]} vertices)", gamma, str(status))
+                f"{status!r} ({self.A_vertices.shape[0]} vertices)", gamma, str(status))
         Xv = 0.5 * (self._X.value + self._X.value.T)
         Ls = np.linalg.solve(Xv, self._Y.value)
-        L = np.zeros((self.model.n_x, self.model.n_y))
+        L = np.zeros((self.n_x, self.n_y))
         L[:, self.sensors] = Ls
-        beta = np.zeros(self.model.n_y)
+        beta = np.zeros(self.n_y)
         beta[self.sensors] = np.maximum(self._beta.value, 0.0) / gamma**2
         kappa = np.sqrt(beta)
-        used = np.zeros(self.model.n_y, dtype=bool)
+        used = np.zeros(self.n_y, dtype=bool)
         used[self.sensors] = beta[self.sensors] > sparsity_tol * beta.max()
         return ObserverDesign(norm=self.norm, gamma=gamma, L=L, X=Xv, beta=beta, kappa=kappa,
                               noise_deg=precision_to_noise_deg(kappa), used=used, status=str(status),
@@ -769,7 +794,7 @@ def design_observer(model: CR3BPLPV, vertices, gamma: float, norm: str = "h2", *
     -------
     ObserverDesign
     """
-    return PrecisionLMI(model, vertices, norm, **kwargs).solve(gamma, solver=solver)
+    return PrecisionLMI.for_cr3bp(model, vertices, norm, **kwargs).solve(gamma, solver=solver)
 
 
 def gamma_sweep(lmi: PrecisionLMI, gammas, *, solver: str = "CLARABEL") -> list:
@@ -951,3 +976,47 @@ def verify_observer(model: CR3BPLPV, design: ObserverDesign, box: ParameterBox, 
             worstinf, rinf = hi, r
     return Verification(V.shape[0], S.shape[0], max_eig, worst2, worstinf, r2.copy(), rinf.copy(),
                         design.gamma, design.norm)
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """The documented set-up of this reproduction: model, resonant orbit, its samples and the parameter box.
+
+    Attributes
+    ----------
+    model : CR3BPLPV
+    orbit : ResonantOrbit
+    t : ndarray (n,)
+        Sample times over one period, TU.
+    states : ndarray (n, 4)
+        Planar states along the orbit.
+    rho : ndarray (n, 6)
+        Scheduling parameters along the orbit.
+    box : ParameterBox
+        Bounds of ``rho`` along the orbit (the polytope whose vertices carry the LMIs).
+    """
+
+    model: CR3BPLPV
+    orbit: ResonantOrbit
+    t: np.ndarray
+    states: np.ndarray
+    rho: np.ndarray
+    box: ParameterBox
+
+
+def paper_scenario(system: CR3BP = EARTH_MOON, *, p: int = 2, q: int = 1, perigee_radius: float = 0.3,
+                   n_samples: int = 2000, margin: float = 0.0) -> Scenario:
+    """Resonant orbit (default the planar 2:1, perigee 0.3 LU) and the scheduling-parameter box over one period.
+
+    ``n_samples`` points over one period bound :math:`\\rho`; ``margin`` widens the box by that fraction of
+    each range (0 by default: the samples are dense enough that the extrema are resolved to ~1e-5).
+    """
+    model = CR3BPLPV(system)
+    orbit = resonant_orbit(system, p, q, perigee_radius)
+    t, x = orbit.sample(int(_checks.positive(n_samples, "n_samples")))
+    s = model.planar(x)
+    rho = model.rho(s)
+    box = ParameterBox.from_samples(rho, margin=margin,
+                                    source=f"planar {p}:{q} resonant orbit, x0 = {orbit.x0[0]:.6f} LU, "
+                                           f"vy0 = {orbit.x0[4]:.6f} LU/TU, T = {orbit.period:.6f} TU")
+    return Scenario(model, orbit, t, s, rho, box)
