@@ -1,0 +1,59 @@
+"""Tracking scenarios: truth with impulses, measurement noise, tuning windows."""
+
+import numpy as np
+import pytest
+
+from cislunar import orbits, tracking
+from cislunar.dynamics import EARTH_MOON as em
+from cislunar.propagation import propagate
+
+
+@pytest.fixture(scope="module")
+def scenario():
+    return tracking.make_scenario(em, orbits.nrho_9_2(em), 2.0)
+
+
+def test_scenario_layout(scenario):
+    sc = scenario
+    assert abs(sc.cadence_hours - 2.0) < 1e-12
+    assert sc.t[-1] <= sc.orbit.period + 1e-9 and sc.t.size == int(np.floor(sc.orbit.period / sc.t[1])) + 1
+    # starts at periapsis: radial velocity w.r.t. the Moon vanishes
+    r = sc.x_start[:3] - em.secondary_position
+    assert abs(r @ sc.x_start[3:]) < 1e-10
+    assert sc.t_apoapsis.size == 1 and abs(sc.t_apoapsis[0] - sc.orbit.period / 2) < 1e-8
+    # Eq. 13: rate sigma = sqrt(2) sigma / 1 s
+    s = np.sqrt(np.diag(sc.meas_cov))
+    assert np.isclose(s[2], np.sqrt(2) * s[0] * em.time_unit_s)
+
+
+def test_truth_with_impulse_matches_piecewise_propagation(scenario):
+    sc = scenario
+    tm = 0.5 * (sc.t[10] + sc.t[11])
+    dv = np.array([1e-3, -2e-3, 5e-4])
+    truth = tracking.simulate_truth(em, sc.x_start, sc.t[:20], [(tm, dv)])
+    plain = propagate(em, sc.x_start, sc.t[:20]).x
+    assert np.array_equal(truth[:11], plain[:11])
+    x_m = propagate(em, sc.x_start, [0.0, tm]).x[-1] + np.r_[0, 0, 0, dv]
+    after = propagate(em, x_m, np.r_[tm, sc.t[11:20]]).x[1:]
+    assert np.max(np.abs(truth[11:] - after)) < 1e-12
+    with pytest.raises(ValueError, match="precede"):
+        tracking.simulate_truth(em, sc.x_start, sc.t[:5], [(-1.0, dv)])
+
+
+def test_measurement_noise_statistics(scenario):
+    sc = scenario
+    truth = propagate(em, sc.x_start, sc.t).x
+    rng = np.random.default_rng(0)
+    res = np.array([sc.model.residual(tracking.simulate_measurements(sc, truth, rng), sc.model(sc.observers, truth))
+                    for _ in range(40)]).reshape(-1, 4)
+    z = res / np.sqrt(np.diag(sc.meas_cov))
+    assert np.all(np.abs(z.mean(axis=0)) < 0.05) and np.all(np.abs(z.std(axis=0) - 1) < 0.05)
+
+
+def test_apoapsis_window(scenario):
+    sc = scenario
+    q = tracking.apoapsis_window_weights(sc.t, sc.t_apoapsis, 1.0, 50.0, 8.0, em)
+    hot = np.flatnonzero(q == 50.0)
+    assert hot.size in (4, 5)  # 8 hours at a 2-hour cadence: four intervals, five if apoapsis falls mid-interval
+    mid = 0.5 * (sc.t[hot[0]] + sc.t[hot[-1] + 1])
+    assert abs(mid - sc.t_apoapsis[0]) < sc.t[1]
