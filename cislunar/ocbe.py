@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import copy
 import functools
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -73,6 +74,19 @@ def _ocbe_template(tol: float):
         m = ta.get_mindex(k)
         index[m[0], int(np.flatnonzero(np.asarray(m[1:]))[0])] = k
     return ta, index
+
+
+_THREAD_LOCAL = threading.local()
+
+
+def _ocbe_integrator(tol: float):
+    """This thread's working copy of the compiled OCBE integrator (see ``propagation._integrator``)."""
+    cache = getattr(_THREAD_LOCAL, "integrators", None)
+    if cache is None:
+        cache = _THREAD_LOCAL.integrators = {}
+    if tol not in cache:
+        cache[tol] = copy.deepcopy(_ocbe_template(tol)[0])
+    return cache[tol]
 
 
 @dataclass(frozen=True)
@@ -132,8 +146,8 @@ def ocbe_transition(system: CR3BP, x0, t, control_weight: float, *, tol: float =
     grid = _grid_from(t)
     q = _checks.positive(control_weight, "control_weight")
     tol = _check_tol(tol)
-    template, index = _ocbe_template(tol)
-    ta = copy.copy(template)
+    _, index = _ocbe_template(tol)
+    ta = _ocbe_integrator(tol)
     ta.pars[:] = [system.mu, q]
     ta.time = grid[0]
     ta.state[:12] = np.r_[x0, np.zeros(6)]

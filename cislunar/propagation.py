@@ -23,6 +23,7 @@ from __future__ import annotations
 import copy
 import functools
 import os
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -126,6 +127,26 @@ class _EventCallback:
         self.records.append((float(time), int(d_sgn)))
 
 
+_THREAD_LOCAL = threading.local()
+
+
+def _integrator(order: int, batch: int, tol: float, events: tuple = ()):
+    """This thread's working copy of a compiled integrator (copied from the template once per thread).
+
+    Copying an integrator costs about a millisecond, more than a short propagation; each thread therefore keeps
+    one copy per configuration and every call resets its time, state and parameters.  Threads never share a
+    copy, so concurrent calls stay safe.
+    """
+    cache = getattr(_THREAD_LOCAL, "integrators", None)
+    if cache is None:
+        cache = _THREAD_LOCAL.integrators = {}
+    key = (order, batch, tol, events)
+    ta = cache.get(key)
+    if ta is None:
+        ta = cache[key] = copy.deepcopy(_template(order, batch, tol, events))
+    return ta
+
+
 def _variational_ic(n_vars: int, order: int) -> np.ndarray:
     """Initial variational state: identity for order one, zeros for order two."""
     parts = []
@@ -197,7 +218,7 @@ def _grid_from(t) -> np.ndarray:
 def _propagate_chunk(system: CR3BP, x0_chunk: np.ndarray, grid: np.ndarray, order: int, tol: float,
                      batch: int, impact: bool = True) -> np.ndarray:
     """Propagate ``x0_chunk`` (k <= batch states) on ``grid``; returns raw variational states (k, m, n_vars)."""
-    ta = copy.copy(_template(order, batch, tol))
+    ta = _integrator(order, batch, tol)
     n_vars = len(ta.state) if batch == 1 else ta.state.shape[0]
     vic = _variational_ic(n_vars, order)
     k = x0_chunk.shape[0]
@@ -435,7 +456,8 @@ def find_events(system: CR3BP, x0, t_end: float, events=("y_crossing",), *, t0: 
         if k not in _EVENT_KINDS:
             raise ValueError(f"events entries must be among {_EVENT_KINDS}; got {k!r}")
     tol = _check_tol(tol)
-    ta = copy.deepcopy(_template(0, 1, tol, kinds))
+    ta = _integrator(0, 1, tol, kinds)
+    ta.reset_cooldowns()
     callbacks = [ev.callback for ev in ta.nt_events]
     for cb in callbacks:
         cb.records = []
