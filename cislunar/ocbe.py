@@ -257,7 +257,7 @@ def _control_integral(t_sub, control) -> float:
 
 
 def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *,
-                         n_sub: int = 9, smooth: bool = True, tol: float = DEFAULT_TOL) -> OCBEResult:
+                         available=None, n_sub: int = 9, smooth: bool = True, tol: float = DEFAULT_TOL) -> OCBEResult:
     """Extended SRI OCBE of Greaves & Scheeres (2021, Eqs. 21-32) with single-step and full smoothing.
 
     At each interval the reference is re-linearised about the current estimate (EKF style): the 12x12 OCBE
@@ -272,13 +272,17 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
     system : CR3BP
     t : array_like, shape (N,)
         Strictly increasing measurement times, TU; the prior refers to ``t[0]``.
-    y : array_like, shape (N, m)
-        Measurements of ``model`` (angles in rad, rates per TU).
-    observer_states : array_like, shape (N, 6)
+    y : array_like, shape (N, m) or (N, K, m)
+        Measurements of ``model`` (angles in rad, rates per TU), from one observer or from K observers.
+    observer_states : array_like, shape (N, 6) or (N, K, 6)
         Observer states at the measurement times (deterministic, as in the paper).
     model : cislunar.measurements.MeasurementModel
     meas_cov : array_like, shape (m, m) or (N, m, m)
-        Measurement noise covariance(s), non-dimensional.
+        Measurement noise covariance(s) of one observer's measurement, non-dimensional (the same for every
+        observer; measurements of different observers are independent).
+    available : array_like of bool, shape (N, K), optional
+        Which observers measured at each epoch (line of sight, horizon); default all.  An epoch without any
+        measurement is a pure time update.
     x0, P0 : array_like
         Prior mean (6,) and covariance (6, 6) at ``t[0]``.
     control_weight : float or array_like, shape (N-1,)
@@ -297,10 +301,18 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
     if np.any(np.diff(t) <= 0):
         raise ValueError("t must be strictly increasing")
     N = t.size
-    y = _checks.as_array(y, "y", ndim=(2,))
-    if y.shape[0] != N or y.shape[1] != model.dim:
-        raise ValueError(f"y must have shape ({N}, {model.dim}); got {y.shape}")
-    obs = _checks.as_array(observer_states, "observer_states", shape=(N, 6))
+    obs = _checks.as_array(observer_states, "observer_states", ndim=(2, 3), last=6)
+    obs = obs[:, None, :] if obs.ndim == 2 else obs
+    K = obs.shape[1]
+    if obs.shape[0] != N:
+        raise ValueError(f"observer_states must have {N} epochs; got shape {obs.shape}")
+    y = _checks.as_array(y, "y", ndim=(2, 3), finite=False)
+    y = y[:, None, :] if y.ndim == 2 else y
+    if y.shape != (N, K, model.dim):
+        raise ValueError(f"y must have shape ({N}, {model.dim}) or ({N}, {K}, {model.dim}); got {y.shape}")
+    avail = np.ones((N, K), dtype=bool) if available is None else np.asarray(available, dtype=bool).reshape(N, K)
+    if not np.all(np.isfinite(y[avail])):
+        raise ValueError("y contains NaN or infinite values where measurements are available")
     R = _checks.as_array(meas_cov, "meas_cov")
     R = np.broadcast_to(R, (N, model.dim, model.dim)) if R.shape == (model.dim, model.dim) else R
     if R.shape != (N, model.dim, model.dim):
@@ -316,9 +328,13 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
     eye6 = np.eye(6)
 
     def update(S, x_ref, k):
-        val, _, Ht = model.evaluate(obs[k], x_ref)
-        dy = model.residual(y[k], val)
-        S_new, b, e = srif.measurement_update(S, np.zeros(6), Ht, dy, R[k])
+        vis = np.flatnonzero(avail[k])
+        if vis.size == 0:
+            return S, x_ref.copy(), 0.0
+        val, _, Ht = model.evaluate(obs[k, vis], x_ref)
+        dy = model.residual(y[k, vis], val).reshape(-1)
+        Rk = np.kron(np.eye(vis.size), R[k])
+        S_new, b, e = srif.measurement_update(S, np.zeros(6), Ht.reshape(-1, 6), dy, Rk)
         return S_new, x_ref + srif.covariance_from_sri(S_new, b)[0], e
 
     x_pred, P_pred, x_filt, P_filt, S_filt, resid = [], [], [], [], [], []

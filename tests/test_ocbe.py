@@ -154,3 +154,18 @@ def test_a_maneuver_shows_as_a_smoothed_control_spike_in_its_interval():
         # the burn happens right after measurement 12; the smoothed control peaks next to it
         assert abs(int(np.argmax(per_interval)) - 25 // 2) <= 1
     assert min(z_burn) > 3 * max(z_quiet)
+
+
+def test_several_observers_equal_sequential_updates_and_gaps_are_time_updates(ocbe_run):
+    (t, y, obs, model, Rm, x0, P0, q), res = ocbe_run
+    # the same observer twice with the same measurement is one measurement with half the noise covariance
+    twice = ocbe.ocbe_filter_smoother(em, t, np.stack([y, y], axis=1), np.stack([obs, obs], axis=1), model, Rm, x0,
+                                      P0, q, smooth=False)
+    half = ocbe.ocbe_filter_smoother(em, t, y, obs, model, Rm / 2, x0, P0, q, smooth=False)
+    assert np.max(np.abs(twice.P_filt - half.P_filt)) < 1e-9 * np.max(np.abs(half.P_filt))
+    assert np.max(np.abs(twice.x_filt - half.x_filt)) < 1e-9
+    # an epoch without measurements: the filtered estimate is the prediction
+    avail = np.ones((t.size, 1), dtype=bool)
+    avail[4] = False
+    gap = ocbe.ocbe_filter_smoother(em, t, y, obs, model, Rm, x0, P0, q, available=avail, smooth=False)
+    assert np.array_equal(gap.x_filt[4], gap.x_pred[4]) and np.allclose(gap.P_filt[4], gap.P_pred[4], rtol=1e-12)
