@@ -49,12 +49,15 @@ class SurfaceStation:
 
 
 #: Three stations chosen so that together they see the whole southern 9:2 NRHO (checked in notebook 01 and the
-#: tests; found by a grid search over mirror-symmetric layouts): the south pole, under the apolune region, and two
-#: stations at 30 deg N, 60 deg E and W, which see the fast perilune passage over the north pole from either side.
+#: tests): a grid search over layouts "one southern station + a pair mirrored in longitude" maximising the worst
+#: elevation of the best-placed station over the orbit (sampled densely through perilune) picked the south pole,
+#: under the apolune region, and two stations at 45 deg N, 90 deg E and W, which see the fast perilune passage over
+#: the north pole from either side.  The target is always at least 12 deg above some station's horizon, and no
+#: pair of the three covers the orbit.
 DEFAULT_STATIONS = (
     SurfaceStation("south pole", -90.0, 0.0),
-    SurfaceStation("30N 60E", 30.0, 60.0),
-    SurfaceStation("30N 60W", 30.0, -60.0),
+    SurfaceStation("45N 90E", 45.0, 90.0),
+    SurfaceStation("45N 90W", 45.0, -90.0),
 )
 
 

@@ -65,8 +65,11 @@ class TrackingScenario:
         Reference (maneuver-free) target state at ``t[0]``.
     t : ndarray, shape (N,)
         Measurement epochs, TU, starting at 0.
-    observers : ndarray, shape (N, 6)
-        Observer state at each epoch.
+    observers : ndarray, shape (N, K, 6)
+        State of each of the K observers at each epoch.
+    available : ndarray of bool, shape (N, K)
+        Whether each observer sees the target (Moon occultation for spacecraft, horizon for surface stations).
+    observer_names : tuple of str
     model : MeasurementModel
     meas_cov : ndarray, shape (m, m)
         Non-dimensional measurement covariance.
@@ -79,6 +82,8 @@ class TrackingScenario:
     x_start: np.ndarray
     t: np.ndarray
     observers: np.ndarray
+    available: np.ndarray
+    observer_names: tuple
     model: measurements.MeasurementModel
     meas_cov: np.ndarray
     t_apoapsis: np.ndarray
@@ -89,9 +94,9 @@ class TrackingScenario:
 
 
 def make_scenario(system: CR3BP, orbit: PeriodicOrbit, cadence_hours: float, *, start: str = "periapsis",
-                  periods: float = 1.0, observer_state=None, rates: bool = True,
+                  periods: float = 1.0, observers: str = "L2", rates: bool = True,
                   sigma_angle_rad: float = DEFAULT_SIGMA_ANGLE_RAD) -> TrackingScenario:
-    """Build a tracking scenario of one (or more) periods of ``orbit`` from a fixed observer.
+    """Build a tracking scenario of one (or more) periods of ``orbit``.
 
     Parameters
     ----------
@@ -101,28 +106,51 @@ def make_scenario(system: CR3BP, orbit: PeriodicOrbit, cadence_hours: float, *, 
         Where the track (and the filter's hand-off) begins.
     periods : float
         Track length in orbit periods.
-    observer_state : array_like (6,), optional
-        Observer at rest in the rotating frame (default: the L2 observer).
+    observers : {"L2", "all"}
+        The L2 observer alone, or the five of the paper: L2, the DRO observer and the three lunar-surface
+        stations of :mod:`cislunar.sites` (the DRO observer starts at its x-axis crossing at ``t = 0``).
     rates : bool
         Angles and angle rates (``True``) or angles only.
+    sigma_angle_rad : float
+        Angular noise (1 sigma), rad.
     """
-    from .sites import l2_observer_state
+    from . import sites
 
     cadence = _checks.positive(cadence_hours, "cadence_hours")
     periods = _checks.positive(periods, "periods")
     if start not in ("periapsis", "apoapsis"):
         raise ValueError(f"start must be 'periapsis' or 'apoapsis'; got {start!r}")
+    if observers not in ("L2", "all"):
+        raise ValueError(f"observers must be 'L2' or 'all'; got {observers!r}")
     ev = find_events(system, orbit.x0, orbit.period * (1 + 1e-9), (start,), impact=False)
     if ev.t.size == 0:
         raise ValueError(f"orbit has no {start} passage")
     x_start = ev.x[0]
     dt = cadence * 3600.0 / system.time_unit_s
     t = np.arange(0.0, periods * orbit.period + 1e-12, dt)
-    obs = np.tile(l2_observer_state(system) if observer_state is None else
-                  _checks.as_state(observer_state, "observer_state", batch=False), (t.size, 1))
+    target = propagate(system, x_start, t).x
+    obs = [np.tile(sites.l2_observer_state(system), (t.size, 1))]
+    names = ["L2"]
+    kinds = ["spacecraft"]
+    if observers == "all":
+        dro = sites.dro_observer_orbit(system)
+        obs.append(propagate(system, dro.x0, t).x)
+        names.append("DRO")
+        kinds.append("spacecraft")
+        for st in sites.DEFAULT_STATIONS:
+            obs.append(np.tile(np.r_[st.position(system), 0.0, 0.0, 0.0], (t.size, 1)))
+            names.append(st.name)
+            kinds.append("station")
+    obs = np.stack(obs, axis=1)
+    avail = np.empty((t.size, len(names)), dtype=bool)
+    for k, kind in enumerate(kinds):
+        if kind == "spacecraft":
+            avail[:, k] = sites.line_of_sight_clear(system, obs[:, k], target)
+        else:
+            avail[:, k] = sites.station_elevation(system, obs[0, k], target) > 0.0
     apo = find_events(system, x_start, t[-1] + 1e-9, ("apoapsis",), impact=False).t
     model = measurements.ANGLES_AND_RATES if rates else measurements.AZIMUTH_ELEVATION
-    return TrackingScenario(system, orbit, x_start, t, obs, model,
+    return TrackingScenario(system, orbit, x_start, t, obs, avail, tuple(names), model,
                             angles_rates_covariance(system, sigma_angle_rad, rates=rates), apo)
 
 
@@ -156,13 +184,14 @@ def simulate_truth(system: CR3BP, x_start, t, maneuvers=()) -> np.ndarray:
 
 
 def simulate_measurements(scenario: TrackingScenario, truth, rng: np.random.Generator) -> np.ndarray:
-    """Noisy measurements of ``truth`` (N, 6) from the scenario's observers; angles wrapped to (-pi, pi]."""
+    """Noisy measurements (N, K, m) of ``truth`` (N, 6) by every observer; NaN where an observer has no view."""
     truth = _checks.as_array(truth, "truth", shape=(scenario.t.size, 6))
     if not isinstance(rng, np.random.Generator):
         raise ValueError("rng must be a numpy.random.Generator")
-    y = scenario.model(scenario.observers, truth)
+    y = scenario.model(scenario.observers, truth[:, None, :])
     y = y + rng.standard_normal(y.shape) * np.sqrt(np.diag(scenario.meas_cov))
-    y[:, 0] = measurements.wrap_angle(y[:, 0])
+    y[..., 0] = measurements.wrap_angle(y[..., 0])
+    y[~scenario.available] = np.nan
     return y
 
 

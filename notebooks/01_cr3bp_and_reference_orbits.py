@@ -337,5 +337,5 @@ table.add("DRO observer outages (9:2 NRHO)", "limited, infrequent and short", f"
 table.add("surface stations needed for the full 9:2 orbit", 3,
           f"all three {100 * v['all3']:.1f}%, best pair {100 * v['best_pair']:.1f}%",
           "reproduced" if v["all3"] == 1 and v["best_pair"] < 1 else "differs: coverage incomplete or a pair suffices",
-          "stations: south pole, 30N 60E, 30N 60W (choice, horizon mask 0 deg)")
+          "stations: south pole, 45N 90E, 45N 90W (choice, horizon mask 0 deg)")
 table.display()

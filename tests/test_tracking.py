@@ -44,8 +44,8 @@ def test_measurement_noise_statistics(scenario):
     sc = scenario
     truth = propagate(em, sc.x_start, sc.t).x
     rng = np.random.default_rng(0)
-    res = np.array([sc.model.residual(tracking.simulate_measurements(sc, truth, rng), sc.model(sc.observers, truth))
-                    for _ in range(40)]).reshape(-1, 4)
+    res = np.array([sc.model.residual(tracking.simulate_measurements(sc, truth, rng)[:, 0],
+                                      sc.model(sc.observers[:, 0], truth)) for _ in range(40)]).reshape(-1, 4)
     z = res / np.sqrt(np.diag(sc.meas_cov))
     assert np.all(np.abs(z.mean(axis=0)) < 0.05) and np.all(np.abs(z.std(axis=0) - 1) < 0.05)
 
@@ -57,3 +57,12 @@ def test_apoapsis_window(scenario):
     assert hot.size in (4, 5)  # 8 hours at a 2-hour cadence: four intervals, five if apoapsis falls mid-interval
     mid = 0.5 * (sc.t[hot[0]] + sc.t[hot[-1] + 1])
     assert abs(mid - sc.t_apoapsis[0]) < sc.t[1]
+
+
+def test_five_observer_scenario_visibility():
+    sc = tracking.make_scenario(em, orbits.nrho_9_2(em), 1.0, observers="all", rates=False)
+    assert sc.observers.shape == (sc.t.size, 5, 6) and sc.available.shape == (sc.t.size, 5)
+    assert sc.available[:, 0].all()  # L2 never occulted
+    assert sc.available[:, 2:].any(axis=1).all()  # the three stations together see the whole orbit
+    y = tracking.simulate_measurements(sc, propagate(em, sc.x_start, sc.t).x, np.random.default_rng(1))
+    assert np.isnan(y[~sc.available]).all() and np.isfinite(y[sc.available]).all()
