@@ -32,6 +32,10 @@ __all__ = [
     "initial_estimate",
     "apoapsis_window_weights",
     "DEFAULT_SIGMA_ANGLE_RAD",
+    "TrialSummary",
+    "nees",
+    "summarize",
+    "filter_trial",
 ]
 
 #: Default angular noise (1 sigma), rad: 10 micro-rad (see the module docstring).
@@ -219,3 +223,93 @@ def apoapsis_window_weights(t, t_apoapsis, q_base: float, q_window: float, windo
     for ta in np.atleast_1d(t_apoapsis):
         q[(t[1:] > ta - half) & (t[:-1] < ta + half)] = qw
     return q
+
+
+#: NEES threshold probability: an epoch is inconsistent when the 6-dof NEES exceeds its 99.9% chi-square quantile.
+NEES_PROBABILITY = 0.999
+#: A run counts as diverged when more than this fraction of epochs is inconsistent (a consistent filter has 0.1%).
+DIVERGED_FRACTION = 0.05
+
+
+@dataclass(frozen=True)
+class TrialSummary:
+    """Outcome of one filter run against its truth.
+
+    Attributes
+    ----------
+    final_sigma_pos_km, final_sigma_vel_m_s : float
+        Root-sum-square 1-sigma of the final filtered covariance (position, velocity).
+    final_error_pos_km, final_error_vel_m_s : float
+        Norm of the final filtered error.
+    max_error_pos_km : float
+        Largest filtered position error over the track.
+    nees_mean : float
+        Mean normalised estimation error squared (6 for a consistent filter).
+    inconsistent_fraction : float
+        Fraction of epochs whose NEES exceeds the 99.9% chi-square quantile.
+    diverged : bool
+        ``inconsistent_fraction > DIVERGED_FRACTION`` or the filter failed numerically.
+    failure : str
+        Exception message when the filter failed, else "".
+    """
+
+    final_sigma_pos_km: float
+    final_sigma_vel_m_s: float
+    final_error_pos_km: float
+    final_error_vel_m_s: float
+    max_error_pos_km: float
+    nees_mean: float
+    inconsistent_fraction: float
+    diverged: bool
+    failure: str = ""
+
+
+def nees(x_est, P, truth) -> np.ndarray:
+    """Normalised estimation error squared :math:`e^\\top P^{-1}e` per epoch, shape (N,)."""
+    e = _checks.as_array(x_est, "x_est", last=6) - _checks.as_array(truth, "truth", last=6)
+    P = _checks.as_array(P, "P")
+    return np.einsum("ni,ni->n", e, np.linalg.solve(P, e[..., None])[..., 0])
+
+
+def summarize(system: CR3BP, x_est, P, truth) -> TrialSummary:
+    """Consistency and accuracy summary of filtered estimates against the truth."""
+    from scipy.stats import chi2
+
+    x_est = _checks.as_array(x_est, "x_est", ndim=(2,), last=6)
+    truth = _checks.as_array(truth, "truth", shape=x_est.shape)
+    e = x_est - truth
+    n = nees(x_est, P, truth)
+    frac = float(np.mean(n > chi2.ppf(NEES_PROBABILITY, 6)))
+    L, V = system.length_unit_km, system.velocity_unit_km_s * 1e3
+    return TrialSummary(
+        final_sigma_pos_km=float(np.sqrt(np.trace(P[-1][:3, :3])) * L),
+        final_sigma_vel_m_s=float(np.sqrt(np.trace(P[-1][3:, 3:])) * V),
+        final_error_pos_km=float(np.linalg.norm(e[-1, :3]) * L),
+        final_error_vel_m_s=float(np.linalg.norm(e[-1, 3:]) * V),
+        max_error_pos_km=float(np.max(np.linalg.norm(e[:, :3], axis=1)) * L),
+        nees_mean=float(np.mean(n)),
+        inconsistent_fraction=frac,
+        diverged=bool(frac > DIVERGED_FRACTION),
+    )
+
+
+def filter_trial(rng: np.random.Generator, scenario: TrackingScenario, control_weight, *,
+                 handoff_scale: float = 1.0, tol: float = 1e-13) -> TrialSummary:
+    """One Monte Carlo trial of the observation-strategy study: truth, measurements, hand-off, OCBE, summary.
+
+    A filter that fails numerically (e.g. a non-positive-definite update after divergence) is reported as
+    diverged with the exception message, not raised: divergence is an outcome of this experiment.
+    """
+    from .ocbe import ocbe_filter_smoother
+
+    truth = simulate_truth(scenario.system, scenario.x_start, scenario.t)
+    y = simulate_measurements(scenario, truth, rng)
+    x0, P0 = initial_estimate(scenario.system, scenario.x_start, rng, scale=handoff_scale)
+    try:
+        res = ocbe_filter_smoother(scenario.system, scenario.t, y, scenario.observers, scenario.model,
+                                   scenario.meas_cov, x0, P0, control_weight, available=scenario.available,
+                                   smooth=False, n_sub=2, tol=tol)
+    except (ValueError, RuntimeError, np.linalg.LinAlgError) as exc:
+        nan = float("nan")
+        return TrialSummary(nan, nan, nan, nan, nan, nan, 1.0, True, str(exc)[:200])
+    return summarize(scenario.system, res.x_filt, res.P_filt, truth)

@@ -66,3 +66,21 @@ def test_five_observer_scenario_visibility():
     assert sc.available[:, 2:].any(axis=1).all()  # the three stations together see the whole orbit
     y = tracking.simulate_measurements(sc, propagate(em, sc.x_start, sc.t).x, np.random.default_rng(1))
     assert np.isnan(y[~sc.available]).all() and np.isfinite(y[sc.available]).all()
+
+
+def test_filter_trial_is_consistent_for_the_papers_strategy(scenario):
+    q = 1e-14 * em.time_unit_s**3 / em.length_unit_km**2
+    out = [tracking.filter_trial(np.random.default_rng(s), scenario, q) for s in range(4)]
+    nees_mean = np.mean([o.nees_mean for o in out])
+    assert not any(o.diverged for o in out)
+    assert 2.0 < nees_mean < 12.0  # chi-square with 6 dof has mean 6
+    assert all(o.final_error_pos_km < 4 * o.final_sigma_pos_km for o in out)
+
+
+def test_nees_of_exact_draws_has_the_chi_square_mean():
+    rng = np.random.default_rng(2)
+    A = rng.standard_normal((6, 6))
+    P = A @ A.T + np.eye(6)
+    e = rng.multivariate_normal(np.zeros(6), P, size=4000)
+    n = tracking.nees(e, np.broadcast_to(P, (4000, 6, 6)), np.zeros((4000, 6)))
+    assert abs(n.mean() - 6.0) < 3 * np.sqrt(12.0 / 4000)
