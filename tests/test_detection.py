@@ -1,0 +1,195 @@
+"""Maneuver detection: station-keeping policy draws, hypothesis test, batched OCBE and Monte Carlo reproducibility."""
+
+import pickle
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from cislunar import detection as det
+from cislunar import orbits
+from cislunar.dynamics import EARTH_MOON as em
+
+# ---------------------------------------------------------------------------------------------------------------
+# Station-keeping policy (Eqs. 3-5)
+# ---------------------------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("policy", [det.ACTIVE_POLICY, det.QUIET_POLICY])
+def test_truncated_gaussian_bounds_and_moments(policy):
+    rng = np.random.default_rng(1)
+    m = policy.sample_magnitude(rng, 40000)
+    mu, sd = policy.mean_m_s, policy.sd_m_s
+    assert m.min() >= mu - 3 * sd and m.max() <= mu + 3 * sd
+    ref = stats.truncnorm(-3, 3, loc=mu, scale=sd)
+    assert abs(m.mean() - ref.mean()) < 4 * ref.std() / np.sqrt(m.size)
+    assert abs(m.var() / ref.var() - 1) < 0.03
+    assert abs(ref.std() / sd - 1) > 0.01  # truncation visibly shrinks the spread (about 1.3 %)
+    assert stats.kstest(m, ref.cdf).pvalue > 1e-3
+    assert np.isclose(policy.second_moment_m2_s2(), ref.var() + ref.mean() ** 2)
+    # the caller's generator drives the draw
+    assert np.array_equal(policy.sample_magnitude(np.random.default_rng(5), 7),
+                          policy.sample_magnitude(np.random.default_rng(5), 7))
+
+
+def test_pointing_follows_the_paper_not_a_uniform_sphere():
+    rng = np.random.default_rng(2)
+    az, el = det.StationKeepingPolicy.sample_pointing(rng, 40000)
+    assert az.min() >= -np.pi and az.max() <= np.pi and el.min() >= -np.pi / 2 and el.max() <= np.pi / 2
+    assert stats.kstest(az, stats.uniform(-np.pi, 2 * np.pi).cdf).pvalue > 1e-3  # Eq. 3
+    assert stats.kstest(el, stats.uniform(-np.pi / 2, np.pi).cdf).pvalue > 1e-3  # Eq. 4
+    u = det.pointing_vector(az, el)
+    assert np.allclose(np.linalg.norm(u, axis=-1), 1.0)
+    # uniform on the sphere would make u_z uniform on [-1, 1]; the paper's rule makes it arcsine distributed
+    assert stats.kstest(u[:, 2], stats.uniform(-1, 2).cdf).pvalue < 1e-10
+    assert stats.kstest(u[:, 2], stats.arcsine(-1, 2).cdf).pvalue > 1e-3
+    assert np.allclose(det.pointing_vector(np.pi / 2, 0.0), [0, 1, 0], atol=1e-15)
+
+
+def test_policy_bad_input():
+    with pytest.raises(ValueError, match="sd_m_s"):
+        det.StationKeepingPolicy("x", 1.0, -0.1)
+    with pytest.raises(ValueError, match="mean_m_s"):
+        det.StationKeepingPolicy("x", 0.1, 0.1)  # mean - 3 sd < 0
+    with pytest.raises(ValueError, match="rng"):
+        det.ACTIVE_POLICY.sample_magnitude(np.random.RandomState(0))
+    with pytest.raises(ValueError, match="window_hours"):
+        det.window_control_weight(det.QUIET_POLICY, 0.0)
+    # E[m^2] / (3 T): 1 m/s^2-ish over 8 h is ~1.26e-11 km^2/s^3
+    assert np.isclose(det.window_control_weight(det.ACTIVE_POLICY, 8.0),
+                      det.ACTIVE_POLICY.second_moment_m2_s2() * 1e-6 / (3 * 8 * 3600))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Hypothesis test (Eqs. 34-35)
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def _gauss_crossing(m0, s0, m1, s1):
+    """Crossing of two normal PDFs between the means (root of the quadratic log-density difference)."""
+    a = 1 / (2 * s1**2) - 1 / (2 * s0**2)
+    b = m0 / s0**2 - m1 / s1**2
+    c = m1**2 / (2 * s1**2) - m0**2 / (2 * s0**2) + np.log(s1 / s0)
+    roots = np.roots([a, b, c]) if a != 0 else np.array([-c / b])
+    return float(roots[(roots > m0) & (roots < m1)][0])
+
+
+def test_crossing_of_known_gaussians():
+    for m0, s0, m1, s1 in ((0.0, 1.0, 3.0, 1.0), (0.2, 0.05, 1.0, 0.3)):
+        d0, d1 = stats.norm(m0, s0), stats.norm(m1, s1)
+        c = det.pdf_crossings(d0, d1, m0, m1)
+        assert c.size == 1 and abs(c[0] - _gauss_crossing(m0, s0, m1, s1)) < 1e-10
+        fp, md = det.error_rates(c[0], d0, d1)
+        assert np.isclose(fp, stats.norm.sf((c[0] - m0) / s0), rtol=1e-12)
+        assert np.isclose(md, stats.norm.cdf((c[0] - m1) / s1), rtol=1e-12)
+
+
+def test_ml_threshold_from_samples_lands_on_the_kde_crossing():
+    rng = np.random.default_rng(3)
+    m0, s0, m1, s1 = 0.2, 0.05, 1.0, 0.3
+    th = det.ml_threshold(rng.normal(m0, s0, 4000), rng.normal(m1, s1, 4000))
+    assert abs(th.pdf0(th.z_lim)[0] - th.pdf1(th.z_lim)[0]) < 1e-8  # on the KDE crossing
+    assert abs(th.z_lim - _gauss_crossing(m0, s0, m1, s1)) < 0.02  # and close to the true one
+    fp, md = det.error_rates(_gauss_crossing(m0, s0, m1, s1), stats.norm(m0, s0), stats.norm(m1, s1))
+    assert abs(th.false_positive - fp) < 0.01 and abs(th.missed_detection - md) < 0.01
+    # the ML threshold minimises the total error over nearby thresholds
+    for dz in (-0.02, 0.02):
+        assert sum(det.error_rates(th.z_lim + dz, th.pdf0, th.pdf1)) >= th.total_error
+
+
+def test_decisions_and_accuracy():
+    score = det.detection_accuracy([0.1, 0.2, 0.5], [0.3, 0.6, 0.9, 1.2], 0.4)
+    assert (score.true_negative, score.false_positive, score.true_positive, score.missed_detection) == (2, 1, 3, 1)
+    assert np.isclose(score.accuracy, 5 / 7)
+    assert det.decide(0.4, 0.4) == np.False_  # Eq. 35: z <= z_lim is H0
+
+
+def test_hypothesis_test_bad_input():
+    with pytest.raises(ValueError, match="samples"):
+        det.fit_pdf([1.0])
+    with pytest.raises(ValueError, match="bandwidth"):
+        det.fit_pdf([1.0, 2.0, 3.0], bandwidth="nope")
+    with pytest.raises(ValueError, match="lo and hi"):
+        det.pdf_crossings(stats.norm(), stats.norm(1), 1.0, 0.0)
+    with pytest.raises(ValueError, match="z_h1"):
+        det.ml_threshold([0.1, 0.2, 0.3], [[1.0]])
+    with pytest.raises(ValueError, match="coincide"):
+        det.ml_threshold([0.0, 0.1, 0.2], [0.0, 0.1, 0.2])
+    with pytest.raises(ValueError, match="z_test_h0"):
+        det.detection_accuracy([np.nan], [1.0], 0.5)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Trials, batched OCBE and the Monte Carlo
+# ---------------------------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def short_setup():
+    """A short, coarse track (0.6 period from periapsis, 8-hour cadence) so the filter runs take milliseconds."""
+    return det.make_setup(em, orbits.nrho_9_2(em), det.window_control_weight(det.ACTIVE_POLICY), 1e-18,
+                          cadence_hours=8.0, window_hours=16.0, periods=0.6)
+
+
+def test_trial_draws_maneuver_at_apoapsis(short_setup):
+    s = short_setup
+    inp = det.draw_trial(np.random.default_rng(4), s, magnitude_m_s=1.0, direction=(np.pi / 2, 0.0))
+    plain = det.draw_trial(np.random.default_rng(4), s)
+    k = int(np.searchsorted(s.scenario.t, s.t_maneuver))
+    assert np.array_equal(inp.truth[:k], plain.truth[:k]) and not np.allclose(inp.truth[k:], plain.truth[k:])
+    assert inp.magnitude_m_s == 1.0 and np.isnan(plain.azimuth)
+    assert np.count_nonzero(s.control_weight > s.control_weight.min()) >= 1
+    with pytest.raises(ValueError, match="magnitude_m_s"):
+        det.draw_trial(np.random.default_rng(0), s, magnitude_m_s=-1.0)
+    with pytest.raises(ValueError, match="q_window_km2_s3"):
+        det.make_setup(em, s.scenario.orbit, 0.0, 1e-18)
+
+
+def test_batched_ocbe_equals_single_trial_filter(short_setup):
+    s = short_setup
+    B = 3
+    res = det.detection_trial_batch(np.random.default_rng(5), s, det.ACTIVE_POLICY, B)
+    kids = np.random.default_rng(5).spawn(B)
+    inputs = [det.draw_trial(k, s, det.ACTIVE_POLICY) for k in kids]
+    sc = s.scenario
+    batch = det.ocbe_batch(em, sc.t, np.array([i.y for i in inputs]), s.observer_states, sc.model, sc.meas_cov,
+                           np.array([i.x0 for i in inputs]), inputs[0].P0, s.control_weight, n_sub=s.n_sub)
+    for b, inp in enumerate(inputs):
+        one = det.run_trial_filter(s, inp)
+        rel = lambda a, ref: np.max(np.abs(a - ref)) / np.max(np.abs(ref))  # noqa: E731
+        assert rel(batch.x_filt[b], one.x_filt) < 1e-10
+        assert rel(batch.x_smooth[b], one.x_smooth) < 1e-10
+        assert rel(batch.P_filt[b], one.P_filt) < 1e-10
+        assert rel(batch.P_smooth[b], one.P_smooth) < 1e-10
+        assert rel(batch.control_step[b], one.control_step) < 1e-10
+        assert rel(batch.control_smooth[b], one.control_smooth) < 1e-10
+        assert abs(batch.z_smooth[b] / one.z_smooth - 1) < 1e-10
+        assert abs(res[b].z_m_s / (one.z_smooth * em.velocity_unit_km_s * 1e3) - 1) < 1e-10
+        assert res[b].magnitude_m_s == inp.magnitude_m_s
+    with pytest.raises(ValueError, match="y"):
+        det.ocbe_batch(em, sc.t, np.zeros((2, 3, 4)), s.observer_states, sc.model, sc.meas_cov, np.zeros((2, 6)),
+                       inputs[0].P0, s.control_weight)
+
+
+def test_monte_carlo_reproducible_and_executor_agnostic(short_setup):
+    s = short_setup
+    a = det.run_detection_monte_carlo(s, det.QUIET_POLICY, 5, 11, batch_size=2, progress=False)
+    b = det.run_detection_monte_carlo(s, det.QUIET_POLICY, 5, 11, batch_size=2, progress=False)
+    with ThreadPoolExecutor(2) as ex:
+        c = det.run_detection_monte_carlo(s, det.QUIET_POLICY, 5, 11, batch_size=2, executor=ex, progress=False)
+    assert len(a) == 5
+    for name in ("z", "z_step", "magnitude", "azimuth", "elevation"):
+        assert np.array_equal(getattr(a, name), getattr(b, name))
+        assert np.array_equal(getattr(a, name), getattr(c, name))
+    d = det.run_detection_monte_carlo(s, det.QUIET_POLICY, 5, 12, batch_size=2, progress=False)
+    assert not np.array_equal(a.z, d.z)
+    h0 = det.run_detection_monte_carlo(s, None, 2, 11, batch_size=0, progress=False)  # single-trial path
+    assert np.all(h0.magnitude == 0) and np.all(h0.z > 0)
+    # what a process pool needs
+    for obj in (det.detection_trial, det.detection_trial_batch, s, det.QUIET_POLICY):
+        pickle.loads(pickle.dumps(obj))
+    with pytest.raises(ValueError, match="n_trials"):
+        det.run_detection_monte_carlo(s, None, 0, 1)
+    with pytest.raises(ValueError, match="batch_size"):
+        det.run_detection_monte_carlo(s, None, 2, 1, batch_size=-1)
