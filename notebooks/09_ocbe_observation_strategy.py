@@ -1,0 +1,306 @@
+# ---
+# jupyter:
+#   jupytext:
+#     formats: py:percent
+#   kernelspec:
+#     display_name: Python 3
+#     language: python
+#     name: python3
+# ---
+
+# %% [markdown]
+# # 09 · Optical tracking of NRHOs with the square-root-information OCBE: which observation strategy works?
+#
+# **What you will learn.** How azimuth/elevation angles and their rates measured by a cislunar observer constrain
+# a spacecraft on a near-rectilinear halo orbit; how the optimal-control-based estimator (OCBE) turns a
+# state/costate transition matrix into a process-noise-like term and is run in square-root-information (SRI) form
+# with Householder triangularisations; and how to decide, by Monte Carlo and a consistency test, whether a
+# measurement strategy keeps the filter on the truth through perilune.
+#
+# **Paper sections followed.** Greaves & Scheeres, *Observation and Maneuver Detection for Cislunar Vehicles*
+# (JAS 2021): "Measurements" (Eqs. 6-13), "State Estimation" with the SRI OCBE (Eqs. 14-32) and "Observation
+# Strategy" (Fig. 4, Table 4, Fig. 5). The reference orbits and observer sites come from notebook 01.
+#
+# The paper's Table 3 (measurement noise) and Table 4 (final covariance levels) are missing from its text; what we
+# use instead is stated where it is used, and the closing table says where our results differ.
+
+# %% tags=["parameters"]
+QUICK = False
+SEED = 0
+OUTPUT_DIR = ""
+
+# %%
+# Sizes derived from QUICK: fewer cadences and Monte Carlo runs in quick mode, the same experiments.
+CADENCES_H = [1.0, 12.0] if QUICK else [1 / 60, 10 / 60, 1.0, 2.0, 6.0, 12.0]
+N_RUNS = 3 if QUICK else 20  # Monte Carlo runs per (orbit, measurement type, cadence)
+N_RUNS_ONE_MINUTE = 2 if QUICK else 4  # the 1-minute cadence has 9450 updates per run
+N_RUNS_FIVE = 3 if QUICK else 20  # runs of the five-observer, angles-only experiment
+WORKERS = 1 if QUICK else 2  # processes for the Monte Carlo (a Dask client works the same way)
+
+from concurrent.futures import ProcessPoolExecutor
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from cislunar import measurements, ocbe, orbits, plotting, tracking
+from cislunar.dynamics import EARTH_MOON as em
+from cislunar.montecarlo import run_monte_carlo
+from cislunar.report import ComparisonTable
+
+plotting.use_style()
+out = OUTPUT_DIR or None
+executor = ProcessPoolExecutor(WORKERS) if WORKERS > 1 else None
+table = ComparisonTable("09 OCBE observation strategy (Greaves & Scheeres 2021 §Measurements, §State Estimation, "
+                        "§Observation Strategy)")
+nrho, stable = orbits.nrho_9_2(em), orbits.stable_nrho(em)
+ORBITS = {"9:2 NRHO": nrho, "stable NRHO": stable}
+
+# %% [markdown]
+# ## 1 · Optical measurements (Eqs. 6-13)
+#
+# With $\boldsymbol\rho = \mathbf r - \mathbf r_{obs}$ the line of sight in the rotating frame, the observer
+# measures the azimuth $\theta = \operatorname{atan2}(\rho_j, \rho_i)$ and the elevation
+# $\psi = \arcsin(\rho_k/\|\boldsymbol\rho\|)$ (Eqs. 7-8) and, from two images $\Delta t$ apart, their rates
+# (Eqs. 10-11). Differencing two independent angles gives the rate noise of Eq. 13,
+# $\sigma_{\dot\theta} = \sqrt2\,\sigma_\theta/\Delta t$, with $\Delta t = 1$ s as in the paper.
+#
+# **Noise level (choice).** Table 3 is missing. The same authors' AMOS 2023 paper takes
+# $\sigma_{\theta} = 10\ \mu$rad for "a high accuracy sensor" from the reference this paper cites for its angular
+# noise, so we use 10 µrad for the angles and, by Eq. 13, 14.1 µrad/s for the rates; Section 4 also varies it.
+# The Jacobians are analytic (`cislunar.measurements`, tested against finite differences).
+
+# %%
+R_rates = tracking.angles_rates_covariance(em)
+print("1-sigma: azimuth, elevation [urad]:", np.sqrt(np.diag(R_rates))[:2] * 1e6,
+      "| rates [urad/s]:", np.sqrt(np.diag(R_rates))[2:] / em.time_unit_s * 1e6)
+sc_demo = tracking.make_scenario(em, nrho, 2.0, start="apoapsis")
+y_demo = sc_demo.model(sc_demo.observers[:, 0], tracking.simulate_truth(em, sc_demo.x_start, sc_demo.t))
+fig, axes = plt.subplots(1, 2, figsize=(12, 3.8))
+days = em.tu_to_days(sc_demo.t)
+axes[0].plot(days, np.degrees(y_demo[:, 0]), label="azimuth")
+axes[0].plot(days, np.degrees(y_demo[:, 1]), label="elevation")
+axes[0].set_ylabel("angle [deg]")
+axes[1].semilogy(days, np.abs(y_demo[:, 2]) / em.time_unit_s * 1e6, label="|azimuth rate|")
+axes[1].semilogy(days, np.abs(y_demo[:, 3]) / em.time_unit_s * 1e6, label="|elevation rate|")
+axes[1].set_ylabel("rate [urad/s]")
+for ax in axes:
+    ax.set_xlabel("days since apoapsis")
+    ax.legend()
+fig.suptitle("What the L2 observer sees of the 9:2 NRHO over one period (noise-free)")
+plotting.save_figure(fig, "09_measurements_from_l2", output_dir=out)
+
+# %% [markdown]
+# Around perilune (day 3.3) the angles swing through tens of degrees in hours and the rates are 1000 times their
+# apolune values: that is where the dynamics are most nonlinear and where, the paper says, linearised filters fail.
+#
+# ## 2 · The OCBE in square-root-information form (Eqs. 14-32)
+#
+# The OCBE models unknown accelerations as an optimal control $\mathbf u = -\tilde Q B^\top\mathbf p$ with
+# costate $\mathbf p$. Its 12x12 transition matrix (Eq. 14) propagates state and costate deviations together;
+# with $\Phi_{px}=0$ and $\Phi_{pp} = \Phi_{xx}^{-\top}$ the covariance time update becomes that of a Kalman
+# filter with process noise $Q = -\Phi_{xp}\Phi_{xx}^\top$ (Eqs. 15-17). In SRI form (Eqs. 21-23, with
+# $\Gamma = I$) the time update triangularises
+# $\begin{bmatrix} S_q & 0 & 0\\ -S_x\Phi_{xx}^{-1} & S_x\Phi_{xx}^{-1} & 0\end{bmatrix}$, the measurement update
+# (Eqs. 24-28) triangularises $\begin{bmatrix}S_x & b_x\\ S_y^{-1}H & S_y^{-1}\delta y\end{bmatrix}$, and a
+# single-step smoother (Eqs. 29-30) gives the costate $\mathbf p_{n|n+1} = -P_{n|n}^{-1}(\mathbf x_{n|n+1}-
+# \mathbf x_{n|n})$ (Eq. 31) and the control estimate (Eq. 32). `cislunar.ocbe.ocbe_filter_smoother` implements
+# exactly this; its tests show that it equals a covariance-form EKF whose $Q$ is computed independently (Lyapunov
+# equation), that the full SRI smoother equals the Rauch-Tung-Striebel smoother, and that
+# $Q = -\Phi_{xp}\Phi_{xx}^\top$ equals the exact discretisation of white-noise acceleration of density
+# $\tilde Q$.
+#
+# Here there is no mismodeling (truth and filter share the CR3BP), so the control weight only has to keep $Q$
+# positive definite: $\tilde Q = 10^{-20}$ km²/s³ per axis (choice; the paper gives no value for this
+# experiment). The hand-off covariance is the paper's Earth-radar one, 3σ = 10 km and 10 cm/s per axis, and the
+# tracks start at apoapsis, as in the paper's observation-strategy runs.
+
+# %%
+Q_QUIET = 1e-20 * em.time_unit_s**3 / em.length_unit_km**2  # km^2/s^3 -> LU^2/TU^3
+sc = tracking.make_scenario(em, nrho, 2.0, start="apoapsis")
+rng = np.random.default_rng(SEED)
+truth = tracking.simulate_truth(em, sc.x_start, sc.t)
+y = tracking.simulate_measurements(sc, truth, rng)
+x0, P0 = tracking.initial_estimate(em, sc.x_start, rng)
+run = ocbe.ocbe_filter_smoother(em, sc.t, y, sc.observers, sc.model, sc.meas_cov, x0, P0, Q_QUIET,
+                                available=sc.available)
+
+
+def error_panels(ax_pos, ax_vel, t, x, P, truth, title):
+    """Position/velocity error norms and 3-sigma bounds (the paper's Fig. 4/5 layout)."""
+    d = em.tu_to_days(t)
+    e = x - truth
+    sp = 3 * np.sqrt(np.trace(P[:, :3, :3], axis1=1, axis2=2)) * em.length_unit_km
+    sv = 3 * np.sqrt(np.trace(P[:, 3:, 3:], axis1=1, axis2=2)) * em.velocity_unit_km_s * 1e3
+    ax_pos.semilogy(d, np.linalg.norm(e[:, :3], axis=1) * em.length_unit_km, color="C0", label="|error|")
+    ax_pos.semilogy(d, sp, color="C1", label="3 sigma")
+    ax_vel.semilogy(d, np.linalg.norm(e[:, 3:], axis=1) * em.velocity_unit_km_s * 1e3, color="C0")
+    ax_vel.semilogy(d, sv, color="C1")
+    ax_pos.set_ylabel("position [km]")
+    ax_vel.set_ylabel("velocity [m/s]")
+    ax_vel.set_xlabel("days since apoapsis")
+    ax_pos.set_title(title)
+
+
+fig, axes = plt.subplots(2, 2, figsize=(12, 6), sharex=True)
+error_panels(axes[0, 0], axes[1, 0], sc.t, run.x_filt, run.P_filt, truth, "forward filter")
+error_panels(axes[0, 1], axes[1, 1], sc.t, run.x_smooth, run.P_smooth, truth, "smoother")
+axes[0, 0].legend()
+fig.suptitle("9:2 NRHO, L2 observer, angles and rates every 2 hours (analogue of the paper's Fig. 5)")
+plotting.save_figure(fig, "09_typical_run_fig5", output_dir=out)
+typical = tracking.summarize(em, run.x_filt, run.P_filt, truth)
+print(typical)
+
+# %% [markdown]
+# The errors stay inside their 3σ envelopes. The forward uncertainty shrinks over the three days before perilune,
+# the velocity uncertainty spikes through perilune where the dynamics are fastest, and the smoother, which uses
+# every measurement at every epoch, is tighter everywhere, as it must be.
+#
+# ## 3 · Consistency as the divergence test
+#
+# "Divergence" needs a definition that a computer can apply to thousands of runs. A filter is consistent when its
+# normalised estimation error squared, $\epsilon_n = \mathbf e_n^\top P_n^{-1}\mathbf e_n$, is $\chi^2_6$
+# distributed: mean 6, and above the 99.9% quantile (22.5) at 0.1% of epochs. We call a run **diverged** when more
+# than 5% of its epochs exceed that quantile, or when the filter fails numerically. Each Monte Carlo run draws its
+# own measurement noise and hand-off error (`tracking.filter_trial`); runs are spread over processes with a
+# `concurrent.futures` executor.
+
+# %%
+def study(rates, observers="L2", sigma=tracking.DEFAULT_SIGMA_ANGLE_RAD, handoff=1.0, cadences=CADENCES_H,
+          orbits_=ORBITS, seed=SEED):
+    """Monte Carlo over cadences and orbits; returns {(orbit, cadence): [TrialSummary, ...]}."""
+    results = {}
+    for k, (name, orb) in enumerate(orbits_.items()):
+        for j, cad in enumerate(cadences):
+            scn = tracking.make_scenario(em, orb, cad, start="apoapsis", rates=rates, observers=observers,
+                                         sigma_angle_rad=sigma)
+            n = N_RUNS_ONE_MINUTE if cad < 0.1 else N_RUNS
+            results[name, cad] = run_monte_carlo(
+                tracking.filter_trial, n, (seed, k, j, int(rates)), args=(scn, Q_QUIET),
+                kwargs={"handoff_scale": handoff}, executor=executor,
+                desc=f"{'angles+rates' if rates else 'angles'} {name} {cad:g} h")
+    return results
+
+
+def summary_rows(results):
+    rows = []
+    for (name, cad), runs in results.items():
+        rows.append((name, cad, np.mean([r.diverged for r in runs]), np.nanmedian([r.nees_mean for r in runs]),
+                     np.nanmedian([3 * r.final_sigma_pos_km for r in runs]),
+                     np.nanmedian([3 * r.final_sigma_vel_m_s for r in runs]), len(runs)))
+    return rows
+
+
+def print_rows(rows, label):
+    print(label)
+    print(f"{'orbit':>12} {'cadence [h]':>11} {'diverged':>9} {'median NEES':>12} {'3s pos [km]':>12} "
+          f"{'3s vel [m/s]':>13} {'runs':>5}")
+    for name, cad, div, ne, sp, sv, n in rows:
+        print(f"{name:>12} {cad:11.3g} {100 * div:8.0f}% {ne:12.2f} {sp:12.4f} {sv:13.5f} {n:5d}")
+
+# %% [markdown]
+# ## 4 · Angles only from L2 (the paper: every cadence diverges before perilune)
+
+# %%
+angles_only = study(rates=False)
+rows_angles = summary_rows(angles_only)
+print_rows(rows_angles, "angles only, L2 observer, 10 urad")
+
+# %%
+def diverged_cells(rows):
+    """(orbit, cadence) cells where most runs diverged."""
+    return [(name, cad) for name, cad, div, *_ in rows if div > 0.5]
+
+
+cells = diverged_cells(rows_angles)
+print(f"angles only: most runs diverged in {len(cells)} of {len(rows_angles)} (orbit, cadence) cells:",
+      ", ".join(f"{n} at {c:g} h" for n, c in cells) or "none")
+
+# %% [markdown]
+# Compare this with the paper, where *every* angles-only cadence diverged for both orbits. Because the paper's
+# noise level is unknown, we repeat a hard case (the 9:2 NRHO at a 12-hour cadence) with noise ten and a hundred
+# times larger, and we rerun the paper's Fig. 4 set-up: measurement noise and hand-off uncertainty one order of
+# magnitude *smaller* but five observers (L2, the DRO observer and the three surface stations, hourly, each used
+# only when it sees the target).
+
+# %%
+noisier = {sig: summary_rows(study(rates=False, sigma=sig, cadences=[12.0], orbits_={"9:2 NRHO": nrho}))[0]
+           for sig in (100e-6, 1000e-6)}
+for sig, row in noisier.items():
+    print(f"angles only, 12 h, sigma = {sig * 1e6:g} urad: diverged {100 * row[2]:.0f}%, median NEES {row[3]:.2f}, "
+          f"final 3-sigma position {row[4]:.2f} km")
+five = study(rates=False, observers="all", sigma=1e-6, handoff=0.1, cadences=[1.0], orbits_={"9:2 NRHO": nrho})
+row_five = summary_rows(five)[0]
+print(f"five observers, angles only, hourly, 1 urad, hand-off x0.1: diverged {100 * row_five[2]:.0f}%, "
+      f"median NEES {row_five[3]:.2f}, final 3-sigma position {row_five[4] * 1e3:.1f} m")
+
+# %% [markdown]
+# Where our angles-only runs stay consistent and the paper's diverged, plausible reasons (none checkable from the
+# text) are a larger angular noise than we can infer (Table 3 is missing), a control weight large enough to erase
+# the dynamical range information angles-only tracking relies on, or integration and linearisation differences
+# in the time update through perilune (our STMs agree with finite differences to about 1e-9, notebook 01). The
+# closing table records each case.
+#
+# ## 5 · Angles and angle rates from L2 (the paper: consistent at every cadence; Table 4)
+
+# %%
+with_rates = study(rates=True)
+rows_rates = summary_rows(with_rates)
+print_rows(rows_rates, "angles and rates, L2 observer, 10 urad and 14.1 urad/s")
+
+fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.2))
+for name, marker in (("9:2 NRHO", "o"), ("stable NRHO", "s")):
+    for rows, ls, lab in ((rows_rates, "-", "angles + rates"), (rows_angles, ":", "angles only")):
+        r = [row for row in rows if row[0] == name]
+        ax1.loglog([row[1] for row in r], [row[4] for row in r], ls, marker=marker, label=f"{name}, {lab}")
+        ax2.loglog([row[1] for row in r], [row[5] for row in r], ls, marker=marker)
+ax1.set_ylabel("final 3-sigma position [km]")
+ax2.set_ylabel("final 3-sigma velocity [m/s]")
+for ax in (ax1, ax2):
+    ax.set_xlabel("measurement cadence [hours]")
+ax1.legend(fontsize=8)
+fig.suptitle("Final filter uncertainty after one period versus cadence (median over runs; analogue of Table 4)")
+plotting.save_figure(fig, "09_final_uncertainty_vs_cadence_table4", output_dir=out)
+
+# %% [markdown]
+# As the paper reports, adding the rates gives consistent filters at every cadence, uncertainty falls with
+# cadence, and the stable NRHO is tracked better than the 9:2 NRHO. In our runs the rates add little *accuracy*
+# once the angles are 10 µrad (their noise, by Eq. 13 with a 1 s baseline, is large); the paper makes the same
+# remark ("the presence of angular rate measurements is not meant to add significant information").
+#
+# ## 6 · Paper versus reproduction
+
+# %%
+if executor is not None:
+    executor.shutdown()
+div_rates = max(r[2] for r in rows_rates)
+r92 = {r[1]: r for r in rows_rates if r[0] == "9:2 NRHO"}
+rst = {r[1]: r for r in rows_rates if r[0] == "stable NRHO"}
+n_cells = len(rows_angles)
+status = ("reproduced" if len(cells) == n_cells else
+          "differs: no angles-only case diverged in our runs" if not cells else
+          "differs: only some angles-only cases diverged in our runs")
+table.add("angles only, L2, 1 min-12 h cadence", "diverges at every cadence, both orbits",
+          f"most runs diverged in {len(cells)} of {n_cells} (orbit, cadence) cells", status,
+          (", ".join(f"{n} {c:g} h" for n, c in cells) + "; " if cells else "") +
+          "10 urad angles (Table 3 missing); noisier cases in Section 4")
+for sig, row in noisier.items():
+    table.add(f"angles only, 9:2 NRHO, 12 h, {sig * 1e6:g} urad", "diverges", f"{100 * row[2]:.0f}% diverged",
+              "reproduced" if row[2] > 0.5 else "differs: consistent in our runs", "noise level varied (Table 3 missing)")
+table.add("angles only, five observers hourly, noise and hand-off / 10 (Fig. 4)", "diverges",
+          f"{100 * row_five[2]:.0f}% diverged, NEES {row_five[3]:.1f}",
+          "reproduced" if row_five[2] > 0.5 else "differs: consistent in our runs", "1 urad, hand-off 3 sigma 1 km")
+table.add("angles and rates, L2, 1 min-12 h cadence", "consistent at every cadence, both orbits",
+          f"{100 * div_rates:.0f}% of runs diverged", "reproduced" if div_rates <= 0.05 else
+          "differs: some runs inconsistent", f"{sum(len(v) for v in with_rates.values())} runs")
+table.add("typical 2-hour run (Fig. 5)", "errors within 3 sigma, forward and smoothed",
+          f"NEES mean {typical.nees_mean:.1f}, {100 * typical.inconsistent_fraction:.1f}% epochs over 99.9%",
+          "reproduced" if not typical.diverged else "differs: the typical run is inconsistent")
+for cad in sorted(r92):
+    table.add(f"Table 4: final 3-sigma position / velocity, {cad:g} h", "Table 4 missing",
+              f"9:2 {r92[cad][4]:.3g} km / {r92[cad][5]:.3g} m/s; stable {rst[cad][4]:.3g} km / {rst[cad][5]:.3g} m/s",
+              "not in paper", "median over runs; angles + rates from L2")
+better = np.mean([rst[c][4] < r92[c][4] for c in r92])
+table.add("stable NRHO better determined than the 9:2", "qualitatively similar, quantitatively better",
+          f"smaller final sigma at {100 * better:.0f}% of cadences",
+          "reproduced" if better >= 0.5 else "differs: the 9:2 NRHO is better determined here")
+table.display()
