@@ -29,16 +29,14 @@ PSD); times in TU, states in LU and LU/TU, rotating frame.
 
 from __future__ import annotations
 
-import copy
 import functools
-import threading
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import _checks
 from .dynamics import CR3BP
-from .propagation import DEFAULT_TOL, _check_outcome, _check_tol, _grid_from, _heyoka
+from .propagation import DEFAULT_TOL, _check_outcome, _check_tol, _grid_from, _heyoka, thread_local_copy
 
 __all__ = ["OCBETransition", "ocbe_transition", "ocbe_process_noise", "estimated_control", "OCBEResult",
            "ocbe_filter_smoother"]
@@ -76,17 +74,9 @@ def _ocbe_template(tol: float):
     return ta, index
 
 
-_THREAD_LOCAL = threading.local()
-
-
 def _ocbe_integrator(tol: float):
-    """This thread's working copy of the compiled OCBE integrator (see ``propagation._integrator``)."""
-    cache = getattr(_THREAD_LOCAL, "integrators", None)
-    if cache is None:
-        cache = _THREAD_LOCAL.integrators = {}
-    if tol not in cache:
-        cache[tol] = copy.deepcopy(_ocbe_template(tol)[0])
-    return cache[tol]
+    """This thread's working copy of the compiled OCBE integrator."""
+    return thread_local_copy(("ocbe", tol), lambda: _ocbe_template(tol)[0])
 
 
 @dataclass(frozen=True)

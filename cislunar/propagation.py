@@ -130,21 +130,25 @@ class _EventCallback:
 _THREAD_LOCAL = threading.local()
 
 
-def _integrator(order: int, batch: int, tol: float, events: tuple = ()):
-    """This thread's working copy of a compiled integrator (copied from the template once per thread).
+def thread_local_copy(key, template):
+    """This thread's working copy of a compiled integrator, made from ``template()`` once per thread and key.
 
     Copying an integrator costs about a millisecond, more than a short propagation; each thread therefore keeps
-    one copy per configuration and every call resets its time, state and parameters.  Threads never share a
+    one copy per configuration and every caller resets its time, state and parameters.  Threads never share a
     copy, so concurrent calls stay safe.
     """
     cache = getattr(_THREAD_LOCAL, "integrators", None)
     if cache is None:
         cache = _THREAD_LOCAL.integrators = {}
-    key = (order, batch, tol, events)
     ta = cache.get(key)
     if ta is None:
-        ta = cache[key] = copy.deepcopy(_template(order, batch, tol, events))
+        ta = cache[key] = copy.deepcopy(template())
     return ta
+
+
+def _integrator(order: int, batch: int, tol: float, events: tuple = ()):
+    """This thread's working copy of the CR3BP integrator of the given configuration."""
+    return thread_local_copy(("cr3bp", order, batch, tol, events), lambda: _template(order, batch, tol, events))
 
 
 def _variational_ic(n_vars: int, order: int) -> np.ndarray:
