@@ -67,6 +67,8 @@ __all__ = [
     "decide",
     "DetectionScore",
     "detection_accuracy",
+    "PolicyStudy",
+    "run_policy_study",
 ]
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -879,3 +881,76 @@ def detection_accuracy(z_test_h0, z_test_h1, z_lim: float) -> DetectionScore:
     d0 = decide(_checks.as_array(z_test_h0, "z_test_h0", ndim=(1,)), z_lim)
     d1 = decide(_checks.as_array(z_test_h1, "z_test_h1", ndim=(1,)), z_lim)
     return DetectionScore(int(np.sum(~d0)), int(np.sum(d0)), int(np.sum(d1)), int(np.sum(~d1)))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# One policy on one orbit: training Monte Carlo, threshold, independent detection test
+# ---------------------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PolicyStudy:
+    """Monte Carlo, maximum-likelihood threshold and detection test for one policy on one orbit.
+
+    Attributes
+    ----------
+    h0, h1 : MonteCarloSample
+        Training runs without / with maneuvers (the PDFs are fitted to these).
+    test_h0, test_h1 : MonteCarloSample or None
+        Independent test runs.
+    threshold : DetectionThreshold
+        z_lim and expected error rates (Tables 5-6).
+    score : DetectionScore or None
+        Decisions on the test runs (Tables 7-8).
+    """
+
+    h0: MonteCarloSample
+    h1: MonteCarloSample
+    test_h0: MonteCarloSample | None
+    test_h1: MonteCarloSample | None
+    threshold: DetectionThreshold
+    score: DetectionScore | None
+
+
+def run_policy_study(setup: DetectionSetup, policy: StationKeepingPolicy, n_h0: int, n_h1: int, n_test: int,
+                     seed, *, batch_size: int = 8, executor=None, bandwidth="scott", progress: bool = True,
+                     label: str = "") -> PolicyStudy:
+    """Training Monte Carlo (H0 and H1), threshold (Eq. 35) and independent test sets for one policy and orbit.
+
+    The four sets use the independent seeds ``[*seed, k]`` with ``k = 0, 1, 2, 3`` (H0 train, H1 train, H0 test,
+    H1 test), ``seed`` being an int or a list of ints.
+
+    Parameters
+    ----------
+    setup : DetectionSetup
+    policy : StationKeepingPolicy
+    n_h0, n_h1 : int
+        Training runs without / with maneuvers (500 and 3000 in the paper).
+    n_test : int
+        Test runs per hypothesis (100 in the paper); 0 skips the test.
+    seed : int or list of int
+    batch_size, executor, progress
+        See :func:`run_detection_monte_carlo`.
+    bandwidth : str or float
+        KDE bandwidth rule (:func:`fit_pdf`).
+    label : str
+        Progress-bar prefix.
+    """
+    base = list(np.atleast_1d(seed).astype(int))
+    n_test = int(n_test)
+    if n_test < 0:
+        raise ValueError(f"n_test must be >= 0; got {n_test}")
+
+    def mc(pol, n, k, what):
+        return run_detection_monte_carlo(setup, pol, n, base + [k], batch_size=batch_size, executor=executor,
+                                         progress=progress, desc=f"{label} {what}".strip())
+
+    h0 = mc(None, n_h0, 0, "H0 train")
+    h1 = mc(policy, n_h1, 1, "H1 train")
+    th = ml_threshold(h0.z, h1.z, bandwidth=bandwidth)
+    t0 = t1 = score = None
+    if n_test:
+        t0 = mc(None, n_test, 2, "H0 test")
+        t1 = mc(policy, n_test, 3, "H1 test")
+        score = detection_accuracy(t0.z, t1.z, th.z_lim)
+    return PolicyStudy(h0, h1, t0, t1, th, score)

@@ -1,0 +1,430 @@
+# ---
+# jupyter:
+#   jupytext:
+#     formats: py:percent
+#   kernelspec:
+#     display_name: Python 3
+#     language: python
+#     name: python3
+# ---
+
+# %% [markdown]
+# # 10 · Maneuver detection with the OCBE control policy
+#
+# **What you will learn.** How Greaves & Scheeres model NRHO station keeping as a randomly pointed impulse at
+# apoapsis with a truncated-Gaussian size; why the optimal-control-based estimator (OCBE) is tuned with a raised
+# control uncertainty in an 8-hour window around apoapsis, and how a maneuver then shows up as a spike in the
+# *smoothed* control estimate; how the integral of the control norm, $z=\int\|\hat{\mathbf u}\|dt$, becomes the
+# statistic of a maximum-likelihood binary hypothesis test whose PDFs come from a Monte Carlo analysis; what the
+# threshold, false-positive and missed-detection rates and the detection accuracy are for an "active" (1 m/s) and a
+# "quiet" (50 mm/s) policy on the 9:2 NRHO and the stable NRHO; and why $z$ is a fast health metric of the filter.
+#
+# **Paper sections followed.** J. A. Greaves, D. J. Scheeres, *Observation and Maneuver Detection for Cislunar
+# Vehicles*, JAS 68 (2021): "Modeling Definitions" (Eqs. 3-5, Table 2), "Filter Tuning Strategy" (Figs. 10-13),
+# "Maneuver Detection" (Eqs. 33-35, Figs. 14-21, Tables 5-8) and "Control as a Health Metric" (Fig. 22). The OCBE
+# itself (Eqs. 14-32) is `cislunar.ocbe`; the tracking scenario (L2 observer, angles and angle rates every 2 hours,
+# Earth-radar hand-off at periapsis) is `cislunar.tracking`; everything specific to detection is
+# `cislunar.detection`.
+#
+# **What the paper does not give.** Tables 1-8 are missing from its text: in particular the measurement noise
+# (Table 3) and the OCBE tuning values. We use 10 micro-rad angles (1 sigma) with Eq. 13 rates from 1 s
+# differencing (see `cislunar.tracking`) and choose the tuning in Section 2 below; both choices are recorded in
+# the closing table.
+
+# %% tags=["parameters"]
+QUICK = False
+SEED = 0
+OUTPUT_DIR = ""
+
+# %%
+# Sizes derived from QUICK: quick mode shrinks every Monte Carlo; every step still runs.
+N_H0 = 40 if QUICK else 500  # non-maneuvering training runs per policy and orbit (paper: 500)
+N_H1 = 60 if QUICK else 3000  # maneuvering training runs per policy and orbit (paper: 3000)
+N_TEST = 20 if QUICK else 100  # test runs per hypothesis, policy and orbit (paper: 100 + 100)
+N_PILOT = 16 if QUICK else 64  # runs per hypothesis in the tuning sweep
+N_POLICY_DRAWS = 20000 if QUICK else 200000  # draws to check the station-keeping distributions
+TUNING_FACTORS = [0.01, 0.1, 1.0]  # sweep of the window control weight, in units of the variance-matched value
+BATCH = 8  # trials run in lockstep by the batched OCBE
+WORKERS = 1 if QUICK else 2  # processes for the Monte Carlo
+
+import time
+import multiprocessing as mp
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+import matplotlib.pyplot as plt
+from scipy import stats
+
+from cislunar import detection as det, orbits, plotting, tracking
+from cislunar.dynamics import EARTH_MOON as em
+from cislunar.report import ComparisonTable, fmt
+
+plotting.use_style()
+out = OUTPUT_DIR or None
+rng = np.random.default_rng(SEED)
+executor = ProcessPoolExecutor(WORKERS, mp_context=mp.get_context("spawn")) if WORKERS > 1 else None
+table = ComparisonTable("10 Maneuver detection (Greaves & Scheeres 2021, Eqs. 3-5, 33-35, Figs. 12-22, Tables 5-8)")
+ORBITS = {"9:2 NRHO": orbits.nrho_9_2(em), "stable NRHO": orbits.stable_nrho(em)}
+POLICIES = {"active": det.ACTIVE_POLICY, "quiet": det.QUIET_POLICY}
+T_START = time.perf_counter()
+for name, o in ORBITS.items():
+    print(f"{name}: period {o.period_days:.3f} d, perilune {o.perilune_radius_km:.0f} km, "
+          f"stability index {o.stability_index:.3f}")
+
+# %% [markdown]
+# ## 1 · The station-keeping model (Eqs. 3-5, Table 2)
+#
+# Every orbit the vehicle may burn at apoapsis. The impulse has azimuth $u_\theta\sim\mathcal U[-\pi,\pi]$
+# (Eq. 3), elevation $u_\psi\sim\mathcal U[-\pi/2,\pi/2]$ (Eq. 4) and magnitude
+# $u_{mag}\sim\mathcal N(\mu_u,\sigma_u)$ truncated to $\mu_u\pm3\sigma_u$ (Eq. 5); the direction in the rotating
+# frame is $(\cos u_\psi\cos u_\theta, \cos u_\psi\sin u_\theta, \sin u_\psi)$. The *active* ("noisy") policy has
+# $\mu_u = 1$ m/s, $\sigma_u = 0.3$ m/s; the *quiet* policy 50 mm/s and 15 mm/s.
+#
+# Two details matter. The truncated Gaussian is drawn exactly (`scipy.stats.truncnorm` with our generator), so its
+# standard deviation is about 1.3 % below $\sigma_u$. And a uniform elevation is **not** a uniform direction on
+# the sphere: the area element is $\cos u_\psi\,du_\psi\,du_\theta$, so uniform $u_\psi$ over-weights the poles
+# $\pm\hat k$ (the $z$ component of the direction is arcsine-distributed instead of uniform on $[-1, 1]$). We
+# implement what the paper writes.
+
+# %%
+fig, ax = plt.subplots(1, 3, figsize=(14, 3.8))
+for name, pol in POLICIES.items():
+    m = pol.sample_magnitude(rng, N_POLICY_DRAWS)
+    d = pol.magnitude_distribution
+    ax[0 if name == "active" else 1].hist(m * 1e3, bins=60, density=True, alpha=0.6, label="draws")
+    zz = np.linspace(d.ppf(0), d.ppf(1), 300)
+    ax[0 if name == "active" else 1].plot(zz * 1e3, d.pdf(zz) / 1e3, "k", lw=1, label="truncnorm PDF")
+    ax[0 if name == "active" else 1].set(title=f"{name}: mean {m.mean() * 1e3:.1f}, sd {m.std() * 1e3:.2f} mm/s",
+                                         xlabel="impulse magnitude (mm/s)", ylabel="PDF (1/(mm/s))")
+    print(f"{name}: range [{m.min() * 1e3:.2f}, {m.max() * 1e3:.2f}] mm/s (bounds {(pol.mean_m_s - 3 * pol.sd_m_s) * 1e3:.1f}, "
+          f"{(pol.mean_m_s + 3 * pol.sd_m_s) * 1e3:.1f}); sd/sigma_u = {m.std() / pol.sd_m_s:.4f} "
+          f"(truncnorm {d.std() / pol.sd_m_s:.4f})")
+az, el = det.StationKeepingPolicy.sample_pointing(rng, N_POLICY_DRAWS)
+uz = det.pointing_vector(az, el)[:, 2]
+ax[2].hist(uz, bins=50, density=True, alpha=0.6, label="Eqs. 3-4 (paper)")
+ax[2].plot(np.linspace(-0.999, 0.999, 200), stats.arcsine(-1, 2).pdf(np.linspace(-0.999, 0.999, 200)), "k", lw=1,
+           label="arcsine PDF")
+ax[2].axhline(0.5, color="C3", ls="--", label="uniform sphere")
+ax[2].set(xlabel=r"$\hat k$ component of the impulse direction", ylabel="PDF", ylim=(0, 3), title="pointing")
+ax[0].legend()
+ax[2].legend(fontsize=8)
+plotting.save_figure(fig, "10_station_keeping_policy", output_dir=out)
+ks_sphere = stats.kstest(uz, stats.uniform(-1, 2).cdf).pvalue
+print(f"KS test of u_z against a uniform sphere: p = {ks_sphere:.1e}; against arcsine: "
+      f"p = {stats.kstest(uz, stats.arcsine(-1, 2).cdf).pvalue:.2f}")
+table.add("Eq. 5 magnitude stays within mean +- 3 sd (both policies)", "by construction",
+          "yes (exact truncnorm draws)", "derived")
+table.add("Eqs. 3-4 pointing", "'random pointing', U[-pi,pi] x U[-pi/2,pi/2]",
+          f"as written; not uniform on the sphere (KS p = {ks_sphere:.0e})", "derived",
+          "uniform elevation over-weights the poles; implemented as the paper writes it")
+
+# %% [markdown]
+# ## 2 · Tuning the OCBE: constant versus an apoapsis window
+#
+# The OCBE absorbs mismodelling in an estimated control $\hat{\mathbf u} = -\tilde Q B^\top\mathbf p$ whose
+# uncertainty is the control weight $\tilde Q = qI_3$ (an acceleration power spectral density, km$^2$/s$^3$). Over
+# an interval the OCBE's process-noise-like term is $Q=-\Phi_{xp}\Phi_{xx}^\top$ (Eq. 17), i.e. white acceleration
+# noise of PSD $q$ mapped through the dynamics. The paper raises $q$ only in an 8-hour window centred on apoapsis,
+# where the station-keeping burn happens, and keeps it small elsewhere; its values are not given.
+#
+# **Our choice.** White acceleration noise of PSD $q$ over a window $T$ accumulates a velocity variance $qT$ per
+# axis. Matching it to the per-axis second moment of the impulse gives the *variance-matched* weight
+# $q_\star = E[u_{mag}^2]/(3T)$ ($1.26\times10^{-11}$ km$^2$/s$^3$ active, $3.15\times10^{-14}$ quiet). We sweep
+# $q_w = f\,q_\star$ in a small pilot Monte Carlo on the 9:2 NRHO (seeds independent of the main runs) and look at
+# the H0 and H1 means of $z$, the pilot's total error rate and how linearly $z$ follows the impulse magnitude.
+# Outside the window $q_b = 10^{-18}$ km$^2$/s$^3$: negligible (results are unchanged at $10^{-20}$), but keeps
+# $Q$ positive definite.
+
+# %%
+Q_BASE = 1e-18  # km^2/s^3 outside the apoapsis window
+WINDOW_HOURS = 8.0
+sweep = {}
+for pname, pol in POLICIES.items():
+    for f in TUNING_FACTORS:
+        setup = det.make_setup(em, ORBITS["9:2 NRHO"], f * det.window_control_weight(pol, WINDOW_HOURS), Q_BASE,
+                               window_hours=WINDOW_HOURS)
+        st = det.run_policy_study(setup, pol, N_PILOT, N_PILOT, 0, [SEED, 99, TUNING_FACTORS.index(f),
+                                  list(POLICIES).index(pname)], batch_size=BATCH, executor=executor,
+                                  label=f"pilot {pname} f={f}")
+        slope, icpt = np.polyfit(st.h1.magnitude, st.h1.z, 1)
+        sweep[pname, f] = st
+        print(f"{pname:6s} f = {f:5.2f}: q_w = {setup.q_window_km2_s3:.2e} km^2/s^3 | H0 z = "
+              f"{st.h0.z.mean() * 1e3:8.2f} +- {st.h0.z.std() * 1e3:6.2f} mm/s | H1 z = {st.h1.z.mean() * 1e3:8.2f}"
+              f" +- {st.h1.z.std() * 1e3:6.2f} mm/s | FP + MD = {st.threshold.total_error:.3f} | z vs magnitude:"
+              f" slope {slope:.2f}, corr {np.corrcoef(st.h1.magnitude, st.h1.z)[0, 1]:.2f}")
+
+# %% [markdown]
+# The variance-matched weight ($f = 1$) lets the smoother fit so much measurement noise as control that the H0
+# integrals reach about half of the H1 ones. Shrinking $q_w$ shrinks H0 roughly as $\sqrt{q_w}$ while the H1
+# integral keeps tracking the impulse (slope near 1) down to $f\approx0.1$; at $f = 0.01$ the quiet filter can no
+# longer absorb the burn in the window ($z$ decorrelates from the magnitude, the state estimate lags). **We use
+# $f = 0.1$ for both policies** — a judgement from this sweep, not a value from the paper. Since $z_{lim}$ scales
+# with this choice, the $z_{lim}$ comparison below checks consistency, not an independent prediction.
+#
+# Below: one quiet-policy run (a 50 mm/s burn along $+\hat j$) filtered with the window tuning and with the same
+# $q_w$ held constant over the whole period (the paper's "constant OCBE tuning", Figs. 10-11). The smoothed control
+# shows the spike at apoapsis (Figs. 12-13); the forward (single-step) control barely sees it.
+
+# %%
+F_TUNE = 0.1
+setups = {(o, p): det.make_setup(em, ORBITS[o], F_TUNE * det.window_control_weight(POLICIES[p], WINDOW_HOURS),
+                                 Q_BASE, window_hours=WINDOW_HOURS) for o in ORBITS for p in POLICIES}
+s_q = setups["9:2 NRHO", "quiet"]
+demo = det.draw_trial(np.random.default_rng([SEED, 7]), s_q, magnitude_m_s=0.05, direction=(np.pi / 2, 0.0))
+runs = {"apoapsis window": det.run_trial_filter(s_q, demo),
+        "constant": det.run_trial_filter(s_q, demo, control_weight=s_q.control_weight.max())}
+hours = s_q.scenario.t * em.time_unit_s / 3600
+to_um_s2 = em.length_unit_km / em.time_unit_s**2 * 1e9  # LU/TU^2 -> micro-m/s^2
+fig, ax = plt.subplots(2, 2, figsize=(13, 7), sharex=True)
+for j, (name, r) in enumerate(runs.items()):
+    th = r.t_sub.ravel() * em.time_unit_s / 3600
+    ax[0, j].plot(th, np.linalg.norm(r.control_step, axis=-1).ravel() * to_um_s2, label=f"forward, z = "
+                  f"{r.z_step * em.velocity_unit_km_s * 1e6:.1f} mm/s")
+    ax[0, j].plot(th, np.linalg.norm(r.control_smooth, axis=-1).ravel() * to_um_s2, label=f"smoothed, z = "
+                  f"{r.z_smooth * em.velocity_unit_km_s * 1e6:.1f} mm/s")
+    ax[0, j].axvline(s_q.t_maneuver * em.time_unit_s / 3600, color="k", ls=":", lw=1)
+    ax[0, j].set(title=f"{name} tuning", ylabel=r"$\|\hat u\|$ ($\mu$m/s$^2$)")
+    ax[0, j].legend(fontsize=8)
+    for xs, Ps, lab, c in ((r.x_filt, r.P_filt, "forward", "C0"), (r.x_smooth, r.P_smooth, "smoothed", "C1")):
+        err = np.linalg.norm(xs[:, :3] - demo.truth[:, :3], axis=1) * em.length_unit_km
+        sig = 3 * np.sqrt(np.trace(Ps[:, :3, :3], axis1=1, axis2=2)) * em.length_unit_km
+        ax[1, j].semilogy(hours, err, c, label=f"{lab} error")
+        ax[1, j].semilogy(hours, sig, c + "--", lw=1, label=f"{lab} 3-sigma")
+    ax[1, j].set(xlabel="hours since periapsis hand-off", ylabel="position error (km)")
+    ax[1, j].legend(fontsize=7, ncol=2)
+    nees = tracking.nees(r.x_smooth, r.P_smooth, demo.truth)
+    print(f"{name:16s}: z_smooth = {r.z_smooth * em.velocity_unit_km_s * 1e6:6.2f} mm/s, z_forward = "
+          f"{r.z_step * em.velocity_unit_km_s * 1e6:6.2f} mm/s, mean smoothed NEES = {nees.mean():.1f} (6 if consistent)")
+plotting.save_figure(fig, "10_tuning_control_spike", output_dir=out)
+
+# %% [markdown]
+# ## 3 · Control-policy distributions (Eq. 33) and the maximum-likelihood test (Eqs. 34-35)
+#
+# For each orbit and policy: $N_{H0}$ runs without a maneuver and $N_{H1}$ runs with one drawn from the policy
+# (500 and 3000 in the paper), each a full OCBE filter and smoother over one period from the periapsis hand-off,
+# giving $z = \int_{t_0}^{t_f}\|\hat{\mathbf u}(t)\|dt$ of the smoothed control (Eq. 33, trapezoid rule on 9 points
+# per 2-hour interval). Runs go through `cislunar.montecarlo.run_monte_carlo` (batches of 8 runs in lockstep in the
+# batched OCBE, which equals the single-run filter to $10^{-10}$; see `tests/test_detection.py`).
+#
+# The PDFs are Gaussian kernel density estimates with Scott's bandwidth ($n^{-1/5}$ times the sample standard
+# deviation). With equal priors and costs the maximum-likelihood rule (Eq. 34) picks H1 where
+# $PDF_{H1}(z) > PDF_{H0}(z)$; with a single crossing it is the threshold rule of Eq. 35, $z > z_{lim}$. The
+# expected false-positive rate is $\int_{z_{lim}}^\infty PDF_{H0}$ and the missed-detection rate
+# $\int_{-\infty}^{z_{lim}} PDF_{H1}$ (Tables 5-6). Then 100 + 100 fresh runs test the rule (Tables 7-8).
+
+# %%
+studies = {}
+for i, o in enumerate(ORBITS):
+    for j, p in enumerate(POLICIES):
+        studies[o, p] = det.run_policy_study(setups[o, p], POLICIES[p], N_H0, N_H1, N_TEST, [SEED, i, j],
+                                             batch_size=BATCH, executor=executor, label=f"{o} {p}")
+print(f"Monte Carlo wall time so far: {(time.perf_counter() - T_START) / 60:.1f} min")
+
+# %%
+fig, ax = plt.subplots(2, 4, figsize=(16, 7))
+for col, (key, st) in enumerate(studies.items()):
+    unit = 1.0 if key[1] == "active" else 1e3
+    ulab = "m/s" if key[1] == "active" else "mm/s"
+    lo, hi = 0.0, max(st.h0.z.max(), st.h1.z.max()) * unit * 1.05
+    bins = np.linspace(lo, hi, 50)
+    ax[0, col].hist(st.h0.z * unit, bins=bins, alpha=0.6, label=f"no maneuver ({len(st.h0)})")
+    ax[0, col].hist(st.h1.z * unit, bins=bins, alpha=0.6, label=f"maneuver ({len(st.h1)})")
+    zz = np.linspace(lo, hi, 600)
+    ax[1, col].plot(zz, st.threshold.pdf0(zz / unit) / unit, label=r"$PDF_{H0}$")
+    ax[1, col].plot(zz, st.threshold.pdf1(zz / unit) / unit, label=r"$PDF_{H1}$")
+    for a in ax[:, col]:
+        a.axvline(st.threshold.z_lim * unit, color="k", ls=":", lw=1)
+    ax[0, col].set(title=f"{key[0]}, {key[1]}", ylabel="count")
+    ax[1, col].set(xlabel=f"z ({ulab})", ylabel=f"PDF (1/({ulab}))",
+                   title=f"z_lim = {st.threshold.z_lim * unit:.4g} {ulab}")
+    ax[0, col].legend(fontsize=7)
+    ax[1, col].legend(fontsize=7)
+plotting.save_figure(fig, "10_control_integral_pdfs", output_dir=out)
+
+print("Tables 5-6 (expected rates from the PDFs)")
+print(f"{'orbit':12s} {'policy':7s} {'z_lim':>12s} {'false pos.':>11s} {'missed det.':>12s} {'crossings':>9s} "
+      f"{'H0 mean':>10s} {'H1 mean':>10s}")
+for (o, p), st in studies.items():
+    th = st.threshold
+    print(f"{o:12s} {p:7s} {th.z_lim * 1e3:9.2f} mm/s {th.false_positive:11.4f} {th.missed_detection:12.4f} "
+          f"{th.crossings.size:9d} {st.h0.z.mean() * 1e3:7.2f} mm/s {st.h1.z.mean() * 1e3:7.2f} mm/s")
+
+# %% [markdown]
+# ## 4 · Sensitivity of $z$ to the maneuver (Figs. 16-17, 20-21)
+#
+# The paper finds $z$ nearly linear in the impulse magnitude (so it could estimate it) and, for the active policy,
+# largest for burns along $\pm\hat j$ (azimuth $\pm90°$, low elevation), where the burn is best aligned with the
+# measurement sensitivity at apoapsis; for the quiet policy that pattern is weaker.
+
+# %%
+fig, ax = plt.subplots(2, 3, figsize=(15, 8))
+for row, p in enumerate(POLICIES):
+    h1 = studies["9:2 NRHO", p].h1
+    unit, ulab = (1.0, "m/s") if p == "active" else (1e3, "mm/s")
+    sc_ = ax[row, 0].scatter(np.degrees(h1.azimuth), np.degrees(h1.elevation), c=h1.z * unit, s=6, cmap="viridis")
+    fig.colorbar(sc_, ax=ax[row, 0], label=f"z ({ulab})")
+    ax[row, 0].set(xlabel="azimuth (deg)", ylabel="elevation (deg)", title=f"9:2 NRHO, {p}")
+    ax[row, 1].scatter(np.degrees(h1.azimuth), h1.z / h1.magnitude, s=4, alpha=0.5)
+    ax[row, 1].set(xlabel="azimuth (deg)", ylabel="z / impulse magnitude")
+    for o, mk in zip(ORBITS, ("o", "x")):
+        s1 = studies[o, p].h1
+        ax[row, 2].scatter(s1.magnitude * unit, s1.z * unit, s=4, alpha=0.4, marker=mk, label=o)
+    mm = np.array([0, h1.magnitude.max() * unit])
+    ax[row, 2].plot(mm, mm, "k--", lw=1, label="z = magnitude")
+    ax[row, 2].set(xlabel=f"impulse magnitude ({ulab})", ylabel=f"z ({ulab})")
+    ax[row, 2].legend(fontsize=8)
+plotting.save_figure(fig, "10_z_vs_maneuver", output_dir=out)
+
+
+def azimuth_contrast(h1):
+    """Mean z/magnitude for |azimuth| within 30 deg of 90 over that within 30 deg of 0 or 180 (low elevation)."""
+    r, a, e = h1.z / h1.magnitude, np.abs(np.degrees(h1.azimuth)), np.abs(np.degrees(h1.elevation))
+    low = e < 45
+    side = low & (np.abs(a - 90) < 30)
+    axial = low & ((a < 30) | (a > 150))
+    return r[side].mean() / r[axial].mean()
+
+
+lin = {}
+for (o, p), st in studies.items():
+    h1 = st.h1
+    slope = np.polyfit(h1.magnitude, h1.z, 1)[0]
+    lin[o, p] = (slope, np.corrcoef(h1.magnitude, h1.z)[0, 1], azimuth_contrast(h1), stats.skew(h1.z))
+    print(f"{o:12s} {p:7s}: z vs magnitude slope {slope:.2f}, corr {lin[o, p][1]:.3f}; z/|dv| at azimuth +-90 "
+          f"over 0/180 (|el| < 45 deg) = {lin[o, p][2]:.2f}; skewness of H1 z = {lin[o, p][3]:.2f}")
+
+# %% [markdown]
+# ## 5 · Detection tests on independent data (Tables 7-8)
+#
+# Fresh runs (seeds independent of the training runs) are classified with Eq. 35 and the $z_{lim}$ above.
+
+# %%
+print(f"{'orbit':12s} {'policy':7s} {'H0 -> H0':>9s} {'H0 -> H1':>9s} {'H1 -> H1':>9s} {'H1 -> H0':>9s} {'accuracy':>9s}")
+for (o, p), st in studies.items():
+    s = st.score
+    print(f"{o:12s} {p:7s} {s.true_negative:9d} {s.false_positive:9d} {s.true_positive:9d} {s.missed_detection:9d} "
+          f"{100 * s.accuracy:8.1f}%")
+
+# %% [markdown]
+# ## 6 · Control as a health metric (Fig. 22)
+#
+# The filter is tuned for the quiet policy but the vehicle burns 0.5 m/s (ten times the quiet mean). The paper
+# reports that the smoothed estimate diverges while the measurement residuals look benign, and that
+# $z = 0.4761$ m/s, "approximately at 30 sigma of the maneuvering distribution of Z" — a fast, sensitive health
+# metric. We run the same experiment (random pointing) and express $z$ in standard deviations of our quiet H1
+# and H0 distributions on the 9:2 NRHO.
+
+# %%
+health = det.draw_trial(np.random.default_rng([SEED, 8]), s_q, magnitude_m_s=0.5)
+rh = det.run_trial_filter(s_q, health)
+ref = studies["9:2 NRHO", "quiet"]
+z_h = rh.z_smooth * em.velocity_unit_km_s * 1e3
+sig_h1 = (z_h - ref.h1.z.mean()) / ref.h1.z.std()
+sig_h0 = (z_h - ref.h0.z.mean()) / ref.h0.z.std()
+nees_h = tracking.nees(rh.x_smooth, rh.P_smooth, health.truth)
+fig, ax = plt.subplots(1, 3, figsize=(15, 3.8))
+err = np.linalg.norm(rh.x_smooth[:, :3] - health.truth[:, :3], axis=1) * em.length_unit_km
+sig = 3 * np.sqrt(np.trace(rh.P_smooth[:, :3, :3], axis1=1, axis2=2)) * em.length_unit_km
+ax[0].semilogy(hours, err, label="smoothed error")
+ax[0].semilogy(hours, sig, "--", label="3-sigma")
+ax[0].set(xlabel="hours", ylabel="position error (km)", title="0.5 m/s burn, quiet tuning")
+ax[0].legend()
+ax[1].plot(hours, rh.residual_norms, ".")
+ax[1].axhline(np.sqrt(stats.chi2.ppf(0.99, 4)), color="k", ls=":", label="99% of a 4-dof residual")
+ax[1].set(xlabel="hours", ylabel="whitened residual norm", title="measurement residuals")
+ax[1].legend()
+ax[2].hist(ref.h1.z, bins=40, alpha=0.6, label="quiet H1")
+ax[2].hist(ref.h0.z, bins=40, alpha=0.6, label="quiet H0")
+ax[2].axvline(z_h, color="C3", label=f"this run: z = {z_h:.3f} m/s")
+ax[2].set(xscale="log", xlabel="z (m/s)", ylabel="count")
+ax[2].legend(fontsize=8)
+plotting.save_figure(fig, "10_health_metric", output_dir=out)
+print(f"impulse 0.5 m/s (azimuth {np.degrees(health.azimuth):.0f} deg, elevation {np.degrees(health.elevation):.0f} deg):"
+      f" z = {z_h:.4f} m/s = {sig_h1:.0f} sigma of quiet H1, {sig_h0:.0f} sigma of quiet H0")
+print(f"smoothed NEES mean {nees_h.mean():.0f} (6 if consistent); residual norms: median {np.median(rh.residual_norms):.2f},"
+      f" max {rh.residual_norms.max():.2f}; fraction above the 99% level "
+      f"{np.mean(rh.residual_norms > np.sqrt(stats.chi2.ppf(0.99, 4))):.2f}")
+
+# %% [markdown]
+# ## Paper versus reproduction
+#
+# Statuses: *reproduced* only when close; *differs* with the reason otherwise. Two inputs are our choices because
+# the paper's tables are missing: the measurement noise (10 micro-rad angles, Eq. 13 rates with 1 s differencing)
+# and the tuning ($q_w = 0.1\,E[u_{mag}^2]/(3T)$ in the 8-hour window, $10^{-18}$ km$^2$/s$^3$ elsewhere). The
+# thresholds scale with the tuning, so they are a consistency check, not an independent prediction.
+
+# %%
+def close(a, b, rel):
+    return abs(a / b - 1) <= rel
+
+
+zl_a = studies["9:2 NRHO", "active"].threshold.z_lim
+zl_q = studies["9:2 NRHO", "quiet"].threshold.z_lim
+table.add("Measurement noise (Table 3)", "missing from the text", "10 micro-rad angles; rates sqrt(2)*10 micro-rad/s",
+          "not in paper", "value the same authors use in their AMOS 2023 paper (cislunar.tracking)")
+table.add("OCBE tuning (8-h apoapsis window)", "values missing",
+          f"q_w = 0.1 E[u^2]/(3T): active {setups['9:2 NRHO', 'active'].q_window_km2_s3:.2e}, quiet "
+          f"{setups['9:2 NRHO', 'quiet'].q_window_km2_s3:.2e} km^2/s^3; base 1e-18", "not in paper",
+          "factor 0.1 chosen from the pilot sweep in Section 2")
+table.add("Monte Carlo sizes (H0 / H1 / tests per hypothesis)", "500 / 3000 / 100", f"{N_H0} / {N_H1} / {N_TEST}",
+          "reproduced" if not QUICK else "differs: quick mode", "per policy and orbit")
+table.add("Smoothed control spike at apoapsis with window tuning (Figs. 12-13)", "spike in smoothed control only",
+          f"z smoothed {runs['apoapsis window'].z_smooth * em.velocity_unit_km_s * 1e6:.1f} mm/s vs forward "
+          f"{runs['apoapsis window'].z_step * em.velocity_unit_km_s * 1e6:.1f} mm/s for a 50 mm/s burn", "reproduced")
+for key, paper, tol in ((("9:2 NRHO", "active"), 0.4106, 0.25), (("9:2 NRHO", "quiet"), 0.01722, 0.25)):
+    zl = studies[key].threshold.z_lim
+    st_ = "reproduced" if close(zl, paper, tol) else \
+        f"differs: {100 * (zl / paper - 1):+.0f} %; z_lim scales with the unpublished tuning and noise"
+    table.add(f"z_lim, {key[0]}, {key[1]} (Eq. 35)", f"{paper * 1e3:.2f} mm/s", f"{zl * 1e3:.2f} mm/s", st_,
+              f"{100 * (zl / paper - 1):+.0f} %; within 25 % counts as reproduced; scales with our tuning choice")
+for key in (("stable NRHO", "active"), ("stable NRHO", "quiet")):
+    table.add(f"z_lim, {key[0]}, {key[1]}", "not given", f"{studies[key].threshold.z_lim * 1e3:.2f} mm/s",
+              "not in paper", "the paper omits the stable-NRHO plots and values")
+for (o, p), st in studies.items():
+    table.add(f"Expected FP / MD, {o}, {p} (Tables 5-6)", "tables missing",
+              f"{st.threshold.false_positive:.4f} / {st.threshold.missed_detection:.4f}", "not in paper",
+              f"{st.threshold.crossings.size} PDF crossing(s)")
+n_cross = [st.threshold.crossings.size for st in studies.values()]
+table.add("H0 and H1 PDFs cross once", "yes (Figs. 15, 19)", f"crossings per case: {n_cross}",
+          "reproduced" if all(c == 1 for c in n_cross) else "differs: KDE tails of the finite sample add crossings",
+          "z_lim is the crossing of least total error")
+acc = {k: st.score.accuracy for k, st in studies.items()}
+for key, paper in ((("9:2 NRHO", "active"), 1.00), (("9:2 NRHO", "quiet"), 0.97)):
+    a = acc[key]
+    ok = abs(a - paper) <= max(0.02, 2 * np.sqrt(paper * (1 - paper) / N_TEST / 2) + 1 / (2 * N_TEST))
+    table.add(f"Detection accuracy, {key[0]}, {key[1]} (Table 7)", f"{100 * paper:.0f} %", f"{100 * a:.1f} %",
+              "reproduced" if ok else "differs: see FP/MD; depends on the unpublished tuning and noise",
+              f"{2 * N_TEST} test runs")
+for p in POLICIES:
+    a_s, a_n = acc["stable NRHO", p], acc["9:2 NRHO", p]
+    table.add(f"Detection accuracy, stable NRHO, {p} (Table 8)",
+              "marginally better than 9:2" + (" (quiet: 200/200)" if p == "quiet" else ""),
+              f"{100 * a_s:.1f} % (9:2: {100 * a_n:.1f} %)",
+              "reproduced" if a_s >= a_n else "differs: not better than the 9:2 NRHO in our test sets")
+for p in POLICIES:
+    sl, cr, ctr, sk = lin["9:2 NRHO", p]
+    table.add(f"z nearly linear in the magnitude, {p} (Figs. 17, 21)", "apparently linear",
+              f"slope {sl:.2f}, corr {cr:.3f}", "reproduced" if cr > 0.8 else "differs: weak correlation")
+ctr_a, ctr_q = lin["9:2 NRHO", "active"][2], lin["9:2 NRHO", "quiet"][2]
+table.add("Largest z for burns at azimuth +-90 deg, active (Fig. 16)", "bimodal, peaks at +-j",
+          f"z/|dv| at +-90 deg over 0/180 deg: {ctr_a:.2f}",
+          "reproduced" if ctr_a > 1.1 else "differs: no clear +-j preference in our runs")
+table.add("Quiet policy: pattern less bimodal (Fig. 20)", "more uniform", f"ratio {ctr_q:.2f} (active {ctr_a:.2f})",
+          "reproduced" if ctr_a > 1.1 and ctr_q < ctr_a else
+          "differs: neither policy shows the +-j pattern clearly, so there is nothing to weaken")
+table.add("H1 z approximately Gaussian, active (Fig. 15)", "approximately Gaussian",
+          f"skewness {lin['9:2 NRHO', 'active'][3]:.2f}",
+          "reproduced" if abs(lin["9:2 NRHO", "active"][3]) < 0.5 else "differs: skewed")
+table.add("Health metric: z for 0.5 m/s burn, quiet tuning", "0.4761 m/s", f"{z_h:.4f} m/s",
+          "reproduced" if close(z_h, 0.4761, 0.25) else "differs: depends on the pointing and tuning",
+          "one run, random pointing")
+table.add("Health metric: sigma level in the quiet H1 distribution", "about 30 sigma", f"{sig_h1:.0f} sigma",
+          "reproduced" if 20 <= sig_h1 <= 45 else "differs: our quiet H1 spread differs from the paper's")
+table.add("Health metric: residuals benign while the estimate diverges (Fig. 22)", "yes",
+          f"NEES mean {nees_h.mean():.0f}; residual median {np.median(rh.residual_norms):.2f}",
+          "reproduced" if nees_h.mean() > 20 and np.median(rh.residual_norms) < 3 else
+          "differs: our filter is " + ("consistent" if nees_h.mean() <= 20 else "diverged with visible residuals"))
+if executor is not None:
+    executor.shutdown()
+print(f"notebook wall time: {(time.perf_counter() - T_START) / 60:.1f} min")
+table.display()
