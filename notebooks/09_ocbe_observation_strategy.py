@@ -261,18 +261,31 @@ ax1.legend(fontsize=8)
 fig.suptitle("Final filter uncertainty after one period versus cadence (median over runs; analogue of Table 4)")
 plotting.save_figure(fig, "09_final_uncertainty_vs_cadence_table4", output_dir=out)
 
+# %%
+def flagged_cells(rows, limit=0.10):
+    """(orbit, cadence, fraction) where more than ``limit`` of the runs were inconsistent."""
+    return [(name, cad, div) for name, cad, div, *_ in rows if div > limit]
+
+
+for label, rows in (("angles only", rows_angles), ("angles + rates", rows_rates)):
+    flagged = flagged_cells(rows)
+    print(f"{label}: cells with more than 10% inconsistent runs:",
+          ", ".join(f"{n} {c:g} h ({100 * d:.0f}%)" for n, c, d in flagged) or "none")
+
 # %% [markdown]
-# As the paper reports, adding the rates gives consistent filters at every cadence, uncertainty falls with
-# cadence, and the stable NRHO is tracked better than the 9:2 NRHO. In our runs the rates add little *accuracy*
-# once the angles are 10 µrad (their noise, by Eq. 13 with a 1 s baseline, is large); the paper makes the same
-# remark ("the presence of angular rate measurements is not meant to add significant information").
+# The paper reports consistent filters at every cadence once the rates are added. Compare the "diverged" columns:
+# with 20 runs per cell, one or two flagged runs are within chance for a consistent filter, while a cell where
+# many runs are flagged points at a real problem (for the stable NRHO, whose perilune is only about 95 km above
+# the surface, long gaps between measurements leave the linearised time update through perilune too coarse). In
+# our runs the rates add little *accuracy* once the angles are 10 µrad: their noise, by Eq. 13 with a 1 s
+# baseline, is large; the paper makes the same remark ("the presence of angular rate measurements is not meant
+# to add significant information").
 #
 # ## 6 · Paper versus reproduction
 
 # %%
 if executor is not None:
     executor.shutdown()
-div_rates = max(r[2] for r in rows_rates)
 r92 = {r[1]: r for r in rows_rates if r[0] == "9:2 NRHO"}
 rst = {r[1]: r for r in rows_rates if r[0] == "stable NRHO"}
 n_cells = len(rows_angles)
@@ -289,9 +302,14 @@ for sig, row in noisier.items():
 table.add("angles only, five observers hourly, noise and hand-off / 10 (Fig. 4)", "diverges",
           f"{100 * row_five[2]:.0f}% diverged, NEES {row_five[3]:.1f}",
           "reproduced" if row_five[2] > 0.5 else "differs: consistent in our runs", "1 urad, hand-off 3 sigma 1 km")
+flagged_rates = flagged_cells(rows_rates)
+n_runs_rates = sum(len(v) for v in with_rates.values())
+frac_rates = np.mean([r.diverged for v in with_rates.values() for r in v])
 table.add("angles and rates, L2, 1 min-12 h cadence", "consistent at every cadence, both orbits",
-          f"{100 * div_rates:.0f}% of runs diverged", "reproduced" if div_rates <= 0.05 else
-          "differs: some runs inconsistent", f"{sum(len(v) for v in with_rates.values())} runs")
+          f"{100 * frac_rates:.1f}% of {n_runs_rates} runs inconsistent",
+          "reproduced" if not flagged_rates else "differs: some cadences have many inconsistent runs",
+          "; ".join(f"{n} {c:g} h: {100 * d:.0f}%" for n, c, d in flagged_rates) or
+          "no cell above 10% inconsistent runs")
 table.add("typical 2-hour run (Fig. 5)", "errors within 3 sigma, forward and smoothed",
           f"NEES mean {typical.nees_mean:.1f}, {100 * typical.inconsistent_fraction:.1f}% epochs over 99.9%",
           "reproduced" if not typical.diverged else "differs: the typical run is inconsistent")
@@ -302,5 +320,6 @@ for cad in sorted(r92):
 better = np.mean([rst[c][4] < r92[c][4] for c in r92])
 table.add("stable NRHO better determined than the 9:2", "qualitatively similar, quantitatively better",
           f"smaller final sigma at {100 * better:.0f}% of cadences",
-          "reproduced" if better >= 0.5 else "differs: the 9:2 NRHO is better determined here")
+          "reproduced" if better >= 0.5 else "differs: the 9:2 NRHO is better determined here",
+          "final epoch at apoapsis after one period; the paper's Table 4 values are not available to compare")
 table.display()
