@@ -492,8 +492,8 @@ def run_detection_monte_carlo(setup: DetectionSetup, policy: StationKeepingPolic
 def _batch_template(tol: float, batch_size: int):
     """heyoka batch integrator of the OCBE variational system (compiled once per process and size)."""
     hy = _heyoka()
-    ta, index = ocbe._ocbe_template(tol)
-    tb = hy.taylor_adaptive_batch(ta.sys, np.zeros((len(ta.sys), batch_size)), pars=np.zeros((2, batch_size)),
+    sys, index = ocbe.variational_system(tol)
+    tb = hy.taylor_adaptive_batch(sys, np.zeros((len(sys), batch_size)), pars=np.zeros((2, batch_size)),
                                   tol=tol, compact_mode=True)
     return tb, index
 

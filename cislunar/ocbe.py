@@ -39,7 +39,7 @@ from .dynamics import CR3BP
 from .propagation import DEFAULT_TOL, _check_outcome, _check_tol, _grid_from, _heyoka, thread_local_copy
 
 __all__ = ["OCBETransition", "ocbe_transition", "ocbe_process_noise", "estimated_control", "OCBEResult",
-           "ocbe_filter_smoother"]
+           "ocbe_filter_smoother", "variational_system"]
 
 
 @functools.lru_cache(maxsize=4)
@@ -72,6 +72,18 @@ def _ocbe_template(tol: float):
         m = ta.get_mindex(k)
         index[m[0], int(np.flatnonzero(np.asarray(m[1:]))[0])] = k
     return ta, index
+
+
+def variational_system(tol: float = DEFAULT_TOL):
+    """The OCBE variational ODE system (heyoka expressions) and the state index of each 12x12 STM entry.
+
+    For callers that build their own integrators from it (e.g. a heyoka batch integrator running several filters
+    in lockstep, :mod:`cislunar.detection`).  Returns ``(sys, index)``: ``sys`` is the list of (variable,
+    expression) pairs, ``index[i, j]`` the position of :math:`\Phi_{ij}` in the integrator state; parameters are
+    ``[mu, q]``.
+    """
+    ta, index = _ocbe_template(_check_tol(tol))
+    return ta.sys, index.copy()
 
 
 def _ocbe_integrator(tol: float):
