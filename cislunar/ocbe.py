@@ -79,7 +79,7 @@ def variational_system(tol: float = DEFAULT_TOL):
 
     For callers that build their own integrators from it (e.g. a heyoka batch integrator running several filters
     in lockstep, :mod:`cislunar.detection`).  Returns ``(sys, index)``: ``sys`` is the list of (variable,
-    expression) pairs, ``index[i, j]`` the position of :math:`\Phi_{ij}` in the integrator state; parameters are
+    expression) pairs, ``index[i, j]`` the position of entry (i, j) of the 12x12 STM in the integrator state; parameters are
     ``[mu, q]``.
     """
     ta, index = _ocbe_template(_check_tol(tol))
