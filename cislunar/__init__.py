@@ -11,6 +11,9 @@ measurements  relative position, range / range-rate, azimuth / elevation (+ rate
 covariance    SPD helpers, process-noise discretisation, EKF covariance (CRLB) recursion, augmented states
 information   mutual information of an observation window (dense Eq. 18 and O(N) chain rule) and its gradient
 srif          square-root information filter and smoother (Householder)
+ocbe          optimal-control-based estimator: state/costate transition, Eq. 17 process noise, SRI filter/smoother
+tracking      optical tracking scenarios (truth with impulses, measurements, hand-off, NEES consistency trials)
+detection     station-keeping policies, batched OCBE Monte Carlo, control-integral hypothesis test
 montecarlo    Monte Carlo trials and sweeps through any concurrent.futures-style executor
 lpv           LPV form of the planar CR3BP and H2 / H-infinity sensing-precision LMIs
 observers     LPV observer and EKF simulations on the nonlinear CR3BP
