@@ -342,7 +342,7 @@ table.add("Eq. 18 on test case 2 window (dense)", "formula only", f"{mi_dense:.4
 table.add("Eq. 18 by chain rule (Kalman recursion)", "not in paper", f"rel. diff {abs(mi_dense - mi_struct) / mi_dense:.1e}",
           "beyond paper", "same value at O(N) cost")
 table.add("Eqs. 44-52 gradient vs central differences", "formula only", f"max rel. err {grad_err:.1e}",
-          "reproduced" if grad_err < 1e-5 else "differs: gradient disagrees with finite differences",
+          "beyond paper" if grad_err < 1e-5 else "differs: gradient disagrees with finite differences",
           "P~ held fixed as in the paper; dense Eq. 48 and the adjoint agree")
 table.add("Eq. 44 linearisation error at 10 km / 100 km steps", "not in paper",
           f"{lin_err[1]:.2e} / {lin_err[2]:.2e} nats", "beyond paper", "scale for the SCvx trust region")
@@ -362,13 +362,21 @@ table.add("Observer RMS below targets on average (Fig. 9)", "yes",
           f"observer {sig_post[0].mean():.2f} km vs targets {sig_post[1:].mean():.2f} km (mean over window)",
           "reproduced" if obs_better else "differs: observer is not better determined than the targets here",
           "un-manoeuvred observer, so only qualitative")
-for name in study:
-    grows = gain[name] > 0 and rms_drop[name] > 1.5
+for name, res in study.items():
+    b_km, obs_rms, mi = em.lu_to_km(res["baseline"]), res["obs"], res["mi"]
+    k_best = int(np.argmin(obs_rms))
+    improves = gain[name] > 0 and rms_drop[name] > 1.5
+    rebound = float(obs_rms[-1] / obs_rms[k_best])  # > 1: the CRLB gets worse again at the longest baselines
+    mi_drop = float(mi.max() - mi[-1])
+    status = ("reproduced" if improves and rebound < 1.2 else
+              f"differs: improves up to about {b_km[k_best]:.0f} km, then the CRLB worsens ({rebound:.1f}x)"
+              if improves else "differs: in-plane range/range-rate gains little from baseline alone")
     table.add(f"MI and CRLB improve with baseline ({name})", "yes (Markley/Psiaki argument, qualitative)",
-              f"MI +{gain[name]:.2f} nats up to {peak[name]:.0f} km; observer RMS down {rms_drop[name]:.1f}x",
-              "reproduced" if grows else "differs: in-plane range/range-rate gains little from baseline alone",
-              "observer phase-shifted on the target's DRO; MI flattens once the pair is half an orbit apart"
-              if grows else "consistent with the paper's remark that range needs out-of-plane observer motion")
+              f"MI +{gain[name]:.2f} nats up to {peak[name]:.0f} km (then -{mi_drop:.2f}); observer RMS "
+              f"{obs_rms[0]:.0f} -> {obs_rms[k_best]:.0f} km at {b_km[k_best]:.0f} km, {obs_rms[-1]:.0f} km at "
+              f"{b_km[-1]:.0f} km", status,
+              "observer phase-shifted on the target's DRO" + (
+                  "" if rebound < 1.2 else "; not monotonic: past about half an orbit apart the geometry repeats"))
 table.add("Structured vs dense speed at test-case-2 size (N = 17)", "not in paper",
           f"MI {r17.ratio_value:.1f}x, MI + gradient {r17.ratio_gradient:.1f}x", "beyond paper",
           "target >= 10x; see the timing figure for the growth with N")
