@@ -52,6 +52,7 @@ inconsistencies resolved) and :func:`verify_observer` for the checks that do not
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 from itertools import product
 
@@ -771,6 +772,9 @@ class PrecisionLMI:
             raise InfeasibleLMIError(
                 f"{self.norm} precision LMI infeasible or unsolved at gamma = {gamma:g}: solver {solver} status "
                 f"{status!r} ({self.A_vertices.shape[0]} vertices)", gamma, str(status))
+        if status == cp.OPTIMAL_INACCURATE:
+            warnings.warn(f"{self.norm} precision LMI at gamma = {gamma:g}: solver {solver} returned "
+                          "optimal_inaccurate; verify the design (verify_design) before trusting it", stacklevel=2)
         Xv = 0.5 * (self._X.value + self._X.value.T)
         Ls = np.linalg.solve(Xv, self._Y.value)
         L = np.zeros((self.n_x, self.n_y))

@@ -119,26 +119,29 @@ settle = t > 0.1 * PERIODS * sc.orbit.period  # after the initial transient
 stats = {n: (np.median(r.position_error[settle]) * KM, np.sqrt(np.mean(r.position_error[settle] ** 2)) * KM,
              np.max(r.position_error[settle]) * KM) for n, r in runs.items()}
 conv = {n: t[np.argmax(r.position_error < GAMMA)] for n, r in runs.items()}
+below = {n: float(np.mean(r.position_error[settle] < GAMMA)) for n, r in runs.items()}  # after settling
 for n, (med, rms, mx) in stats.items():
     print(f"{n:4s}: median {med:7.1f} km, rms {rms:7.1f} km, max {mx:8.1f} km; first below gamma at t = {conv[n]:.3f} TU")
 
 # %% [markdown]
 # **Reading the result.** Both LPV observers converge from a 10,900 km initial error and then stay at the level
-# printed above (it shrinks with the measurement interval, since the noise intensity is sigma² DT), but their
-# error is *not* bounded by gamma everywhere: the LMIs treat $\rho$ as
+# printed above, but their error is *not* bounded by gamma everywhere: the LMIs treat $\rho$ as
 # exactly known, while here it comes from noisy angles (its error enters $A(\rho)$, $b(\rho)$ and $d(\rho)$), and
 # near the Earth-Moon line it comes from the estimate. The EKF, which uses both angles as measurements and the
 # full nonlinear model, is more accurate on the same data (numbers in the table).
 
 # %%
 table.add("observers converge from large initial error", "yes (Fig. 3c)",
-          f"H2 below gamma after {conv['h2']:.2f} TU, Hinf after {conv['hinf']:.2f} TU", "reproduced",
-          "initial error 0.028 LU, 0.014 LU/TU (our choice)")
+          f"first below gamma at {conv['h2']:.2f} TU (H2), {conv['hinf']:.2f} TU (Hinf); after settling below gamma "
+          f"{100 * below['h2']:.0f}% (H2) and {100 * below['hinf']:.0f}% (Hinf) of the time",
+          "reproduced" if min(below["h2"], below["hinf"]) > 0.5 else
+          "differs: after the first dip the error stays above gamma most of the time",
+          "initial error 0.028 LU, 0.014 LU/TU (our choice); rho comes from noisy angles, which the LMIs do not model")
 table.add("H2 position error after convergence", "small (Fig. 3c, no number)",
           f"median {stats['h2'][0]:.0f} km, max {stats['h2'][2]:.0f} km", "derived", f"{SIGMA_DEG} deg on both angles")
 table.add("Hinf error larger than H2", "yes (Fig. 3c)", f"median {stats['hinf'][0]:.0f} vs {stats['h2'][0]:.0f} km",
           "reproduced" if stats["hinf"][0] > stats["h2"][0] else "differs: H2 error not smaller here",
-          "paper: Hinf run uses more noise than its design allows")
+          "both runs use 0.1 deg: about 5x the H2 allowance and 1.4x the Hinf allowance of notebook 11")
 table.add("rho from estimate where |sin th3| < 0.04", "used", f"{100 * frac:.1f} % of samples", "reproduced",
           "triangulation singular near the Earth-Moon line")
 table.add("EKF on same angles", "-", f"median {stats['ekf'][0]:.0f} km, max {stats['ekf'][2]:.0f} km",
