@@ -508,7 +508,7 @@ def angles_and_rates(observer, target, *, jacobian: bool = False):
 
 def wrap_angle(angle) -> np.ndarray:
     """Wrap angles (rad) to :math:`[-\\pi, \\pi)`."""
-    a = np.asarray(angle, dtype=float)
+    a = _checks.as_array(angle, "angle")
     return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 

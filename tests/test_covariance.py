@@ -103,11 +103,15 @@ def test_process_noise_quadrature_matches_lyapunov_ode():
         ref = C.process_noise_lyapunov(EARTH_MOON, tr.x[k], t[k + 1] - t[k], q)
         np.testing.assert_allclose(Qd[k], ref, rtol=1e-9, atol=1e-9 * np.max(np.abs(ref)))
         C.check_spd(Qd[k], "Qd")
-    # a frozen-A Van Loan over a short arc agrees to first order only: checks that A(t) matters
+    # a frozen-A Van Loan agrees over a short arc but not over a long one: A(t) matters, and the exact
+    # discretisation along the reference is what captures it
     A = EARTH_MOON.jacobian(tr.x[0])
     _, Qvl = C.van_loan(A, q, 1e-3)
     ref = C.process_noise_lyapunov(EARTH_MOON, tr.x[0], 1e-3, q)
     np.testing.assert_allclose(Qvl, ref, rtol=1e-2, atol=1e-6 * np.max(np.abs(ref)))
+    _, Qvl_long = C.van_loan(A, q, 0.5)
+    ref_long = C.process_noise_lyapunov(EARTH_MOON, tr.x[0], 0.5, q)
+    assert np.max(np.abs(Qvl_long - ref_long)) > 1e-2 * np.max(np.abs(ref_long))
     # linear in q; batch of objects
     Qb = C.process_noise(EARTH_MOON, np.stack([tr.x, tr.x]), t, 2 * q)
     np.testing.assert_allclose(Qb[1], 2 * Qd, rtol=1e-12)
