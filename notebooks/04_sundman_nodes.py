@@ -1,0 +1,209 @@
+# ---
+# jupyter:
+#   jupytext:
+#     formats: py:percent
+#   kernelspec:
+#     display_name: Python 3
+#     language: python
+#     name: python3
+# ---
+
+# %% [markdown]
+# # 04 · Where to put the nodes: Sundman-spaced time grids and first-order-hold linearisation
+#
+# **What you will learn.** Why a successive-convexification (SCvx) trajectory optimiser needs its time nodes
+# where the dynamics are most nonlinear; how the generalised Sundman transformation $dt = r_m^{\sigma}d\tau$ places
+# them; how the first-order-hold (FOH) discretisation turns the controlled CR3BP into the affine model that each
+# convex subproblem uses, and how accurate that model is between nodes; and how the thrust bound is spread over
+# unequal intervals.
+#
+# **Paper sections followed.** Wolf & Jones (arXiv 2408.17435), "Sequential Convex Programming for Trajectory
+# Generation": "Discretization" (Eqs. 27-33) and "Selection of Discrete Time Nodes" (Eqs. 37-41). The paper gives
+# neither the number of nodes nor $\sigma$; both are swept here.
+
+# %% tags=["parameters"]
+QUICK = False
+SEED = 0
+OUTPUT_DIR = ""
+
+# %%
+# Sizes derived from QUICK: fewer exponents, nodes and perturbation draws in quick mode; the same experiments.
+SIGMAS = [0.0, 1.0, 2.0] if QUICK else [0.0, 0.5, 1.0, 1.5, 2.0]
+N_NODES = 24 if QUICK else 48  # nodes over each reference arc
+N_DRAWS = 2 if QUICK else 8  # random control perturbations per (orbit, sigma)
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from cislunar import discretization as D
+from cislunar import orbits, plotting, propagation, reference
+from cislunar.dynamics import EARTH_MOON as em
+from cislunar.report import ComparisonTable
+
+plotting.use_style()
+out = OUTPUT_DIR or None
+rng = np.random.default_rng(SEED)
+table = ComparisonTable("04 Sundman nodes and FOH discretisation (Wolf & Jones Eqs. 27-33, 37-41)")
+
+# The two references: the Wolf & Jones test-case-1 observer DRO (corrected, notebook 01) over the scenario's two
+# periods, and, beyond the paper, the 9:2 NRHO over one period, where perilune makes the dynamics far less benign.
+obs_row = [r for r in reference.load_wolf_jones_table() if r.table == 2 and r.label == "observer_t0"][0]
+dro = reference.verify_table_row(em, obs_row).corrected
+nrho = orbits.nrho_9_2(em)
+ARCS = {"W&J observer DRO (2 periods)": (dro.x0, 2 * dro.period), "9:2 NRHO (1 period)": (nrho.x0, nrho.period)}
+A_MAX = 1e-6 / em.acceleration_unit_km_s2  # Wolf & Jones Table 3: 1e-6 km/s^2, in LU/TU^2
+
+# %% [markdown]
+# ## 1 · The Sundman transformation (Eqs. 37-39)
+#
+# With $dt = r_m^{\sigma}d\tau$, equal steps in $\tau$ are short in $t$ where the distance to the Moon $r_m$ is
+# small. The paper integrates $dz/d\tau = r_m^{\sigma}[f;\,1]$ with $z = [x;\,t]$ (Eq. 38; the exponent is printed
+# there as $\alpha$, the same $\sigma$ as in Eq. 37). We integrate the equivalent $d\tau/dt = r_m^{-\sigma}$
+# alongside the reference in time and find the node times by root finding on the dense output;
+# `tests/test_discretization.py` checks that $\sigma = 0$ returns uniform nodes and that $\tau$ equals the
+# quadrature of $r_m^{-\sigma}$.
+
+# %%
+nodes = {(name, s): D.sundman_nodes(em, x0, tf, N_NODES, s)[0] for name, (x0, tf) in ARCS.items() for s in SIGMAS}
+fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
+for ax, name in zip(axes, ARCS):
+    for s in SIGMAS:
+        t = nodes[name, s]
+        ax.semilogy(em.tu_to_days(0.5 * (t[1:] + t[:-1])), em.tu_to_days(np.diff(t)) * 24, ".-",
+                    label=rf"$\sigma$ = {s:g}")
+    ax.set_xlabel("time [days]")
+    ax.set_ylabel("node spacing [hours]")
+    ax.set_title(name)
+axes[0].legend()
+fig.suptitle(f"Sundman-spaced nodes ({N_NODES} per arc)")
+plotting.save_figure(fig, "04_node_spacing", output_dir=out)
+spread = {(name, s): float(np.diff(nodes[name, s]).max() / np.diff(nodes[name, s]).min()) for name, s in nodes}
+for key, v in spread.items():
+    print(f"{key[0]:30s} sigma = {key[1]:3.1f}: longest / shortest interval = {v:8.2f}")
+
+# %%
+fig, axes = plt.subplots(1, 2, figsize=(12, 5))
+for ax, name, plane in zip(axes, ARCS, ("xy", "yz")):
+    x0, tf = ARCS[name]
+    dense = propagation.propagate(em, x0, np.linspace(0, tf, 1500)).x
+    plotting.plot_rotating(ax, dense, em, plane, moon_centred=True, units="km", color="0.6", lw=0.8)
+    for s, marker in ((0.0, "o"), (max(SIGMAS), "x")):
+        pts = propagation.propagate(em, x0, nodes[name, s]).x
+        plotting.plot_rotating(ax, pts, em, plane, moon_centred=True, units="km", ls="none", marker=marker, ms=4,
+                               label=rf"nodes, $\sigma$ = {s:g}")
+    plotting.plot_primaries(ax, em, plane, moon_centred=True, units="km", earth=False)
+    ax.set_title(name)
+    ax.legend(loc="lower left")
+    ax.locator_params(axis="x", nbins=5)
+plotting.save_figure(fig, "04_nodes_on_orbits", output_dir=out)
+
+# %% [markdown]
+# On the DRO $r_m$ varies only between about 70,000 and 120,000 km, so even $\sigma = 2$ changes the spacing by a
+# factor of about two; on the NRHO, $r_m$ spans 3,200 to 71,000 km and the nodes pile up at perilune.
+#
+# ## 2 · First-order hold and the discrete affine model (Eqs. 27-33)
+#
+# Between nodes the control acceleration is interpolated linearly,
+# $u(t) = \lambda^-_k(t)u_k + \lambda^+_k(t)u_{k+1}$ (Eq. 27a), and the dynamics linearised about the reference
+# give $x_{k+1} = A_kx_k + B_k^-u_k + B_k^+u_{k+1} + r_k + E_k\epsilon_k$ (Eqs. 28-31). The paper integrates the
+# matrices of Eq. 32, which needs $\Phi^{-1}$. Here heyoka differentiates the controlled flow with respect to the
+# state, the two node controls and a constant virtual control directly: those sensitivities *are* $A_k$,
+# $B_k^\mp$ and $E_k$ ($E(t) = I$), and $r_k$ makes the model exact at the reference. The tests check $A_k$
+# against the STM, $B_k^\mp$ against finite differences and the second-order decay of the linearisation error.
+#
+# **How good is the affine model between nodes?** SCvx trusts it inside a trust region. About a ballistic
+# reference we apply random smooth control profiles of size $a_{max}$ (Table 3, $10^{-6}$ km/s², about 1 mm/s²),
+# propagate each interval from its reference node with the true nonlinear flow, and compare with the affine
+# prediction: the largest discrepancy over the arc is the linearisation error the convex subproblem cannot see.
+# With a fixed number of nodes, where should they go?
+
+# %%
+def linearisation_error(x0, t_nodes, draws):
+    """Largest one-interval affine-model error (km) for random FOH control perturbations of size a_max.
+
+    Each interval starts from its reference node (multiple shooting, as SCvx linearises); the nonlinear flow with
+    the perturbed controls is compared with the affine prediction of Eq. 28.
+    """
+    x_ref = propagation.propagate(em, x0, t_nodes).x
+    model = D.foh_discretize(em, t_nodes, x_ref, np.zeros((t_nodes.size, 3)))
+    worst = []
+    for _ in range(draws):
+        phase = rng.uniform(0, 2 * np.pi, 3)
+        du = A_MAX * np.sin(2 * np.pi * t_nodes[:, None] / t_nodes[-1] * rng.integers(1, 4) + phase)
+        nonlinear = D.foh_discretize(em, t_nodes, x_ref, du).x_next
+        worst.append(np.max(np.linalg.norm(model.predict(x_ref, du) - nonlinear, axis=1)))
+    return float(np.median(worst) * em.length_unit_km)
+
+
+lin_err = {(name, s): linearisation_error(ARCS[name][0], nodes[name, s], N_DRAWS) for name, s in nodes}
+fig, ax = plt.subplots()
+for name in ARCS:
+    ax.semilogy(SIGMAS, [lin_err[name, s] for s in SIGMAS], "o-", label=name)
+ax.set_xlabel(r"Sundman exponent $\sigma$")
+ax.set_ylabel("largest one-step linearisation error [km]")
+ax.set_title(f"FOH affine model vs nonlinear flow ({N_NODES} nodes, controls of size a_max)")
+ax.legend()
+plotting.save_figure(fig, "04_linearisation_error_vs_sigma", output_dir=out)
+for key, v in lin_err.items():
+    print(f"{key[0]:30s} sigma = {key[1]:3.1f}: {v:.3e} km")
+
+# %% [markdown]
+# The error is not monotonic in $\sigma$: crowding the nodes into perilune leaves long intervals elsewhere, where
+# the affine model then degrades, so an intermediate exponent is best (printed above). On the NRHO the right
+# spacing matters by orders of magnitude; on the quiescent DRO of the paper's test cases it matters little.
+#
+# ## 3 · Thrust bounds on unequal intervals (Eqs. 40-41)
+#
+# The paper bounds the node controls so that the trapezoid impulse over each interval matches $a_{max}$:
+# $(u_{max,k} + u_{max,k+1})/(2\Delta t_k) = a_{max}$ (Eq. 40), i.e. the $N-1$ rows of Eq. 41 for $N$ unknowns,
+# solved in the minimum-norm sense. As printed, this gives bounds with the units of an impulse (acceleration times
+# time), larger on long intervals. If the node controls are accelerations, as in the FOH of Eq. 27, the trapezoid
+# rule instead gives $(u_{max,k}+u_{max,k+1})/2 = a_{max}$, whose minimum-norm solution is simply
+# $u_{max,k} = a_{max}$ everywhere. We show the printed reading (it is the one that depends on the spacing).
+
+# %%
+fig, ax = plt.subplots()
+name = "9:2 NRHO (1 period)"
+for s in SIGMAS:
+    t = nodes[name, s]
+    umax = D.max_control_per_node(t, A_MAX)
+    ax.plot(em.tu_to_days(t), umax * em.velocity_unit_km_s * 1e3, ".-", label=rf"$\sigma$ = {s:g}")
+ax.set_xlabel("time [days]")
+ax.set_ylabel(r"$u_{max,k}$ as printed [m/s]")
+ax.set_title("Eq. 41 minimum-norm node bounds on the NRHO arc")
+ax.legend()
+plotting.save_figure(fig, "04_umax_per_node", output_dir=out)
+t_demo = nodes[name, max(SIGMAS)]
+u_demo = D.max_control_per_node(t_demo, A_MAX)
+residual_40 = float(np.max(np.abs((u_demo[:-1] + u_demo[1:]) / (2 * np.diff(t_demo)) - A_MAX)) / A_MAX)
+print(f"Eq. 40 relative residual of the minimum-norm solution: {residual_40:.1e}")
+
+# %% [markdown]
+# ## 4 · Paper versus reproduction
+
+# %%
+dro_name, nrho_name = list(ARCS)
+gain_dro = lin_err[dro_name, 0.0] / min(lin_err[dro_name, s] for s in SIGMAS)
+gain_nrho = lin_err[nrho_name, 0.0] / min(lin_err[nrho_name, s] for s in SIGMAS)
+best_nrho = min(SIGMAS, key=lambda s: lin_err[nrho_name, s])
+table.add("sigma = 0: t and tau coincide (Eq. 37)", "one-to-one equivalence", "uniform nodes, tau = t (tested)",
+          "reproduced")
+table.add("positive sigma dilates time near perilune", "yes",
+          f"NRHO shortest interval at perilune; spacing ratio {spread[nrho_name, max(SIGMAS)]:.0f} at sigma = "
+          f"{max(SIGMAS):g}", "reproduced" if spread[nrho_name, max(SIGMAS)] > 5 else "differs: little dilation")
+table.add("exponent symbol in Eq. 38", "alpha (Eq. 37: sigma)", "sigma used throughout", "differs: naming only",
+          "Eq. 38's r_m^alpha is the Sundman factor of Eq. 37")
+table.add("number of nodes and sigma", "not given", f"N = {N_NODES}; sigma in {SIGMAS}", "not in paper",
+          "swept here")
+table.add("Sundman nodes improve linearisation accuracy, DRO arc", "effective (qualitative)",
+          f"best sigma reduces the worst one-step error {gain_dro:.2f}x vs uniform",
+          "reproduced" if gain_dro > 1.1 else "differs: the DRO is too benign for spacing to matter",
+          f"uniform {lin_err[dro_name, 0.0]:.2e} km")
+table.add("Sundman nodes improve linearisation accuracy, NRHO arc", "not in paper (motivation)",
+          f"{gain_nrho:.1f}x at sigma = {best_nrho:g} vs uniform", "beyond paper",
+          f"uniform {lin_err[nrho_name, 0.0]:.2e} km")
+table.add("Eq. 41 minimum-norm node bounds", "QR minimum-norm solution", f"Eq. 40 residual {residual_40:.0e}",
+          "reproduced", "bounds have impulse units as printed; the acceleration reading gives u_max = a_max")
+table.add("FOH matrices (Eqs. 29-31)", "integrated with Phi^-1 (Eq. 32)", "heyoka state/parameter sensitivities",
+          "beyond paper", "same matrices without inverting the STM; tests vs STM and finite differences")
+table.display()
