@@ -11,6 +11,7 @@ measurements  relative position, range / range-rate, azimuth / elevation (+ rate
 covariance    SPD helpers, process-noise discretisation, EKF covariance (CRLB) recursion, augmented states
 information   mutual information of an observation window (dense Eq. 18 and O(N) chain rule) and its gradient
 discretization  Sundman-spaced nodes and first-order-hold discretisation for SCvx
+scvx          successive convexification with trust region and virtual control (Wolf & Jones)
 srif          square-root information filter and smoother (Householder)
 ocbe          optimal-control-based estimator: state/costate transition, Eq. 17 process noise, SRI filter/smoother
 tracking      optical tracking scenarios (truth with impulses, measurements, hand-off, NEES consistency trials)

@@ -176,7 +176,8 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
     t_nodes : array_like, shape (N,)
         Node times (e.g. Sundman-spaced), TU.
     x_guess, u_guess : array_like, shapes (N, 6), (N, 3)
-        Initial reference; ``x_guess[0]`` is the fixed initial state and the last node is replaced by
+        Initial reference (guess controls above ``u_max`` are scaled down onto the bound); ``x_guess[0]`` is the
+        fixed initial state and the last node is replaced by
         ``x_final`` when given (the reference must satisfy the boundary conditions; the mismatch shows up as
         defects, which the virtual control and the penalty then remove).
     u_max : array_like, shape (N,)
@@ -217,6 +218,10 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
     if np.any(umax < 0):
         raise ValueError("u_max must be non-negative")
     alpha = _checks.in_range(alpha, "alpha", 0.0, 1.0)
+    # project the guess controls onto the bounds so that the first trust region can contain a feasible point
+    norms = np.linalg.norm(u_ref, axis=1)
+    over = norms > umax
+    u_ref[over] *= (umax[over] / norms[over])[:, None]
     x_tc = None if x_final is None else _checks.as_state(x_final, "x_final", batch=False)
     if x_tc is not None:
         x_ref[-1] = x_tc  # the reference must meet the boundary conditions; its defects carry the mismatch

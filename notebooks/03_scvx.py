@@ -1,0 +1,186 @@
+# ---
+# jupyter:
+#   jupytext:
+#     formats: py:percent
+#   kernelspec:
+#     display_name: Python 3
+#     language: python
+#     name: python3
+# ---
+
+# %% [markdown]
+# # 03 · Successive convexification (SCvx) with first-order hold
+#
+# **What you will learn.** How SCvx turns a nonconvex low-thrust trajectory problem in the CR3BP into a sequence
+# of convex second-order-cone programs: the first-order-hold affine model of each step, the virtual control that
+# keeps every subproblem feasible, the trust region that keeps the linearisation honest, and the ratio test of
+# Table 1 that accepts or rejects each step. We watch it converge on the boundary conditions of Wolf & Jones' test
+# case 1 (minimum impulse, no information reward yet: that is notebook 05) and check that the answer does not
+# depend on the initial guess.
+#
+# **Paper sections followed.** Wolf & Jones (arXiv 2408.17435), "Sequential Convex Programming for Trajectory
+# Generation": Linearization (Eqs. 24-26), Discretization (Eqs. 27-33), Trust Region Update (Eqs. 34-36, Table 1),
+# and the objective of "Convex Objective Approximation" (Eqs. 42-43). The node placement is notebook 04.
+
+# %% tags=["parameters"]
+QUICK = False
+SEED = 0
+OUTPUT_DIR = ""
+
+# %%
+# Sizes derived from QUICK: fewer nodes and fewer random initial guesses in quick mode; the same experiments.
+N_NODES = 24 if QUICK else 60
+N_GUESSES = 2 if QUICK else 6
+SIGMA = 1.0  # Sundman exponent (notebook 04); the DRO is benign, so its value matters little here
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from cislunar import discretization as D
+from cislunar import plotting, reference, scvx
+from cislunar.dynamics import EARTH_MOON as em
+from cislunar.propagation import propagate
+from cislunar.report import ComparisonTable
+
+plotting.use_style()
+out = OUTPUT_DIR or None
+rng = np.random.default_rng(SEED)
+table = ComparisonTable("03 SCvx with first-order hold (Wolf & Jones Eqs. 24-36, 42-43, Table 1)")
+
+# %% [markdown]
+# ## 1 · The problem
+#
+# Test case 1's observer starts on the DRO of Table 2 (its printed $\dot y_0$ is corrected in notebook 01) and must
+# reach the printed final state $x_{\mathcal S}(t_f)$ on a neighbouring DRO after two periods, with a thrust
+# acceleration of at most $a_{max} = 10^{-6}$ km/s² (Table 3). With $\alpha_h = 0$ the objective of Eq. 42 is the
+# total impulse plus the defect penalty.
+
+# %%
+rows = {r.label: r for r in reference.load_wolf_jones_table() if r.table == 2}
+dro = reference.verify_table_row(em, rows["observer_t0"]).corrected
+x_final = np.array([rows["observer_tf"].x0, 0, 0, 0, rows["observer_tf"].vy0, 0])
+T = 2 * dro.period
+t, _ = D.sundman_nodes(em, dro.x0, T, N_NODES, SIGMA)
+A_MAX = 1e-6 / em.acceleration_unit_km_s2
+# The node controls are accelerations (first-order hold, Eq. 27), so the bound is a_max at every node: the
+# acceleration reading of Eqs. 40-41 discussed in notebook 04 (the printed reading has impulse units).
+u_max = np.full(t.size, A_MAX)
+print(f"transfer time {em.tu_to_days(T):.2f} d, {N_NODES} Sundman nodes (sigma = {SIGMA}), "
+      f"a_max = {A_MAX:.4f} LU/TU^2; |x_f - x(T) ballistic| = "
+      f"{np.linalg.norm(propagate(em, dro.x0, T).x[-1] - x_final):.2e}")
+
+# %% [markdown]
+# ## 2 · One SCvx run, step by step
+#
+# Each iteration (i) discretises the controlled dynamics about the reference nodes with a first-order hold:
+# $x_{k+1} = A_kx_k + B_k^-u_k + B_k^+u_{k+1} + r_k + E_k\epsilon_k$ (Eq. 30b, matrices from heyoka's state and
+# parameter sensitivities, notebook 04); (ii) solves the second-order-cone program of Eq. 30 with the trust region
+# $\|\delta x_k\|+\|\delta u_k\|\le\eta$ and the virtual control $\epsilon_k$ penalised by $\gamma\|E_k\epsilon_k\|_1$;
+# (iii) compares the actual decrease of the nonlinear cost $\mathcal J$ (Eq. 42, with the multiple-shooting defects
+# of Eq. 34) with the decrease $\mathcal J - \mathcal L$ predicted by the convex model (Eq. 36):
+#
+# | $\rho$ | trust region | reference |
+# |---|---|---|
+# | $\rho<\rho_0$ | $\eta/\beta_{sh}$ | kept (step rejected) |
+# | $\rho_0\le\rho<\rho_1$ | $\eta/\beta_{sh}$ | new |
+# | $\rho_1\le\rho<\rho_2$ | $\eta$ | new |
+# | $\rho_2\le\rho$ | $\beta_{gr}\eta$ | new |
+#
+# The paper leaves $\rho_{0,1,2}$, $\beta$, $\gamma$ and $\eta_0$ to the user; ours (from Malyuta et al. 2022) are
+# printed below. The convex subproblem is built once with `cvxpy.Parameter`s and re-solved by Clarabel.
+
+# %%
+settings = scvx.SCvxSettings()
+print(settings)
+x_guess = propagate(em, dro.x0, t).x  # ballistic initial guess
+res = scvx.solve_scvx(em, t, x_guess, np.zeros((t.size, 3)), u_max, x_final=x_final, settings=settings)
+print(f"converged in {len(res.history)} iterations: impulse {res.impulse * em.velocity_unit_km_s * 1e3:.4f} m/s, "
+      f"largest defect {res.max_defect:.1e}")
+for h in res.history:
+    print(f"  it {h['iteration']:2d}: J = {h['cost']:.6e} -> {h['new_cost']:.6e}, predicted {h['predicted']:.2e}, "
+          f"rho = {h['rho']:.3f}, eta = {h['eta']:.3g}, {'accepted' if h['accepted'] else 'rejected'}, "
+          f"max defect {h['max_defect']:.1e}")
+
+fig, axes = plt.subplots(1, 3, figsize=(14, 4))
+its = [h["iteration"] for h in res.history]
+axes[0].semilogy(its, [max(h["cost"], 1e-16) for h in res.history], "o-")
+axes[0].set(xlabel="iteration", ylabel=r"nonlinear cost $\mathcal{J}$")
+axes[1].semilogy(its, [max(h["max_defect"], 1e-16) for h in res.history], "o-")
+axes[1].set(xlabel="iteration", ylabel="largest defect after the step")
+axes[2].semilogy(its, [h["eta"] for h in res.history], "o-")
+axes[2].set(xlabel="iteration", ylabel=r"trust-region radius $\eta$")
+fig.suptitle("SCvx iterations, minimum-impulse DRO transfer (test case 1 boundary conditions)")
+plotting.save_figure(fig, "03_iterations", output_dir=out)
+
+# %% [markdown]
+# ## 3 · Is the converged trajectory real?
+#
+# The virtual control is a modelling device: at convergence it must vanish, and the first-order-hold control, fed
+# to the *nonlinear* dynamics from the initial state alone (single shooting), must reach the terminal state.
+
+# %%
+x_single = D.propagate_foh(em, dro.x0, t, res.u)
+terminal_miss_km = float(np.linalg.norm(x_single[-1, :3] - x_final[:3]) * em.length_unit_km)
+terminal_miss_mm_s = float(np.linalg.norm(x_single[-1, 3:] - x_final[3:]) * em.velocity_unit_km_s * 1e6)
+print(f"single shooting with the converged control misses x_f by {terminal_miss_km:.2e} km and "
+      f"{terminal_miss_mm_s:.2e} mm/s")
+fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.2))
+unorm = np.linalg.norm(res.u, axis=1) * em.acceleration_unit_km_s2 * 1e9
+ax1.semilogy(em.tu_to_days(t), np.maximum(unorm, 1e-6), ".-", label="|u| (nodes, FOH in between)")
+ax1.axhline(A_MAX * em.acceleration_unit_km_s2 * 1e9, color="k", lw=0.8, ls="--", label="a_max")
+ax1.set(xlabel="time [days]", ylabel="thrust acceleration [um/s^2]", title="converged control")
+ax1.legend(fontsize=8)
+dense_t = np.linspace(0, T, 800)
+ref = propagate(em, dro.x0, dense_t).x
+plotting.plot_rotating(ax2, (x_single - propagate(em, dro.x0, t).x)[None], em, "xy", units="km", marker=".",
+                       label="converged minus initial DRO")
+ax2.set_title("relative motion w.r.t. the initial DRO (rotating frame)")
+ax2.legend()
+plotting.save_figure(fig, "03_converged_control", output_dir=out)
+
+# %% [markdown]
+# ## 4 · Independence from the initial guess
+#
+# SCvx converges to a local optimum; for this mildly nonlinear transfer we expect the same one from different
+# starting points: a straight blend between the forward and backward ballistic arcs with random controls (5% of
+# $a_{max}$; from much rougher guesses the trust region shrinks and progress becomes slow, a known SCvx trait).
+
+# %%
+impulses, iterations = [], []
+for _ in range(N_GUESSES):
+    back = propagate(em, x_final, t[::-1]).x[::-1]
+    s = (t / t[-1])[:, None]
+    guess = (1 - s) * x_guess + s * back
+    r = scvx.solve_scvx(em, t, guess, 0.05 * A_MAX * rng.standard_normal((t.size, 3)), u_max, x_final=x_final,
+                        settings=scvx.SCvxSettings(max_iter=200))
+    impulses.append(r.impulse)
+    iterations.append(len(r.history))
+spread = float((max(impulses) - min(impulses)) / res.impulse)
+print("impulses from random guesses [m/s]:", np.round(np.array(impulses) * em.velocity_unit_km_s * 1e3, 6),
+      f"relative spread {spread:.1e}; iterations {iterations}")
+
+# %% [markdown]
+# ## 5 · Paper versus reproduction
+#
+# The paper reports no standalone SCvx run; its numbers come with the information reward (notebooks 05-06). The
+# rows below check what the method section states.
+
+# %%
+table.add("SCvx converges with defects driven to zero (Eqs. 30, 42)", "yes (method)",
+          f"{len(res.history)} iterations, largest defect {res.max_defect:.0e}",
+          "reproduced" if res.max_defect < 1e-9 else "differs: defects remain")
+table.add("converged FOH control flies the nonlinear dynamics to x_f", "implied",
+          f"miss {terminal_miss_km:.1e} km, {terminal_miss_mm_s:.1e} mm/s", "reproduced" if terminal_miss_km < 1e-3
+          else "differs: single-shooting miss too large")
+table.add("trust-region parameters (Table 1)", "user-defined, not given",
+          f"rho = {settings.rho0}/{settings.rho1}/{settings.rho2}, beta = {settings.beta_shrink}/{settings.beta_grow}, "
+          f"gamma = {settings.defect_weight:g}, eta0 = {settings.eta0:g}", "not in paper",
+          "typical values from Malyuta et al. 2022")
+table.add("minimum impulse, test case 1 boundary conditions", "not reported (alpha_h = 0 not shown)",
+          f"{res.impulse * em.velocity_unit_km_s * 1e3:.4f} m/s", "not in paper",
+          "corrected x_S(t0) (notebook 01) to printed x_S(tf), two periods")
+table.add("same optimum from different initial guesses", "-", f"relative impulse spread {spread:.0e}",
+          "beyond paper", f"{N_GUESSES} random guesses")
+table.add("defect penalty weighting", "trapezoid over node defects (Eqs. 42-43)", "one weight dt_k per interval",
+          "differs: documented choice", "Eq. 42's trapezoid needs a defect at the last node, where none exists")
+table.display()
