@@ -81,12 +81,14 @@ def in_range(value, name: str, lo: float, hi: float, *, closed: bool = True) -> 
     return v
 
 
-def time_grid(value, name: str = "t") -> np.ndarray:
-    """Check a strictly monotonic 1-D time grid with at least two entries."""
+def time_grid(value, name: str = "t", *, increasing: bool = False) -> np.ndarray:
+    """Check a strictly monotonic 1-D time grid with at least two entries (strictly increasing if asked)."""
     t = as_array(value, name, ndim=(1,))
     if t.size < 2:
         raise ValueError(f"{name} must hold at least two times (start and end); got {t.size}")
     d = np.diff(t)
+    if increasing and not np.all(d > 0):
+        raise ValueError(f"{name} must be strictly increasing")
     if not (np.all(d > 0) or np.all(d < 0)):
         raise ValueError(f"{name} must be strictly increasing or strictly decreasing")
     return t

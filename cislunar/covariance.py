@@ -302,9 +302,7 @@ def process_noise(system: CR3BP, x, t, q: float, *, n_nodes: int = 12) -> np.nda
     """
     _check_system(system)
     x = _checks.as_array(x, "x", ndim=(2, 3), last=6)
-    t = _checks.time_grid(t, "t")
-    if np.any(np.diff(t) <= 0):
-        raise ValueError("t must be strictly increasing")
+    t = _checks.time_grid(t, "t", increasing=True)
     if x.shape[-2] != t.size:
         raise ValueError(f"x must hold one state per time of t ({t.size}); got shape {x.shape}")
     q = _checks.positive(q, "q", allow_zero=True)
@@ -630,9 +628,7 @@ def linearize_augmented(system: CR3BP, observer_x0, targets_x0, t, model: Measur
         xt0 = xt0[None]
     if xt0.ndim != 2 or xt0.shape[0] < 1:
         raise ValueError(f"targets_x0 must have shape (N_T, 6); got {xt0.shape}")
-    t = _checks.time_grid(t, "t")
-    if np.any(np.diff(t) <= 0):
-        raise ValueError("t must be strictly increasing")
+    t = _checks.time_grid(t, "t", increasing=True)
     if (q is None) == (Q is None):
         raise ValueError("give exactly one of q (process-noise PSD) and Q (discrete process noise)")
     NT, N, m = xt0.shape[0], t.size, model.dim

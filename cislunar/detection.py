@@ -581,9 +581,7 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
     tol : float
         Integrator tolerance.
     """
-    t = _checks.time_grid(t, "t")
-    if np.any(np.diff(t) <= 0):
-        raise ValueError("t must be strictly increasing")
+    t = _checks.time_grid(t, "t", increasing=True)
     N = t.size
     y = _checks.as_array(y, "y", ndim=(3,))
     B, m = y.shape[0], model.dim

@@ -130,9 +130,7 @@ def max_control_per_node(t_nodes, a_max: float) -> np.ndarray:
     ndarray, shape (N,)
         Minimum-norm solution (``numpy.linalg.lstsq``; the paper uses a QR factorisation, same solution).
     """
-    t = _checks.time_grid(t_nodes, "t_nodes")
-    if np.any(np.diff(t) <= 0):
-        raise ValueError("t_nodes must be strictly increasing")
+    t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
     a = _checks.positive(a_max, "a_max", allow_zero=True)
     dt = np.diff(t)
     n = t.size
@@ -239,9 +237,7 @@ def foh_discretize(system: CR3BP, t_nodes, x_nodes, u_nodes, *, tol: float = DEF
     tol : float
         Integrator tolerance.
     """
-    t = _checks.time_grid(t_nodes, "t_nodes")
-    if np.any(np.diff(t) <= 0):
-        raise ValueError("t_nodes must be strictly increasing")
+    t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
     n = t.size
     x = _checks.as_array(x_nodes, "x_nodes", shape=(n, 6))
     u = _checks.as_array(u_nodes, "u_nodes", shape=(n, 3))

@@ -299,9 +299,7 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
     """
     from . import srif
 
-    t = _checks.time_grid(t, "t")
-    if np.any(np.diff(t) <= 0):
-        raise ValueError("t must be strictly increasing")
+    t = _checks.time_grid(t, "t", increasing=True)
     N = t.size
     obs = _checks.as_array(observer_states, "observer_states", ndim=(2, 3), last=6)
     obs = obs[:, None, :] if obs.ndim == 2 else obs

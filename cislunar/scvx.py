@@ -208,9 +208,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
     import cvxpy as cp
 
     st = settings or SCvxSettings()
-    t = _checks.time_grid(t_nodes, "t_nodes")
-    if np.any(np.diff(t) <= 0):
-        raise ValueError("t_nodes must be strictly increasing")
+    t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
     n = t.size
     x_ref = _checks.as_array(x_guess, "x_guess", shape=(n, 6)).copy()
     u_ref = _checks.as_array(u_guess, "u_guess", shape=(n, 3)).copy()
