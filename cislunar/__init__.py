@@ -21,6 +21,7 @@ lpv           LPV form of the planar CR3BP and H2 / H-infinity sensing-precision
 observers     LPV observer and EKF simulations on the nonlinear CR3BP
 plotting      packaged matplotlib style, ``save_figure``, rotating-frame plot helpers
 report        paper-vs-reproduction tables gathered into ``build/report.md``
+progress      one progress bar for long loops (widget, plain text when headless, or off)
 notebooks     command-line runner executing ``notebooks/NN_*.py`` with papermill
 """
 

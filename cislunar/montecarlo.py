@@ -28,11 +28,9 @@ def _run_chunk(trial, seed, indices, args, kwargs):
 
 
 def _progress(iterable, total, desc, enabled):
-    if not enabled:
-        return iterable
-    from tqdm.auto import tqdm
+    from .progress import progress
 
-    return tqdm(iterable, total=total, desc=desc)
+    return progress(iterable, total=total, desc=desc, enabled=enabled)
 
 
 def run_monte_carlo(trial, n_trials: int, seed, *, args=(), kwargs=None, executor=None, chunk_size: int | None = None,

@@ -385,11 +385,9 @@ def continue_family(system: CR3BP, orbit: PeriodicOrbit, n_steps: int, step: flo
     X = _pack(orbit.x0, orbit.period / 2.0, planar)
     family = [orbit]
     tangent = None
-    iterator = range(n_steps)
-    if progress:
-        from tqdm.auto import tqdm
+    from .progress import progress as _bar
 
-        iterator = tqdm(iterator, desc=f"continuing {orbit.label or 'family'}")
+    iterator = _bar(range(n_steps), desc=f"continuing {orbit.label or 'family'}", enabled=progress)
     for _ in iterator:
         ds = step
         for attempt in range(4):
