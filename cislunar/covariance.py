@@ -60,6 +60,7 @@ __all__ = [
     "WOLF_JONES_PSD_KM2_S3",
     "symmetrize",
     "check_spd",
+    "check_psd",
     "cholesky_spd",
     "logdet_spd",
     "block_diag",
@@ -76,6 +77,9 @@ __all__ = [
     "covariance_analysis",
     "position_sigma_km",
     "AugmentedLinearization",
+    "ObjectArcs",
+    "propagate_arcs",
+    "assemble_augmented",
     "linearize_augmented",
 ]
 
@@ -90,9 +94,12 @@ WOLF_JONES_PSD_KM2_S3 = 1e-11
 # --------------------------------------------------------------------------------------------------------------
 # SPD helpers
 # --------------------------------------------------------------------------------------------------------------
-def symmetrize(P) -> np.ndarray:
-    """Symmetric part :math:`(P + P^T)/2` of square matrices ``(..., n, n)``."""
-    P = np.asarray(P, dtype=float)
+def symmetrize(P, name: str = "P") -> np.ndarray:
+    """Symmetric part :math:`(P + P^T)/2` of square matrices ``(..., n, n)``.
+
+    Raises ``ValueError`` naming ``name`` for a non-square or non-finite input.
+    """
+    P = _square(P, name)
     return 0.5 * (P + np.swapaxes(P, -1, -2))
 
 
@@ -138,6 +145,31 @@ def check_spd(P, name: str = "P", *, rtol: float = 1e-8) -> np.ndarray:
     """
     cholesky_spd(P, name, rtol=rtol)
     return symmetrize(P)
+
+
+def check_psd(Q, name: str = "Q", *, rtol: float = 1e-8) -> np.ndarray:
+    """Check that ``Q`` (..., n, n) is symmetric positive *semi*-definite; return its symmetric part.
+
+    Zero matrices are allowed (no process noise).  The smallest eigenvalue may be negative by at most ``rtol``
+    times the largest absolute entry (round-off of a computed covariance).
+
+    Raises
+    ------
+    ValueError
+        Not square, NaN, asymmetric beyond ``rtol`` or with a negative eigenvalue (names ``name``).
+    """
+    Q = _square(Q, name)
+    scale = float(np.max(np.abs(Q))) if Q.size else 0.0
+    if scale == 0.0:
+        return symmetrize(Q, name)
+    asym = float(np.max(np.abs(Q - np.swapaxes(Q, -1, -2))))
+    if asym > rtol * scale:
+        raise ValueError(f"{name} must be symmetric (max asymmetry {asym:.3g})")
+    Qs = symmetrize(Q, name)
+    lam = float(np.min(np.linalg.eigvalsh(Qs)))
+    if lam < -rtol * scale:
+        raise ValueError(f"{name} must be positive semi-definite (smallest eigenvalue {lam:.3g})")
+    return Qs
 
 
 def logdet_spd(P, name: str = "P") -> np.ndarray:
@@ -348,12 +380,16 @@ def process_noise_lyapunov(system: CR3BP, x0, dt: float, q: float, *, rtol: floa
 # EKF covariance recursion
 # --------------------------------------------------------------------------------------------------------------
 def ekf_predict(P, F, Q) -> np.ndarray:
-    """Covariance time update :math:`\\bar P = F P F^T + Q` (broadcast over leading axes)."""
-    P = _square(P, "P")
+    """Covariance time update :math:`\\bar P = F P F^T + Q` (broadcast over leading axes).
+
+    Raises ``ValueError`` naming the argument when ``P`` is not symmetric positive definite, ``Q`` not symmetric
+    positive semi-definite, or the shapes do not match.
+    """
+    P = check_spd(P, "P")
     F = _checks.as_array(F, "F")
-    Q = _square(Q, "Q")
+    Q = check_psd(Q, "Q")
     n = P.shape[-1]
-    if F.shape[-2:] != (n, n) or Q.shape[-1] != n:
+    if F.ndim < 2 or F.shape[-2:] != (n, n) or Q.shape[-1] != n:
         raise ValueError(f"F and Q must be ({n}, {n}) to match P; got F {F.shape}, Q {Q.shape}")
     return symmetrize(F @ P @ np.swapaxes(F, -1, -2) + Q)
 
@@ -379,7 +415,7 @@ def ekf_update(P, H, R):
     S : ndarray (..., m, m)
         Innovation covariance :math:`HPH^T + R`.
     """
-    P = _square(P, "P")
+    P = check_spd(P, "P")
     H = _checks.as_array(H, "H")
     R = _square(R, "R")
     n = P.shape[-1]
@@ -574,6 +610,153 @@ class AugmentedLinearization:
         return self.P0, self.F, self.Q, self.H, self.R
 
 
+@dataclass(frozen=True)
+class ObjectArcs:
+    """Ballistic arcs of K objects on a common grid, with per-interval transitions (building block of
+    :func:`linearize_augmented`; lets a caller propagate fixed targets once and re-linearise only the observer).
+
+    Attributes
+    ----------
+    t : ndarray (N,)
+        Grid times, TU.
+    x : ndarray (K, N, 6)
+        States at ``t``.
+    F : ndarray (K, N-1, 6, 6)
+        :math:`\\Phi(t_{k+1}, t_k)` of each object.
+    Q : ndarray (K, N-1, 6, 6) or None
+        Process noise over each interval (when a PSD was given).
+    stt : ndarray (K, N-1, 6, 6, 6) or None
+        Second-order STT of each interval with respect to the interval's start state (``order=2``).
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    F: np.ndarray
+    Q: np.ndarray | None
+    stt: np.ndarray | None
+
+    @property
+    def stm_from_start(self) -> np.ndarray:
+        """:math:`\\Phi(t_k, t_0)` of each object, (K, N, 6, 6): running product of the interval STMs."""
+        K, N = self.x.shape[0], self.t.size
+        out = np.empty((K, N, 6, 6))
+        out[:, 0] = np.eye(6)
+        for k in range(1, N):
+            out[:, k] = self.F[:, k - 1] @ out[:, k - 1]
+        return out
+
+
+def propagate_arcs(system: CR3BP, x0, t, *, q: float | None = None, order: int = 1,
+                   n_nodes: int = 12) -> ObjectArcs:
+    """Propagate K objects from ``t[0]`` over the grid ``t``; interval STMs (order 1) or STMs and STTs (order 2).
+
+    Parameters
+    ----------
+    system : CR3BP
+    x0 : array_like (K, 6) or (6,)
+        States at ``t[0]``.
+    t : array_like (N,)
+        Strictly increasing times, TU (N >= 2).
+    q : float, optional
+        Acceleration PSD (LU^2/TU^3); if given the exact process noise of every interval is computed too.
+    order : {1, 2}
+    n_nodes : int
+        Quadrature nodes per interval for the process noise.
+    """
+    from .propagation import propagate
+
+    _check_system(system)
+    x0 = _checks.as_array(x0, "x0", last=6)
+    if x0.ndim == 1:
+        x0 = x0[None]
+    if x0.ndim != 2:
+        raise ValueError(f"x0 must have shape (K, 6) or (6,); got {x0.shape}")
+    t = _checks.time_grid(t, "t", increasing=True)
+    if order not in (1, 2):
+        raise ValueError(f"order must be 1 or 2; got {order!r}")
+    qq = None if q is None else _checks.positive(q, "q", allow_zero=True)
+    K, N = x0.shape[0], t.size
+    X = propagate(system, x0, t).x
+    X = X if X.ndim == 3 else X[None]
+    starts = X[:, :-1].reshape(-1, 6)
+    dts = np.tile(np.diff(t), K)
+    F, Qd, Psi = _interval_transitions(system, starts, dts, qq, int(n_nodes), order)
+    return ObjectArcs(t=t, x=X, F=F.reshape(K, N - 1, 6, 6),
+                      Q=None if Qd is None else Qd.reshape(K, N - 1, 6, 6),
+                      stt=None if Psi is None else Psi.reshape(K, N - 1, 6, 6, 6))
+
+
+def assemble_augmented(model: MeasurementModel, noise, P0, observer: ObjectArcs, targets: ObjectArcs, *,
+                       Q=None, index: int = 0) -> AugmentedLinearization:
+    """Augmented linearisation (Eqs. 19-23 ingredients) from already propagated observer and target arcs.
+
+    Parameters
+    ----------
+    model : MeasurementModel
+    noise : array_like (m, m) or callable
+        As in :func:`linearize_augmented`.
+    P0 : array_like (n, n)
+        Augmented covariance at ``t[0]``.
+    observer : ObjectArcs
+        Arcs of one or more observer candidates; ``index`` selects one.  With ``stt`` present, the derivatives
+        ``dF``, ``dH`` with respect to the observer state at ``t[0]`` are filled in.
+    targets : ObjectArcs
+        Arcs of the N_T targets on the same grid.
+    Q : array_like (N-1, n, n), optional
+        Fixed augmented process noise; default: block diagonal of the arcs' own ``Q``.
+    index : int
+        Which observer arc to use.
+    """
+    if not isinstance(model, MeasurementModel):
+        raise ValueError(f"model must be a cislunar.measurements.MeasurementModel; got {type(model).__name__}")
+    if observer.t.shape != targets.t.shape or not np.array_equal(observer.t, targets.t):
+        raise ValueError("observer and targets arcs must share the same time grid")
+    t = observer.t
+    NT, N, m = targets.x.shape[0], t.size, model.dim
+    n = 6 * (NT + 1)
+    P0 = check_spd(_checks.as_array(P0, "P0", shape=(n, n)), "P0")
+    i = int(index)
+    obs = observer.x[i]
+    tgts = targets.x
+    Fo = observer.F[i]
+    F = block_diag(np.moveaxis(np.concatenate([Fo[None], targets.F], axis=0), 0, 1))
+    if Q is None:
+        if observer.Q is None or targets.Q is None:
+            raise ValueError("give Q, or arcs propagated with a process-noise PSD q")
+        Qa = block_diag(np.moveaxis(np.concatenate([observer.Q[i][None], targets.Q], axis=0), 0, 1))
+    else:
+        Qa = _as_sequence(Q, "Q", N - 1, (n, n))
+    stm = np.empty((N, 6, 6))
+    stm[0] = np.eye(6)
+    for k in range(1, N):
+        stm[k] = Fo[k - 1] @ stm[k - 1]
+    _, Hs, Ht = model.evaluate(obs[None], tgts)  # (NT, N, m, 6)
+    H = np.zeros((N, NT * m, n))
+    for j in range(NT):
+        H[:, j * m:(j + 1) * m, 0:6] = Hs[j]
+        H[:, j * m:(j + 1) * m, 6 * (j + 1):6 * (j + 2)] = Ht[j]
+    if callable(noise):
+        Rt = _checks.as_array(noise(obs[None], tgts), "noise(observer, target)", shape=(NT, N, m, m))
+    else:
+        Rt = np.broadcast_to(_checks.as_array(noise, "noise", shape=(m, m)), (NT, N, m, m))
+    R = block_diag(np.moveaxis(Rt, 0, 1))
+    check_spd(R, "noise")
+    dF = dH = None
+    if observer.stt is not None:
+        Psi = observer.stt[i]
+        dF = np.zeros((N - 1, n, n, 6))
+        dF[:, 0:6, 0:6, :] = np.einsum("kabd,kdc->kabc", Psi, stm[:-1])
+        hess = model.hessian(obs[None], tgts)  # (NT, N, m, 6, 6): d2h/ddelta2
+        # dH_obs/dx_S = +hess, dH_tgt/dx_S = -hess (delta = x_T - x_S); chain with Phi_S(t_k, t_0)
+        dhx = np.einsum("ikabd,kdc->ikabc", hess, stm)
+        dH = np.zeros((N, NT * m, n, 6))
+        for j in range(NT):
+            dH[:, j * m:(j + 1) * m, 0:6, :] = dhx[j]
+            dH[:, j * m:(j + 1) * m, 6 * (j + 1):6 * (j + 2), :] = -dhx[j]
+    return AugmentedLinearization(t=t, observer=obs, targets=tgts, P0=P0, F=F, Q=Qa, H=H, R=R, dF=dF, dH=dH,
+                                  observer_stm=stm)
+
+
 def linearize_augmented(system: CR3BP, observer_x0, targets_x0, t, model: MeasurementModel, noise, P0, *,
                         q: float | None = None, Q=None, derivatives: bool = False,
                         n_nodes: int = 12) -> AugmentedLinearization:
@@ -615,10 +798,9 @@ def linearize_augmented(system: CR3BP, observer_x0, targets_x0, t, model: Measur
     Transition matrices are propagated interval by interval from the reference states (no inversion of long-arc
     STMs); :math:`\\Phi_{\\mathcal S}(t_k, t_0)` is their running product.  The noise covariance is treated as
     independent of the states in ``dH`` (exact for constant noise; for range-dependent angular noise the
-    sensitivity of R is neglected, like that of :math:`\\tilde P` in the paper).
+    sensitivity of R is neglected, like that of :math:`\\tilde P` in the paper).  Built from
+    :func:`propagate_arcs` and :func:`assemble_augmented`.
     """
-    from .propagation import propagate
-
     _check_system(system)
     if not isinstance(model, MeasurementModel):
         raise ValueError(f"model must be a cislunar.measurements.MeasurementModel; got {type(model).__name__}")
@@ -631,54 +813,10 @@ def linearize_augmented(system: CR3BP, observer_x0, targets_x0, t, model: Measur
     t = _checks.time_grid(t, "t", increasing=True)
     if (q is None) == (Q is None):
         raise ValueError("give exactly one of q (process-noise PSD) and Q (discrete process noise)")
-    NT, N, m = xt0.shape[0], t.size, model.dim
-    n = 6 * (NT + 1)
+    n = 6 * (xt0.shape[0] + 1)
     P0 = check_spd(_checks.as_array(P0, "P0", shape=(n, n)), "P0")
-
-    # true trajectories on the measurement grid (batch: observer first)
-    tr = propagate(system, np.vstack([xs0, xt0]), t)
-    X = tr.x  # (NT+1, N, 6)
-    starts = X[:, :-1].reshape(-1, 6)
-    dts = np.tile(np.diff(t), NT + 1)
-    qq = None if q is None else _checks.positive(q, "q", allow_zero=True)
-    Fo, Qo, Psi = _interval_transitions(system, starts[:N - 1], dts[:N - 1], qq, n_nodes, 2 if derivatives else 1)
-    Ft, Qt, _ = _interval_transitions(system, starts[N - 1:], dts[N - 1:], qq, n_nodes, 1)
-    Fobj = np.concatenate([Fo[None], Ft.reshape(NT, N - 1, 6, 6)], axis=0)  # (NT+1, N-1, 6, 6)
-    F = block_diag(np.moveaxis(Fobj, 0, 1))
-    if Q is None:
-        Qobj = np.concatenate([Qo[None], Qt.reshape(NT, N - 1, 6, 6)], axis=0)
-        Qa = block_diag(np.moveaxis(Qobj, 0, 1))
-    else:
-        Qa = _as_sequence(Q, "Q", N - 1, (n, n))
-    # observer STM from t[0]
-    stm = np.empty((N, 6, 6))
-    stm[0] = np.eye(6)
-    for k in range(1, N):
-        stm[k] = Fo[k - 1] @ stm[k - 1]
-
-    obs, tgts = X[0], X[1:]
-    _, Hs, Ht = model.evaluate(obs[None], tgts)  # (NT, N, m, 6)
-    H = np.zeros((N, NT * m, n))
-    for i in range(NT):
-        H[:, i * m:(i + 1) * m, 0:6] = Hs[i]
-        H[:, i * m:(i + 1) * m, 6 * (i + 1):6 * (i + 2)] = Ht[i]
-    if callable(noise):
-        Rt = _checks.as_array(noise(obs[None], tgts), "noise(observer, target)", shape=(NT, N, m, m))
-    else:
-        Rt = np.broadcast_to(_checks.as_array(noise, "noise", shape=(m, m)), (NT, N, m, m))
-    R = block_diag(np.moveaxis(Rt, 0, 1))
-    check_spd(R, "noise")
-
-    dF = dH = None
-    if derivatives:
-        dF = np.zeros((N - 1, n, n, 6))
-        dF[:, 0:6, 0:6, :] = np.einsum("kabd,kdc->kabc", Psi, stm[:-1])
-        hess = model.hessian(obs[None], tgts)  # (NT, N, m, 6, 6): d2h/ddelta2
-        # dH_obs/dx_S = +hess, dH_tgt/dx_S = -hess (delta = x_T - x_S); chain with Phi_S(t_k, t_0)
-        dhx = np.einsum("ikabd,kdc->ikabc", hess, stm)
-        dH = np.zeros((N, NT * m, n, 6))
-        for i in range(NT):
-            dH[:, i * m:(i + 1) * m, 0:6, :] = dhx[i]
-            dH[:, i * m:(i + 1) * m, 6 * (i + 1):6 * (i + 2), :] = -dhx[i]
-    return AugmentedLinearization(t=t, observer=obs, targets=tgts, P0=P0, F=F, Q=Qa, H=H, R=R, dF=dF, dH=dH,
-                                  observer_stm=stm)
+    if Q is not None:
+        Q = _as_sequence(Q, "Q", t.size - 1, (n, n))
+    obs = propagate_arcs(system, xs0, t, q=q, order=2 if derivatives else 1, n_nodes=n_nodes)
+    tgt = propagate_arcs(system, xt0, t, q=q, order=1, n_nodes=n_nodes)
+    return assemble_augmented(model, noise, P0, obs, tgt, Q=Q)

@@ -272,3 +272,70 @@ def test_covariance_analysis_bad_input():
         C.covariance_analysis(P0, F, np.eye(3), H[..., :2], np.eye(2))
     with pytest.raises(ValueError, match="P0"):
         C.covariance_analysis(np.diag([1.0, 0.0, 1.0]), F, np.eye(3), H, np.eye(2))
+
+
+# ---------------------------------------------------------------------------------------------- reliability (issue 11)
+def test_ekf_predict_rejects_non_spd_arguments_by_name():
+    P, F, Q = np.eye(3), np.eye(3), 0.1 * np.eye(3)
+    np.testing.assert_allclose(C.ekf_predict(P, F, Q), 1.1 * np.eye(3))
+    np.testing.assert_allclose(C.ekf_predict(P, F, np.zeros((3, 3))), P)  # zero process noise is allowed
+    with pytest.raises(ValueError, match=r"\bP\b.*positive definite"):
+        C.ekf_predict(-P, F, Q)
+    with pytest.raises(ValueError, match=r"\bP\b.*positive definite"):
+        C.ekf_predict(np.diag([1.0, 1.0, 0.0]), F, Q)  # singular: semi-definite is not enough for P
+    with pytest.raises(ValueError, match=r"\bQ\b.*semi-definite"):
+        C.ekf_predict(P, F, np.diag([0.1, -0.1, 0.1]))
+    with pytest.raises(ValueError, match=r"\bQ\b.*symmetric"):
+        C.ekf_predict(P, F, [[0.1, 0.05, 0], [0, 0.1, 0], [0, 0, 0.1]])
+    with pytest.raises(ValueError, match=r"\bP\b.*symmetric"):
+        C.ekf_predict([[1.0, 0.5, 0], [0, 1.0, 0], [0, 0, 1.0]], F, Q)
+    with pytest.raises(ValueError, match="F and Q"):
+        C.ekf_predict(P, np.eye(2), Q)
+    with pytest.raises(ValueError, match=r"\bQ\b.*NaN"):
+        C.ekf_predict(P, F, np.full((3, 3), np.nan))
+
+
+def test_ekf_update_rejects_non_spd_prior():
+    H, R = np.ones((1, 2)), np.eye(1)
+    with pytest.raises(ValueError, match=r"\bP\b.*positive definite"):
+        C.ekf_update(np.diag([1.0, -2.0]), H, R)
+    with pytest.raises(ValueError, match=r"\bR\b.*positive definite"):
+        C.ekf_update(np.eye(2), H, -R)
+
+
+def test_check_psd_tolerance_and_batch():
+    # a rank-deficient PSD matrix with round-off passes; a clearly negative eigenvalue fails
+    v = np.array([1.0, 2.0, 3.0])
+    Q = np.outer(v, v)
+    Q[0, 0] -= 1e-14
+    np.testing.assert_allclose(C.check_psd(Q), Q)
+    batch = np.stack([np.eye(2), np.diag([1.0, -1e-3])])
+    with pytest.raises(ValueError, match="Qb.*semi-definite"):
+        C.check_psd(batch, "Qb")
+
+
+def test_symmetrize_rejects_non_square_and_is_projection():
+    with pytest.raises(ValueError, match=r"\bP\b.*square"):
+        C.symmetrize(np.ones((2, 3)))
+    with pytest.raises(ValueError, match="Mx.*square"):
+        C.symmetrize(np.ones(4), "Mx")
+    A = np.random.default_rng(1).normal(size=(2, 4, 4))
+    S = C.symmetrize(A)
+    np.testing.assert_allclose(S, np.swapaxes(S, -1, -2))
+    np.testing.assert_allclose(C.symmetrize(S), S)  # idempotent
+    np.testing.assert_allclose(S + 0.5 * (A - np.swapaxes(A, -1, -2)), A)  # symmetric + skew parts recover A
+
+
+def test_assembled_from_cached_targets_equals_one_shot_linearisation(dro_window):
+    """Propagating the targets once and assembling must give the same linearisation as linearize_augmented."""
+    lin = dro_window
+    R = M.range_range_rate_noise(0.1, 0.01, EARTH_MOON)
+    q = C.psd_to_nondimensional(1e-11, EARTH_MOON)
+    obs = C.propagate_arcs(EARTH_MOON, OBSERVER, lin.t, q=q, order=2)
+    tgt = C.propagate_arcs(EARTH_MOON, TARGETS[:2], lin.t, q=q)
+    lin2 = C.assemble_augmented(M.RANGE_RANGE_RATE, R, lin.P0, obs, tgt)
+    for a, b in zip(lin.arrays + (lin.dF, lin.dH), lin2.arrays + (lin2.dF, lin2.dH)):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-300)
+    stm = obs.stm_from_start[0]
+    np.testing.assert_allclose(stm[-1], propagate_stm(EARTH_MOON, OBSERVER, [lin.t[0], lin.t[-1]]).stm[-1],
+                               rtol=1e-9, atol=1e-9)
