@@ -1,0 +1,278 @@
+"""SSAT state, covariance analysis and MMD guidance (Greaves & Scheeres AMOS 2023, Eqs. 1-7, 13-24)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cislunar import ssat
+from cislunar.dynamics import EARTH_MOON as em
+from cislunar.measurements import AZIMUTH_ELEVATION
+from cislunar.orbits import nrho_9_2
+from cislunar.propagation import propagate, propagate_stm
+
+HR = 3600.0 / em.time_unit_s
+
+
+@pytest.fixture(scope="module")
+def pair():
+    """Target at the 9:2 NRHO apolune, agent trailing 0.6 h on the same orbit (about 229 km)."""
+    o = nrho_9_2(em)
+    xt0 = o.x0.copy()
+    xa0 = propagate(em, o.x0, np.array([0.0, -0.6 * HR])).x[-1]
+    return xa0, xt0
+
+
+def _random_spd(rng, n):
+    A = rng.standard_normal((n, n))
+    return A @ A.T + n * np.eye(n)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Eqs. 1-7 and 13-14: identities
+# ---------------------------------------------------------------------------------------------------------------
+def test_transform_matches_eq6_and_inverts():
+    rng = np.random.default_rng(1)
+    x = rng.standard_normal((5, 12))
+    T = ssat.transform_matrix()
+    assert np.allclose(T[:6, :6], 0.5 * np.eye(6)) and np.allclose(T[6:, :6], -np.eye(6))
+    xr = ssat.to_relative(x)
+    assert np.allclose(xr, x @ T.T, atol=1e-15)
+    assert np.allclose(xr[:, :6], 0.5 * (x[:, :6] + x[:, 6:]))  # Eq. 3
+    assert np.allclose(xr[:, 6:], x[:, 6:] - x[:, :6])  # Eq. 4: target minus agent
+    assert np.allclose(ssat.from_relative(xr), x, atol=1e-14)
+    xb = ssat.to_agent_based(x)
+    assert np.allclose(xb, x @ ssat.agent_transform_matrix().T)
+    assert np.allclose(ssat.from_agent_based(xb), x, atol=1e-14)
+
+
+def test_covariance_maps_and_equivalence_of_relative_partitions():
+    rng = np.random.default_rng(2)
+    P = _random_spd(rng, 12)
+    T = ssat.transform_matrix()
+    Pr = ssat.relative_covariance(P)
+    assert np.allclose(Pr, T @ P @ T.T)  # Eq. 7
+    assert np.allclose(ssat.inertial_covariance(Pr), P, atol=1e-12)
+    # sample covariance of transformed samples equals T P T^T (independent check of Eq. 7)
+    L = np.linalg.cholesky(P)
+    s = (L @ rng.standard_normal((12, 200000))).T
+    emp = np.cov(ssat.to_relative(s).T)
+    assert np.allclose(emp, Pr, atol=0.05 * np.max(np.abs(Pr)))
+    # agent-based and mean-based states share the relative block
+    Pa = ssat.agent_based_covariance(P)
+    assert np.allclose(Pa[6:, 6:], Pr[6:, 6:])
+    assert not np.allclose(Pa[:6, :6], Pr[:6, :6])
+    x = rng.standard_normal(12)
+    J = [ssat.range_variance(C, x, c) for C, c in ((P, "inertial"), (Pr, "relative"), (Pa, "agent"))]
+    assert np.allclose(J, J[0])
+
+
+def test_angles_see_only_the_relative_partition(pair):
+    xa, xt = pair
+    _, Ha, Ht = AZIMUTH_ELEVATION.evaluate(xa, xt)
+    H = np.hstack([Ha, Ht])
+    for C in (ssat.transform_matrix(), ssat.agent_transform_matrix()):
+        Hc = H @ np.linalg.inv(C)
+        assert np.max(np.abs(Hc[:, :6])) < 1e-12 * np.max(np.abs(H))
+        assert np.allclose(Hc[:, 6:], Ht)
+
+
+def test_control_on_agent_only():
+    B = ssat.control_matrix()
+    assert B.shape == (12, 3) and np.allclose(B[3:6], np.eye(3)) and np.count_nonzero(B) == 3
+    rng = np.random.default_rng(3)
+    x, u = rng.standard_normal(12), rng.standard_normal(3)
+    xp = ssat.apply_impulse(x, u)
+    assert np.allclose(xp - x, B @ u)  # Eq. 13
+    # in relative coordinates: the mean velocity moves by u/2, the relative velocity by -u
+    dr = ssat.to_relative(xp) - ssat.to_relative(x)
+    assert np.allclose(dr, ssat.control_matrix("relative") @ u)
+    assert np.allclose(dr[3:6], 0.5 * u) and np.allclose(dr[9:12], -u)
+    with pytest.raises(ValueError, match="coordinates"):
+        ssat.control_matrix("polar")
+
+
+def test_range_projection_is_line_of_sight():
+    x = np.zeros(12)
+    x[6:9] = [3.0, 4.0, 0.0]
+    M = ssat.range_projection(x)
+    assert np.allclose(M[0:3], [-0.6, -0.8, 0]) and np.allclose(M[6:9], [0.6, 0.8, 0])
+    assert np.allclose(ssat.range_projection(x, "relative")[6:9], [0.6, 0.8, 0])
+    with pytest.raises(ValueError, match="coincident"):
+        ssat.range_projection(np.zeros(12))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# trajectories with impulses
+# ---------------------------------------------------------------------------------------------------------------
+def test_impulses_between_grid_points_and_stm(pair):
+    xa, _ = pair
+    t = np.linspace(0, 10 * HR, 11)
+    dv1, dv2 = np.array([1e-4, -2e-4, 5e-5]), np.array([-3e-4, 1e-4, 2e-4])
+    tb = 4.5 * HR
+    tr = ssat.propagate_with_impulses(em, xa, t, [(t[0], dv1), (tb, dv2)])
+    # manual reference
+    x = xa.copy()
+    x[3:6] += dv1
+    seg1 = propagate(em, x, np.array([0.0, 4 * HR, tb])).x
+    y = seg1[-1].copy()
+    y[3:6] += dv2
+    seg2 = propagate(em, y, np.array([tb, 5 * HR, 10 * HR])).x
+    assert np.allclose(tr.x[0, 4], seg1[1], atol=1e-13)
+    assert np.allclose(tr.x[0, 5], seg2[1], atol=1e-13)
+    assert np.allclose(tr.x[0, -1], seg2[-1], atol=1e-13)
+    # STM w.r.t. the post-impulse initial state, checked by central differences through both impulses
+    h = 1e-7
+    E = h * np.eye(6)
+    xp = ssat.propagate_with_impulses(em, np.vstack([x + E, x - E]) - np.r_[0, 0, 0, dv1], t, [(t[0], dv1), (tb, dv2)])
+    fd = (xp.x[:6, -1] - xp.x[6:, -1]).T / (2 * h)
+    assert np.allclose(tr.stm[0, -1], fd, rtol=1e-5, atol=1e-5 * np.max(np.abs(fd)))
+    assert np.allclose(tr.stm[0, 0], np.eye(6))
+
+
+def test_impulse_validation(pair):
+    xa, _ = pair
+    t = np.linspace(0, 1, 3)
+    with pytest.raises(ValueError, match=r"impulses\[0\] time"):
+        ssat.propagate_with_impulses(em, xa, t, [(2.0, np.zeros(3))])
+    with pytest.raises(ValueError, match=r"impulses\[0\] dv"):
+        ssat.propagate_with_impulses(em, xa, t, [(0.5, np.zeros(4))])
+    with pytest.raises(ValueError, match="x0"):
+        ssat.propagate_with_impulses(em, np.zeros(5), t)
+    with pytest.raises(ValueError, match="t must be strictly increasing"):
+        ssat.propagate_with_impulses(em, xa, t[::-1])
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# covariance analysis (Eqs. 15-22)
+# ---------------------------------------------------------------------------------------------------------------
+def test_initial_covariance_numbers():
+    P0 = ssat.initial_covariance(em)
+    assert np.isclose(np.sqrt(P0[0, 0]) * em.length_unit_km, 20.0)
+    assert np.isclose(np.sqrt(P0[9, 9]) * em.velocity_unit_km_s * 1e5, 20.0)  # 20 cm/s
+    assert np.allclose(P0[:6, 6:], 0)
+    with pytest.raises(ValueError, match="sigma3_pos_km"):
+        ssat.initial_covariance(em, -1.0)
+
+
+def test_sri_covariance_equals_ekf_recursion_in_all_coordinates(pair):
+    xa, xt = pair
+    t = np.arange(0, 25) * HR
+    P0 = ssat.initial_covariance(em)
+    ag = ssat.propagate_with_impulses(em, xa, t, [(t[0], np.array([2e-4, 0, -1e-4])), (7.3 * HR, np.array([0, 3e-4, 0]))])
+    tg = ssat.propagate_with_impulses(em, xt, t)
+    res = ssat.ssat_covariance(em, ag, tg, P0)
+    # no information yet along the line of sight at t0: J = 2 sigma^2 (both vehicles), sqrt = 28.28 km
+    assert np.isclose(res.range_sigma_km[0, 0], np.sqrt(2) * 20.0, rtol=1e-9)
+    assert np.all(res.range_sigma_km[0, 1:] < res.range_sigma_km[0, 0])
+    for coords in ("inertial", "relative", "agent"):
+        post, J = ssat.ssat_covariance_ekf(em, ag, tg, P0, coordinates=coords)
+        assert np.allclose(J, res.J_rho[0], rtol=1e-5)
+    post, _ = ssat.ssat_covariance_ekf(em, ag, tg, P0)
+    assert np.allclose(res.P_final[0], post[-1], rtol=1e-4, atol=1e-6 * np.max(np.abs(post[-1])))
+    # the relative-coordinate recursion is T P T^T of the inertial one
+    postr, _ = ssat.ssat_covariance_ekf(em, ag, tg, P0, coordinates="relative")
+    assert np.allclose(postr[-1], ssat.relative_covariance(post[-1]), rtol=1e-4,
+                       atol=1e-6 * np.max(np.abs(postr[-1])))
+
+
+def test_covariance_noise_model_and_batching(pair):
+    xa, xt = pair
+    t = np.arange(0, 13) * HR
+    P0 = ssat.initial_covariance(em)
+    tg = ssat.propagate_with_impulses(em, xt, t)
+    dvs = np.array([[0, 0, 0], [3e-4, 0, 0], [0, 0, -3e-4]])
+    ag = ssat.propagate_with_impulses(em, np.tile(xa, (3, 1)), t, [(t[0], dvs)])
+    batch = ssat.ssat_covariance(em, ag, tg, P0)
+    for i in range(3):
+        one = ssat.ssat_covariance(em, ssat.ImpulsiveTrajectory(t, ag.x[i:i + 1], ag.stm[i:i + 1]), tg, P0)
+        assert np.allclose(one.J_rho[0], batch.J_rho[i], rtol=1e-10)
+    # Eq. 20 at the true range
+    sig = np.sqrt((10e-6) ** 2 + (4e-3 / batch.range_km) ** 2)
+    assert np.allclose(batch.sigma_theta_rad, sig)
+    # a noisier sensor cannot know the range better
+    noisy = ssat.ssat_covariance(em, ag, tg, P0, sigma_min_rad=100e-6)
+    assert np.all(noisy.J_rho[:, 1:] > batch.J_rho[:, 1:])
+    with pytest.raises(ValueError, match="P0"):
+        ssat.ssat_covariance(em, ag, tg, -P0)
+    with pytest.raises(ValueError, match="target"):
+        ssat.ssat_covariance(em, ag, ssat.propagate_with_impulses(em, np.tile(xt, (2, 1)), t), P0)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# MMD (Eqs. 23-24)
+# ---------------------------------------------------------------------------------------------------------------
+def test_mmd_matrix_equals_full_state_formula(pair):
+    xa, xt = pair
+    tf = 6 * HR
+    Sa = propagate_stm(em, xa, tf).stm[-1]
+    St = propagate_stm(em, xt, tf).stm[-1]
+    xf = propagate(em, np.vstack([xa, xt]), tf).x[:, -1]
+    _, Ha, Ht = AZIMUTH_ELEVATION.evaluate(xf[0], xf[1])
+    Phi = np.zeros((12, 12))
+    Phi[:6, :6], Phi[6:, 6:] = Sa, St
+    H = np.hstack([Ha, Ht])
+    B = ssat.control_matrix()
+    Qfull = B.T @ Phi.T @ H.T @ H @ Phi @ B
+    assert np.allclose(ssat.mmd_matrix(Sa, Ha), Qfull, rtol=1e-12, atol=1e-12 * np.max(np.abs(Qfull)))
+    assert np.linalg.matrix_rank(Qfull, tol=1e-9 * np.max(np.abs(Qfull))) == 2
+
+
+def test_mmd_is_brute_force_maximiser_of_nonlinear_measurement_deviation(pair):
+    """The eigenvector maximises the (small-burn) measurement deviation over a dense sphere of directions."""
+    xa, xt = pair
+    tf = 6 * HR
+    St = propagate(em, np.vstack([xa, xt]), tf).x[:, -1]
+    y0 = AZIMUTH_ELEVATION(St[0], St[1])
+    Sa = propagate_stm(em, xa, tf).stm[-1]
+    _, Ha, _ = AZIMUTH_ELEVATION.evaluate(St[0], St[1])
+    e = ssat.mmd_direction(ssat.mmd_matrix(Sa, Ha))
+    D = ssat.fibonacci_sphere(4000)
+    v = 1e-7  # small impulse: the linear surrogate regime
+    x = np.tile(xa, (D.shape[0], 1))
+    x[:, 3:6] += v * D
+    xf = propagate(em, x, tf).x[:, -1]
+    dev = np.linalg.norm(AZIMUTH_ELEVATION.residual(AZIMUTH_ELEVATION(xf, St[1]), y0), axis=-1)
+    best = D[np.argmax(dev)]
+    spacing = np.sqrt(4 * np.pi / D.shape[0])
+    assert np.arccos(min(1.0, abs(best @ e))) < 1.5 * spacing
+    # and the surrogate value: the eigenvalue equals the max of u^T Q u on the sphere
+    Q = ssat.mmd_matrix(Sa, Ha)
+    quad = np.einsum("ni,ij,nj->n", D, Q, D)
+    lam = np.linalg.eigvalsh(Q)[-1]
+    assert quad.max() <= lam * (1 + 1e-12) and quad.max() > lam * (1 - spacing**2)
+    assert np.isclose(e @ Q @ e, lam)
+
+
+def test_mmd_policy_sign_and_optimiser(pair):
+    xa, xt = pair
+    t = np.arange(0, 7) * HR
+    P0 = ssat.initial_covariance(em)
+    v = 1e-3 / em.velocity_unit_km_s
+    u, Q, Jpm = ssat.mmd_policy(em, xa, xt, t, v, P0)
+    e = ssat.mmd_direction(Q)
+    assert np.isclose(np.linalg.norm(u), v)
+    assert np.allclose(u, (v if Jpm[0] <= Jpm[1] else -v) * e)
+    assert Jpm[0] != Jpm[1]
+    tg = ssat.propagate_with_impulses(em, xt, t)
+    d, Jmin = ssat.minimize_range_sigma(em, xa, None, t, v, P0, n_grid=400, target=tg)
+    assert np.isclose(np.linalg.norm(d), 1.0)
+    grid = ssat.range_sigma_over_directions(em, xa, None, t, v, ssat.fibonacci_sphere(400), P0, target=tg)
+    assert Jmin <= grid.J_rho[:, -1].min() and Jmin <= Jpm.min()
+    check = ssat.range_sigma_over_directions(em, xa, None, t, v, d[None], P0, target=tg)
+    assert np.isclose(check.J_rho[0, -1], Jmin, rtol=1e-10)
+
+
+def test_direction_helpers():
+    D = ssat.fibonacci_sphere(500)
+    assert np.allclose(np.linalg.norm(D, axis=1), 1)
+    assert np.allclose(D.mean(axis=0), 0, atol=5e-3)
+    los = np.array([0.3, -1.0, 0.2])
+    P = ssat.perpendicular_directions(los, 36)
+    assert np.allclose(P @ los, 0, atol=1e-14) and np.allclose(np.linalg.norm(P, axis=1), 1)
+    with pytest.raises(ValueError, match="n must be"):
+        ssat.fibonacci_sphere(1)
+    with pytest.raises(ValueError, match="line_of_sight"):
+        ssat.perpendicular_directions(np.zeros(3), 4)
+    with pytest.raises(ValueError, match="dv_magnitude"):
+        ssat.mmd_policy(em, np.ones(6), np.ones(6), [0, 1], -1.0, np.eye(12))
