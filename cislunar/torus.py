@@ -314,7 +314,7 @@ class InvariantTorus:
         return out
 
     def ring(self, t: float = 0.0, n_theta: int | None = None) -> np.ndarray:
-        """The invariant ring at time ``t`` (TU) at ``n_theta`` equally spaced initial angles, shape ``(n_theta, 6)``."""
+        """The invariant ring at time ``t`` (TU) at ``n_theta`` equally spaced initial angles, ``(n_theta, 6)``."""
         n_theta = self.N if n_theta is None else int(n_theta)
         if n_theta < 1:
             raise ValueError(f"n_theta must be a positive integer; got {n_theta}")
@@ -639,7 +639,8 @@ def solve_torus(guess: InvariantTorus, *, fix: dict, free_period: bool = False, 
 
 
 def torus_from_orbit(orbit: PeriodicOrbit, N: int = 25, size_km: float = 10.0, *,  # noqa: N803
-                     start_km: float = 2.0, step_km: float = 25.0, progress: bool = False, **solve_kw) -> InvariantTorus:
+                     start_km: float = 2.0, step_km: float = 25.0, progress: bool = False,
+                     **solve_kw) -> InvariantTorus:
     """Solve the torus of ring size ``size_km`` about ``orbit``: seed at ``start_km``, then continue in size.
 
     Parameters
@@ -662,7 +663,8 @@ def torus_from_orbit(orbit: PeriodicOrbit, N: int = 25, size_km: float = 10.0, *
     size_km = _checks.positive(size_km, "size_km")
     start_km = min(_checks.positive(start_km, "start_km"), size_km)
     step_km = _checks.positive(step_km, "step_km")
-    torus = solve_torus(torus_seed(orbit, N, start_km), fix={"size_km": start_km}, **solve_kw)
+    torus = solve_torus(torus_seed(orbit, N, start_km), fix={"size_km": start_km}, label=f"torus size_km={start_km:g}",
+                        **solve_kw)
     if size_km == start_km:
         return torus
     n_steps = int(np.ceil((size_km - start_km) / step_km))
@@ -732,7 +734,7 @@ def continue_tori(torus: InvariantTorus, values, *, parameter: str = "size_km", 
         while True:
             try:
                 guess = _predict(prev, cur, p_prev, p_cur, p_new)
-                nxt = solve_torus(guess, fix={parameter: p_new}, **solve_kw)
+                nxt = solve_torus(guess, fix={parameter: p_new}, label=f"torus {parameter}={p_new:g}", **solve_kw)
             except TorusConvergenceError:
                 if halvings >= max_halvings:
                     raise
