@@ -63,7 +63,6 @@ States are in LU and LU/TU in the barycentric rotating frame, times in TU, angle
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from functools import cached_property
 
 import numpy as np
 
