@@ -90,6 +90,8 @@ __all__ = [
     "perpendicular_directions",
     "range_sigma_over_directions",
     "minimize_range_sigma",
+    "PolicyComparison",
+    "compare_burn_policies",
 ]
 
 #: AMOS 2023 Sec. 5: initial 3-sigma position uncertainty per axis, both vehicles, km.
@@ -724,3 +726,133 @@ def minimize_range_sigma(system: CR3BP, agent_x0, target_x0, t, dv_magnitude: fl
     if res.fun * Jbest < Jbest:
         return to_vec(res.x), float(res.fun * Jbest)
     return best, Jbest
+
+
+@dataclass(frozen=True)
+class PolicyComparison:
+    """Final range uncertainty :math:`\\sqrt{J_\\rho}` (km) of burn policies over several coast times.
+
+    Every array has one entry per coast time.  ``grid_*`` summarise a Fibonacci sphere of directions (the
+    distribution of a uniformly random burn direction); ``perp_*`` the circle of directions perpendicular to the
+    line of sight at the burn; ``optimum`` the refined minimiser; ``mmd`` the MMD policy with its sign chosen by
+    the quick covariance analysis and ``mmd_other`` the rejected sign.
+
+    Attributes
+    ----------
+    coast_hours : ndarray
+    none, mmd, mmd_other, optimum, grid_median, grid_max, perp_best, perp_median, perp_worst : ndarray, km
+    mmd_percentile : ndarray
+        Percent of sphere-grid directions that do better than MMD (0 = MMD beats every grid direction).
+    mmd_direction, optimum_direction : ndarray (m, 3)
+        Unit burn directions (rotating frame).
+    angle_mmd_optimum_deg : ndarray
+        Angle between the MMD axis (either sign) and the optimum, deg.
+    optimum_perp_angle_deg : ndarray
+        Angle between the optimum and the plane perpendicular to the line of sight, deg (0: in the plane).
+    """
+
+    coast_hours: np.ndarray
+    none: np.ndarray
+    mmd: np.ndarray
+    mmd_other: np.ndarray
+    optimum: np.ndarray
+    grid_median: np.ndarray
+    grid_max: np.ndarray
+    perp_best: np.ndarray
+    perp_median: np.ndarray
+    perp_worst: np.ndarray
+    mmd_percentile: np.ndarray
+    mmd_direction: np.ndarray
+    optimum_direction: np.ndarray
+    angle_mmd_optimum_deg: np.ndarray
+    optimum_perp_angle_deg: np.ndarray
+
+    @property
+    def mmd_excess_percent(self) -> np.ndarray:
+        """How far MMD is above the optimum, percent of the optimum's :math:`\\sqrt{J_\\rho}`."""
+        return 100.0 * (self.mmd / self.optimum - 1.0)
+
+    @property
+    def mmd_gain_fraction(self) -> np.ndarray:
+        """Fraction of the possible improvement over a median (random) direction that MMD achieves (1 = optimal)."""
+        return (self.grid_median - self.mmd) / (self.grid_median - self.optimum)
+
+
+def compare_burn_policies(system: CR3BP, agent_x0, target_x0, t, coast_indices, dv_magnitude: float, P0, *,
+                          n_grid: int = 2000, n_perp: int = 72, refine: bool = True,
+                          sigma_min_rad: float = AMOS_SIGMA_MIN_RAD,
+                          resolution_km: float = AMOS_RESOLUTION_KM) -> PolicyComparison:
+    """MMD against the true minimiser of :math:`J_\\rho` and the perpendicular heuristic, for several coast times.
+
+    A single impulse of magnitude ``dv_magnitude`` (LU/TU) at ``t[0]``; measurements at every grid time up to the
+    end of the coast :math:`\\tau_f = t_k`, ``k`` in ``coast_indices``.  The sphere grid and the perpendicular
+    circle are propagated once for the longest coast (the measurement sets of shorter coasts are prefixes).
+
+    Parameters
+    ----------
+    system : CR3BP
+    agent_x0, target_x0 : array_like (6,)
+        States at ``t[0]``.
+    t : array_like (N,)
+        Measurement grid, TU.
+    coast_indices : sequence of int
+        Grid indices (>= 1) of the coast end times.
+    dv_magnitude : float
+        :math:`\\upsilon`, LU/TU.
+    P0 : array_like (12, 12)
+    n_grid, n_perp : int
+        Sphere-grid and perpendicular-circle sizes.
+    refine : bool
+        Refine the grid optimum with Nelder-Mead (:func:`minimize_range_sigma`).
+    """
+    t = _checks.time_grid(t, "t", increasing=True)
+    ks = np.asarray(coast_indices, dtype=int)
+    if ks.ndim != 1 or ks.size == 0 or np.any(ks < 1) or np.any(ks >= t.size):
+        raise ValueError(f"coast_indices must be grid indices in 1..{t.size - 1}; got {coast_indices!r}")
+    xa0 = _checks.as_state(agent_x0, "agent_x0", batch=False)
+    xt0 = _checks.as_state(target_x0, "target_x0", batch=False)
+    v = _checks.positive(dv_magnitude, "dv_magnitude")
+    kmax = int(ks.max())
+    tt = t[:kmax + 1]
+    L = system.length_unit_km
+    target = propagate_with_impulses(system, xt0, tt)
+    nominal = propagate_with_impulses(system, xa0, tt)
+    none = ssat_covariance(system, nominal, target, P0, sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
+    D = fibonacci_sphere(int(n_grid))
+    grid = range_sigma_over_directions(system, xa0, None, tt, v, D, P0, target=target,
+                                       sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
+    los = xt0[:3] - xa0[:3]
+    los = los / np.linalg.norm(los)
+    perp = range_sigma_over_directions(system, xa0, None, tt, v, perpendicular_directions(los, int(n_perp)), P0,
+                                       target=target, sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
+    out = {k: [] for k in ("none", "mmd", "mmd_other", "optimum", "grid_median", "grid_max", "perp_best",
+                           "perp_median", "perp_worst", "mmd_percentile", "mmd_direction", "optimum_direction",
+                           "angle_mmd_optimum_deg", "optimum_perp_angle_deg")}
+    for k in ks:
+        tk = tt[:k + 1]
+        u, Q, Jpm = mmd_policy(system, xa0, xt0, tk, v, P0, sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
+        Jg = grid.J_rho[:, k]
+        sub = SSATCovariance(tk, grid.J_rho[:, :k + 1], grid.P_final, grid.range_km[:, :k + 1],
+                             grid.sigma_theta_rad[:, :k + 1], L)
+        tgt_k = ImpulsiveTrajectory(tk, target.x[:, :k + 1], target.stm[:, :k + 1])
+        d_opt, J_opt = minimize_range_sigma(system, xa0, None, tk, v, P0, n_grid=int(n_grid), refine=refine,
+                                            target=tgt_k, grid_result=sub)
+        J_mmd = float(Jpm.min())
+        e = u / v
+        out["none"].append(np.sqrt(none.J_rho[0, k]) * L)
+        out["mmd"].append(np.sqrt(J_mmd) * L)
+        out["mmd_other"].append(np.sqrt(Jpm.max()) * L)
+        out["optimum"].append(np.sqrt(J_opt) * L)
+        out["grid_median"].append(np.sqrt(np.median(Jg)) * L)
+        out["grid_max"].append(np.sqrt(Jg.max()) * L)
+        Jp = perp.J_rho[:, k]
+        out["perp_best"].append(np.sqrt(Jp.min()) * L)
+        out["perp_median"].append(np.sqrt(np.median(Jp)) * L)
+        out["perp_worst"].append(np.sqrt(Jp.max()) * L)
+        out["mmd_percentile"].append(100.0 * np.mean(Jg < J_mmd))
+        out["mmd_direction"].append(e)
+        out["optimum_direction"].append(d_opt)
+        out["angle_mmd_optimum_deg"].append(np.degrees(np.arccos(min(1.0, abs(float(e @ d_opt))))))
+        out["optimum_perp_angle_deg"].append(np.degrees(np.arcsin(min(1.0, abs(float(d_opt @ los))))))
+    hours = (tt[ks] - tt[0]) * system.time_unit_s / 3600.0
+    return PolicyComparison(coast_hours=hours, **{k: np.asarray(v_) for k, v_ in out.items()})

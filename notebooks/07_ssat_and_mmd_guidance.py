@@ -1,0 +1,322 @@
+# ---
+# jupyter:
+#   jupytext:
+#     formats: py:percent
+#   kernelspec:
+#     display_name: Python 3
+#     language: python
+#     name: python3
+# ---
+
+# %% [markdown]
+# # 07 · Spacecraft-to-spacecraft absolute tracking and MMD guidance
+#
+# **What you will learn.** How two spacecraft that only see each other through a camera can estimate *both*
+# absolute states (spacecraft-to-spacecraft absolute tracking, SSAT); why the range between them is the weak
+# direction of an angles-only estimate; how a linear covariance analysis along the true trajectories measures the
+# 1-sigma range uncertainty $\sqrt{J_\rho}$; and how the maximum-measurement-deviation (MMD) policy picks an
+# information-gathering burn from a 3x3 eigenproblem. Beyond the paper, we compare MMD with the true minimiser of
+# $J_\rho$ over all burn directions and with the "burn perpendicular to the line of sight" heuristic over a range of
+# coast times, and say how near-optimal MMD is.
+#
+# **Paper sections followed.** Greaves & Scheeres, "Autonomous information gathering guidance for
+# spacecraft-to-spacecraft tracking with optical sensors" (AMOS 2023): Sec. 3.1 (Eqs. 1-7), 3.2 (Eqs. 8-14),
+# 3.3 (Eqs. 15-20), 3.4 (Eqs. 21-24) and the covariance-analysis set-up of Sec. 5. The quasi-periodic orbit and the
+# informed station keeping of Secs. 4-5 are notebook 08.
+
+# %% tags=["parameters"]
+QUICK = False
+SEED = 0
+OUTPUT_DIR = ""
+
+# %%
+# Sizes derived from QUICK: a coarser sphere of burn directions and fewer coast times in quick mode.
+N_GRID = 600 if QUICK else 3000  # burn directions on the sphere (Fibonacci lattice)
+N_PERP = 36 if QUICK else 120  # directions on the circle perpendicular to the line of sight
+COAST_HOURS = [1, 4, 12, 24, 48] if QUICK else [1, 2, 4, 8, 12, 18, 24, 36, 48]
+DV_M_S = [0.1, 1.0]  # burn magnitudes upsilon, m/s (the paper gives none for this experiment)
+LEAD_DAYS = 1.0  # the burn happens this long before the target's apolune
+APOLUNE_RANGE_KM = 215.0  # agent-target range at apolune (scale of the paper's scenario)
+
+import matplotlib.pyplot as plt
+import numpy as np
+from scipy.optimize import brentq
+
+from cislunar import plotting, ssat
+from cislunar.dynamics import EARTH_MOON as em
+from cislunar.measurements import AZIMUTH_ELEVATION
+from cislunar.orbits import nrho_9_2
+from cislunar.propagation import propagate
+from cislunar.report import ComparisonTable
+
+plotting.use_style()
+out = OUTPUT_DIR or None
+rng = np.random.default_rng(SEED)
+table = ComparisonTable("07 SSAT and MMD guidance (Greaves & Scheeres AMOS 2023, Eqs. 1-24)")
+L, V = em.length_unit_km, em.velocity_unit_km_s
+HR = 3600.0 / em.time_unit_s
+
+# %% [markdown]
+# ## 1 · The SSAT state (Eqs. 1-7)
+#
+# The *inertial* SSAT state stacks the agent and target CR3BP states, $\mathbf x = [\mathbf s_a; \mathbf s_t]$
+# (Eq. 1; "inertial" is the paper's name, both states live in the rotating frame). The *relative* SSAT state holds
+# their mean and difference, $\tilde{\mathbf x} = [\mathbf s_\alpha; \mathbf s_\rho] = T\mathbf x$ with
+# $\mathbf s_\alpha = (\mathbf s_a+\mathbf s_t)/2$, $\mathbf s_\rho = \mathbf s_t - \mathbf s_a$ and
+# $T = \begin{bmatrix}\tfrac12 I & \tfrac12 I\\ -I & I\end{bmatrix}$ (Eqs. 3-6); covariances map as
+# $\tilde P = TPT^T$ (Eq. 7). The paper also mentions an *agent-based* absolute state
+# $\bar{\mathbf x} = [\mathbf s_a; \mathbf s_\rho] = T_a\mathbf x$. We check the identities on random states and
+# covariances, and the reason the relative form is useful: the angle measurements of Eqs. 15-18 depend on
+# $\mathbf s_\rho$ only, so in both relative coordinate systems the measurement Jacobian is $[0\ \ H_\rho]$, and
+# both give the same range variance.
+
+# %%
+x_rand = rng.standard_normal((4, 12))
+A = rng.standard_normal((12, 12))
+P_rand = A @ A.T + 12 * np.eye(12)
+T = ssat.transform_matrix()
+err_state = np.max(np.abs(ssat.from_relative(ssat.to_relative(x_rand)) - x_rand))
+err_cov = np.max(np.abs(ssat.inertial_covariance(ssat.relative_covariance(P_rand)) - P_rand)) / np.max(P_rand)
+P_rel, P_agent = ssat.relative_covariance(P_rand), ssat.agent_based_covariance(P_rand)
+same_rel_block = np.max(np.abs(P_rel[6:, 6:] - P_agent[6:, 6:])) / np.max(np.abs(P_rel))
+J3 = [ssat.range_variance(C, x_rand[0], c) for C, c in ((P_rand, "inertial"), (P_rel, "relative"),
+                                                          (P_agent, "agent"))]
+print(f"round trip T^-1 T x: {err_state:.1e};  T^-1 (T P T^T) T^-T vs P (relative): {err_cov:.1e}")
+print(f"relative block of T P T^T vs T_a P T_a^T: {same_rel_block:.1e};  J_rho in the three coordinates: "
+      f"{np.ptp(J3) / np.mean(J3):.1e} relative spread")
+print("T B_a (control in relative coordinates) =\n", ssat.control_matrix("relative")[:, 0].reshape(4, 3)[:, 0])
+
+# %% [markdown]
+# The last line is the first column of $TB_a$, block by block: an impulse $\mathbf u$ on the agent moves the mean
+# velocity by $\mathbf u/2$ and the relative velocity by $-\mathbf u$ (Eqs. 13-14 in relative coordinates).
+#
+# ## 2 · The demonstration scenario and a covariance analysis without maneuvers
+#
+# The paper does not give the two orbits used for its MMD guidance (that is its Ref. [8]); we need a close,
+# naturally bounded pair about the Gateway orbit. **Choice:** the target flies the 9:2 southern L2 NRHO, the agent
+# flies the *same* orbit a few minutes behind, with the phase lag chosen so that their range at the target's
+# apolune is 215 km (the scale of the paper's Sec. 4 scenario). The burn happens `LEAD_DAYS` = 1 day before
+# apolune, so every coast of up to 48 h straddles apolune. Measurements (Sec. 3.3, 5): azimuth and elevation of the
+# target seen from the agent every hour, with the RMS angular noise of Eq. 20,
+# $\sigma_\theta = \sqrt{\sigma_{\theta,min}^2 + D^2/\rho^2}$, $\sigma_{\theta,min}$ = 10 micro-rad, $D$ = 4 m;
+# initial 3-sigma of 60 km and 60 cm/s per axis for both vehicles, uncorrelated; no process noise (the paper lists
+# none); the covariance is propagated along the true trajectories.
+
+# %%
+nrho = nrho_9_2(em)
+t_lead = LEAD_DAYS * 86400.0 / em.time_unit_s
+
+
+def range_at_apolune(lag_hours):
+    back = propagate(em, nrho.x0, np.array([0.0, -lag_hours * HR])).x[-1]
+    return np.linalg.norm(back[:3] - nrho.x0[:3]) * L - APOLUNE_RANGE_KM
+
+
+lag_h = brentq(range_at_apolune, 0.05, 2.0, xtol=1e-12)
+xt_apo = nrho.x0
+xa_apo = propagate(em, nrho.x0, np.array([0.0, -lag_h * HR])).x[-1]
+xt0 = propagate(em, xt_apo, np.array([0.0, -t_lead])).x[-1]
+xa0 = propagate(em, xa_apo, np.array([0.0, -t_lead])).x[-1]
+P0 = ssat.initial_covariance(em)
+t = np.arange(0, 24 * 3 + 1) * HR  # three days of hourly measurements
+tgt = ssat.propagate_with_impulses(em, xt0, t)
+agt = ssat.propagate_with_impulses(em, xa0, t)
+base = ssat.ssat_covariance(em, agt, tgt, P0)
+print(f"phase lag {lag_h * 60:.2f} min; range at the burn {base.range_km[0, 0]:.1f} km, "
+      f"at apolune {base.range_km[0, 24]:.1f} km, after 3 d {base.range_km[0, -1]:.1f} km")
+print(f"sqrt(J_rho): {base.range_sigma_km[0, 0]:.2f} km at t0 (= sqrt(2) x 20 km), "
+      f"{base.range_sigma_km[0, 24]:.2f} km after 24 h, {base.range_sigma_km[0, -1]:.2f} km after 72 h")
+
+# the same analysis by the reference Joseph-form EKF recursion, in the three coordinate systems
+for coords in ("inertial", "relative", "agent"):
+    _, J_ekf = ssat.ssat_covariance_ekf(em, agt, tgt, P0, coordinates=coords)
+    print(f"EKF recursion in {coords:8s} coordinates vs square-root information form: "
+          f"max relative difference of J_rho {np.max(np.abs(J_ekf / base.J_rho[0] - 1)):.1e}")
+
+# %%
+fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+hours = (t - t[0]) / HR
+for s, lab, c in ((tgt.x[0], "target (9:2 NRHO)", "k"), (agt.x[0], "agent", "tab:red")):
+    m = em.moon_centred(s) * L / 1e3
+    axes[0].plot(m[:, 1], m[:, 2], color=c, lw=1.5, label=lab)
+axes[0].set_xlabel("y, Moon-centred (1000 km)")
+axes[0].set_ylabel("z (1000 km)")
+axes[0].set_title("three days about apolune")
+axes[0].legend(loc="lower left")
+axes[1].plot(hours, base.range_km[0], color="tab:blue")
+axes[1].set_xlabel("time since the burn epoch (h)")
+axes[1].set_ylabel("agent-target range (km)", color="tab:blue")
+ax2 = axes[1].twinx()
+ax2.plot(hours, base.sigma_theta_rad[0] * 1e6, color="tab:orange")
+ax2.set_ylabel(r"$\sigma_\theta$ (micro-rad, Eq. 20)", color="tab:orange")
+axes[1].axvline(LEAD_DAYS * 24, color="0.6", ls=":", lw=1)
+axes[2].semilogy(hours, base.range_sigma_km[0], color="k")
+axes[2].set_xlabel("time since the burn epoch (h)")
+axes[2].set_ylabel(r"$\sqrt{J_\rho}$, 1-sigma range (km)")
+axes[2].set_title("no maneuver")
+fig.tight_layout()
+_ = plotting.save_figure(fig, "07_ssat_scenario", output_dir=out)
+
+# %% [markdown]
+# The first hour of measurements removes much of the range uncertainty even without a burn: with velocities known
+# to 20 cm/s, a range error needs a proportional relative-velocity error to stay invisible in the angles, and the
+# prior limits that. After that the range is only weakly observable, and its uncertainty grows with the range
+# itself. Both forms of the covariance analysis (square-root information referred to $t_0$, batched; Joseph-form
+# EKF recursion) agree, in all three SSAT coordinate systems.
+#
+# ## 3 · MMD guidance (Eqs. 23-24)
+#
+# For a burn $\mathbf u$ at $\tau_0$ the linearised change of the measurement at the end of the coast $\tau_f$ is
+# $\delta\mathbf y_f = H_f\Phi(\tau_f,\tau_0)B_a\mathbf u$. MMD maximises $\|\delta\mathbf y_f\|^2 =
+# \mathbf u^TQ\mathbf u$, $Q = B_a^T\Phi^TH_f^TH_f\Phi B_a$ (Eq. 24), over $\|\mathbf u\| = \upsilon$: the
+# eigenvector of the largest eigenvalue (Eq. 23). $Q$ has rank 2 (two angles), so its null direction is the burn
+# that leaves the final line of sight unchanged. The sign is not determined by the eigenproblem; as in the paper we
+# run both and keep the smaller $J_\rho$. Beyond the paper, for each coast time we evaluate $J_\rho$ for every
+# direction of a Fibonacci sphere (`N_GRID` directions, one batched covariance analysis each), refine the best one
+# with Nelder-Mead (the *true minimiser*), and scan the circle perpendicular to the initial line of sight (the
+# heuristic of Ref. [8], reported as best / median / worst over the circle, since it is a set, not a policy).
+
+# %%
+coast_idx = [int(round(h)) for h in COAST_HOURS]
+results = {}
+for dv in DV_M_S:
+    results[dv] = ssat.compare_burn_policies(em, xa0, xt0, t, coast_idx, dv * 1e-3 / V, P0, n_grid=N_GRID,
+                                             n_perp=N_PERP)
+for dv, r in results.items():
+    print(f"\nupsilon = {dv} m/s")
+    print(" coast h | none   | MMD    | MMD(-) | optimum | median dir | perp best/worst | MMD pct | MMD-opt deg")
+    for i, h in enumerate(r.coast_hours):
+        print(f" {h:7.0f} | {r.none[i]:6.2f} | {r.mmd[i]:6.2f} | {r.mmd_other[i]:6.2f} | {r.optimum[i]:7.2f} | "
+              f"{r.grid_median[i]:10.2f} | {r.perp_best[i]:6.2f}/{r.perp_worst[i]:6.2f}  | {r.mmd_percentile[i]:6.1f}% | "
+              f"{r.angle_mmd_optimum_deg[i]:6.1f}")
+
+# %%
+fig, axes = plt.subplots(1, len(DV_M_S), figsize=(12, 4.8), sharey=False)
+for ax, (dv, r) in zip(np.atleast_1d(axes), results.items()):
+    h = r.coast_hours
+    ax.fill_between(h, r.perp_best, r.perp_worst, color="tab:green", alpha=0.2, lw=0,
+                    label="perpendicular to LOS (range over the circle)")
+    ax.plot(h, r.none, "k--", label="no burn")
+    ax.plot(h, r.grid_median, color="0.5", label="median random direction")
+    ax.plot(h, r.mmd, "o-", color="magenta", label="MMD (selected sign)")
+    ax.plot(h, r.mmd_other, "x:", color="magenta", label="MMD (rejected sign)")
+    ax.plot(h, r.optimum, "s-", color="tab:blue", ms=4, label="true minimiser")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("coast time $\\tau_f-\\tau_0$ (h)")
+    ax.set_ylabel(r"$\sqrt{J_\rho(\tau_f)}$ (km)")
+    ax.set_title(f"burn magnitude {dv} m/s")
+handles, labels = np.atleast_1d(axes)[0].get_legend_handles_labels()
+fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=8, bbox_to_anchor=(0.5, 0.0))
+fig.tight_layout(rect=(0, 0.12, 1, 1))
+_ = plotting.save_figure(fig, "07_mmd_vs_optimum", output_dir=out)
+
+# %% [markdown]
+# ### The cost over the sphere of burn directions
+#
+# One coast time (12 h) and the larger burn: each dot is a burn direction (rotating-frame azimuth and elevation of
+# $\mathbf u$), coloured by $\sqrt{J_\rho}$. The MMD axis ($\pm$), the true minimiser and the great circle
+# perpendicular to the initial line of sight are marked.
+
+# %%
+k12 = int(round(12))
+dv_map = DV_M_S[-1]
+D = ssat.fibonacci_sphere(N_GRID)
+grid12 = ssat.range_sigma_over_directions(em, xa0, None, t[:k12 + 1], dv_map * 1e-3 / V, D, P0,
+                                          target=ssat.ImpulsiveTrajectory(t[:k12 + 1], tgt.x[:, :k12 + 1],
+                                                                          tgt.stm[:, :k12 + 1]))
+r12 = results[dv_map]
+i12 = list(r12.coast_hours).index(12.0) if 12.0 in list(r12.coast_hours) else int(np.argmin(abs(r12.coast_hours - 12)))
+
+
+def azel_deg(v):
+    v = np.atleast_2d(v)
+    return np.degrees(np.arctan2(v[:, 1], v[:, 0])), np.degrees(np.arcsin(np.clip(v[:, 2], -1, 1)))
+
+
+fig, ax = plt.subplots(figsize=(9, 4.5))
+az, el = azel_deg(D)
+sc = ax.scatter(az, el, c=grid12.range_sigma_km[:, -1], s=8, cmap="viridis")
+fig.colorbar(sc, ax=ax, label=r"$\sqrt{J_\rho}$ after 12 h (km)")
+los0 = (xt0[:3] - xa0[:3]) / np.linalg.norm(xt0[:3] - xa0[:3])
+pc = ssat.perpendicular_directions(los0, 361)
+paz, pel = azel_deg(pc)
+order = np.argsort(paz)
+ax.plot(paz[order], pel[order], ".", color="tab:orange", ms=2, label="perpendicular to LOS")
+for sgn, mk in ((1, "^"), (-1, "v")):
+    a, e = azel_deg(sgn * r12.mmd_direction[i12])
+    ax.plot(a, e, mk, color="magenta", ms=11, mec="k", label="MMD axis" if sgn == 1 else None)
+a, e = azel_deg(r12.optimum_direction[i12])
+ax.plot(a, e, "*", color="tab:red", ms=15, mec="k", label="true minimiser")
+a, e = azel_deg(los0)
+ax.plot(a, e, "P", color="orange", ms=10, mec="k", label="line of sight")
+ax.set_xlabel("burn azimuth in the rotating frame (deg)")
+ax.set_ylabel("burn elevation (deg)")
+ax.set_xlim(-180, 180)
+ax.set_ylim(-90, 90)
+ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=4, fontsize=8)
+fig.tight_layout()
+_ = plotting.save_figure(fig, "07_cost_over_burn_directions", output_dir=out)
+
+# %% [markdown]
+# ## 4 · How near-optimal is MMD?
+#
+# Three numbers per coast time: MMD's excess over the true minimiser (percent of $\sqrt{J_\rho}$), the fraction of
+# the achievable improvement over a random direction that MMD captures, and the percentile of MMD among all
+# directions of the sphere (0 % would mean no direction is better).
+
+# %%
+for dv, r in results.items():
+    print(f"upsilon = {dv} m/s: MMD excess over optimum {np.round(r.mmd_excess_percent, 1)} %")
+    print(f"   fraction of the possible gain captured {np.round(r.mmd_gain_fraction, 2)}")
+    print(f"   directions better than MMD {np.round(r.mmd_percentile, 1)} %")
+    print(f"   angle between optimum and the perpendicular plane {np.round(r.optimum_perp_angle_deg, 1)} deg")
+    print(f"   perpendicular-circle best vs optimum: {np.round(100 * (r.perp_best / r.optimum - 1), 1)} %")
+    print(f"   sign choice matters: rejected sign worse by {np.round(100 * (r.mmd_other / r.mmd - 1), 1)} %")
+
+# %% [markdown]
+# **Reading.** The sign choice of the quick covariance analysis matters: the two signs of the MMD axis differ by
+# several percent in $\sqrt{J_\rho}$. For short coasts the best burn lies (nearly) in the plane perpendicular to the
+# line of sight, as Ref. [8] states, and the best direction on that circle is essentially the optimum; but the
+# circle also contains the worst directions, so the heuristic is a *set* that contains the answer, not a policy.
+# MMD is a policy, but in this scenario it is clearly suboptimal: it captures only part of the achievable range
+# information and a sizeable fraction of random directions beat it (numbers above). The surrogate maximises the
+# size of the measurement change at $\tau_f$ alone, whereas $J_\rho$ integrates all measurements of the coast and
+# projects on the final line of sight; the two agree in direction only roughly. This is the honest form of the
+# paper's "nearly optimal" (stated there for its Ref. [8] scenarios, which are not given).
+
+# %%
+r1 = results[DV_M_S[-1]]
+r0 = results[DV_M_S[0]]
+short = 0
+table.add("Eq. 7: T P T^T and its inverse (identity)", "exact", f"{err_cov:.1e} rel. error", "derived")
+table.add("agent-based absolute state equivalent (same relative block, same J_rho)", "stated, not shown",
+          f"{same_rel_block:.1e} / {np.ptp(J3) / np.mean(J3):.1e}", "derived",
+          "angles depend on s_rho only: Jacobian [0 H_rho] in both relative systems (tested)")
+table.add("initial 1-sigma range uncertainty from 3-sigma 60 km per axis, both vehicles", "-",
+          f"{base.range_sigma_km[0, 0]:.2f} km", "derived", "sqrt(2) x 20 km")
+table.add("covariance analysis: SRI batch form vs EKF recursion", "-",
+          f"{np.max(np.abs(ssat.ssat_covariance_ekf(em, agt, tgt, P0)[1] / base.J_rho[0] - 1)):.1e} rel.",
+          "beyond paper", "two independent implementations agree")
+table.add("sqrt(J_rho) without maneuver after 24 h / 72 h (demonstration pair)", "-",
+          f"{base.range_sigma_km[0, 24]:.1f} / {base.range_sigma_km[0, -1]:.1f} km", "not in paper",
+          "the paper's MMD scenario (its Ref. [8]) is not given; our pair: same 9:2 NRHO, 215 km at apolune")
+table.add("MMD = brute-force maximiser of its surrogate", "analytic eigenvector", "agrees (test_ssat)", "derived",
+          "dense-sphere brute force on the nonlinear measurement deviation")
+table.add("Ref. [8]: perpendicular-to-LOS set contains the optimum for short coasts",
+          "stated", f"best on circle {r1.perp_best[short]:.2f} vs optimum {r1.optimum[short]:.2f} km "
+          f"({r1.coast_hours[short]:.0f} h, {DV_M_S[-1]} m/s)",
+          "reproduced" if r1.perp_best[short] <= 1.02 * r1.optimum[short] else "differs: see note",
+          "tolerance fixed before comparing: within 2 %; optimum off the perpendicular plane by "
+          f"{r1.optimum_perp_angle_deg[short]:.1f} deg")
+table.add("MMD near-optimal (excess over the true minimiser, range over coast times)", "'nearly optimal'",
+          f"{r1.mmd_excess_percent.min():.0f}-{r1.mmd_excess_percent.max():.0f} % ({DV_M_S[-1]} m/s); "
+          f"{r0.mmd_excess_percent.min():.0f}-{r0.mmd_excess_percent.max():.0f} % ({DV_M_S[0]} m/s)",
+          "differs: see note" if r1.mmd_excess_percent.max() > 5 else "beyond paper",
+          f"directions better than MMD: {r1.mmd_percentile.min():.0f}-{r1.mmd_percentile.max():.0f} %; gain captured "
+          f"{r1.mmd_gain_fraction.min() + 0.0:.2f} to {r1.mmd_gain_fraction.max() + 0.0:.2f}; paper's claim rests on Ref. [8] "
+          "scenarios not given here")
+table.add("+/- sign choice by quick covariance analysis", "needed",
+          f"rejected sign worse by {np.min(100 * (r1.mmd_other / r1.mmd - 1)):.1f}-"
+          f"{np.max(100 * (r1.mmd_other / r1.mmd - 1)):.1f} %", "beyond paper")
+table.display()
