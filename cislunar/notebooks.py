@@ -2,21 +2,26 @@
 
 Usage::
 
-    python -m cislunar.notebooks                 # every notebook at full fidelity (make reproduce)
-    python -m cislunar.notebooks --quick         # every notebook in quick mode (make test runs them via pytest)
+    python -m cislunar.notebooks                 # every notebook at full fidelity into build/ (make reproduce)
+    python -m cislunar.notebooks --quick         # every notebook in quick mode into build-quick/
     python -m cislunar.notebooks --quick 01 02   # a selection, by number or name prefix
 
 Each ``notebooks/NN_topic.py`` (jupytext py:percent) is converted to ``.ipynb`` and executed with papermill on the
 ``python3`` kernel with the parameters ``QUICK``, ``SEED`` and ``OUTPUT_DIR``.  Executed notebooks land in
 ``<build>/notebooks/``, figures in ``<build>/figures/`` (written by the notebooks through
 :func:`cislunar.plotting.save_figure`), each notebook's closing table in ``<build>/report/NN_topic.md``, and all
-tables present are assembled into ``<build>/report.md``.  A failing cell fails the command, naming the notebook
-and the cell.
+tables present are assembled into ``<build>/report.md``, which says in which mode they ran.  A failing cell fails
+the command, naming the notebook and the cell.
+
+``build/`` only ever holds full runs: quick runs default to ``build-quick/`` and are refused in ``build/``
+(``make test`` runs them in a temporary directory).  The kernels run headless with ``CISLUNAR_PROGRESS=plain``
+(text progress bars on standard error, never widgets) over IPC sockets.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 import time
@@ -26,7 +31,8 @@ from pathlib import Path
 from . import paths
 from .report import REPORT_METADATA_KEY
 
-__all__ = ["NotebookFailure", "NotebookResult", "discover", "run_notebook", "assemble_report", "main"]
+__all__ = ["NotebookFailure", "NotebookResult", "discover", "resolve_build", "run_notebook", "assemble_report",
+           "main"]
 
 
 class NotebookFailure(RuntimeError):
@@ -71,6 +77,70 @@ def _extract_report(nb) -> str:
     return "\n\n".join(parts)
 
 
+def resolve_build(output_dir, *, quick: bool) -> Path:
+    """The build directory of a run: ``output_dir`` if given, else ``build/`` (full) or ``build-quick/`` (quick).
+
+    Raises
+    ------
+    ValueError
+        If a quick run would write into the full build directory ``build/``.
+    """
+    if output_dir is None or str(output_dir) == "":
+        return paths.quick_build_dir() if quick else paths.build_dir()
+    build = paths.build_dir(output_dir)
+    if quick and build.resolve() == (paths.repo_root() / "build").resolve():
+        raise ValueError(f"output_dir: quick runs never write into the full build directory {build}; "
+                         "omit it (build-quick/) or pick another directory")
+    return build
+
+
+def _parameter_path(build: Path) -> str:
+    """``OUTPUT_DIR`` as passed to the notebook: relative to the repository when inside it (no machine paths)."""
+    try:
+        return str(build.resolve().relative_to(paths.repo_root().resolve()))
+    except ValueError:
+        return str(build)
+
+
+@contextlib.contextmanager
+def _headless_environment():
+    """Environment inherited by the kernel: plain-text progress bars (unless switched off) for headless runs."""
+    saved = {k: os.environ.get(k) for k in ("CISLUNAR_PROGRESS", "JUPYTER_PREFER_ENV_PATH")}
+    if os.environ.get("CISLUNAR_PROGRESS", "").strip().lower() != "off":
+        os.environ["CISLUNAR_PROGRESS"] = "plain"
+    os.environ.setdefault("JUPYTER_PREFER_ENV_PATH", "1")
+    try:
+        yield
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+
+
+@contextlib.contextmanager
+def _kernel_config():
+    """Kernel manager configuration: IPC sockets in a private temporary directory instead of unencrypted TCP.
+
+    Each run gets its own socket directory, so concurrent runs (two pytest workers, two terminals) never share
+    socket names, and nothing is left in the build directory.
+    """
+    import shutil
+    import tempfile
+
+    from traitlets.config import Config
+
+    sockets = tempfile.mkdtemp(prefix="cislunar-kernel-")
+    cfg = Config()
+    cfg.KernelManager.transport = "ipc"
+    cfg.KernelManager.ip = os.path.join(sockets, "kernel")
+    try:
+        yield cfg
+    finally:
+        shutil.rmtree(sockets, ignore_errors=True)
+
+
 def run_notebook(source: Path, *, quick: bool, seed: int = 0, output_dir=None, kernel: str = "python3",
                  extra_parameters: dict | None = None) -> NotebookResult:
     """Convert ``source`` with jupytext, execute it with papermill and collect its report table.
@@ -84,7 +154,8 @@ def run_notebook(source: Path, *, quick: bool, seed: int = 0, output_dir=None, k
     seed : int
         Passed as ``SEED``.
     output_dir : path-like, optional
-        Build directory (default ``build/``), passed as ``OUTPUT_DIR``.
+        Build directory, passed as ``OUTPUT_DIR`` (relative to the repository when inside it).  Default
+        ``build/`` for full runs and ``build-quick/`` for quick ones; a quick run into ``build/`` is refused.
     kernel : str
         Jupyter kernel name.
     extra_parameters : dict, optional
@@ -94,13 +165,14 @@ def run_notebook(source: Path, *, quick: bool, seed: int = 0, output_dir=None, k
     ------
     NotebookFailure
         When a cell raises; the message names the notebook and the cell.
+    ValueError
+        When a quick run targets ``build/``.
     """
     import jupytext
     import nbformat
     import papermill as pm
 
-    os.environ.setdefault("JUPYTER_PREFER_ENV_PATH", "1")
-    build = paths.build_dir(output_dir)
+    build = resolve_build(output_dir, quick=quick)
     src_dir = build / "notebooks" / "_sources"
     src_dir.mkdir(parents=True, exist_ok=True)
     name = source.stem
@@ -113,12 +185,14 @@ def run_notebook(source: Path, *, quick: bool, seed: int = 0, output_dir=None, k
     ipynb = src_dir / f"{name}.ipynb"
     nbformat.write(nb, ipynb)
     executed = build / "notebooks" / f"{name}.ipynb"
-    params = {"QUICK": bool(quick), "SEED": int(seed), "OUTPUT_DIR": str(build)}
+    params = {"QUICK": bool(quick), "SEED": int(seed), "OUTPUT_DIR": _parameter_path(build)}
     params.update(extra_parameters or {})
     start = time.perf_counter()
     try:
-        pm.execute_notebook(str(ipynb), str(executed), parameters=params, kernel_name=kernel,
-                            cwd=str(build / "notebooks"), progress_bar=False, log_output=False)
+        with _headless_environment(), _kernel_config() as config:
+            pm.execute_notebook(str(ipynb), str(executed), parameters=params, kernel_name=kernel,
+                                cwd=str(build / "notebooks"), progress_bar=False, log_output=False,
+                                config=config)
     except pm.PapermillExecutionError as exc:
         done = nbformat.read(executed, as_version=4)
         cell = done.cells[exc.cell_index] if exc.cell_index < len(done.cells) else None
@@ -136,19 +210,31 @@ def run_notebook(source: Path, *, quick: bool, seed: int = 0, output_dir=None, k
     rep_dir.mkdir(parents=True, exist_ok=True)
     mode = "quick" if quick else "full"
     (rep_dir / f"{name}.md").write_text(f"## {name} ({mode} mode, {seconds:.0f} s)\n\n{report}\n")
-    assemble_report(output_dir)
+    assemble_report(build)
     return NotebookResult(name, seconds, executed, report)
 
 
 def assemble_report(output_dir=None) -> Path:
-    """Concatenate ``<build>/report/*.md`` into ``<build>/report.md``."""
+    """Concatenate ``<build>/report/*.md`` into ``<build>/report.md``, stating the mode(s) the sections ran in."""
     build = paths.build_dir(output_dir)
     parts = sorted((build / "report").glob("*.md"))
-    text = ["# Paper versus reproduction", "",
+    bodies = [p.read_text() for p in parts]
+    modes = sorted({m for b in bodies for m in ("full", "quick") if f" ({m} mode," in b.split("\n", 1)[0]})
+    if modes == ["full"]:
+        mode_line = "**Mode: full.** Every section below comes from a full-fidelity run (`make reproduce`)."
+    elif modes == ["quick"]:
+        mode_line = ("**Mode: quick.** Every section below comes from a quick run (reduced sizes, same science); "
+                     "the paper-scale numbers come from `make reproduce`.")
+    elif modes:
+        mode_line = "**Mode: mixed.** Sections come from full and quick runs; each heading says which."
+    else:
+        mode_line = "No notebook has run into this directory yet."
+    text = ["# Paper versus reproduction", "", mode_line, "",
             "Generated by `python -m cislunar.notebooks`; one section per executed notebook. Status words: "
-            "*reproduced* (agrees within the stated tolerance), *differs* (with the reason), *derived* (the paper "
-            "gives no number; computed here), *beyond paper*.", ""]
-    text += [p.read_text() for p in parts]
+            "*reproduced* (agrees within the tolerance stated in the row), *consistent (tuned)* (agrees after a "
+            "choice made while looking at the paper's number), *differs* (with the reason), *derived* (the paper "
+            "gives no number; computed here), *not in paper*, *beyond paper*.", ""]
+    text += bodies
     out = build / "report.md"
     out.write_text("\n".join(text))
     return out
@@ -160,10 +246,16 @@ def main(argv=None) -> int:
     parser.add_argument("names", nargs="*", help="notebook number or name prefixes (default: all)")
     parser.add_argument("--quick", action="store_true", help="quick mode: smaller sizes, same science")
     parser.add_argument("--seed", type=int, default=0, help="random seed passed to every notebook")
-    parser.add_argument("--output-dir", default=None, help="build directory (default: <repo>/build)")
+    parser.add_argument("--output-dir", default=None,
+                        help="build directory (default: <repo>/build, or <repo>/build-quick with --quick)")
     args = parser.parse_args(argv)
     try:
         sources = discover(args.names)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    try:
+        build = resolve_build(args.output_dir, quick=args.quick)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -172,13 +264,13 @@ def main(argv=None) -> int:
     for src in sources:
         print(f"[{src.stem}] running ({'quick' if args.quick else 'full'})...", flush=True)
         try:
-            res = run_notebook(src, quick=args.quick, seed=args.seed, output_dir=args.output_dir)
+            res = run_notebook(src, quick=args.quick, seed=args.seed, output_dir=build)
         except NotebookFailure as exc:
             failures += 1
             print(f"[{src.stem}] FAILED: {exc}", file=sys.stderr, flush=True)
             continue
         print(f"[{src.stem}] done in {res.seconds:.1f} s -> {res.executed_path}", flush=True)
-    report = assemble_report(args.output_dir)
+    report = assemble_report(build)
     print(f"report: {report}; total {time.perf_counter() - total:.1f} s; {failures} failed", flush=True)
     return 1 if failures else 0
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-__all__ = ["repo_root", "build_dir", "figures_dir"]
+__all__ = ["repo_root", "build_dir", "quick_build_dir", "figures_dir"]
 
 
 def repo_root() -> Path:
@@ -34,6 +34,16 @@ def build_dir(output_dir: str | os.PathLike | None = None) -> Path:
         path = Path(output_dir)
         if not path.is_absolute():
             path = repo_root() / path
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def quick_build_dir() -> Path:
+    """``build-quick/`` under the repository root, created if missing: the default home of quick runs.
+
+    Quick runs never write into ``build/``, which only ever holds a full run (``make reproduce``).
+    """
+    path = repo_root() / "build-quick"
     path.mkdir(parents=True, exist_ok=True)
     return path
 

@@ -1,0 +1,63 @@
+"""Sphinx configuration of the cislunar book (built by ``python -m cislunar.book``; see ``cislunar/book.py``).
+
+The book is assembled from already executed notebooks: nothing is executed here (``nb_execution_mode = "off"``).
+Everything a page needs is served from the build itself, so the book reads offline: MathJax comes from the Python
+package ``sphinx-mathjax-offline`` (copied into ``_static/mathjax``), no widget JavaScript, no external links in the
+theme.
+"""
+
+import os
+
+project = "cislunar: a literate reproduction of four cislunar navigation and tracking papers"
+author = "the cislunar contributors"
+copyright = "the cislunar contributors"
+release = os.environ.get("CISLUNAR_BOOK_RELEASE", "")
+
+extensions = [
+    "myst_nb",
+    "sphinx.ext.mathjax",
+]
+
+# Notebooks are executed by cislunar.notebooks (papermill); the book only renders them.
+nb_execution_mode = "off"
+nb_merge_streams = True
+nb_output_stderr = "show"  # shown, but styled as plain output (book/_static/cislunar-book.css)
+nb_render_markdown_format = "myst"  # the closing comparison tables are Markdown outputs, with math
+nb_ipywidgets_js = {}  # never load widget renderers from the internet
+myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence"]
+myst_heading_anchors = 3
+suppress_warnings = ["myst.header", "mystnb.unknown_mime_type"]
+
+# MathJax 3 from a Python package, never a CDN.  The files are copied into _static/mathjax after the build.
+mathjax_path = "mathjax/tex-chtml.js"
+mathjax3_config = {
+    "tex": {"inlineMath": [["\\(", "\\)"]], "displayMath": [["\\[", "\\]"]]},
+    "options": {"enableMenu": False},
+}
+
+exclude_patterns = ["_build", "**.ipynb_checkpoints"]
+source_suffix = {".md": "myst-nb", ".ipynb": "myst-nb"}
+
+html_theme = "sphinx_book_theme"
+html_title = "cislunar reproduction"
+html_static_path = ["_static"]
+html_css_files = ["cislunar-book.css"]
+html_show_sphinx = False
+html_show_sourcelink = False
+html_copy_source = False
+html_last_updated_fmt = None
+html_theme_options = {
+    "home_page_in_toc": True,
+    "show_navbar_depth": 1,
+    "use_download_button": False,
+    "use_fullscreen_button": False,
+    "use_repository_button": False,
+    "use_source_button": False,
+    "use_edit_page_button": False,
+    "use_issues_button": False,
+    "launch_buttons": {},
+    "footer_content_items": [],
+    "extra_footer": "",
+    "show_toc_level": 2,
+}
+html_context = {"default_mode": "light"}
