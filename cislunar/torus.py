@@ -241,16 +241,19 @@ class InvariantTorus:
         """RMS distance of the ring's velocities from their mean, m/s."""
         return _rms_about_mean(self.circle[:, 3:]) * self.system.velocity_unit_km_s * 1e3
 
+    def _dense_circle(self, n: int = 1440) -> np.ndarray:
+        return self.circle_at(2.0 * np.pi * np.arange(n) / n)
+
     @property
     def max_offset_km(self) -> float:
-        """Largest distance of a ring point from the base orbit's initial position, km."""
-        d = np.linalg.norm(self.circle[:, :3] - self.orbit.x0[:3], axis=1)
+        """Largest distance of the ring (interpolated at 1440 angles) from the base orbit's initial position, km."""
+        d = np.linalg.norm(self._dense_circle()[:, :3] - self.orbit.x0[:3], axis=1)
         return float(d.max() * self.system.length_unit_km)
 
     @property
     def max_velocity_offset_mps(self) -> float:
-        """Largest velocity difference between a ring point and the base orbit's initial state, m/s."""
-        d = np.linalg.norm(self.circle[:, 3:] - self.orbit.x0[3:], axis=1)
+        """Largest velocity difference between the ring (1440 angles) and the base orbit's initial state, m/s."""
+        d = np.linalg.norm(self._dense_circle()[:, 3:] - self.orbit.x0[3:], axis=1)
         return float(d.max() * self.system.velocity_unit_km_s * 1e3)
 
     @property
@@ -297,8 +300,8 @@ class InvariantTorus:
         T = self.period
         k = np.floor(t / T)
         s = t - k * T
-        s = np.where(s >= T, 0.0, s)  # rounding
-        k = np.where(t - k * T >= T, k + 1, k)
+        k = np.where(s >= T, k + 1, k)  # rounding
+        s = np.clip(np.where(s >= T, 0.0, s), 0.0, None)
         out = np.empty((theta0.size, t.size, 6))
         for kk in np.unique(k):
             idx = np.nonzero(k == kk)[0]
@@ -875,8 +878,8 @@ def _refine_extremum(torus, th, t, rng, sign, tol):
 
 
 def qpo_for_mean_range(orbit: PeriodicOrbit, target_km: float = 215.0, N: int = 25, *,  # noqa: N803
-                       rtol: float = 1e-5, n_theta: int = 48, n_t: int = 1201, progress: bool = False,
-                       max_iter: int = 12, **solve_kw) -> tuple[InvariantTorus, RangeStats]:
+                       statistic: str = "mean_km", rtol: float = 1e-5, n_theta: int = 48, n_t: int = 1201,
+                       progress: bool = False, max_iter: int = 12, **solve_kw) -> tuple[InvariantTorus, RangeStats]:
     """The member of the torus family (stroboscopic time = the orbit's period) with a given mean range.
 
     The family is continued in ring size from a small torus; a secant iteration on the size then matches
@@ -890,6 +893,10 @@ def qpo_for_mean_range(orbit: PeriodicOrbit, target_km: float = 215.0, N: int = 
         Wanted mean agent-target range, km (the paper: 215 km).
     N : int
         Circle points.
+    statistic : {"mean_km", "ring_mean_km", "rms_km"}
+        Which :class:`RangeStats` reading is matched: the torus average of :func:`mean_range` (default, the
+        long-time mean along natural trajectories), the mean over the initial ring at apolune only, or the RMS
+        range.  The alternatives exist to show how much the member depends on the reading of "average range".
     rtol : float
         Relative tolerance on the mean range.
     n_theta, n_t : int
@@ -911,12 +918,14 @@ def qpo_for_mean_range(orbit: PeriodicOrbit, target_km: float = 215.0, N: int = 
         If the secant iteration does not reach ``rtol``.
     """
     target_km = _checks.positive(target_km, "target_km")
+    if statistic not in ("mean_km", "ring_mean_km", "rms_km"):
+        raise ValueError(f"statistic must be 'mean_km', 'ring_mean_km' or 'rms_km'; got {statistic!r}")
     rtol = _checks.in_range(rtol, "rtol", 1e-12, 0.1)
     N = _check_n(N)
     small = torus_from_orbit(orbit, N, min(5.0, target_km / 10.0), **solve_kw)
     stats = mean_range(small, n_theta=n_theta, n_t=n_t)
-    sizes, means = [small.size_km], [stats.mean_km]
-    guess_km = small.size_km * target_km / stats.mean_km
+    sizes, means = [small.size_km], [getattr(stats, statistic)]
+    guess_km = small.size_km * target_km / means[0]
     torus = small
     history = []
     for _ in range(max_iter):
@@ -924,14 +933,15 @@ def qpo_for_mean_range(orbit: PeriodicOrbit, target_km: float = 215.0, N: int = 
         values = np.linspace(torus.size_km, guess_km, n_steps + 1)[1:]
         torus = continue_tori(torus, values, parameter="size_km", progress=progress, **solve_kw)[-1]
         stats = mean_range(torus, n_theta=n_theta, n_t=n_t)
-        history.append(stats.mean_km - target_km)
-        if abs(stats.mean_km - target_km) <= rtol * target_km:
+        value = getattr(stats, statistic)
+        history.append(value - target_km)
+        if abs(value - target_km) <= rtol * target_km:
             return torus, stats
         sizes.append(torus.size_km)
-        means.append(stats.mean_km)
+        means.append(value)
         slope = (means[-1] - means[-2]) / (sizes[-1] - sizes[-2])
         guess_km = sizes[-1] + (target_km - means[-1]) / slope
         if guess_km <= 0:
             break
-    raise TorusConvergenceError(f"no torus member with mean range {target_km} km found", history,
+    raise TorusConvergenceError(f"no torus member with {statistic} = {target_km} km found", history,
                                 np.array(sizes))

@@ -146,6 +146,10 @@ def test_states_are_on_torus_and_consistent_with_flow(big):
     assert np.allclose(a[:, 0], big.circle_at(th), atol=1e-15)
     assert np.allclose(a[:, 2], big.states(th + big.rho, [0.4 * T])[:, 0], atol=1e-12)
     assert np.allclose(a[:, 3], big.circle_at(th + 2 * big.rho), atol=1e-12)
+    # times just below / at a whole period, negative times
+    b = big.states(th, [np.nextafter(T, 0.0), -0.5 * T])
+    assert np.allclose(b[:, 0], big.circle_at(th + big.rho), atol=1e-12)
+    assert np.allclose(b[:, 1], big.states(th - big.rho, [0.5 * T])[:, 0], atol=1e-15)
     direct = propagate(big.system, big.circle_at(th), [0.0, 0.4 * T, 1.4 * T]).x
     assert np.allclose(a[:, :3], direct, atol=1e-10)
     # ring at a given time: flowing the circle for t equals the ring function
@@ -161,6 +165,9 @@ def test_two_values_of_n_agree(big):
     th = np.linspace(0, 2 * np.pi, 17)
     assert np.max(np.abs(other.circle_at(th) - big.circle_at(th))) < 1e-11
     assert abs(other.jacobi - big.jacobi) < 1e-12
+    assert abs(other.max_offset_km - big.max_offset_km) < 1e-5
+    assert abs(other.max_velocity_offset_mps - big.max_velocity_offset_mps) < 1e-6
+    assert abs(other.velocity_size_mps - big.velocity_size_mps) < 1e-8
 
 
 def test_member_constraints_select_the_same_torus(big):
@@ -215,6 +222,12 @@ def test_member_with_215_km_mean_range(orbit):
     assert torus.invariance_error() < 1e-9
     assert 100.0 < torus.size_km < 215.0
     assert stats.min_km < 215.0 < stats.max_km
+    # matching the mean over the apolune ring instead selects a larger member (the ring is smallest near apolune)
+    ring, ring_stats = tm.qpo_for_mean_range(orbit, 215.0, N=11, n_theta=24, n_t=601, statistic="ring_mean_km")
+    assert abs(ring_stats.ring_mean_km - 215.0) < 215.0 * 1e-5
+    assert ring.size_km > torus.size_km
+    with pytest.raises(ValueError, match="statistic"):
+        tm.qpo_for_mean_range(orbit, 215.0, N=11, statistic="median")
 
 
 # ------------------------------------------------------------------------------------------ failures
