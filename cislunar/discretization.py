@@ -41,7 +41,8 @@ from . import _checks
 from .dynamics import CR3BP
 from .propagation import DEFAULT_TOL, _check_outcome, _check_tol, _heyoka, thread_local_copy
 
-__all__ = ["sundman_nodes", "max_control_per_node", "FOHModel", "foh_discretize", "propagate_foh"]
+__all__ = ["sundman_nodes", "snap_nodes", "max_control_per_node", "coast_bounds", "FOHModel", "foh_discretize",
+           "propagate_foh"]
 
 
 @functools.lru_cache(maxsize=4)
@@ -57,7 +58,24 @@ def _sundman_template(tol: float):
            (vy, -2.0 * vx + y - (1.0 - mu) * y / r1_3 - mu * y / r2_3),
            (vz, -(1.0 - mu) * z / r1_3 - mu * z / r2_3),
            (tau, rm2 ** (-0.5 * sigma))]
-    return hy.taylor_adaptive(sys, [0.8, 0, 0, 0, 0.5, 0, 0], pars=[0.01, 0.0], tol=tol, compact_mode=True)
+    return hy.taylor_adaptive(sys, [0.8, 0, 0, 0, 0.5, 0, 0], pars=[0.01, 0.0, 0.0, 0.0], tol=tol,
+                              compact_mode=True, t_events=_impact_events(hy, x, y, z, mu, hy.par[2], hy.par[3]))
+
+
+def _impact_events(hy, x, y, z, mu, r_moon, r_earth):
+    """Terminal events at the surface of the Moon (event 0) and of the Earth (event 1), entered from outside."""
+    return [hy.t_event(((x - 1.0 + mu) ** 2 + y**2 + z**2) - r_moon**2, direction=hy.event_direction.negative),
+            hy.t_event(((x + mu) ** 2 + y**2 + z**2) - r_earth**2, direction=hy.event_direction.negative)]
+
+
+def _check_outside(system: CR3BP, x, name: str):
+    """Refuse states inside either primary (an integration from there would run through the body)."""
+    x = np.atleast_2d(x)
+    rm = np.linalg.norm(x[:, :3] - [1.0 - system.mu, 0.0, 0.0], axis=1)
+    re = np.linalg.norm(x[:, :3] - [-system.mu, 0.0, 0.0], axis=1)
+    bad = np.flatnonzero((rm <= system.secondary_radius) | (re <= system.primary_radius))
+    if bad.size:
+        raise ValueError(f"{name} holds a state inside a primary (row {int(bad[0])})")
 
 
 def sundman_nodes(system: CR3BP, x0, t_final: float, n_nodes: int, sigma: float, *, tol: float = DEFAULT_TOL):
@@ -83,6 +101,13 @@ def sundman_nodes(system: CR3BP, x0, t_final: float, n_nodes: int, sigma: float,
         Node times, TU, from 0 to ``t_final``.
     tau_nodes : ndarray, shape (n_nodes,)
         The Sundman variable at the nodes (LU^-sigma TU).
+
+    Raises
+    ------
+    ValueError
+        ``x0`` lies inside a primary.
+    RuntimeError
+        The ballistic reference hits the surface of the Moon or the Earth before ``t_final`` (terminal event).
     """
     x0 = _checks.as_state(x0, "x0", batch=False)
     tf = _checks.positive(t_final, "t_final")
@@ -92,7 +117,8 @@ def sundman_nodes(system: CR3BP, x0, t_final: float, n_nodes: int, sigma: float,
     sigma = _checks.in_range(sigma, "sigma", -3.0, 3.0)
     tol = _check_tol(tol)
     ta = thread_local_copy(("sundman", tol), lambda: _sundman_template(tol))
-    ta.pars[:] = [system.mu, sigma]
+    _check_outside(system, x0, "x0")
+    ta.pars[:] = [system.mu, sigma, system.secondary_radius, system.primary_radius]
     ta.time = 0.0
     ta.state[:] = np.r_[x0, 0.0]
     res = ta.propagate_until(tf, c_output=True)
@@ -141,12 +167,84 @@ def max_control_per_node(t_nodes, a_max: float) -> np.ndarray:
     return np.linalg.lstsq(M, np.full(n - 1, 2.0 * a), rcond=None)[0]
 
 
+def snap_nodes(t_nodes, times) -> tuple[np.ndarray, np.ndarray]:
+    """Move the nodes nearest to ``times`` onto them (e.g. observation-window ends), keeping the node count.
+
+    Parameters
+    ----------
+    t_nodes : array_like (N,)
+        Strictly increasing node times, TU.
+    times : array_like (M,)
+        Times that must be nodes, strictly inside ``(t_nodes[0], t_nodes[-1])`` or equal to an end.
+
+    Returns
+    -------
+    t : ndarray (N,)
+        Node times with ``times`` among them.
+    index : ndarray of int (M,)
+        Index of each of ``times`` in ``t``.
+    """
+    t = _checks.time_grid(t_nodes, "t_nodes", increasing=True).copy()
+    tm = _checks.as_array(times, "times", ndim=(1,))
+    if np.any(tm < t[0]) or np.any(tm > t[-1]):
+        raise ValueError(f"times must lie within [{t[0]}, {t[-1]}]")
+    index = np.empty(tm.size, dtype=int)
+    used = set()
+    for j, s in enumerate(tm):
+        order = np.argsort(np.abs(t - s))
+        k = next((int(i) for i in order if int(i) not in used), None)
+        if k is None or (k in (0, t.size - 1) and not np.isclose(t[k], s, rtol=0, atol=1e-12)):
+            raise ValueError("times must be distinct and need interior nodes near them; use more nodes")
+        t[k] = s
+        used.add(k)
+        index[j] = k
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("snapping times onto nodes broke the node order; use more nodes")
+    return t, index
+
+
+def coast_bounds(t_nodes, a_max: float, windows=()) -> np.ndarray:
+    """Per-node acceleration bounds: ``a_max`` everywhere, zero at every node of a coast window.
+
+    The node controls are accelerations with a first-order hold, so Eq. 40 on an interval,
+    :math:`(u_{max,k}+u_{max,k+1})/2 = a_{max}`, holds with the uniform bound (the acceleration reading of Eq. 41,
+    notebook 04); zero at both ends of every interval of a window makes the thrust zero across the window
+    (the paper's :math:`a_{max} = 0` in the observation window).  Window ends must be nodes
+    (:func:`snap_nodes`).
+
+    Parameters
+    ----------
+    t_nodes : array_like (N,)
+    a_max : float
+        LU/TU^2, >= 0.
+    windows : sequence of (t_start, t_end)
+        Closed coast windows, TU.
+
+    Returns
+    -------
+    ndarray (N,)
+    """
+    t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
+    a = _checks.positive(a_max, "a_max", allow_zero=True)
+    out = np.full(t.size, a)
+    for i, win in enumerate(windows):
+        w = _checks.as_array(win, f"windows[{i}]", shape=(2,))
+        if not w[0] < w[1]:
+            raise ValueError(f"windows[{i}] must have start < end; got {w}")
+        for end in w:
+            if not np.any(np.isclose(t, end, rtol=0, atol=1e-12)):
+                raise ValueError(f"windows[{i}] end {end} is not a node (use snap_nodes)")
+        out[(t >= w[0] - 1e-12) & (t <= w[1] + 1e-12)] = 0.0
+    return out
+
+
 @functools.lru_cache(maxsize=4)
 def _foh_template(tol: float):
     """Variational system of the CR3BP with a first-order-hold acceleration and a constant virtual control.
 
     Parameters: ``par[0]`` mu, ``par[1:4]`` u_k, ``par[4:7]`` u_{k+1}, ``par[7:13]`` epsilon (added to the six
-    state derivatives), ``par[13]`` t_k, ``par[14]`` t_{k+1}.
+    state derivatives), ``par[13]`` t_k, ``par[14]`` t_{k+1}, ``par[15:17]`` Moon and Earth radii (LU; terminal
+    impact events).
     """
     hy = _heyoka()
     x, y, z, vx, vy, vz = hy.make_vars("x", "y", "z", "vx", "vy", "vz")
@@ -165,8 +263,9 @@ def _foh_template(tol: float):
     sys = list(zip((x, y, z, vx, vy, vz), rhs))
     args = [x, y, z, vx, vy, vz] + [hy.par[i] for i in range(1, 13)]
     vsys = hy.var_ode_sys(sys, args, order=1)
-    ta = hy.taylor_adaptive(vsys, [0.8, 0, 0, 0, 0.5, 0], pars=np.r_[0.01, np.zeros(12), 0.0, 1.0], tol=tol,
-                            compact_mode=True)
+    ta = hy.taylor_adaptive(vsys, [0.8, 0, 0, 0, 0.5, 0], pars=np.r_[0.01, np.zeros(12), 0.0, 1.0, 0.0, 0.0],
+                            tol=tol, compact_mode=True,
+                            t_events=_impact_events(hy, x, y, z, mu, hy.par[15], hy.par[16]))
     index = np.zeros((6, 18), dtype=int)
     for k in range(6, len(ta.state)):
         m = ta.get_mindex(k)
@@ -213,7 +312,7 @@ class FOHModel:
 def _foh_interval(system, x0, uk, uk1, t0, t1, tol):
     ta = thread_local_copy(("foh", tol), lambda: _foh_template(tol)[0])
     _, index = _foh_template(tol)
-    ta.pars[:] = np.r_[system.mu, uk, uk1, np.zeros(6), t0, t1]
+    ta.pars[:] = np.r_[system.mu, uk, uk1, np.zeros(6), t0, t1, system.secondary_radius, system.primary_radius]
     ta.time = t0
     ta.state[:6] = x0
     ta.state[6:] = np.concatenate([np.eye(6), np.zeros((6, 12))], axis=1).ravel()
@@ -236,11 +335,19 @@ def foh_discretize(system: CR3BP, t_nodes, x_nodes, u_nodes, *, tol: float = DEF
         Reference accelerations at the nodes, LU/TU^2 (rotating-frame components).
     tol : float
         Integrator tolerance.
+
+    Raises
+    ------
+    ValueError
+        A reference node lies inside a primary.
+    RuntimeError
+        An interval's propagation hits the surface of the Moon or the Earth (terminal event) or fails.
     """
     t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
     n = t.size
     x = _checks.as_array(x_nodes, "x_nodes", shape=(n, 6))
     u = _checks.as_array(u_nodes, "u_nodes", shape=(n, 3))
+    _check_outside(system, x, "x_nodes")
     tol = _check_tol(tol)
     A = np.empty((n - 1, 6, 6))
     Bm = np.empty((n - 1, 6, 3))
@@ -256,11 +363,34 @@ def foh_discretize(system: CR3BP, t_nodes, x_nodes, u_nodes, *, tol: float = DEF
 
 
 def propagate_foh(system: CR3BP, x0, t_nodes, u_nodes, *, tol: float = DEFAULT_TOL) -> np.ndarray:
-    """Nonlinear propagation of ``x0`` through the nodes under the FOH control (single shooting), shape (N, 6)."""
-    t = _checks.time_grid(t_nodes, "t_nodes")
+    """Nonlinear propagation of ``x0`` through the nodes under the FOH control (single shooting).
+
+    Parameters
+    ----------
+    system : CR3BP
+    x0 : array_like (6,)
+        State at ``t_nodes[0]``.
+    t_nodes : array_like (N,)
+        Strictly increasing node times, TU.
+    u_nodes : array_like (N, 3)
+        Node accelerations, LU/TU^2 (linear in between).
+    tol : float
+
+    Returns
+    -------
+    ndarray (N, 6)
+        States at the nodes.
+
+    Raises
+    ------
+    RuntimeError
+        The trajectory hits the surface of the Moon or the Earth (terminal event), or the integration fails.
+    """
+    t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
     u = _checks.as_array(u_nodes, "u_nodes", shape=(t.size, 3))
     x = np.empty((t.size, 6))
     x[0] = _checks.as_state(x0, "x0", batch=False)
+    _check_outside(system, x[0], "x0")
     for k in range(t.size - 1):
         x[k + 1], _ = _foh_interval(system, x[k], u[k], u[k + 1], t[k], t[k + 1], _check_tol(tol))
     return x
