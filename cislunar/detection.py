@@ -76,6 +76,26 @@ __all__ = [
 # ---------------------------------------------------------------------------------------------------------------
 
 
+def _size(size):
+    """``None``, a non-negative int or a tuple of them (numpy's ``size`` argument)."""
+    if size is None:
+        return None
+    if isinstance(size, tuple):
+        return tuple(_checks.integer(v, "size", minimum=0) for v in size)
+    return _checks.integer(size, "size", minimum=0)
+
+
+def _check_policy(policy, name: str = "policy", *, optional: bool = False):
+    if policy is None and optional:
+        return None
+    return _checks.instance(policy, name, StationKeepingPolicy,
+                            "a cislunar.detection.StationKeepingPolicy" + (" or None" if optional else ""))
+
+
+def _check_setup(setup, name: str = "setup"):
+    return _checks.instance(setup, name, DetectionSetup, "a cislunar.detection.DetectionSetup (make_setup)")
+
+
 @dataclass(frozen=True)
 class StationKeepingPolicy:
     """Randomly pointed apoapsis impulse with a truncated-Gaussian magnitude (Eqs. 3-5).
@@ -98,6 +118,8 @@ class StationKeepingPolicy:
     n_sigma: float = 3.0
 
     def __post_init__(self):
+        if not isinstance(self.name, str):
+            raise _checks.ArgumentTypeError(f"name must be a str; got {type(self.name).__name__}")
         _checks.positive(self.mean_m_s, "mean_m_s")
         _checks.positive(self.sd_m_s, "sd_m_s")
         _checks.positive(self.n_sigma, "n_sigma")
@@ -111,15 +133,15 @@ class StationKeepingPolicy:
 
     def sample_magnitude(self, rng: np.random.Generator, size=None) -> np.ndarray:
         """Magnitudes (m/s) drawn from the truncated Gaussian with the caller's generator."""
-        if not isinstance(rng, np.random.Generator):
-            raise ValueError("rng must be a numpy.random.Generator")
+        _checks.rng(rng)
+        size = _size(size)
         return self.magnitude_distribution.rvs(size=size, random_state=rng)
 
     @staticmethod
     def sample_pointing(rng: np.random.Generator, size=None) -> tuple[np.ndarray, np.ndarray]:
         """Azimuth :math:`\\mathcal U[-\\pi,\\pi]` (Eq. 3) and elevation :math:`\\mathcal U[-\\pi/2,\\pi/2]` (Eq. 4), rad."""
-        if not isinstance(rng, np.random.Generator):
-            raise ValueError("rng must be a numpy.random.Generator")
+        _checks.rng(rng)
+        size = _size(size)
         return rng.uniform(-np.pi, np.pi, size), rng.uniform(-np.pi / 2, np.pi / 2, size)
 
     def sample(self, rng: np.random.Generator, size=None):
@@ -171,6 +193,7 @@ def window_control_weight(policy: StationKeepingPolicy, window_hours: float = 8.
     window_hours : float
         Window length, hours (8 in the paper).
     """
+    _check_policy(policy)
     T = _checks.positive(window_hours, "window_hours") * 3600.0
     return policy.second_moment_m2_s2() * 1e-6 / (3.0 * T)
 
@@ -253,9 +276,13 @@ def make_setup(system: CR3BP, orbit: PeriodicOrbit, q_window_km2_s3: float, q_ba
     sigma_angle_rad : float
         Angular noise (1 sigma), rad.
     """
+    _checks.system(system)
+    _checks.instance(orbit, "orbit", PeriodicOrbit, "a cislunar.orbits.PeriodicOrbit")
     qw = _checks.positive(q_window_km2_s3, "q_window_km2_s3")
     qb = _checks.positive(q_base_km2_s3, "q_base_km2_s3")
     wh = _checks.positive(window_hours, "window_hours")
+    n_sub = _checks.integer(n_sub, "n_sub", minimum=2)
+    tol = _check_tol(tol)
     sc = tracking.make_scenario(system, orbit, cadence_hours, start="periapsis", periods=periods,
                                 sigma_angle_rad=sigma_angle_rad)
     if sc.t_apoapsis.size == 0:
@@ -330,8 +357,9 @@ def draw_trial(rng: np.random.Generator, setup: DetectionSetup, policy: StationK
     direction : array_like (2,), optional
         ``(azimuth, elevation)`` in rad overriding the drawn pointing.
     """
-    if not isinstance(rng, np.random.Generator):
-        raise ValueError("rng must be a numpy.random.Generator")
+    _checks.rng(rng)
+    _check_setup(setup)
+    _check_policy(policy, optional=True)
     em, sc = setup.system, setup.scenario
     maneuvers, mag, az, el = [], 0.0, np.nan, np.nan
     if policy is not None or magnitude_m_s is not None:
@@ -357,6 +385,8 @@ def run_trial_filter(setup: DetectionSetup, inputs: TrialInputs, control_weight=
 
     ``control_weight`` (LU^2/TU^3, scalar or per interval) overrides the setup's tuning.
     """
+    _check_setup(setup)
+    _checks.instance(inputs, "inputs", TrialInputs, "a cislunar.detection.TrialInputs (draw_trial)")
     sc = setup.scenario
     q = setup.control_weight if control_weight is None else control_weight
     return ocbe.ocbe_filter_smoother(setup.system, sc.t, inputs.y, setup.observer_states, sc.model, sc.meas_cov, inputs.x0,
@@ -396,11 +426,10 @@ def detection_trial_batch(rng: np.random.Generator, setup: DetectionSetup, polic
     -------
     list of TrialResult
     """
-    if not isinstance(rng, np.random.Generator):
-        raise ValueError("rng must be a numpy.random.Generator")
-    B = int(batch_size)
-    if B < 1:
-        raise ValueError(f"batch_size must be >= 1; got {batch_size}")
+    _checks.rng(rng)
+    _check_setup(setup)
+    _check_policy(policy, optional=True)
+    B = _checks.integer(batch_size, "batch_size", minimum=1)
     inputs = [draw_trial(child, setup, policy) for child in rng.spawn(B)]
     sc = setup.scenario
     res = ocbe_batch(setup.system, sc.t, np.array([i.y for i in inputs]), setup.observer_states, sc.model, sc.meas_cov,
@@ -465,12 +494,11 @@ def run_detection_monte_carlo(setup: DetectionSetup, policy: StationKeepingPolic
     """
     from .montecarlo import run_monte_carlo
 
-    n = int(n_trials)
-    if n < 1:
-        raise ValueError(f"n_trials must be >= 1; got {n_trials}")
-    B = int(batch_size)
-    if B < 0:
-        raise ValueError(f"batch_size must be >= 0; got {batch_size}")
+    _check_setup(setup)
+    _check_policy(policy, optional=True)
+    n = _checks.integer(n_trials, "n_trials", minimum=1)
+    B = _checks.integer(batch_size, "batch_size", minimum=0)
+    _checks.seed_entropy(seed, "seed")
     label = desc or f"{'H0' if policy is None else policy.name} MC"
     if B == 0:
         res = run_monte_carlo(detection_trial, n, seed, args=(setup, policy), executor=executor, chunk_size=None,
@@ -581,22 +609,23 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
     tol : float
         Integrator tolerance.
     """
+    _checks.system(system)
+    model = ocbe.check_model(model)
     t = _checks.time_grid(t, "t", increasing=True)
     N = t.size
-    y = _checks.as_array(y, "y", ndim=(3,))
+    y = _checks.as_array(y, "y", ndim=(3,), min_size=1)
     B, m = y.shape[0], model.dim
     if y.shape[1:] != (N, m):
         raise ValueError(f"y must have shape (B, {N}, {m}); got {y.shape}")
     obs = _checks.as_array(observer_states, "observer_states", shape=(N, 6))
-    R = _checks.as_array(meas_cov, "meas_cov", shape=(m, m))
+    R = _checks.spd(meas_cov, "meas_cov", n=m)
     x = _checks.as_array(x0, "x0", shape=(B, 6)).copy()
-    P0 = np.broadcast_to(_checks.as_array(P0, "P0"), (B, 6, 6))
-    qs = np.broadcast_to(_checks.as_array(control_weight, "control_weight"), (B, N - 1)).astype(float)
-    if np.any(qs <= 0):
-        raise ValueError("control_weight must be positive on every interval")
-    n_sub = int(n_sub)
-    if n_sub < 2:
-        raise ValueError(f"n_sub must be at least 2; got {n_sub}")
+    P0 = _checks.spd(P0, "P0", n=6, batch=True)
+    if P0.shape not in ((6, 6), (B, 6, 6)):
+        raise ValueError(f"P0 must have shape (6, 6) or ({B}, 6, 6); got {P0.shape}")
+    P0 = np.broadcast_to(P0, (B, 6, 6))
+    qs = ocbe.control_weights(control_weight, N - 1, batch=B)
+    n_sub = _checks.integer(n_sub, "n_sub", minimum=2)
     tol = _check_tol(tol)
     hy = _heyoka()
     template, index = _batch_template(tol, B)
@@ -718,8 +747,9 @@ def fit_pdf(samples, bandwidth="scott") -> stats.gaussian_kde:
     z = _checks.as_array(samples, "samples", ndim=(1,))
     if z.size < 2 or np.std(z) == 0:
         raise ValueError("samples must hold at least two distinct values")
-    ok = bandwidth in ("scott", "silverman") or (isinstance(bandwidth, (int, float)) and np.isfinite(bandwidth)
-                                                  and bandwidth > 0)
+    ok = (isinstance(bandwidth, str) and bandwidth in ("scott", "silverman")) or (
+        isinstance(bandwidth, (int, float)) and not isinstance(bandwidth, bool) and np.isfinite(bandwidth)
+        and bandwidth > 0)
     if not ok:
         raise ValueError(f"bandwidth must be 'scott', 'silverman' or a positive factor; got {bandwidth!r}")
     return stats.gaussian_kde(z, bw_method=bandwidth)
@@ -748,11 +778,14 @@ def pdf_crossings(pdf0, pdf1, lo: float, hi: float, *, n_grid: int = 4001) -> np
     n_grid : int
         Grid points for bracketing.
     """
-    lo = float(lo)
-    hi = float(hi)
-    if not (np.isfinite(lo) and np.isfinite(hi) and hi > lo):
+    lo = _checks.real(lo, "lo")
+    hi = _checks.real(hi, "hi")
+    if not hi > lo:
         raise ValueError(f"lo and hi must be finite with lo < hi; got lo={lo}, hi={hi}")
+    n_grid = _checks.integer(n_grid, "n_grid", minimum=3)
     f0, f1 = _pdf(pdf0), _pdf(pdf1)
+    _checks.callable_(f0, "pdf0")
+    _checks.callable_(f1, "pdf1")
 
     def g(z):
         return float(np.asarray(f0(z)).ravel()[0] - np.asarray(f1(z)).ravel()[0])
@@ -780,7 +813,11 @@ def error_rates(z_lim: float, dist0, dist1) -> tuple[float, float]:
     dist0, dist1 : gaussian_kde or frozen scipy distribution
         Densities under H0 and H1.
     """
-    zl = float(_checks.as_array(z_lim, "z_lim", shape=()))
+    zl = _checks.real(z_lim, "z_lim")
+    for name, dist in (("dist0", dist0), ("dist1", dist1)):
+        if not (isinstance(dist, stats.gaussian_kde) or callable(getattr(dist, "cdf", None))):
+            raise _checks.ArgumentTypeError(f"{name} must be a scipy.stats.gaussian_kde or a frozen scipy "
+                                            f"distribution; got {type(dist).__name__}")
     return 1.0 - _cdf(dist0, zl), _cdf(dist1, zl)
 
 
@@ -844,7 +881,7 @@ def ml_threshold(z_h0, z_h1, *, bandwidth="scott") -> DetectionThreshold:
 
 def decide(z, z_lim: float) -> np.ndarray:
     """Eq. 35: ``True`` (H1, maneuver) where ``z > z_lim``, ``False`` (H0) otherwise."""
-    return _checks.as_array(z, "z") > float(_checks.as_array(z_lim, "z_lim", shape=()))
+    return _checks.as_array(z, "z") > _checks.real(z_lim, "z_lim")
 
 
 @dataclass(frozen=True)
@@ -876,8 +913,8 @@ class DetectionScore:
 
 def detection_accuracy(z_test_h0, z_test_h1, z_lim: float) -> DetectionScore:
     """Apply Eq. 35 to independent non-maneuvering (``z_test_h0``) and maneuvering (``z_test_h1``) test sets."""
-    d0 = decide(_checks.as_array(z_test_h0, "z_test_h0", ndim=(1,)), z_lim)
-    d1 = decide(_checks.as_array(z_test_h1, "z_test_h1", ndim=(1,)), z_lim)
+    d0 = decide(_checks.as_array(z_test_h0, "z_test_h0", ndim=(1,), min_size=1), z_lim)
+    d1 = decide(_checks.as_array(z_test_h1, "z_test_h1", ndim=(1,), min_size=1), z_lim)
     return DetectionScore(int(np.sum(~d0)), int(np.sum(d0)), int(np.sum(d1)), int(np.sum(~d1)))
 
 
@@ -934,10 +971,16 @@ def run_policy_study(setup: DetectionSetup, policy: StationKeepingPolicy, n_h0: 
     label : str
         Progress-bar prefix.
     """
-    base = list(np.atleast_1d(seed).astype(int))
-    n_test = int(n_test)
-    if n_test < 0:
-        raise ValueError(f"n_test must be >= 0; got {n_test}")
+    _check_setup(setup)
+    _check_policy(policy)
+    _checks.seed_entropy(seed, "seed")
+    if isinstance(seed, np.random.SeedSequence):
+        raise _checks.ArgumentTypeError("seed must be an int or a list of ints here (the four sets append an index)")
+    base = [int(v) for v in np.atleast_1d(seed)]
+    _checks.integer(n_h0, "n_h0", minimum=2)
+    _checks.integer(n_h1, "n_h1", minimum=2)
+    n_test = _checks.integer(n_test, "n_test", minimum=0)
+    _checks.integer(batch_size, "batch_size", minimum=0)
 
     def mc(pol, n, k, what):
         return run_detection_monte_carlo(setup, pol, n, base + [k], batch_size=batch_size, executor=executor,

@@ -94,6 +94,17 @@ class CR3BP:
             raise ValueError("mu must lie in (0, 0.5]; got 0.0")
         _checks.positive(self.length_unit_km, "length_unit_km")
         _checks.positive(self.time_unit_s, "time_unit_s")
+        # radii drive impact detection: NaN, negative or non-numeric radii would silently switch it off
+        _checks.positive(self.primary_radius_km, "primary_radius_km")
+        _checks.positive(self.secondary_radius_km, "secondary_radius_km")
+        if not isinstance(self.name, str):
+            raise _checks.ArgumentTypeError(f"name must be a str; got {type(self.name).__name__}")
+        d = self.length_unit_km
+        if self.primary_radius_km + self.secondary_radius_km >= d:
+            raise ValueError(f"primary_radius_km + secondary_radius_km must be smaller than length_unit_km = {d} km "
+                             "(the primaries would overlap)")
+        for attr in ("mu", "length_unit_km", "time_unit_s", "primary_radius_km", "secondary_radius_km"):
+            object.__setattr__(self, attr, float(getattr(self, attr)))
 
     # ------------------------------------------------------------------ units
     @property
@@ -113,19 +124,19 @@ class CR3BP:
 
     def days_to_tu(self, days):
         """Convert a duration in days to TU."""
-        return np.asarray(days, dtype=float) / self.time_unit_days
+        return _checks.as_array(days, "days", finite=False) / self.time_unit_days
 
     def tu_to_days(self, tu):
         """Convert a duration in TU to days."""
-        return np.asarray(tu, dtype=float) * self.time_unit_days
+        return _checks.as_array(tu, "tu", finite=False) * self.time_unit_days
 
     def km_to_lu(self, km):
         """Convert a length in km to LU."""
-        return np.asarray(km, dtype=float) / self.length_unit_km
+        return _checks.as_array(km, "km", finite=False) / self.length_unit_km
 
     def lu_to_km(self, lu):
         """Convert a length in LU to km."""
-        return np.asarray(lu, dtype=float) * self.length_unit_km
+        return _checks.as_array(lu, "lu", finite=False) * self.length_unit_km
 
     def state_to_km(self, state):
         """Convert non-dimensional states ``(..., 6)`` to km and km/s (same frame and origin)."""
@@ -162,7 +173,9 @@ class CR3BP:
 
     def distances(self, state):
         """Distances ``(r1, r2)`` to the primary and the secondary, LU, for positions ``(..., >=3)``."""
-        s = np.asarray(state, dtype=float)
+        s = _checks.as_array(state, "state", finite=False)
+        if s.ndim == 0 or s.shape[-1] < 3:
+            raise ValueError(f"state must have at least 3 components on its last axis; got shape {s.shape}")
         x, y, z = s[..., 0], s[..., 1], s[..., 2]
         r1 = np.sqrt((x + self.mu) ** 2 + y**2 + z**2)
         r2 = np.sqrt((x - 1.0 + self.mu) ** 2 + y**2 + z**2)
@@ -184,7 +197,11 @@ class CR3BP:
         return 2.0 * self.pseudo_potential(s) - v2
 
     def eom(self, state, t: float = 0.0):
-        """Time derivative of states ``(..., 6)`` (the CR3BP vector field; autonomous, ``t`` unused)."""
+        """Time derivative of states ``(..., 6)`` (the CR3BP vector field; autonomous, ``t`` unused).
+
+        At a primary's centre the field is singular: the result holds infinities there (no error is raised, so
+        that integrators can detect it).
+        """
         s = _checks.as_array(state, "state", last=6)
         mu = self.mu
         x, y, z, vx, vy, vz = np.moveaxis(s, -1, 0)
@@ -212,7 +229,9 @@ class CR3BP:
 
     def potential_hessian(self, state):
         """Hessian :math:`U_{rr}` of the pseudo-potential, shape ``(..., 3, 3)``."""
-        s = np.asarray(state, dtype=float)
+        s = _checks.as_array(state, "state")
+        if s.ndim == 0 or s.shape[-1] < 3:
+            raise ValueError(f"state must have at least 3 components on its last axis; got shape {s.shape}")
         mu = self.mu
         r = s[..., 0:3]
         d1 = r - self.primary_position
@@ -247,7 +266,9 @@ class CR3BP:
 
     def moon_centred(self, state):
         """Shift positions ``(..., >=3)`` to a Moon-centred origin (same rotating axes), LU."""
-        s = np.array(state, dtype=float, copy=True)
+        s = np.array(_checks.as_array(state, "state", finite=False), copy=True)
+        if s.ndim == 0 or s.shape[-1] < 3:
+            raise ValueError(f"state must have at least 3 components on its last axis; got shape {s.shape}")
         s[..., 0] -= 1.0 - self.mu
         return s
 

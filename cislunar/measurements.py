@@ -424,6 +424,8 @@ MODELS = {m.name: m for m in (RELATIVE_POSITION, RANGE_RANGE_RATE, AZIMUTH_ELEVA
 
 
 def _apply(model: MeasurementModel, observer, target, jacobian: bool):
+    if not isinstance(jacobian, (bool, np.bool_)):
+        raise _checks.ArgumentTypeError(f"jacobian must be True or False; got {type(jacobian).__name__}")
     if jacobian:
         return model.evaluate(observer, target)
     return model(observer, target)
@@ -516,15 +518,15 @@ def wrap_angle(angle) -> np.ndarray:
 # noise models
 # --------------------------------------------------------------------------------------------------------------
 def _check_system(system):
-    if not isinstance(system, CR3BP):
-        raise ValueError(f"system must be a cislunar.dynamics.CR3BP; got {type(system).__name__}")
-    return system
+    return _checks.system(system)
 
 
 def diagonal_covariance(sigmas) -> np.ndarray:
     """Diagonal covariance ``diag(sigmas**2)``; ``sigmas`` (..., m) must be non-negative (else ``ValueError``)."""
     s = _checks.as_array(sigmas, "sigmas", ndim=None)
     s = np.atleast_1d(s)
+    if s.shape[-1] == 0:
+        raise ValueError("sigmas must hold at least one standard deviation")
     if np.any(s < 0):
         raise ValueError(f"sigmas must be non-negative; got {s}")
     out = np.zeros(s.shape + (s.shape[-1],))

@@ -1,30 +1,198 @@
 """Monte Carlo and parameter sweeps that scale out through any ``concurrent.futures``-style executor.
 
 A trial is a picklable function of a ``numpy.random.Generator`` (plus optional fixed arguments).  Trial ``i``
-always receives the generator spawned as child ``i`` of ``numpy.random.SeedSequence(seed)``, so results do not
-depend on how trials are chunked or which executor runs them: serial, ``ThreadPoolExecutor``,
-``ProcessPoolExecutor`` or a Dask ``distributed.Client`` (anything with ``submit(fn, *args)`` returning a future
-with ``result()``).
+always receives the generator of child ``i`` of ``numpy.random.SeedSequence(seed)``, so results do not depend on
+how trials are chunked or which executor runs them: serial, ``ThreadPoolExecutor``, ``ProcessPoolExecutor`` or a
+Dask ``distributed.Client`` (anything with ``submit(fn, *args)`` returning a future with ``result()``).
+
+Seeding costs O(1) per trial whatever the chunking: child ``i`` is built directly from the root's entropy and the
+spawn key ``(i,)`` (:func:`trial_seed_sequence`), which is exactly what ``SeedSequence(seed).spawn(n)[i]`` returns.
+
+Failures
+--------
+A trial that raises does not lose the run.  With ``on_error="raise"`` (default) :class:`MonteCarloError` names the
+first failing trial and its seed, carries the original exception (and its traceback text) and every result that
+completed, and the queued work is cancelled.  With ``on_error="collect"`` the run continues and the failed entries
+of the result list are :class:`TrialFailure` records.  ``KeyboardInterrupt`` cancels the queued work and stops the
+chunks still running in this process (threads) after their current trial.  All of these objects pickle, so they
+cross process pools intact.
 """
 
 from __future__ import annotations
 
+import concurrent.futures as _cf
+import itertools
+import pickle
+import threading
+import traceback
+from dataclasses import dataclass
+
 import numpy as np
 
-__all__ = ["spawn_rngs", "run_monte_carlo", "map_tasks"]
+from . import _checks
+
+__all__ = ["spawn_rngs", "trial_seed_sequence", "trial_rng", "run_monte_carlo", "map_tasks", "MonteCarloError",
+           "TrialFailure"]
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# seeding
+# ---------------------------------------------------------------------------------------------------------------
+def _root(seed) -> np.random.SeedSequence:
+    seed = _checks.seed_entropy(seed, "seed")
+    return seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+
+
+def trial_seed_sequence(seed, i: int) -> np.random.SeedSequence:
+    """Child ``i`` of ``SeedSequence(seed)``, built in O(1) (equal to ``SeedSequence(seed).spawn(i + 1)[i]``).
+
+    For a ``SeedSequence`` root, children are numbered from its ``n_children_spawned`` as ``spawn`` would.
+    """
+    root = _root(seed)
+    i = _checks.integer(i, "i", minimum=0)
+    return np.random.SeedSequence(root.entropy, spawn_key=tuple(root.spawn_key) + (root.n_children_spawned + i,),
+                                  pool_size=root.pool_size)
+
+
+def trial_rng(seed, i: int) -> np.random.Generator:
+    """The generator trial ``i`` of ``run_monte_carlo(..., seed)`` receives (to rerun one trial alone)."""
+    return np.random.default_rng(trial_seed_sequence(seed, i))
 
 
 def spawn_rngs(seed, n: int) -> list:
     """``n`` independent generators, child ``i`` of ``SeedSequence(seed)`` for trial ``i``."""
-    n = int(n)
-    if n < 0:
-        raise ValueError(f"n must be non-negative; got {n}")
-    return [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(n)]
+    n = _checks.integer(n, "n", minimum=0)
+    return [np.random.default_rng(s) for s in _root(seed).spawn(n)]
 
 
-def _run_chunk(trial, seed, indices, args, kwargs):
-    children = np.random.SeedSequence(seed).spawn(max(indices) + 1 if indices else 0)
-    return [trial(np.random.default_rng(children[i]), *args, **kwargs) for i in indices]
+def _describe_seed(seed, i) -> str:
+    ss = trial_seed_sequence(seed, i)
+    return f"SeedSequence(entropy={ss.entropy}, spawn_key={tuple(ss.spawn_key)})"
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# failure records
+# ---------------------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class TrialFailure:
+    """A trial that raised.
+
+    Attributes
+    ----------
+    index : int
+        Trial (or task) index.
+    seed : str
+        The trial's seed sequence, e.g. ``"SeedSequence(entropy=11, spawn_key=(17,))"`` (``""`` for a sweep task);
+        :func:`trial_rng` rebuilds its generator.
+    error : BaseException
+        The exception raised by the trial (replaced by a ``RuntimeError`` with the same text when the original
+        cannot be pickled, so that it can leave a worker process).
+    traceback : str
+        Formatted traceback from the worker.
+    """
+
+    index: int
+    seed: str
+    error: BaseException
+    traceback: str
+
+    def __str__(self) -> str:
+        where = f"trial {self.index}" + (f" (seed {self.seed})" if self.seed else "")
+        return f"{where} raised {type(self.error).__name__}: {self.error}"
+
+
+class MonteCarloError(RuntimeError):
+    """A Monte Carlo trial (or sweep task) raised; the completed results are kept.
+
+    Attributes
+    ----------
+    failure : TrialFailure
+        The first failure: trial index, seed, original exception and worker traceback.
+    trial_index : int
+        ``failure.index``.
+    seed : str
+        ``failure.seed``.
+    completed : dict
+        ``{trial index: result}`` of every trial that finished before the run was stopped.
+    n_trials : int
+        Number of trials requested.
+
+    The original exception is also chained as ``__cause__`` when raised in this process.
+    """
+
+    def __init__(self, failure: TrialFailure, completed: dict, n_trials: int):
+        super().__init__(f"{failure} ({len(completed)} of {n_trials} trials completed; their results are in "
+                         f".completed)\n--- worker traceback ---\n{failure.traceback}")
+        self.failure = failure
+        self.completed = dict(completed)
+        self.n_trials = int(n_trials)
+
+    @property
+    def trial_index(self) -> int:
+        return self.failure.index
+
+    @property
+    def seed(self) -> str:
+        return self.failure.seed
+
+    def __reduce__(self):
+        return (type(self), (self.failure, self.completed, self.n_trials))
+
+
+def _picklable(exc: BaseException) -> BaseException:
+    try:
+        pickle.loads(pickle.dumps(exc))
+        return exc
+    except Exception:
+        return RuntimeError(f"{type(exc).__name__}: {exc} (original exception could not be pickled)")
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# workers
+# ---------------------------------------------------------------------------------------------------------------
+#: Tokens of runs stopped in this process; chunks running in threads of this process check it between trials.
+_STOPPED: set = set()
+_STOP_LOCK = threading.Lock()
+_TOKENS = itertools.count()
+
+
+def _stop(token) -> None:
+    with _STOP_LOCK:
+        _STOPPED.add(token)
+
+
+def _run_chunk(trial, seed, indices, args, kwargs, token=None, collect=False):
+    """Run trials ``indices``; returns ``[(index, ok, result_or_failure), ...]`` (never raises for a trial error)."""
+    root = np.random.SeedSequence(seed) if not isinstance(seed, np.random.SeedSequence) else seed
+    base = tuple(root.spawn_key)
+    offset = root.n_children_spawned
+    out = []
+    for i in indices:
+        if token is not None and token in _STOPPED:
+            break
+        ss = np.random.SeedSequence(root.entropy, spawn_key=base + (offset + i,), pool_size=root.pool_size)
+        try:
+            out.append((i, True, trial(np.random.default_rng(ss), *args, **kwargs)))
+        except Exception as exc:  # noqa: BLE001 - reported with index, seed and traceback
+            seed_txt = f"SeedSequence(entropy={ss.entropy}, spawn_key={tuple(ss.spawn_key)})"
+            out.append((i, False, TrialFailure(i, seed_txt, _picklable(exc), traceback.format_exc())))
+            if not collect:
+                break
+    return out
+
+
+def _run_tasks(fn, items, token=None, collect=False):
+    out = []
+    for i, task in items:
+        if token is not None and token in _STOPPED:
+            break
+        try:
+            out.append((i, True, fn(task)))
+        except Exception as exc:  # noqa: BLE001
+            out.append((i, False, TrialFailure(i, "", _picklable(exc), traceback.format_exc())))
+            if not collect:
+                break
+    return out
 
 
 def _progress(iterable, total, desc, enabled):
@@ -33,8 +201,81 @@ def _progress(iterable, total, desc, enabled):
     return progress(iterable, total=total, desc=desc, enabled=enabled)
 
 
+def _check_executor(executor):
+    if not callable(getattr(executor, "submit", None)):
+        raise _checks.ArgumentTypeError(f"executor must have a submit(fn, *args) method (a concurrent.futures "
+                                        f"executor or a Dask Client); got {type(executor).__name__}")
+
+
+def _completion_order(futures):
+    """Futures in completion order when they are standard futures, else in submission order (e.g. Dask)."""
+    if futures and all(isinstance(f, _cf.Future) for f in futures):
+        return _cf.as_completed(futures)
+    try:  # Dask futures
+        from distributed import Future as DaskFuture, as_completed as dask_as_completed
+
+        if futures and all(isinstance(f, DaskFuture) for f in futures):
+            return dask_as_completed(futures)
+    except ImportError:  # pragma: no cover - dask is optional
+        pass
+    return iter(futures)
+
+
+def _drive(submit_chunks, n_total, desc, progress, collect, serial_run):
+    """Common driver: run chunks serially or through futures; returns the ordered results or raises."""
+    done: dict = {}
+    first_failure = None
+    token = next(_TOKENS)
+
+    def absorb(records):
+        nonlocal first_failure
+        for i, ok, value in records:
+            done[i] = value
+            if not ok and first_failure is None:
+                first_failure = value
+
+    if submit_chunks is None:  # serial
+        bar = _progress(None, n_total, desc, progress)
+        try:
+            for records in serial_run():
+                absorb(records)
+                bar.update(len(records))
+                if first_failure is not None and not collect:
+                    break
+        finally:
+            bar.close()
+    else:
+        futures, sizes = submit_chunks(token)
+        by_future = {id(f): k for k, f in enumerate(futures)}
+        bar = _progress(None, n_total, desc, progress)
+        try:
+            for fut in _completion_order(futures):
+                absorb(fut.result())
+                bar.update(sizes[by_future[id(fut)]])
+                if first_failure is not None and not collect:
+                    break
+        except BaseException:  # KeyboardInterrupt, a lost worker, ...: stop everything queued and running here
+            _stop(token)
+            for f in futures:
+                f.cancel()
+            raise
+        finally:
+            bar.close()
+        if first_failure is not None and not collect:
+            _stop(token)
+            for f in futures:
+                f.cancel()
+    with _STOP_LOCK:
+        _STOPPED.discard(token)
+    if first_failure is not None and not collect:
+        completed = {i: v for i, v in done.items() if not isinstance(v, TrialFailure)}
+        err = MonteCarloError(first_failure, completed, n_total)
+        raise err from first_failure.error
+    return [done[i] for i in range(n_total)]
+
+
 def run_monte_carlo(trial, n_trials: int, seed, *, args=(), kwargs=None, executor=None, chunk_size: int | None = None,
-                    progress: bool = True, desc: str = "Monte Carlo") -> list:
+                    progress: bool = True, desc: str = "Monte Carlo", on_error: str = "raise") -> list:
     """Run ``trial(rng, *args, **kwargs)`` for ``n_trials`` independent generators.
 
     Parameters
@@ -43,8 +284,9 @@ def run_monte_carlo(trial, n_trials: int, seed, *, args=(), kwargs=None, executo
         Picklable function (module level) when a process pool or a cluster runs it.
     n_trials : int
         Number of trials (>= 1).
-    seed : int or SeedSequence entropy
-        Root seed; trial ``i`` gets child ``i``.
+    seed : int, sequence of int or numpy.random.SeedSequence
+        Root seed; trial ``i`` gets child ``i`` (:func:`trial_rng`).  ``None`` is refused (it would make every run
+        different).
     args, kwargs
         Fixed extra arguments passed to every trial.
     executor : object with ``submit``, optional
@@ -52,42 +294,90 @@ def run_monte_carlo(trial, n_trials: int, seed, *, args=(), kwargs=None, executo
     chunk_size : int, optional
         Trials per submitted task (default: about four tasks per worker, at most 64 trials).
     progress : bool
-        tqdm progress bar over completed chunks.
+        Progress bar over completed trials (:func:`cislunar.progress.progress`).
+    desc : str
+        Progress-bar label.
+    on_error : {"raise", "collect"}
+        ``"raise"``: stop at the first failing trial with :class:`MonteCarloError` (queued work is cancelled; the
+        completed results are on the exception).  ``"collect"``: run every trial; failed entries of the returned
+        list are :class:`TrialFailure` records.
 
     Returns
     -------
     list
-        Trial results in trial order.
+        Trial results in trial order (bit-identical whatever the executor and chunking).
+
+    Raises
+    ------
+    MonteCarloError
+        A trial raised (``on_error="raise"``); names the trial index and its seed.
     """
-    n_trials = int(n_trials)
-    if n_trials < 1:
-        raise ValueError(f"n_trials must be >= 1; got {n_trials}")
-    kwargs = kwargs or {}
+    _checks.callable_(trial, "trial")
+    n_trials = _checks.integer(n_trials, "n_trials", minimum=1)
+    root = _root(seed)
+    if not isinstance(args, (tuple, list)):
+        raise _checks.ArgumentTypeError(f"args must be a tuple of extra positional arguments; got "
+                                        f"{type(args).__name__}")
+    if kwargs is None:
+        kwargs = {}
+    if not isinstance(kwargs, dict):
+        raise _checks.ArgumentTypeError(f"kwargs must be a dict of keyword arguments; got {type(kwargs).__name__}")
+    _checks.boolean(progress, "progress")
+    _checks.choice(on_error, "on_error", ("raise", "collect"))
+    collect = on_error == "collect"
+    args = tuple(args)
     if executor is None:
-        rngs = spawn_rngs(seed, n_trials)
-        return [trial(r, *args, **kwargs) for r in _progress(rngs, n_trials, desc, progress)]
-    if not hasattr(executor, "submit"):
-        raise ValueError(f"executor must have a submit(fn, *args) method; got {type(executor).__name__}")
+        if chunk_size is not None:
+            _checks.integer(chunk_size, "chunk_size", minimum=1)
+
+        def serial():
+            for i in range(n_trials):
+                yield _run_chunk(trial, root, [i], args, kwargs, None, collect)
+
+        return _drive(None, n_trials, desc, progress, collect, serial)
+    _check_executor(executor)
     if chunk_size is None:
         workers = getattr(executor, "_max_workers", None) or 2
         chunk_size = max(1, min(64, n_trials // (4 * workers) or 1))
-    chunk_size = int(chunk_size)
-    if chunk_size < 1:
-        raise ValueError(f"chunk_size must be >= 1; got {chunk_size}")
-    chunks = [list(range(i, min(i + chunk_size, n_trials))) for i in range(0, n_trials, chunk_size)]
-    futures = [executor.submit(_run_chunk, trial, seed, c, tuple(args), kwargs) for c in chunks]
-    out = []
-    for fut in _progress(futures, len(futures), desc, progress):
-        out.extend(fut.result())
-    return out
+    chunk_size = _checks.integer(chunk_size, "chunk_size", minimum=1)
+    chunks = [range(i, min(i + chunk_size, n_trials)) for i in range(0, n_trials, chunk_size)]
+
+    def submit(token):
+        futures = [executor.submit(_run_chunk, trial, root, c, args, kwargs, token, collect) for c in chunks]
+        return futures, [len(c) for c in chunks]
+
+    return _drive(submit, n_trials, desc, progress, collect, None)
 
 
-def map_tasks(fn, tasks, *, executor=None, progress: bool = True, desc: str = "sweep") -> list:
-    """``[fn(task) for task in tasks]``, optionally through an executor, results in task order (parameter sweeps)."""
-    tasks = list(tasks)
+def map_tasks(fn, tasks, *, executor=None, progress: bool = True, desc: str = "sweep", chunk_size: int = 1,
+              on_error: str = "raise") -> list:
+    """``[fn(task) for task in tasks]``, optionally through an executor, results in task order (parameter sweeps).
+
+    Failures behave as in :func:`run_monte_carlo` (the :class:`MonteCarloError` names the task index; there is no
+    seed).
+    """
+    _checks.callable_(fn, "fn")
+    try:
+        tasks = list(tasks)
+    except TypeError:
+        raise _checks.ArgumentTypeError(f"tasks must be iterable; got {type(tasks).__name__}") from None
+    _checks.boolean(progress, "progress")
+    _checks.choice(on_error, "on_error", ("raise", "collect"))
+    chunk_size = _checks.integer(chunk_size, "chunk_size", minimum=1)
+    collect = on_error == "collect"
+    items = list(enumerate(tasks))
+    if not items:
+        return []
     if executor is None:
-        return [fn(t) for t in _progress(tasks, len(tasks), desc, progress)]
-    if not hasattr(executor, "submit"):
-        raise ValueError(f"executor must have a submit(fn, *args) method; got {type(executor).__name__}")
-    futures = [executor.submit(fn, t) for t in tasks]
-    return [f.result() for f in _progress(futures, len(futures), desc, progress)]
+        def serial():
+            for item in items:
+                yield _run_tasks(fn, [item], None, collect)
+
+        return _drive(None, len(items), desc, progress, collect, serial)
+    _check_executor(executor)
+    chunks = [items[i:i + chunk_size] for i in range(0, len(items), chunk_size)]
+
+    def submit(token):
+        return [executor.submit(_run_tasks, fn, c, token, collect) for c in chunks], [len(c) for c in chunks]
+
+    return _drive(submit, len(items), desc, progress, collect, None)

@@ -39,7 +39,48 @@ from .dynamics import CR3BP
 from .propagation import DEFAULT_TOL, _check_outcome, _check_tol, _grid_from, _heyoka, thread_local_copy
 
 __all__ = ["OCBETransition", "ocbe_transition", "ocbe_process_noise", "estimated_control", "OCBEResult",
-           "ocbe_filter_smoother", "variational_system"]
+           "ocbe_filter_smoother", "variational_system", "FilterDivergenceError"]
+
+
+class FilterDivergenceError(RuntimeError):
+    """The OCBE failed numerically while filtering (a diverged filter, not a configuration error).
+
+    Attributes
+    ----------
+    epoch : int
+        Index of the epoch being processed when the failure occurred.
+    time : float
+        Its time, TU.
+    cause : str
+        Type and message of the underlying numerical error.
+    """
+
+    def __init__(self, epoch: int, time: float, cause: str):
+        super().__init__(f"OCBE failed numerically at epoch {epoch} (t = {time:.6g} TU): {cause}")
+        self.epoch, self.time, self.cause = int(epoch), float(time), str(cause)
+
+    def __reduce__(self):
+        return (type(self), (self.epoch, self.time, self.cause))
+
+
+def check_model(model, name: str = "model"):
+    """A :class:`cislunar.measurements.MeasurementModel` (e.g. ``measurements.ANGLES_AND_RATES``)."""
+    from .measurements import MeasurementModel
+
+    return _checks.instance(model, name, MeasurementModel,
+                            "a cislunar.measurements.MeasurementModel (e.g. measurements.ANGLES_AND_RATES)")
+
+
+def control_weights(control_weight, n_intervals: int, name: str = "control_weight", *, batch: int | None = None):
+    """Per-interval control weights: a positive scalar or an array of shape ``(n_intervals,)`` (or ``(B, n)``)."""
+    q = _checks.as_array(control_weight, name)
+    shapes = [(), (n_intervals,)] + ([] if batch is None else [(batch, n_intervals)])
+    if q.shape not in shapes:
+        raise ValueError(f"{name} must be a scalar or have shape {' or '.join(map(str, shapes[1:]))}; got {q.shape}")
+    if np.any(q <= 0):
+        raise ValueError(f"{name} must be positive on every interval")
+    target = (n_intervals,) if batch is None else (batch, n_intervals)
+    return np.broadcast_to(q, target).astype(float)
 
 
 @functools.lru_cache(maxsize=4)
@@ -144,6 +185,7 @@ def ocbe_transition(system: CR3BP, x0, t, control_weight: float, *, tol: float =
     tol : float
         Integrator tolerance.
     """
+    _checks.system(system)
     x0 = _checks.as_state(x0, "x0", batch=False)
     grid = _grid_from(t)
     q = _checks.positive(control_weight, "control_weight")
@@ -155,7 +197,7 @@ def ocbe_transition(system: CR3BP, x0, t, control_weight: float, *, tol: float =
     ta.state[:12] = np.r_[x0, np.zeros(6)]
     ta.state[12:] = np.eye(12).ravel()
     res = ta.propagate_grid(grid)
-    _check_outcome(res[0], grid[-1], ta.time)
+    _check_outcome(res[0], grid[-1], ta.time, None, np.array(ta.state[:6]))
     out = res[-1]
     return OCBETransition(t=grid, x=out[:, :6], phi=out[:, index], control_weight=q)
 
@@ -299,6 +341,8 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
     """
     from . import srif
 
+    _checks.system(system)
+    model = check_model(model)
     t = _checks.time_grid(t, "t", increasing=True)
     N = t.size
     obs = _checks.as_array(observer_states, "observer_states", ndim=(2, 3), last=6)
@@ -310,20 +354,28 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
     y = y[:, None, :] if y.ndim == 2 else y
     if y.shape != (N, K, model.dim):
         raise ValueError(f"y must have shape ({N}, {model.dim}) or ({N}, {K}, {model.dim}); got {y.shape}")
-    avail = np.ones((N, K), dtype=bool) if available is None else np.asarray(available, dtype=bool).reshape(N, K)
+    if available is None:
+        avail = np.ones((N, K), dtype=bool)
+    else:
+        avail = np.asarray(available)
+        if avail.dtype != bool:
+            raise _checks.ArgumentTypeError(f"available must be an array of bool; got dtype {avail.dtype}")
+        if avail.shape not in ((N, K), (N,) if K == 1 else (N, K)):
+            raise ValueError(f"available must have shape ({N}, {K}); got {avail.shape}")
+        avail = avail.reshape(N, K)
     if not np.all(np.isfinite(y[avail])):
         raise ValueError("y contains NaN or infinite values where measurements are available")
     R = _checks.as_array(meas_cov, "meas_cov")
     R = np.broadcast_to(R, (N, model.dim, model.dim)) if R.shape == (model.dim, model.dim) else R
     if R.shape != (N, model.dim, model.dim):
         raise ValueError(f"meas_cov must have shape ({model.dim}, {model.dim}) or ({N}, {model.dim}, {model.dim})")
-    qs = np.broadcast_to(_checks.as_array(control_weight, "control_weight"), (N - 1,)).astype(float)
-    if np.any(qs <= 0):
-        raise ValueError("control_weight must be positive on every interval")
-    n_sub = int(n_sub)
-    if n_sub < 2:
-        raise ValueError(f"n_sub must be at least 2; got {n_sub}")
+    _checks.spd(R, "meas_cov", batch=True)
+    qs = control_weights(control_weight, N - 1)
+    n_sub = _checks.integer(n_sub, "n_sub", minimum=2)
+    smooth = _checks.boolean(smooth, "smooth")
+    tol = _check_tol(tol)
     x = _checks.as_state(x0, "x0", batch=False).copy()
+    P0 = _checks.spd(P0, "P0", n=6)
     S, _ = srif.sri_from_covariance(np.zeros(6), P0)
     eye6 = np.eye(6)
 
@@ -337,63 +389,72 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
         S_new, b, e = srif.measurement_update(S, np.zeros(6), Ht.reshape(-1, 6), dy, Rk)
         return S_new, x_ref + srif.covariance_from_sri(S_new, b)[0], e
 
-    x_pred, P_pred, x_filt, P_filt, S_filt, resid = [], [], [], [], [], []
-    phis, terms, Qs, t_sub, phi_pp_sub, p_step = [], [], [], [], [], []
-    x_pred.append(x.copy())
-    P_pred.append(srif.covariance_from_sri(S))
-    S, x, e = update(S, x, 0)
-    x_filt.append(x.copy())
-    P_filt.append(srif.covariance_from_sri(S))
-    S_filt.append(S)
-    resid.append(e)
-    for n in range(N - 1):
-        grid = np.linspace(t[n], t[n + 1], n_sub)
-        tr = ocbe_transition(system, x, grid, qs[n], tol=tol)
-        Phi = tr.phi[-1]
-        Phi_xx, Phi_xp = Phi[:6, :6], Phi[:6, 6:]
-        Q = ocbe_process_noise(Phi)
-        S_bar, _, term = srif.time_update(S, np.zeros(6), Phi_xx, eye6, Q)  # Eq. 23 (b_x,n|n = 0)
-        x_prior = tr.x[-1]
-        x_pred.append(x_prior.copy())
-        P_pred.append(srif.covariance_from_sri(S_bar))
-        S_new, x_new, e = update(S_bar, x_prior, n + 1)  # Eqs. 24-28
-        # single-step smoother (Eqs. 29-30) and costate (Eq. 31)
-        S1, b1 = srif.smoother_step(S_new, S_new @ (x_new - x_prior), Phi_xx, eye6, term)
-        dx_n = srif.covariance_from_sri(S1, b1)[0]
-        p_step.append(-(S.T @ S) @ dx_n)
-        phis.append(Phi)
-        terms.append(term)
-        Qs.append(Q)
-        t_sub.append(grid)
-        phi_pp_sub.append(tr.phi_pp)
-        S, x = S_new, x_new
+    epoch = [0]
+
+    def run(S, x):
+        x_pred, P_pred, x_filt, P_filt, S_filt, resid = [], [], [], [], [], []
+        phis, terms, Qs, t_sub, phi_pp_sub, p_step = [], [], [], [], [], []
+        x_pred.append(x.copy())
+        P_pred.append(srif.covariance_from_sri(S))
+        S, x, e = update(S, x, 0)
         x_filt.append(x.copy())
         P_filt.append(srif.covariance_from_sri(S))
         S_filt.append(S)
         resid.append(e)
-    p_step = np.array(p_step)
-    t_sub = np.array(t_sub)
-    phi_pp_sub = np.array(phi_pp_sub)
-    control_step = -qs[:, None, None] * np.einsum("nkij,nj->nki", phi_pp_sub, p_step)[..., 3:6]
-    z_step = _control_integral(t_sub, control_step)
-    x_s = P_s = p_s = control_s = z_s = None
-    if smooth:
-        xs, Ps = [None] * N, [None] * N
-        Rs, bs = S_filt[-1], np.zeros(6)
-        xs[-1], Ps[-1] = x_filt[-1], P_filt[-1]
-        for n in range(N - 2, -1, -1):
-            Phi_xx = phis[n][:6, :6]
-            z_next = bs + Rs @ (x_filt[n + 1] - x_pred[n + 1])  # info about the deviation from x_{n+1|n}
-            Rs, bs = srif.smoother_step(Rs, z_next, Phi_xx, eye6, terms[n])
-            dx, Ps[n] = srif.covariance_from_sri(Rs, bs)
-            xs[n] = x_filt[n] + dx
-        x_s, P_s = np.array(xs), np.array(Ps)
-        p_s = np.empty((N - 1, 6))
         for n in range(N - 1):
-            Phi_xx, Phi_xp = phis[n][:6, :6], phis[n][:6, 6:]
-            w = (x_s[n + 1] - x_pred[n + 1]) - Phi_xx @ (x_s[n] - x_filt[n])
-            p_s[n] = np.linalg.solve(Phi_xp, w)
-        control_s = -qs[:, None, None] * np.einsum("nkij,nj->nki", phi_pp_sub, p_s)[..., 3:6]
-        z_s = _control_integral(t_sub, control_s)
-    return OCBEResult(t, np.array(x_pred), np.array(P_pred), np.array(x_filt), np.array(P_filt), x_s, P_s, p_step,
-                      p_s, t_sub, control_step, control_s, z_step, z_s, np.array(resid))
+            epoch[0] = n + 1
+            grid = np.linspace(t[n], t[n + 1], n_sub)
+            tr = ocbe_transition(system, x, grid, qs[n], tol=tol)
+            Phi = tr.phi[-1]
+            Phi_xx, Phi_xp = Phi[:6, :6], Phi[:6, 6:]
+            Q = ocbe_process_noise(Phi)
+            S_bar, _, term = srif.time_update(S, np.zeros(6), Phi_xx, eye6, Q)  # Eq. 23 (b_x,n|n = 0)
+            x_prior = tr.x[-1]
+            x_pred.append(x_prior.copy())
+            P_pred.append(srif.covariance_from_sri(S_bar))
+            S_new, x_new, e = update(S_bar, x_prior, n + 1)  # Eqs. 24-28
+            # single-step smoother (Eqs. 29-30) and costate (Eq. 31)
+            S1, b1 = srif.smoother_step(S_new, S_new @ (x_new - x_prior), Phi_xx, eye6, term)
+            dx_n = srif.covariance_from_sri(S1, b1)[0]
+            p_step.append(-(S.T @ S) @ dx_n)
+            phis.append(Phi)
+            terms.append(term)
+            Qs.append(Q)
+            t_sub.append(grid)
+            phi_pp_sub.append(tr.phi_pp)
+            S, x = S_new, x_new
+            x_filt.append(x.copy())
+            P_filt.append(srif.covariance_from_sri(S))
+            S_filt.append(S)
+            resid.append(e)
+        p_step = np.array(p_step)
+        t_sub = np.array(t_sub)
+        phi_pp_sub = np.array(phi_pp_sub)
+        control_step = -qs[:, None, None] * np.einsum("nkij,nj->nki", phi_pp_sub, p_step)[..., 3:6]
+        z_step = _control_integral(t_sub, control_step)
+        x_s = P_s = p_s = control_s = z_s = None
+        if smooth:
+            xs, Ps = [None] * N, [None] * N
+            Rs, bs = S_filt[-1], np.zeros(6)
+            xs[-1], Ps[-1] = x_filt[-1], P_filt[-1]
+            for n in range(N - 2, -1, -1):
+                Phi_xx = phis[n][:6, :6]
+                z_next = bs + Rs @ (x_filt[n + 1] - x_pred[n + 1])  # info about the deviation from x_{n+1|n}
+                Rs, bs = srif.smoother_step(Rs, z_next, Phi_xx, eye6, terms[n])
+                dx, Ps[n] = srif.covariance_from_sri(Rs, bs)
+                xs[n] = x_filt[n] + dx
+            x_s, P_s = np.array(xs), np.array(Ps)
+            p_s = np.empty((N - 1, 6))
+            for n in range(N - 1):
+                Phi_xx, Phi_xp = phis[n][:6, :6], phis[n][:6, 6:]
+                w = (x_s[n + 1] - x_pred[n + 1]) - Phi_xx @ (x_s[n] - x_filt[n])
+                p_s[n] = np.linalg.solve(Phi_xp, w)
+            control_s = -qs[:, None, None] * np.einsum("nkij,nj->nki", phi_pp_sub, p_s)[..., 3:6]
+            z_s = _control_integral(t_sub, control_s)
+        return OCBEResult(t, np.array(x_pred), np.array(P_pred), np.array(x_filt), np.array(P_filt), x_s, P_s, p_step,
+                          p_s, t_sub, control_step, control_s, z_step, z_s, np.array(resid))
+
+    try:
+        return run(S, x)
+    except (np.linalg.LinAlgError, ValueError, RuntimeError, FloatingPointError) as exc:
+        raise FilterDivergenceError(epoch[0], float(t[epoch[0]]), f"{type(exc).__name__}: {exc}") from exc

@@ -38,7 +38,7 @@ import numpy as np
 
 from . import _checks
 from .dynamics import CR3BP
-from .propagation import DEFAULT_TOL, find_events, propagate, propagate_stm
+from .propagation import DEFAULT_TOL, ImpactError, PropagationError, find_events, propagate, propagate_stm
 
 __all__ = [
     "ConvergenceError",
@@ -54,21 +54,34 @@ _FREE_NAMES = ("x0", "z0", "vy0", "half_period")
 
 
 class ConvergenceError(RuntimeError):
-    """A differential corrector did not converge.
+    """A differential corrector did not converge, or converged to a degenerate solution.
 
     Attributes
     ----------
+    message : str
+        What went wrong (without the residual history).
     residuals : list of float
         Norm of the constraint vector at each Newton iteration.
     last_guess : ndarray
         Free-variable vector at the last iteration.
+    reason : str
+        ``"max_iter"`` (no convergence), ``"non_finite"``, ``"bad_iterate"`` (e.g. a non-positive half period),
+        ``"equilibrium"`` (converged to an equilibrium point, not an orbit), ``"impact"`` (the orbit passes
+        through a primary) or ``"other"``.
+
+    Survives pickling with all attributes (it travels through process pools).
     """
 
-    def __init__(self, message: str, residuals, last_guess):
-        history = ", ".join(f"{r:.3e}" for r in residuals)
-        super().__init__(f"{message}; residual history: [{history}]")
-        self.residuals = list(residuals)
-        self.last_guess = np.asarray(last_guess)
+    def __init__(self, message: str, residuals=(), last_guess=(), reason: str = "other"):
+        self.message = str(message)
+        self.residuals = [float(r) for r in residuals]
+        self.last_guess = np.asarray(last_guess, dtype=float)
+        self.reason = str(reason)
+        history = ", ".join(f"{r:.3e}" for r in self.residuals)
+        super().__init__(f"{self.message}; residual history: [{history}]")
+
+    def __reduce__(self):
+        return (type(self), (self.message, self.residuals, self.last_guess, self.reason))
 
 
 def broucke_indices(monodromy) -> np.ndarray:
@@ -172,10 +185,8 @@ class PeriodicOrbit:
 
     def sample(self, n: int = 400, periods: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """Times (TU) and states ``(n, 6)`` on a uniform grid over ``periods`` periods."""
-        n = int(n)
-        if n < 2:
-            raise ValueError(f"n must be at least 2; got {n}")
-        _checks.positive(periods, "periods")
+        n = _checks.integer(n, "n", minimum=2)
+        periods = _checks.positive(periods, "periods")
         t = np.linspace(0.0, periods * self.period, n)
         return t, propagate(self.system, self.x0, t, impact=False).x
 
@@ -211,11 +222,16 @@ def _unpack(X: np.ndarray, planar: bool) -> tuple[np.ndarray, float]:
     return np.array([X[0], 0.0, X[1], 0.0, X[2], 0.0]), float(X[3])
 
 
-def _residual_jacobian(system: CR3BP, X: np.ndarray, planar: bool, tol: float):
+def _residual_jacobian(system: CR3BP, X: np.ndarray, planar: bool, tol: float, history=None):
     x0, tau = _unpack(X, planar)
-    if not tau > 0:
-        raise ValueError(f"half period must be positive; got {tau}")
-    tr = propagate_stm(system, x0, np.array([0.0, tau]), tol=tol, impact=False)  # iterates may graze the Moon
+    if not tau > 0:  # an iterate or a continuation predictor overshot: let the caller halve the step
+        raise ConvergenceError(f"half period became non-positive ({tau:.6g} TU) during the correction",
+                               history or [], X, reason="bad_iterate")
+    try:
+        tr = propagate_stm(system, x0, np.array([0.0, tau]), tol=tol, impact=False)  # iterates may graze the Moon
+    except PropagationError as exc:
+        raise ConvergenceError(f"an iterate could not be propagated ({exc})", history or [], X,
+                               reason="non_finite") from exc
     xf, phi = tr.x[-1], tr.stm[-1]
     f = system.eom(xf)
     rows = [1, 3] if planar else [1, 3, 5]
@@ -228,12 +244,14 @@ def _residual_jacobian(system: CR3BP, X: np.ndarray, planar: bool, tol: float):
 def _newton(system, X, planar, fixed: int | None, arclength=None, *, tol=1e-12, max_iter=25, int_tol=DEFAULT_TOL):
     """Newton iteration on the symmetric-orbit constraints; ``fixed`` pins one free variable.
 
-    ``arclength = (X_prev, tangent, ds)`` appends the pseudo-arclength equation instead.
+    ``arclength = (X_prev, tangent, ds)`` appends the pseudo-arclength equation instead.  Every failure (no
+    convergence, a non-finite residual, an iterate with a non-positive half period or that cannot be propagated)
+    raises :class:`ConvergenceError`.
     """
     X = np.array(X, dtype=float)
     history = []
     for _ in range(max_iter):
-        G, DG = _residual_jacobian(system, X, planar, int_tol)
+        G, DG = _residual_jacobian(system, X, planar, int_tol, history)
         if arclength is not None:
             Xp, tangent, ds = arclength
             G = np.append(G, (X - Xp) @ tangent - ds)
@@ -245,13 +263,17 @@ def _newton(system, X, planar, fixed: int | None, arclength=None, *, tol=1e-12, 
         err = float(np.linalg.norm(G))
         history.append(err)
         if not np.isfinite(err):
-            break
+            raise ConvergenceError("symmetric-orbit corrector produced a non-finite residual", history, X,
+                                   reason="non_finite")
         if err < tol:
             return X, DG, history
-        if arclength is not None or J.shape[0] == J.shape[1]:
-            step = np.linalg.solve(J, -G)
-        else:
-            step = np.linalg.lstsq(J, -G, rcond=None)[0]
+        try:
+            if arclength is not None or J.shape[0] == J.shape[1]:
+                step = np.linalg.solve(J, -G)
+            else:
+                step = np.linalg.lstsq(J, -G, rcond=None)[0]
+        except np.linalg.LinAlgError as exc:
+            raise ConvergenceError(f"singular Newton Jacobian ({exc})", history, X, reason="non_finite") from exc
         # damp huge steps (they usually jump to another family or into a primary)
         scale = min(1.0, 0.1 / max(np.max(np.abs(step)), 1e-300))
         if arclength is not None:
@@ -259,21 +281,45 @@ def _newton(system, X, planar, fixed: int | None, arclength=None, *, tol=1e-12, 
         else:
             X[keep] = X[keep] + scale * step
     raise ConvergenceError(
-        f"symmetric-orbit corrector did not reach |G| < {tol:g} in {max_iter} iterations", history, X
-    )
+        f"symmetric-orbit corrector did not reach |G| < {tol:g} in {max_iter} iterations", history, X,
+        reason="max_iter")
 
 
 def half_period_guess(system: CR3BP, x0, *, max_time: float = 20.0, tol: float = DEFAULT_TOL) -> float:
     """Time of the first return to the x-z plane (a half-period guess for a symmetric orbit), TU."""
+    _checks.system(system)
+    x0 = _checks.as_state(x0, "x0", batch=False)
+    max_time = _checks.positive(max_time, "max_time")
     ev = find_events(system, x0, max_time, ("y_crossing",), tol=tol, impact=False)
     if ev.t.size == 0:
         raise ValueError(f"x0 does not return to the x-z plane within max_time = {max_time} TU")
     return float(ev.t[0])
 
 
+#: A converged "orbit" whose state derivative is below this norm (LU/TU and LU/TU^2) is an equilibrium point.
+EQUILIBRIUM_TOL = 1e-9
+
+
 def _finish(system, X, planar, history, label, int_tol) -> PeriodicOrbit:
+    """Build the orbit from converged free variables, refusing degenerate solutions.
+
+    The full period is propagated with impact detection on (the corrector's own iterates are not), so an orbit
+    that passes through the Earth or the Moon is refused, as is an equilibrium point (whose "period" is arbitrary).
+    """
     x0, tau = _unpack(X, planar)
-    tr = propagate_stm(system, x0, np.array([0.0, 2.0 * tau]), tol=int_tol, impact=False)
+    speed = float(np.linalg.norm(system.eom(x0)))
+    if speed < EQUILIBRIUM_TOL:
+        raise ConvergenceError(f"the corrector converged to an equilibrium point (|f(x0)| = {speed:.2e}), not a "
+                               "periodic orbit; start from a guess away from the libration point", history, X,
+                               reason="equilibrium")
+    try:
+        tr = propagate_stm(system, x0, np.array([0.0, 2.0 * tau]), tol=int_tol, impact=True)
+    except ImpactError as exc:
+        raise ConvergenceError(f"the corrected orbit passes through a primary ({exc})", history, X,
+                               reason="impact") from exc
+    except PropagationError as exc:
+        raise ConvergenceError(f"the corrected orbit cannot be propagated over its period ({exc})", history, X,
+                               reason="non_finite") from exc
     closure = float(np.linalg.norm(tr.x[-1] - x0))
     return PeriodicOrbit(system=system, x0=x0, period=2.0 * tau, monodromy=tr.stm[-1], closure=closure,
                          residuals=tuple(history), label=label)
@@ -315,16 +361,26 @@ def correct_symmetric(system: CR3BP, x0_guess, half_period: float | None = None,
     ConvergenceError
         Newton did not converge; carries the residual history.
     """
+    _checks.system(system)
     x0 = _checks.as_state(x0_guess, "x0_guess", batch=False).copy()
     x0[[1, 3, 5]] = 0.0
     planar = x0[2] == 0.0
     valid = ("x0", "vy0", "half_period", "none") if planar else _FREE_NAMES + ("none",)
+    if not isinstance(fix, str):
+        raise _checks.ArgumentTypeError(f"fix must be one of {valid}; got {type(fix).__name__}")
     if fix not in valid:
         raise ValueError(f"fix must be one of {valid} for a {'planar' if planar else 'spatial'} orbit; got {fix!r}")
     _checks.in_range(tol, "tol", 1e-15, 1e-3)
+    max_iter = _checks.integer(max_iter, "max_iter", minimum=1)
+    int_tol = _checks.in_range(int_tol, "int_tol", 1e-16, 1e-3)
+    if not isinstance(label, str):
+        raise _checks.ArgumentTypeError(f"label must be a str; got {type(label).__name__}")
+    r1, r2 = system.distances(x0)
+    if r2 <= system.secondary_radius or r1 <= system.primary_radius:
+        raise ValueError("x0_guess lies inside the Moon or the Earth")
     if half_period is None:
         half_period = half_period_guess(system, x0, tol=int_tol)
-    _checks.positive(half_period, "half_period")
+    half_period = _checks.positive(half_period, "half_period")
     X = _pack(x0, half_period, planar)
     names = ("x0", "vy0", "half_period") if planar else _FREE_NAMES
     fixed = None if fix == "none" else names.index(fix)
@@ -367,20 +423,24 @@ def continue_family(system: CR3BP, orbit: PeriodicOrbit, n_steps: int, step: flo
     ConvergenceError
         When a member fails to converge even after halving the step three times.
     """
-    if not isinstance(orbit, PeriodicOrbit):
-        raise ValueError(f"orbit must be a PeriodicOrbit; got {type(orbit).__name__}")
-    if method not in ("pseudo-arclength", "natural"):
-        raise ValueError(f"method must be 'pseudo-arclength' or 'natural'; got {method!r}")
-    n_steps = int(n_steps)
-    if n_steps < 1:
-        raise ValueError(f"n_steps must be >= 1; got {n_steps}")
-    step = float(step)
-    if not np.isfinite(step) or step == 0:
+    _checks.system(system)
+    _checks.instance(orbit, "orbit", PeriodicOrbit, "a cislunar.orbits.PeriodicOrbit")
+    if orbit.system != system:
+        raise ValueError("orbit belongs to another system than system")
+    _checks.choice(method, "method", ("pseudo-arclength", "natural"))
+    n_steps = _checks.integer(n_steps, "n_steps", minimum=1)
+    step = _checks.real(step, "step")
+    if step == 0:
         raise ValueError(f"step must be finite and non-zero; got {step}")
+    if stop is not None:
+        _checks.callable_(stop, "stop")
+    _checks.in_range(tol, "tol", 1e-15, 1e-3)
+    max_iter = _checks.integer(max_iter, "max_iter", minimum=1)
+    int_tol = _checks.in_range(int_tol, "int_tol", 1e-16, 1e-3)
+    progress = _checks.boolean(progress, "progress")
     planar = orbit.is_planar
     names = ("x0", "vy0", "half_period") if planar else _FREE_NAMES
-    if parameter not in names:
-        raise ValueError(f"parameter must be one of {names}; got {parameter!r}")
+    _checks.choice(parameter, "parameter", names)
     p_index = names.index(parameter)
     X = _pack(orbit.x0, orbit.period / 2.0, planar)
     family = [orbit]
@@ -410,6 +470,9 @@ def continue_family(system: CR3BP, orbit: PeriodicOrbit, n_steps: int, step: flo
                         t_new = -t_new
                     Xn, DG, hist = _newton(system, X + abs(ds) * t_new, planar, None, (X, t_new, abs(ds)),
                                            tol=tol, max_iter=max_iter, int_tol=int_tol)
+                # a member through a primary (or an equilibrium) is refused like a failed correction
+                member = _finish(system, Xn, planar, hist, orbit.label, int_tol)
+                if method != "natural":
                     tangent = t_new
                 break
             except ConvergenceError:
@@ -417,7 +480,6 @@ def continue_family(system: CR3BP, orbit: PeriodicOrbit, n_steps: int, step: flo
                     raise
                 ds = ds / 2.0
         X = Xn
-        member = _finish(system, X, planar, hist, orbit.label, int_tol)
         family.append(member)
         if stop is not None and stop(member):
             break
@@ -441,10 +503,16 @@ def refine_on_family(system: CR3BP, a: PeriodicOrbit, b: PeriodicOrbit, func, *,
     """
     from scipy.optimize import brentq
 
+    _checks.system(system)
+    _checks.instance(a, "a", PeriodicOrbit, "a cislunar.orbits.PeriodicOrbit")
+    _checks.instance(b, "b", PeriodicOrbit, "a cislunar.orbits.PeriodicOrbit")
+    _checks.callable_(func, "func")
+    xtol = _checks.positive(xtol, "xtol")
     planar = a.is_planar
+    if b.is_planar != planar:
+        raise ValueError("a and b must both be planar or both spatial members of one family")
     names = ("x0", "vy0", "half_period") if planar else _FREE_NAMES
-    if parameter not in names:
-        raise ValueError(f"parameter must be one of {names}; got {parameter!r}")
+    _checks.choice(parameter, "parameter", names)
     k = names.index(parameter)
     Xa, Xb = _pack(a.x0, a.period / 2, planar), _pack(b.x0, b.period / 2, planar)
     fa, fb = func(a), func(b)
@@ -479,6 +547,7 @@ def nrho_9_2(system: CR3BP) -> PeriodicOrbit:
     Single shooting from apolune (``y0 = vx0 = vz0 = 0``) with the half period held fixed; the guess
     :data:`NRHO_9_2_GUESS` only seeds Newton's method.
     """
+    _checks.system(system)
     half = system.synodic_month_tu() / 9.0
     return correct_symmetric(system, NRHO_9_2_GUESS, half, fix="half_period", label="9:2 NRHO")
 
@@ -496,6 +565,11 @@ def l2_southern_halo_family(system: CR3BP, *, step: float = 0.01, n_moonward: in
     list of PeriodicOrbit
         Ordered by decreasing period is not guaranteed; ordered along the family from the Moon side outwards.
     """
+    _checks.system(system)
+    step = _checks.positive(step, "step")
+    n_moonward = _checks.integer(n_moonward, "n_moonward", minimum=1)
+    n_l2ward = _checks.integer(n_l2ward, "n_l2ward", minimum=1)
+    min_perilune_km = _checks.positive(min_perilune_km, "min_perilune_km")
     start = nrho_9_2(system)
     moonward = continue_family(system, start, n_moonward, -abs(step), parameter="half_period",
                                stop=lambda o: o.perilune_radius_km < min_perilune_km, progress=progress)
@@ -517,6 +591,8 @@ def stable_nrho(system: CR3BP, *, step: float = 0.01) -> PeriodicOrbit:
     half period, so its stability index is 1 to the root-finding tolerance.  Greaves & Scheeres' Table 1 (which
     would give their member's state) is missing from the paper's text; this is the documented choice.
     """
+    _checks.system(system)
+    step = _checks.positive(step, "step")
     start = nrho_9_2(system)
     fam = continue_family(system, start, 80, -abs(step), parameter="half_period",
                           stop=lambda o: _hyperbolic_margin(o) < 0)
@@ -532,9 +608,14 @@ def dro_family(system: CR3BP, x0_values, *, seed=None) -> list:
     Each member is corrected with ``x0`` fixed (natural parameter), seeded by the previous member (or by
     ``seed``, a DRO state, for the first).  ``x0_values`` should be ordered so consecutive members are close.
     """
-    xs = _checks.as_array(x0_values, "x0_values", ndim=(1,))
+    _checks.system(system)
+    xs = _checks.as_array(x0_values, "x0_values", ndim=(1,), min_size=1)
     if np.any(xs >= 1.0 - system.mu) or np.any(xs <= 0.5):
         raise ValueError("x0_values must lie between 0.5 LU and the Moon (DRO crossings on the Earth side)")
+    if np.any(1.0 - system.mu - xs <= system.secondary_radius):
+        raise ValueError(f"x0_values must lie outside the Moon (more than {system.secondary_radius_km} km from its "
+                         f"centre, i.e. below {1.0 - system.mu - system.secondary_radius:.6f} LU); got "
+                         f"{xs[1.0 - system.mu - xs <= system.secondary_radius]}")
     guess = np.array([xs[0], 0, 0, 0, 0.0, 0]) if seed is None else _checks.as_state(seed, "seed", batch=False)
     if seed is None:
         d = 1.0 - system.mu - xs[0]  # retrograde circular-orbit guess about the Moon, rotating-frame speed

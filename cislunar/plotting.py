@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.patches import Circle
 
-from . import paths
+from . import _checks, paths
 from .dynamics import CR3BP
 
 __all__ = ["use_style", "style_path", "save_figure", "plot_primaries", "plot_rotating", "three_plane_axes",
@@ -51,6 +51,16 @@ def save_figure(fig, name: str, *, output_dir=None, formats=("png",)) -> list[Pa
     list of pathlib.Path
         Written files.
     """
+    from matplotlib.figure import Figure
+
+    if not isinstance(fig, Figure):
+        raise TypeError(f"fig must be a matplotlib.figure.Figure; got {type(fig).__name__}")
+    if not isinstance(name, str):
+        raise TypeError(f"name must be a str; got {type(name).__name__}")
+    if isinstance(formats, str):
+        formats = (formats,)
+    if not formats:
+        raise ValueError("formats must name at least one format")
     if not name or not all(c.isalnum() or c in "_-" for c in name):
         raise ValueError(f"name must be a non-empty file stem of letters, digits, '_' or '-'; got {name!r}")
     out = []
@@ -63,6 +73,12 @@ def save_figure(fig, name: str, *, output_dir=None, formats=("png",)) -> list[Pa
         fig.savefig(path, format=fmt, metadata=meta)
         out.append(path)
     return out
+
+
+def _check_axes(ax, method: str = "add_patch"):
+    if not callable(getattr(ax, method, None)):
+        raise TypeError(f"ax must be a matplotlib Axes; got {type(ax).__name__}")
+    return ax
 
 
 def plot_primaries(ax, system: CR3BP, plane: str = "xy", *, moon_centred: bool = False, units: str = "LU",
@@ -80,10 +96,10 @@ def plot_primaries(ax, system: CR3BP, plane: str = "xy", *, moon_centred: bool =
     units : {"LU", "km"}
         Axis units.
     """
-    if plane not in _PLANES:
-        raise ValueError(f"plane must be one of {tuple(_PLANES)}; got {plane!r}")
-    if units not in ("LU", "km"):
-        raise ValueError(f"units must be 'LU' or 'km'; got {units!r}")
+    _check_axes(ax)
+    _checks.system(system)
+    _checks.choice(plane, "plane", tuple(_PLANES))
+    _checks.choice(units, "units", ("LU", "km"))
     scale = system.length_unit_km if units == "km" else 1.0
     shift = system.secondary_position if moon_centred else np.zeros(3)
     i, j = _PLANES[plane]
@@ -100,13 +116,16 @@ def plot_primaries(ax, system: CR3BP, plane: str = "xy", *, moon_centred: bool =
 def plot_rotating(ax, states, system: CR3BP | None = None, plane: str = "xy", *, moon_centred: bool = False,
                   units: str = "LU", **kwargs):
     """Plot trajectories ``(..., m, 6)`` (or ``(..., m, 3)``) projected on ``plane`` of the rotating frame."""
-    if plane not in _PLANES:
-        raise ValueError(f"plane must be one of {tuple(_PLANES)}; got {plane!r}")
-    s = np.asarray(states, dtype=float)
+    _check_axes(ax, "plot")
+    _checks.choice(plane, "plane", tuple(_PLANES))
+    _checks.choice(units, "units", ("LU", "km"))
+    s = _checks.as_array(states, "states", finite=False)
     if s.ndim < 2 or s.shape[-1] < 3:
         raise ValueError(f"states must have shape (..., m, >=3); got {s.shape}")
     if (moon_centred or units == "km") and system is None:
         raise ValueError("system is required for moon_centred=True or units='km'")
+    if system is not None:
+        _checks.system(system)
     pos = s[..., :3].copy()
     if moon_centred:
         pos = pos - system.secondary_position
@@ -132,5 +151,7 @@ def three_plane_axes(figsize=(12, 4)):
 
 def plot_three_planes(axes: dict, states, system: CR3BP | None = None, **kwargs) -> None:
     """Plot trajectories on the three principal planes (axes from :func:`three_plane_axes`)."""
+    if not isinstance(axes, dict):
+        raise TypeError(f"axes must be the dict returned by three_plane_axes; got {type(axes).__name__}")
     for plane, ax in axes.items():
         plot_rotating(ax, states, system, plane, **dict(kwargs))

@@ -44,10 +44,88 @@ __all__ = [
     "stm_finite_difference",
     "stt_finite_difference",
     "default_threads",
+    "ImpactError",
+    "PropagationError",
+    "check_outside_primaries",
 ]
 
 #: Default heyoka tolerance (relative and absolute); machine precision is 2.2e-16.
 DEFAULT_TOL = 1e-15
+
+
+class ImpactError(RuntimeError):
+    """A trajectory reached (or started inside) the surface of a primary.
+
+    Attributes
+    ----------
+    body : str
+        ``"Moon"`` or ``"Earth"``.
+    time : float
+        Time of the impact (or of the start when the trajectory starts inside the body), TU.
+    member : int or None
+        Index of the offending state in a batch (``None`` for a single state).
+    state : ndarray or None
+        State at the impact or start, LU and LU/TU, when known.
+    started_inside : bool
+        True when the initial state already lies inside the body.
+    """
+
+    def __init__(self, body: str, time: float, member=None, state=None, started_inside: bool = False,
+                 detail: str = ""):
+        who = "" if member is None else f"member {member} of the batch: "
+        what = (f"starts inside the {body} at t = {time} TU (impact on the {body}'s surface before the start)"
+                if started_inside else f"stopped at t = {time} TU: impact on the {body}'s surface")
+        super().__init__(f"{who}the trajectory {what}" + (f" ({detail})" if detail else ""))
+        self.body = body
+        self.time = float(time)
+        self.member = member
+        self.state = None if state is None else np.asarray(state, dtype=float)
+        self.started_inside = bool(started_inside)
+        self.detail = detail
+
+    def __reduce__(self):
+        return (type(self), (self.body, self.time, self.member, self.state, self.started_inside, self.detail))
+
+
+class PropagationError(RuntimeError):
+    """The integrator stopped early for a reason other than an impact (non-finite state, step-size collapse).
+
+    Attributes
+    ----------
+    time, target : float
+        Time reached and time wanted, TU.
+    member : int or None
+        Batch member, if known.
+    outcome : str
+        The integrator's outcome code.
+    """
+
+    def __init__(self, time: float, target: float, member=None, outcome: str = ""):
+        who = "" if member is None else f"member {member} of the batch: "
+        super().__init__(f"{who}propagation stopped early at t = {time} TU (wanted {target} TU): {outcome} "
+                         "(non-finite state or step-size collapse)")
+        self.time, self.target, self.member, self.outcome = float(time), float(target), member, str(outcome)
+
+    def __reduce__(self):
+        return (type(self), (self.time, self.target, self.member, self.outcome))
+
+
+def check_outside_primaries(system: CR3BP, states, name: str = "x0", *, t0: float = 0.0) -> None:
+    """Raise :class:`ImpactError` if any state ``(6,)`` or ``(n, 6)`` lies on or inside the Earth or the Moon.
+
+    The heyoka impact events only fire on a crossing of the surface from outside; a start inside a primary would
+    otherwise integrate (through the singularity at its centre) without a warning.
+    """
+    s = np.atleast_2d(states)
+    r1, r2 = system.distances(s)
+    for body, r, radius in (("Moon", r2, system.secondary_radius), ("Earth", r1, system.primary_radius)):
+        inside = np.flatnonzero(r <= radius)
+        if inside.size:
+            k = int(inside[0])
+            member = None if np.ndim(states) == 1 else k
+            raise ImpactError(body, t0, member, s[k], started_inside=True,
+                              detail=f"{name} is {r[k] * system.length_unit_km:.6g} km from the {body}'s centre, "
+                                     f"radius {radius * system.length_unit_km:.6g} km")
 
 
 def _heyoka():
@@ -212,15 +290,15 @@ def _check_tol(tol):
     return _checks.in_range(tol, "tol", 1e-16, 1e-3)
 
 
-def _grid_from(t) -> np.ndarray:
-    t = np.atleast_1d(np.asarray(t, dtype=float))
+def _grid_from(t, name: str = "t") -> np.ndarray:
+    t = np.atleast_1d(_checks.as_array(t, name, finite=False))
     if t.ndim == 1 and t.size == 1:
         t = np.array([0.0, t[0]])
-    return _checks.time_grid(t, "t")
+    return _checks.time_grid(t, name)
 
 
 def _propagate_chunk(system: CR3BP, x0_chunk: np.ndarray, grid: np.ndarray, order: int, tol: float,
-                     batch: int, impact: bool = True) -> np.ndarray:
+                     batch: int, impact: bool = True, first: int | None = None) -> np.ndarray:
     """Propagate ``x0_chunk`` (k <= batch states) on ``grid``; returns raw variational states (k, m, n_vars)."""
     ta = _integrator(order, batch, tol)
     n_vars = len(ta.state) if batch == 1 else ta.state.shape[0]
@@ -233,7 +311,7 @@ def _propagate_chunk(system: CR3BP, x0_chunk: np.ndarray, grid: np.ndarray, orde
         ta.state[:6] = x0_chunk[0]
         ta.state[6:] = vic
         res = ta.propagate_grid(grid)
-        _check_outcome(res[0], grid[-1], ta.time)
+        _check_outcome(res[0], grid[-1], ta.time, first, np.array(ta.state[:6]))
         out[0] = res[-1]
         return out
     padded = np.concatenate([x0_chunk, np.repeat(x0_chunk[-1:], batch - k, axis=0)], axis=0)
@@ -242,8 +320,10 @@ def _propagate_chunk(system: CR3BP, x0_chunk: np.ndarray, grid: np.ndarray, orde
     ta.state[:6, :] = padded.T
     ta.state[6:, :] = vic[:, None]
     res = ta.propagate_grid(np.repeat(grid[:, None], batch, axis=1))
-    for outcome, tfinal in zip(ta.propagate_res, ta.time):
-        _check_outcome(outcome[0], grid[-1], tfinal)
+    for j, (outcome, tfinal) in enumerate(zip(ta.propagate_res, ta.time)):
+        if j < k:
+            _check_outcome(outcome[0], grid[-1], tfinal, None if first is None else first + j,
+                           np.array(ta.state[:6, j]))
     arr = res[-1]  # (m, n_vars, batch)
     return np.transpose(arr, (2, 0, 1))[:k]
 
@@ -255,41 +335,51 @@ def _pars(system: CR3BP, impact: bool = True) -> np.ndarray:
     return np.array([system.mu, system.secondary_radius, system.primary_radius])
 
 
-def _check_outcome(outcome, t_target, t_reached):
+def _check_outcome(outcome, t_target, t_reached, member=None, state=None):
     hy = _heyoka()
     if outcome == hy.taylor_outcome.time_limit and np.isclose(t_reached, t_target, rtol=0, atol=1e-12):
         return
     code = int(outcome)
     event = -(code + 1) if -3 <= code < 0 else code  # heyoka: terminal event i without callback -> -(i + 1)
-    why = {0: "impact on the Moon's surface", 1: "impact on the Earth's surface"}.get(
-        event, f"outcome {outcome} (non-finite state or step-size collapse)")
-    raise RuntimeError(f"heyoka propagation stopped early at t = {t_reached} TU (wanted {t_target} TU): {why}")
+    body = {0: "Moon", 1: "Earth"}.get(event)
+    if body is not None:
+        raise ImpactError(body, float(t_reached), member, state)
+    raise PropagationError(float(t_reached), float(t_target), member, str(outcome))
+
+
+def _check_threads(threads):
+    if threads is None:
+        return 1
+    return _checks.integer(threads, "threads", minimum=1)
 
 
 def _propagate(system: CR3BP, x0, t, order: int, tol: float, threads: int | None, impact: bool = True) -> Trajectory:
-    if not isinstance(system, CR3BP):
-        raise ValueError(f"system must be a cislunar.dynamics.CR3BP; got {type(system).__name__}")
+    _checks.system(system)
     x0 = _checks.as_state(x0, "x0", batch=True)
     grid = _grid_from(t)
     tol = _check_tol(tol)
+    threads = _check_threads(threads)
+    impact = _checks.boolean(impact, "impact")
     single = x0.ndim == 1
     states = x0[None, :] if single else x0
     n = states.shape[0]
     if n == 0:
         raise ValueError("x0 must hold at least one state; got shape (0, 6)")
+    if impact:
+        check_outside_primaries(system, x0, "x0", t0=grid[0])
     hy = _heyoka()
     batch = 1 if n == 1 else int(hy.recommended_simd_size())
-    chunks = [states[i:i + batch] for i in range(0, n, batch)]
-    threads = 1 if threads is None else int(threads)
-    if threads < 1:
-        raise ValueError(f"threads must be a positive integer; got {threads}")
+    starts = list(range(0, n, batch))
+    chunks = [states[i:i + batch] for i in starts]
+    firsts = [None if single else i for i in starts]
     if threads == 1 or len(chunks) == 1:
-        raw = [_propagate_chunk(system, c, grid, order, tol, batch, impact) for c in chunks]
+        raw = [_propagate_chunk(system, c, grid, order, tol, batch, impact, f) for c, f in zip(chunks, firsts)]
     else:
         from concurrent.futures import ThreadPoolExecutor  # heyoka releases the GIL while integrating
 
         with ThreadPoolExecutor(max_workers=min(threads, len(chunks))) as pool:
-            raw = list(pool.map(lambda c: _propagate_chunk(system, c, grid, order, tol, batch, impact), chunks))
+            raw = list(pool.map(lambda cf: _propagate_chunk(system, cf[0], grid, order, tol, batch, impact, cf[1]),
+                                zip(chunks, firsts)))
     raw = np.concatenate(raw, axis=0)  # (n, m, n_vars)
     x = raw[..., :6]
     stm = stt = None
@@ -323,8 +413,10 @@ def propagate(system: CR3BP, x0, t, *, tol: float = DEFAULT_TOL, threads: int | 
     threads : int, optional
         Number of threads over which batch chunks are spread (heyoka releases the GIL); default 1.
     impact : bool
-        Stop with ``RuntimeError`` when a trajectory reaches the Moon's or the Earth's surface (default).  Set
-        False for purely mathematical trajectories, e.g. intermediate iterates of a differential corrector.
+        Raise :class:`ImpactError` (a ``RuntimeError``) when a trajectory starts inside or reaches the Moon's or the
+        Earth's surface (default); in a batch the error names the member.  Set False for purely mathematical
+        trajectories, e.g. intermediate iterates of a differential corrector (the integrator then still stops with
+        :class:`PropagationError` at a non-finite state near a primary's centre).
 
     Returns
     -------
@@ -335,8 +427,10 @@ def propagate(system: CR3BP, x0, t, *, tol: float = DEFAULT_TOL, threads: int | 
     ------
     ValueError
         Wrong shapes, NaN, a non-monotonic grid or an out-of-range tolerance.
-    RuntimeError
-        The integration stopped before the final time (impact on a primary, non-finite state).
+    ImpactError
+        A trajectory starts inside or reaches a primary's surface (``impact=True``).
+    PropagationError
+        The integration stopped before the final time for another reason (non-finite state).
     """
     return _propagate(system, x0, t, 0, tol, threads, impact)
 
@@ -361,7 +455,7 @@ def propagate_stt(system: CR3BP, x0, t, *, tol: float = DEFAULT_TOL, threads: in
 
 
 def propagate_scipy(system: CR3BP, x0, t, *, stm: bool = False, rtol: float = 1e-13, atol: float = 1e-13,
-                    method: str = "DOP853") -> Trajectory:
+                    method: str = "DOP853", impact: bool = True) -> Trajectory:
     """Reference propagation with ``scipy.integrate.solve_ivp`` (independent of heyoka; for cross-checks).
 
     Parameters
@@ -375,13 +469,27 @@ def propagate_scipy(system: CR3BP, x0, t, *, stm: bool = False, rtol: float = 1e
         Also integrate the STM, :math:`\\dot\\Phi = A(x)\\Phi`.
     rtol, atol : float
         scipy tolerances.
-    method : str
+    method : {"DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA"}
         scipy integrator name.
+    impact : bool
+        As in :func:`propagate`: a start inside a primary, or a crossing of a primary's surface (terminal
+        ``solve_ivp`` events on the squared distances), raises :class:`ImpactError`.
+
+    Raises
+    ------
+    ImpactError, PropagationError
+        As in :func:`propagate`.
     """
+    _checks.system(system)
     x0 = _checks.as_state(x0, "x0", batch=False)
     grid = _grid_from(t)
     _checks.in_range(rtol, "rtol", 1e-16, 1e-2)
     _checks.in_range(atol, "atol", 1e-20, 1e-2)
+    stm = _checks.boolean(stm, "stm")
+    impact = _checks.boolean(impact, "impact")
+    _checks.choice(method, "method", ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA"))
+    if impact:
+        check_outside_primaries(system, x0, "x0", t0=grid[0])
 
     if stm:
         def rhs(_t, y):
@@ -395,9 +503,25 @@ def propagate_scipy(system: CR3BP, x0, t, *, stm: bool = False, rtol: float = 1e
             return system.eom(y)
 
         y0 = x0
-    sol = solve_ivp(rhs, (grid[0], grid[-1]), y0, method=method, t_eval=grid, rtol=rtol, atol=atol)
-    if not sol.success:
-        raise RuntimeError(f"solve_ivp failed: {sol.message}")
+    events = None
+    if impact:
+        def hit_moon(_t, y):
+            return (y[0] - 1.0 + system.mu) ** 2 + y[1] ** 2 + y[2] ** 2 - system.secondary_radius ** 2
+
+        def hit_earth(_t, y):
+            return (y[0] + system.mu) ** 2 + y[1] ** 2 + y[2] ** 2 - system.primary_radius ** 2
+
+        for ev in (hit_moon, hit_earth):
+            ev.terminal, ev.direction = True, -1.0
+        events = [hit_moon, hit_earth]
+    sol = solve_ivp(rhs, (grid[0], grid[-1]), y0, method=method, t_eval=grid, rtol=rtol, atol=atol, events=events)
+    if impact and sol.status == 1:
+        for body, te, ye in zip(("Moon", "Earth"), sol.t_events, sol.y_events):
+            if len(te):
+                raise ImpactError(body, float(te[0]), None, ye[0][:6])
+    if not sol.success or sol.y.shape[1] != grid.size:
+        raise PropagationError(float(sol.t[-1]) if sol.t.size else grid[0], grid[-1], None,
+                               f"solve_ivp: {sol.message}")
     y = sol.y.T
     return Trajectory(t=grid, x=y[:, :6], stm=y[:, 6:].reshape(-1, 6, 6) if stm else None)
 
@@ -449,17 +573,27 @@ def find_events(system: CR3BP, x0, t_end: float, events=("y_crossing",), *, t0: 
     -------
     EventRecord
     """
+    _checks.system(system)
     x0 = _checks.as_state(x0, "x0", batch=False)
-    t_end = float(t_end)
-    if not np.isfinite(t_end) or t_end == t0:
-        raise ValueError(f"t_end must be finite and differ from t0 = {t0}; got {t_end}")
+    t0 = _checks.real(t0, "t0")
+    t_end = _checks.real(t_end, "t_end")
+    if t_end == t0:
+        raise ValueError(f"t_end must differ from t0 = {t0}; got {t_end}")
     if isinstance(events, str):
         events = (events,)
-    kinds = tuple(events)
+    try:
+        kinds = tuple(events)
+    except TypeError:
+        raise _checks.ArgumentTypeError(f"events must be a str or a sequence of str; got "
+                                        f"{type(events).__name__}") from None
+    if not kinds:
+        raise ValueError(f"events must name at least one of {_EVENT_KINDS}")
     for k in kinds:
-        if k not in _EVENT_KINDS:
-            raise ValueError(f"events entries must be among {_EVENT_KINDS}; got {k!r}")
+        _checks.choice(k, "events", _EVENT_KINDS)
     tol = _check_tol(tol)
+    impact = _checks.boolean(impact, "impact")
+    if impact:
+        check_outside_primaries(system, x0, "x0", t0=t0)
     ta = _integrator(0, 1, tol, kinds)
     ta.reset_cooldowns()
     callbacks = [ev.callback for ev in ta.nt_events]
@@ -469,7 +603,7 @@ def find_events(system: CR3BP, x0, t_end: float, events=("y_crossing",), *, t0: 
     ta.time = t0
     ta.state[:] = x0
     res = ta.propagate_until(t_end, c_output=True)
-    _check_outcome(res[0], t_end, ta.time)
+    _check_outcome(res[0], t_end, ta.time, None, np.array(ta.state[:6]))
     c_out = res[4]
     rows = []
     for kind, cb in zip(kinds, callbacks):
@@ -487,10 +621,23 @@ def find_events(system: CR3BP, x0, t_end: float, events=("y_crossing",), *, t0: 
 
 
 def default_threads() -> int:
-    """Number of threads for batch work: ``CISLUNAR_THREADS`` if set, else the CPU count."""
-    env = os.environ.get("CISLUNAR_THREADS")
-    return int(env) if env else (os.cpu_count() or 1)
+    """Number of threads for batch work: ``CISLUNAR_THREADS`` if set, else the CPU count.
 
+    Raises
+    ------
+    ValueError
+        ``CISLUNAR_THREADS`` is set to anything but a positive integer.
+    """
+    env = os.environ.get("CISLUNAR_THREADS", "").strip()
+    if not env:
+        return os.cpu_count() or 1
+    try:
+        n = int(env)
+    except ValueError:
+        raise ValueError(f"CISLUNAR_THREADS must be a positive integer; got {env!r}") from None
+    if n < 1:
+        raise ValueError(f"CISLUNAR_THREADS must be a positive integer; got {env!r}")
+    return n
 
 
 def stm_finite_difference(system: CR3BP, x0, t_final: float, h: float, *, tol: float = DEFAULT_TOL) -> np.ndarray:
@@ -499,8 +646,12 @@ def stm_finite_difference(system: CR3BP, x0, t_final: float, h: float, *, tol: f
     Used to verify :func:`propagate_stm`; the error versus ``h`` shows truncation (``h^2``) and round-off
     (``eps/h``) regimes.
     """
+    _checks.system(system)
     x0 = _checks.as_state(x0, "x0", batch=False)
     h = _checks.positive(h, "h")
+    t_final = _checks.real(t_final, "t_final")
+    if t_final == 0:
+        raise ValueError("t_final must be non-zero")
     E = h * np.eye(6)
     out = propagate(system, np.vstack([x0 + E, x0 - E]), np.array([0.0, float(t_final)]), tol=tol).x[:, -1]
     return (out[:6] - out[6:]).T / (2.0 * h)
@@ -508,8 +659,12 @@ def stm_finite_difference(system: CR3BP, x0, t_final: float, h: float, *, tol: f
 
 def stt_finite_difference(system: CR3BP, x0, t_final: float, h: float, *, tol: float = DEFAULT_TOL) -> np.ndarray:
     """Central-difference STT :math:`\\Psi_{:,:,k} = [\\Phi(x_0 + h e_k) - \\Phi(x_0 - h e_k)] / 2h`."""
+    _checks.system(system)
     x0 = _checks.as_state(x0, "x0", batch=False)
     h = _checks.positive(h, "h")
+    t_final = _checks.real(t_final, "t_final")
+    if t_final == 0:
+        raise ValueError("t_final must be non-zero")
     E = h * np.eye(6)
     phis = propagate_stm(system, np.vstack([x0 + E, x0 - E]), np.array([0.0, float(t_final)]), tol=tol).stm[:, -1]
     return np.moveaxis((phis[:6] - phis[6:]) / (2.0 * h), 0, -1)

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
 __all__ = ["ComparisonTable", "Row", "REPORT_METADATA_KEY", "STATUSES", "fmt"]
 
 #: Key placed in the display metadata of a rendered table.
@@ -19,6 +21,9 @@ STATUSES = ("reproduced", "differs", "derived", "not in paper", "beyond paper")
 
 def fmt(value, digits: int = 6) -> str:
     """Format numbers compactly for tables (strings pass through)."""
+    if isinstance(digits, bool) or not isinstance(digits, int) or not 1 <= digits <= 17:
+        raise (TypeError if not isinstance(digits, int) or isinstance(digits, bool) else ValueError)(
+            f"digits must be an integer in [1, 17]; got {digits!r}")
     if value is None:
         return "-"
     if isinstance(value, str):
@@ -58,12 +63,31 @@ class ComparisonTable:
     title: str
     rows: list = field(default_factory=list)
 
+    def __post_init__(self):
+        if not isinstance(self.title, str):
+            raise TypeError(f"title must be a str; got {type(self.title).__name__}")
+        if not isinstance(self.rows, list):
+            raise TypeError(f"rows must be a list of Row; got {type(self.rows).__name__}")
+
     def add(self, quantity: str, paper, reproduced, status: str, note: str = "") -> "ComparisonTable":
         """Append a row.
 
         ``status`` must start with one of :data:`STATUSES`; a ``differs`` or ``not in paper`` row needs a ``note``
         that says why.
         """
+        for name, v in (("quantity", quantity), ("status", status), ("note", note)):
+            if not isinstance(v, str):
+                raise TypeError(f"{name} must be a str; got {type(v).__name__} {v!r:.40}")
+        if not quantity.strip():
+            raise ValueError("quantity must be a non-empty str")
+        for name, v in (("paper", paper), ("reproduced", reproduced)):
+            if isinstance(v, (bool, np.bool_)):
+                raise TypeError(f"{name} must be a number, a str or None; got bool")
+            if isinstance(v, (int, float, np.number)) and not np.isfinite(float(v)):
+                raise ValueError(f"{name} must be finite (a table may not hold NaN or inf); got {v!r}; use a str "
+                                 "such as 'not computed' with a note instead")
+        if reproduced is None:
+            raise ValueError("reproduced must be given (a number or a str); None would print as '-'")
         head = status.split(":")[0].strip()
         if head not in STATUSES:
             raise ValueError(f"status must start with one of {STATUSES}; got {status!r}")

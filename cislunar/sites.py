@@ -43,6 +43,12 @@ class SurfaceStation:
     latitude_deg: float
     longitude_deg: float
 
+    def __post_init__(self):
+        if not isinstance(self.name, str):
+            raise _checks.ArgumentTypeError(f"name must be a str; got {type(self.name).__name__}")
+        _checks.in_range(self.latitude_deg, "latitude_deg", -90.0, 90.0)
+        _checks.in_range(self.longitude_deg, "longitude_deg", -360.0, 360.0)
+
     def position(self, system: CR3BP) -> np.ndarray:
         """Position in the rotating frame, LU (barycentric origin)."""
         return surface_station_position(system, self.latitude_deg, self.longitude_deg)
@@ -63,6 +69,7 @@ DEFAULT_STATIONS = (
 
 def surface_station_position(system: CR3BP, latitude_deg: float, longitude_deg: float) -> np.ndarray:
     """Rotating-frame position (LU) of a point on the Moon's mean sphere at the given selenographic coordinates."""
+    _checks.system(system)
     lat = np.deg2rad(_checks.in_range(latitude_deg, "latitude_deg", -90.0, 90.0))
     lon = np.deg2rad(_checks.in_range(longitude_deg, "longitude_deg", -360.0, 360.0))
     up = np.array([-np.cos(lat) * np.cos(lon), -np.cos(lat) * np.sin(lon), np.sin(lat)])
@@ -71,15 +78,29 @@ def surface_station_position(system: CR3BP, latitude_deg: float, longitude_deg: 
 
 def station_elevation(system: CR3BP, station_position, target_positions) -> np.ndarray:
     """Elevation (rad) of targets ``(..., >=3)`` above a surface station's local horizon."""
-    s = _checks.as_array(station_position, "station_position", ndim=(1,))[:3]
-    t = _checks.as_array(target_positions, "target_positions")[..., :3]
+    _checks.system(system)
+    s = _checks.as_array(station_position, "station_position", ndim=(1,))
+    if s.size not in (3, 6):
+        raise ValueError(f"station_position must be a position (3,) or a state (6,); got shape {s.shape}")
+    s = s[:3]
+    t = _position_stack(target_positions, "target_positions")
     up = s - system.secondary_position
+    if abs(np.linalg.norm(up) - system.secondary_radius) > 1e-6 * system.secondary_radius:
+        raise ValueError("station_position must lie on the Moon's surface (use surface_station_position)")
     up = up / np.linalg.norm(up)
     rel = t - s
     rng = np.linalg.norm(rel, axis=-1)
     if np.any(rng == 0):
         raise ValueError("target_positions coincide with the station (zero range)")
     return np.arcsin(np.clip(rel @ up / rng, -1.0, 1.0))
+
+
+def _position_stack(value, name):
+    a = _checks.as_array(value, name)
+    if a.ndim == 0 or a.shape[-1] not in (3, 6):
+        raise ValueError(f"{name} must have positions (..., 3) or states (..., 6) on its last axis; got shape "
+                         f"{a.shape}")
+    return a[..., :3]
 
 
 def line_of_sight_clear(system: CR3BP, observer_positions, target_positions, *, body: str = "moon") -> np.ndarray:
@@ -91,12 +112,16 @@ def line_of_sight_clear(system: CR3BP, observer_positions, target_positions, *, 
         Broadcastable positions, LU.
     body : {"moon", "earth"}
     """
-    if body not in ("moon", "earth"):
-        raise ValueError(f"body must be 'moon' or 'earth'; got {body!r}")
+    _checks.system(system)
+    _checks.choice(body, "body", ("moon", "earth"))
     c = system.secondary_position if body == "moon" else system.primary_position
     radius = system.secondary_radius if body == "moon" else system.primary_radius
-    o = _checks.as_array(observer_positions, "observer_positions")[..., :3]
-    t = _checks.as_array(target_positions, "target_positions")[..., :3]
+    o = _position_stack(observer_positions, "observer_positions")
+    t = _position_stack(target_positions, "target_positions")
+    try:
+        np.broadcast_shapes(o.shape, t.shape)
+    except ValueError:
+        raise ValueError(f"observer_positions and target_positions do not broadcast: {o.shape} vs {t.shape}") from None
     d = t - o
     dd = np.sum(d * d, axis=-1)
     if np.any(dd == 0):
@@ -109,6 +134,7 @@ def line_of_sight_clear(system: CR3BP, observer_positions, target_positions, *, 
 
 def l2_observer_state(system: CR3BP) -> np.ndarray:
     """State of the L2 observer: at rest at L2, shape (6,)."""
+    _checks.system(system)
     return np.r_[system.libration_points()[1], np.zeros(3)]
 
 
@@ -120,6 +146,7 @@ def dro_observer_orbit(system: CR3BP):
     """The DRO observer's orbit: the periodic DRO through ``x0 = 0.778008526`` LU (about 16.2 days)."""
     from .orbits import correct_symmetric
 
+    _checks.system(system)
     return correct_symmetric(system, [DRO_OBSERVER_X0, 0, 0, 0, 0.556190606, 0], fix="x0", label="DRO observer")
 
 
@@ -130,7 +157,20 @@ def surface_coverage(system: CR3BP, target_positions, stations=DEFAULT_STATIONS,
     -------
     ndarray of bool, shape (len(stations), m)
     """
+    _checks.system(system)
     t = _checks.as_array(target_positions, "target_positions", ndim=(2,))
+    _position_stack(t, "target_positions")
     _checks.in_range(min_elevation_deg, "min_elevation_deg", -90.0, 90.0)
+    if isinstance(stations, SurfaceStation):
+        stations = (stations,)
+    try:
+        stations = tuple(stations)
+    except TypeError:
+        raise _checks.ArgumentTypeError(f"stations must be a sequence of SurfaceStation; got "
+                                        f"{type(stations).__name__}") from None
+    if not stations:
+        raise ValueError("stations must hold at least one SurfaceStation")
+    for st in stations:
+        _checks.instance(st, "stations", SurfaceStation, "a sequence of cislunar.sites.SurfaceStation")
     return np.array([station_elevation(system, s.position(system), t) > np.deg2rad(min_elevation_deg)
                      for s in stations])

@@ -50,9 +50,9 @@ def householder_triangularize(A) -> np.ndarray:
 
 def _chol_upper_inverse(C, name):
     """Upper-triangular W with W^T W = C^{-1} (i.e. the square-root information matrix of covariance C)."""
-    C = _checks.as_array(C, name, ndim=(2,))
-    if C.shape[0] != C.shape[1]:
-        raise ValueError(f"{name} must be square; got shape {C.shape}")
+    C = _checks.square(C, name)
+    if C.shape[0] == 0:
+        raise ValueError(f"{name} must not be empty")
     if not np.allclose(C, C.T, rtol=1e-10, atol=1e-14 * max(1.0, np.max(np.abs(C)))):
         raise ValueError(f"{name} must be symmetric")
     try:
@@ -64,10 +64,13 @@ def _chol_upper_inverse(C, name):
     return householder_triangularize(W)
 
 
-def sri_from_covariance(x, P) -> tuple[np.ndarray, np.ndarray]:
-    """Square-root information pair ``(R, z)`` of a mean ``x`` (n,) and covariance ``P`` (n, n)."""
+def sri_from_covariance(x, P, *, name: str = "P") -> tuple[np.ndarray, np.ndarray]:
+    """Square-root information pair ``(R, z)`` of a mean ``x`` (n,) and covariance ``P`` (n, n).
+
+    ``name`` is the caller's name for ``P`` in error messages (e.g. ``"P0"``).
+    """
     x = _checks.as_array(x, "x", ndim=(1,))
-    R = _chol_upper_inverse(P, "P")
+    R = _chol_upper_inverse(P, name)
     if R.shape[0] != x.size:
         raise ValueError(f"x has length {x.size} but P is {P.shape}")
     return R, R @ x
@@ -75,11 +78,7 @@ def sri_from_covariance(x, P) -> tuple[np.ndarray, np.ndarray]:
 
 def covariance_from_sri(R, z=None):
     """Covariance :math:`R^{-1}R^{-\\top}` (and mean :math:`R^{-1}z` if ``z`` is given) of an SRI pair."""
-    R = _checks.as_array(R, "R", ndim=(2,))
-    if R.shape[0] != R.shape[1]:
-        raise ValueError(f"R must be square; got shape {R.shape}")
-    if np.any(np.abs(np.diag(R)) == 0):
-        raise ValueError("R is singular (zero on its diagonal): the information matrix is not invertible")
+    R = _checks.upper_triangular(R, "R")
     Rinv = solve_triangular(R, np.eye(R.shape[0]), lower=False)
     P = Rinv @ Rinv.T
     if z is None:
@@ -100,7 +99,7 @@ def measurement_update(R, z, H, y, meas_cov):
         Norm of the whitened residual that this update adds to the least-squares cost (the one non-zero entry
         below ``z_new`` after triangularisation).
     """
-    R = _checks.as_array(R, "R", ndim=(2,))
+    R = _checks.upper_triangular(R, "R", nonsingular=False)
     n = R.shape[0]
     z = _checks.as_array(z, "z", shape=(n,))
     H = _checks.as_array(H, "H", ndim=(2,))
@@ -148,10 +147,12 @@ def time_update(R, z, Phi, Gamma=None, Q=None):
     smoother_terms : tuple or None
         ``(Rw_bar, Rwx_bar, zw_bar)``: the first block row, kept for :func:`smoother_step`.
     """
-    R = _checks.as_array(R, "R", ndim=(2,))
+    R = _checks.upper_triangular(R, "R", nonsingular=False)
     n = R.shape[0]
     z = _checks.as_array(z, "z", shape=(n,))
     Phi = _checks.as_array(Phi, "Phi", shape=(n, n))
+    if np.linalg.cond(Phi) > 1e15:
+        raise ValueError(f"Phi must be an invertible transition matrix; condition number {np.linalg.cond(Phi):.3e}")
     Rt = np.linalg.solve(Phi.T, R.T).T  # R Phi^{-1}
     if Gamma is None and Q is None:
         U = householder_triangularize(np.hstack([Rt, z[:, None]]))
@@ -177,9 +178,22 @@ def smoother_step(Rs_next, zs_next, Phi, Gamma, smoother_terms):
     :math:`x_{k+1} = \\Phi x_k + \\Gamma w_k` into both information equations and triangularise in
     :math:`(w_k, x_k)`; the lower block is the smoothed pair at ``k``.
     """
-    Rw, Rwx, zw = smoother_terms
-    r = Rw.shape[0]
+    Rs_next = _checks.upper_triangular(Rs_next, "Rs_next", nonsingular=False)
     n = Rs_next.shape[0]
+    zs_next = _checks.as_array(zs_next, "zs_next", shape=(n,))
+    Phi = _checks.as_array(Phi, "Phi", shape=(n, n))
+    Gamma = _checks.as_array(Gamma, "Gamma", ndim=(2,))
+    if Gamma.shape[0] != n:
+        raise ValueError(f"Gamma must have {n} rows; got shape {Gamma.shape}")
+    if not isinstance(smoother_terms, (tuple, list)) or len(smoother_terms) != 3:
+        raise _checks.ArgumentTypeError("smoother_terms must be the (Rw_bar, Rwx_bar, zw_bar) tuple returned by "
+                                        "time_update with process noise")
+    Rw = _checks.as_array(smoother_terms[0], "smoother_terms[0]", ndim=(2,))
+    r = Rw.shape[0]
+    Rwx = _checks.as_array(smoother_terms[1], "smoother_terms[1]", shape=(r, n))
+    zw = _checks.as_array(smoother_terms[2], "smoother_terms[2]", shape=(r,))
+    if Gamma.shape[1] != r:
+        raise ValueError(f"Gamma must have {r} columns to match smoother_terms; got shape {Gamma.shape}")
     A = np.block([[Rw + Rwx @ Gamma, Rwx @ Phi, zw[:, None]], [Rs_next @ Gamma, Rs_next @ Phi, zs_next[:, None]]])
     U = householder_triangularize(A)
     return U[r:r + n, r:r + n], U[r:r + n, r + n]
@@ -230,8 +244,14 @@ def filter_smoother(x0, P0, Phis, Hs, ys, meas_covs, Gammas=None, Qs=None, *, sm
     smooth : bool
         Run the backward pass.
     """
-    x0 = _checks.as_array(x0, "x0", ndim=(1,))
+    x0 = _checks.as_array(x0, "x0", ndim=(1,), min_size=1)
     n = x0.size
+    _checks.spd(P0, "P0", n=n)
+    smooth = _checks.boolean(smooth, "smooth")
+    for name, seq in (("Phis", Phis), ("Hs", Hs), ("ys", ys), ("meas_covs", meas_covs)):
+        if not hasattr(seq, "__len__") or isinstance(seq, (str, bytes)):
+            raise _checks.ArgumentTypeError(f"{name} must be a sequence (one entry per epoch); got "
+                                            f"{type(seq).__name__}")
     Phis = _checks.as_array(Phis, "Phis", ndim=(3,)) if len(Phis) else np.zeros((0, n, n))
     N = Phis.shape[0] + 1
     if Phis.shape[1:] != (n, n):
@@ -242,13 +262,13 @@ def filter_smoother(x0, P0, Phis, Hs, ys, meas_covs, Gammas=None, Qs=None, *, sm
     noise = Gammas is not None
     if noise and (Qs is None or len(Gammas) != N - 1 or len(Qs) != N - 1):
         raise ValueError(f"Gammas and Qs must both have {N - 1} entries")
-    R, z = sri_from_covariance(x0, P0)
+    R, z = sri_from_covariance(x0, P0, name="P0")
     xf, Pf, xp, Pp, Rf, res, terms = [], [], [], [], [], [], []
     for k in range(N):
         m, P = covariance_from_sri(R, z)
         xp.append(m)
         Pp.append(P)
-        H = np.asarray(Hs[k], dtype=float).reshape(-1, n)
+        H = _checks.as_array(Hs[k], f"Hs[{k}]").reshape(-1, n) if np.size(Hs[k]) else np.zeros((0, n))
         if H.shape[0]:
             R, z, e = measurement_update(R, z, H, ys[k], meas_covs[k])
         else:

@@ -48,8 +48,10 @@ HANDOFF_3SIGMA_KM_S = 1e-4
 def angles_rates_covariance(system: CR3BP, sigma_angle_rad: float = DEFAULT_SIGMA_ANGLE_RAD, rate_dt_s: float = 1.0,
                             *, rates: bool = True) -> np.ndarray:
     """Measurement covariance of [azimuth, elevation(, rates)]: angles in rad, rates in rad/TU (Eq. 13)."""
+    _checks.system(system)
     s = _checks.positive(sigma_angle_rad, "sigma_angle_rad")
     dt = _checks.positive(rate_dt_s, "rate_dt_s")
+    rates = _checks.boolean(rates, "rates")
     if not rates:
         return np.diag([s**2, s**2])
     sr = np.sqrt(2.0) * s / dt * system.time_unit_s  # rad/s -> rad/TU
@@ -120,12 +122,16 @@ def make_scenario(system: CR3BP, orbit: PeriodicOrbit, cadence_hours: float, *, 
     """
     from . import sites
 
+    _checks.system(system)
+    _checks.instance(orbit, "orbit", PeriodicOrbit, "a cislunar.orbits.PeriodicOrbit")
     cadence = _checks.positive(cadence_hours, "cadence_hours")
     periods = _checks.positive(periods, "periods")
-    if start not in ("periapsis", "apoapsis"):
-        raise ValueError(f"start must be 'periapsis' or 'apoapsis'; got {start!r}")
-    if observers not in ("L2", "all"):
-        raise ValueError(f"observers must be 'L2' or 'all'; got {observers!r}")
+    _checks.choice(start, "start", ("periapsis", "apoapsis"))
+    _checks.choice(observers, "observers", ("L2", "all"))
+    rates = _checks.boolean(rates, "rates")
+    _checks.positive(sigma_angle_rad, "sigma_angle_rad")
+    if cadence * 3600.0 / system.time_unit_s >= periods * orbit.period:
+        raise ValueError(f"cadence_hours = {cadence} leaves fewer than two epochs in {periods} period(s)")
     ev = find_events(system, orbit.x0, orbit.period * (1 + 1e-9), (start,), impact=False)
     if ev.t.size == 0:
         raise ValueError(f"orbit has no {start} passage")
@@ -164,9 +170,17 @@ def simulate_truth(system: CR3BP, x_start, t, maneuvers=()) -> np.ndarray:
     A maneuver at ``t_m`` is applied to the state at ``t_m`` (between epochs); epochs at or before ``t_m`` see the
     pre-maneuver state.
     """
+    _checks.system(system)
     x = _checks.as_state(x_start, "x_start", batch=False)
-    t = _checks.time_grid(t, "t")
-    events = sorted((float(tm), _checks.as_array(dv, "dv", shape=(3,))) for tm, dv in maneuvers)
+    t = _checks.time_grid(t, "t", increasing=True)
+    try:
+        pairs = [tuple(m) for m in maneuvers]
+    except TypeError:
+        raise _checks.ArgumentTypeError("maneuvers must be a sequence of (t_m, dv) pairs") from None
+    if any(len(m) != 2 for m in pairs):
+        raise ValueError("maneuvers must be a sequence of (t_m, dv) pairs")
+    events = sorted(((_checks.real(tm, "maneuvers time"), _checks.as_array(dv, "maneuvers dv", shape=(3,)))
+                     for tm, dv in pairs), key=lambda e: e[0])
     if events and events[0][0] < t[0]:
         raise ValueError(f"maneuvers must not precede t[0] = {t[0]}")
     out = np.empty((t.size, 6))
@@ -189,9 +203,9 @@ def simulate_truth(system: CR3BP, x_start, t, maneuvers=()) -> np.ndarray:
 
 def simulate_measurements(scenario: TrackingScenario, truth, rng: np.random.Generator) -> np.ndarray:
     """Noisy measurements (N, K, m) of ``truth`` (N, 6) by every observer; NaN where an observer has no view."""
+    _check_scenario(scenario)
     truth = _checks.as_array(truth, "truth", shape=(scenario.t.size, 6))
-    if not isinstance(rng, np.random.Generator):
-        raise ValueError("rng must be a numpy.random.Generator")
+    _checks.rng(rng)
     y = scenario.model(scenario.observers, truth[:, None, :])
     y = y + rng.standard_normal(y.shape) * np.sqrt(np.diag(scenario.meas_cov))
     y[..., 0] = measurements.wrap_angle(y[..., 0])
@@ -204,7 +218,9 @@ def initial_estimate(system: CR3BP, x_true0, rng: np.random.Generator, *, scale:
 
     Returns ``(x0_estimate, P0)``; ``scale`` multiplies the standard deviations (the paper also tries 0.1).
     """
+    _checks.system(system)
     x = _checks.as_state(x_true0, "x_true0", batch=False)
+    _checks.rng(rng)
     s = _checks.positive(scale, "scale")
     sp = s * system.km_to_lu(HANDOFF_3SIGMA_KM / 3.0)
     sv = s * HANDOFF_3SIGMA_KM_S / 3.0 / system.velocity_unit_km_s
@@ -215,7 +231,9 @@ def initial_estimate(system: CR3BP, x_true0, rng: np.random.Generator, *, scale:
 def apoapsis_window_weights(t, t_apoapsis, q_base: float, q_window: float, window_hours: float,
                             system: CR3BP) -> np.ndarray:
     """Per-interval control weights: ``q_window`` on intervals overlapping +-window/2 around each apoapsis."""
-    t = _checks.time_grid(t, "t")
+    _checks.system(system)
+    t = _checks.time_grid(t, "t", increasing=True)
+    t_apoapsis = _checks.as_array(t_apoapsis, "t_apoapsis", ndim=(0, 1))
     qb = _checks.positive(q_base, "q_base")
     qw = _checks.positive(q_window, "q_window")
     half = _checks.positive(window_hours, "window_hours") * 3600.0 / system.time_unit_s / 2.0
@@ -266,17 +284,27 @@ class TrialSummary:
 
 def nees(x_est, P, truth) -> np.ndarray:
     """Normalised estimation error squared :math:`e^\\top P^{-1}e` per epoch, shape (N,)."""
-    e = _checks.as_array(x_est, "x_est", last=6) - _checks.as_array(truth, "truth", last=6)
-    P = _checks.as_array(P, "P")
-    return np.einsum("ni,ni->n", e, np.linalg.solve(P, e[..., None])[..., 0])
+    x_est = _checks.as_array(x_est, "x_est", ndim=(1, 2), last=6)
+    truth = _checks.as_array(truth, "truth", shape=x_est.shape)
+    e = np.atleast_2d(x_est - truth)
+    P = _checks.spd(P, "P", n=6, batch=True)
+    P = P.reshape(-1, 6, 6)
+    if P.shape[0] != e.shape[0]:
+        raise ValueError(f"P must have one 6x6 covariance per epoch ({e.shape[0]}); got shape {P.shape}")
+    out = np.einsum("ni,ni->n", e, np.linalg.solve(P, e[..., None])[..., 0])
+    return out if x_est.ndim == 2 else out[0]
 
 
 def summarize(system: CR3BP, x_est, P, truth) -> TrialSummary:
     """Consistency and accuracy summary of filtered estimates against the truth."""
     from scipy.stats import chi2
 
-    x_est = _checks.as_array(x_est, "x_est", ndim=(2,), last=6)
+    _checks.system(system)
+    x_est = _checks.as_array(x_est, "x_est", ndim=(2,), last=6, min_size=6)
     truth = _checks.as_array(truth, "truth", shape=x_est.shape)
+    P = _checks.spd(P, "P", n=6, batch=True)
+    if P.shape != (x_est.shape[0], 6, 6):
+        raise ValueError(f"P must have shape ({x_est.shape[0]}, 6, 6); got {P.shape}")
     e = x_est - truth
     n = nees(x_est, P, truth)
     frac = float(np.mean(n > chi2.ppf(NEES_PROBABILITY, 6)))
@@ -293,15 +321,27 @@ def summarize(system: CR3BP, x_est, P, truth) -> TrialSummary:
     )
 
 
+def _check_scenario(scenario, name: str = "scenario"):
+    return _checks.instance(scenario, name, TrackingScenario, "a cislunar.tracking.TrackingScenario (make_scenario)")
+
+
 def filter_trial(rng: np.random.Generator, scenario: TrackingScenario, control_weight, *,
                  handoff_scale: float = 1.0, tol: float = 1e-13) -> TrialSummary:
     """One Monte Carlo trial of the observation-strategy study: truth, measurements, hand-off, OCBE, summary.
 
-    A filter that fails numerically (e.g. a non-positive-definite update after divergence) is reported as
-    diverged with the exception message, not raised: divergence is an outcome of this experiment.
+    A filter that fails numerically while filtering (:class:`cislunar.ocbe.FilterDivergenceError`, e.g. a
+    non-positive-definite update after divergence) is reported as diverged with the failure message, not raised:
+    divergence is an outcome of this experiment.  A configuration error (a bad ``control_weight``,
+    ``handoff_scale``, ``tol``, ``rng`` or ``scenario``) raises ``ValueError``/``TypeError`` before anything runs.
     """
-    from .ocbe import ocbe_filter_smoother
+    from .ocbe import FilterDivergenceError, control_weights, ocbe_filter_smoother
+    from .propagation import _check_tol
 
+    _checks.rng(rng)
+    _check_scenario(scenario)
+    control_weight = control_weights(control_weight, scenario.t.size - 1)
+    handoff_scale = _checks.positive(handoff_scale, "handoff_scale")
+    tol = _check_tol(tol)
     truth = simulate_truth(scenario.system, scenario.x_start, scenario.t)
     y = simulate_measurements(scenario, truth, rng)
     x0, P0 = initial_estimate(scenario.system, scenario.x_start, rng, scale=handoff_scale)
@@ -309,7 +349,7 @@ def filter_trial(rng: np.random.Generator, scenario: TrackingScenario, control_w
         res = ocbe_filter_smoother(scenario.system, scenario.t, y, scenario.observers, scenario.model,
                                    scenario.meas_cov, x0, P0, control_weight, available=scenario.available,
                                    smooth=False, n_sub=2, tol=tol)
-    except (ValueError, RuntimeError, np.linalg.LinAlgError) as exc:
+    except FilterDivergenceError as exc:
         nan = float("nan")
         return TrialSummary(nan, nan, nan, nan, nan, nan, 1.0, True, str(exc)[:200])
     return summarize(scenario.system, res.x_filt, res.P_filt, truth)
