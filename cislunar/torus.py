@@ -374,6 +374,43 @@ class InvariantTorus:
         return out
 
 
+    def closest_approach(self, body: str = "Moon", *, n_theta: int = 32, n_t: int = 1601,
+                         tol: float = DEFAULT_TOL) -> tuple[float, tuple[float, float]]:
+        """Smallest distance of the torus from a primary's centre, km, and where it occurs.
+
+        A grid over initial ring angles and one stroboscopic period, refined by Nelder-Mead.
+
+        Parameters
+        ----------
+        body : {"Moon", "Earth"}
+        n_theta, n_t : int
+            Grid sizes (angles, times per period).
+        tol : float
+            heyoka tolerance.
+
+        Returns
+        -------
+        distance_km : float
+        (theta0, t) : tuple of float
+            Initial ring angle (rad) and time (TU) of the closest approach.
+        """
+        if body not in ("Moon", "Earth"):
+            raise ValueError(f"body must be 'Moon' or 'Earth'; got {body!r}")
+        n_theta, n_t = int(n_theta), int(n_t)
+        if n_theta < 4 or n_t < 11:
+            raise ValueError(f"n_theta must be >= 4 and n_t >= 11; got {n_theta}, {n_t}")
+        centre = self.system.secondary_position if body == "Moon" else self.system.primary_position
+        km = self.system.length_unit_km
+        th = 2.0 * np.pi * np.arange(n_theta) / n_theta
+        t = np.linspace(0.0, self.period, n_t)
+        d = np.linalg.norm(self.states(th, t, tol=tol)[..., :3] - centre, axis=-1) * km
+
+        def point(a, b):
+            return float(np.linalg.norm(self.states([a], [b], tol=tol)[0, 0, :3] - centre) * km)
+
+        return _refine_extremum(self, th, t, d, +1.0, tol, point)
+
+
 def _rms_about_mean(a: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.sum((a - a.mean(axis=0)) ** 2, axis=1))))
 
@@ -737,9 +774,12 @@ def continue_tori(torus: InvariantTorus, values, *, parameter: str = "size_km", 
             try:
                 guess = _predict(prev, cur, p_prev, p_cur, p_new)
                 nxt = solve_torus(guess, fix={parameter: p_new}, label=f"torus {parameter}={p_new:g}", **solve_kw)
-            except TorusConvergenceError:
+            except TorusConvergenceError as exc:
                 if halvings >= max_halvings:
-                    raise
+                    raise TorusConvergenceError(
+                        f"continuation in {parameter} failed from {p_cur:.10g} towards {float(target):.10g} after "
+                        f"{max_halvings} step halvings (last try {p_new:.10g}): {exc.message}",
+                        exc.residuals, exc.last_guess) from None
                 halvings += 1
                 p_new = 0.5 * (p_cur + p_new)
                 continue
@@ -856,25 +896,27 @@ def _range_at(torus: InvariantTorus, theta0: float, t: float, tol: float) -> flo
     return float(np.linalg.norm(agent[:3] - target[:3]) * torus.system.length_unit_km)
 
 
-def _refine_extremum(torus, th, t, rng, sign, tol):
-    """Refine the grid minimum (sign=+1) or maximum (sign=-1) of the range over (theta0, t) by Nelder-Mead."""
+def _refine_extremum(torus, th, t, values, sign, tol, point=None):
+    """Refine the grid minimum (sign=+1) or maximum (sign=-1) of ``values`` over (theta0, t) by Nelder-Mead.
+
+    ``point(theta0, t)`` evaluates the quantity at one point (default: the agent-target range, km).
+    """
     from scipy.optimize import minimize
 
-    i, j = np.unravel_index(np.argmin(sign * rng), rng.shape)
-    t_max = t[-1]
+    point = (lambda a, b: _range_at(torus, a, b, tol)) if point is None else point
+    i, j = np.unravel_index(np.argmin(sign * values), values.shape)
+    t_lo, t_hi = t[0], t[-1]
 
     def f(p):
-        tt = float(np.clip(p[1], 0.0, t_max))
-        return sign * _range_at(torus, float(p[0]), tt, tol)
+        return sign * point(float(p[0]), float(np.clip(p[1], t_lo, t_hi)))
 
     dth, dt = th[1] - th[0], t[1] - t[0]
     simplex = np.array([[th[i], t[j]], [th[i] + dth, t[j]], [th[i], t[j] + dt]])
     res = minimize(f, simplex[0], method="Nelder-Mead",
                    options={"initial_simplex": simplex, "xatol": 1e-9, "fatol": 1e-9, "maxiter": 400})
-    best = min(res.fun, sign * rng[i, j])
-    where = (float(np.mod(res.x[0], 2 * np.pi)), float(np.clip(res.x[1], 0.0, t_max))) if res.fun <= sign * rng[i, j] \
-        else (float(th[i]), float(t[j]))
-    return float(sign * best), where
+    if res.fun <= sign * values[i, j]:
+        return float(sign * res.fun), (float(np.mod(res.x[0], 2 * np.pi)), float(np.clip(res.x[1], t_lo, t_hi)))
+    return float(values[i, j]), (float(th[i]), float(t[j]))
 
 
 def qpo_for_mean_range(orbit: PeriodicOrbit, target_km: float = 215.0, N: int = 25, *,  # noqa: N803

@@ -216,6 +216,21 @@ def test_mean_range_definition(big):
     assert abs(np.trapezoid(r, tt) / tt[-1] - fine.mean_km) < 0.03 * fine.mean_km
 
 
+def test_closest_approach_to_the_moon(orbit, big):
+    d, (th, t) = big.closest_approach()
+    # brute force on a fine grid near the reported point and over the whole torus on a coarse grid
+    km = EARTH_MOON.length_unit_km
+    x = big.states(np.linspace(0, 2 * np.pi, 64, endpoint=False), np.linspace(0, big.period, 801))
+    coarse = np.linalg.norm(x[..., :3] - EARTH_MOON.secondary_position, axis=-1).min() * km
+    assert d <= coarse + 1e-9 and d > coarse - 5.0
+    y = big.states([th], [t])[0, 0]
+    assert abs(np.linalg.norm(y[:3] - EARTH_MOON.secondary_position) * km - d) < 1e-6
+    assert abs(t - orbit.period / 2) < 0.01  # at perilune
+    assert d < orbit.perilune_radius_km  # the torus dips below the NRHO's perilune
+    with pytest.raises(ValueError, match="body"):
+        big.closest_approach("Sun")
+
+
 def test_member_with_215_km_mean_range(orbit):
     torus, stats = tm.qpo_for_mean_range(orbit, 215.0, N=11, n_theta=24, n_t=601)
     assert abs(stats.mean_km - 215.0) < 215.0 * 1e-5
