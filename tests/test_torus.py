@@ -13,11 +13,13 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from cislunar import EARTH_MOON
 from cislunar import torus as tm
 from cislunar.orbits import ConvergenceError, nrho_9_2
-from cislunar.propagation import propagate
+from cislunar.propagation import propagate, propagate_scipy
 
 
 @pytest.fixture(scope="module")
@@ -52,6 +54,31 @@ def test_invariance_at_grid_and_midpoints(big):
     assert mid <= 1e-9
     # a random set of angles as well
     assert big.invariance_error(np.random.default_rng(1).uniform(0, 2 * np.pi, 9)) <= 1e-9
+
+
+def test_invariance_with_an_independent_integrator(big):
+    """scipy DOP853 (not heyoka) maps a midpoint of the circle onto the rotated circle."""
+    th = big.thetas[3] + np.pi / big.N
+    x = propagate_scipy(big.system, big.circle_at([th])[0], [0.0, big.period], rtol=1e-13, atol=1e-13).x[-1]
+    assert np.linalg.norm(x - big.circle_at([th + big.rho])[0]) < 1e-9
+
+
+@given(n=st.sampled_from([5, 7, 11]), seed=st.integers(0, 2**31), theta=st.floats(-10.0, 10.0))
+def test_fourier_interpolation_is_exact_for_trigonometric_polynomials(n, seed, theta):
+    rng = np.random.default_rng(seed)
+    m = (n - 1) // 2
+    a, b = rng.standard_normal(m + 1), rng.standard_normal(m + 1)
+    k = np.arange(m + 1)
+
+    def f(x):
+        return np.cos(np.outer(x, k)) @ a + np.sin(np.outer(x, k)) @ b
+
+    def df(x):
+        return -np.sin(np.outer(x, k)) @ (a * k) + np.cos(np.outer(x, k)) @ (b * k)
+
+    grid = 2 * np.pi * np.arange(n) / n
+    assert np.allclose(tm.fourier_weights([theta], n) @ f(grid), f([theta]), atol=1e-12)
+    assert np.allclose(tm.fourier_weights([theta], n, derivative=True) @ f(grid), df([theta]), atol=1e-11)
 
 
 def test_midpoint_check_bites_when_circle_is_under_resolved(orbit, big):
