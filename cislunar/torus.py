@@ -45,11 +45,13 @@ continuous symmetries or parameters that the equations leave free: the latitudin
 * one **member-selecting constraint** (two with ``free_period``): ring size, Jacobi constant, rotation number or
   period.
 
-The system has :math:`6N+3` equations in :math:`6N+1` unknowns (:math:`U, \rho`; plus :math:`T` if free).  It is
-consistent but row-rank-deficient (the Jacobi constant is conserved by :math:`\varphi_T`, so the invariance
-equations are dependent along its gradient); instead of adding an unfolding parameter we take Gauss-Newton steps
-with the minimum-norm least-squares solution, which converges quadratically on a consistent system whose Jacobian
-has full column rank.
+The system has :math:`6N+3` equations in :math:`6N+1` unknowns (:math:`U, \rho`; plus :math:`T` if free).  The
+:math:`6N` invariance equations alone have rank :math:`6N-2`: their Jacobian annihilates the two phase directions
+:math:`(\partial u/\partial\theta, 0)` and :math:`(f(u), 0)` and the family tangent, and two rows are dependent
+(the Jacobi constant is conserved by :math:`\varphi_T`; this is the deficiency that an unfolding parameter would
+remove).  With the three constraints the Jacobian has full column rank (checked in the tests), and instead of
+unfolding we take Gauss-Newton steps with the minimum-norm least-squares solution, which converges quadratically on
+this consistent over-determined system.
 
 Sizes
 -----

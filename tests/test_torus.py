@@ -119,6 +119,25 @@ def test_jacobian_matches_finite_differences(big):
     assert np.allclose(jt[:, -1], fd, atol=1e-6)
 
 
+def test_jacobian_null_space_and_rank(big):
+    """The invariance block annihilates the two phase directions (d/dtheta and the flow) and has a 3-D null space
+    (phases + family); the phase and member constraints restore full column rank."""
+    fixes = tm._parse_fix({"size_km": big.size_km}, False, big.system)
+    prob = tm._Problem(big.orbit, big.N, fixes, False, big.phase_component, 1e-15, big.period)
+    _, jac = prob.evaluate(prob.pack(big.circle, big.rho, big.period))
+    n = big.N
+    inv = jac[: 6 * n]
+    du = tm.fourier_weights(big.thetas, n, derivative=True) @ big.circle
+    flow = big.system.eom(big.circle)
+    for v in (du, flow):
+        vec = np.append(v.ravel(), 0.0)
+        assert np.linalg.norm(inv @ vec) < 1e-9 * np.linalg.norm(vec)
+    sv = np.linalg.svd(inv, compute_uv=False)  # 6N values for 6N+1 columns
+    assert np.sum(sv < 1e-10 * sv[0]) == 2  # rank 6N - 2: null space of dimension 3
+    sv_full = np.linalg.svd(jac, compute_uv=False)
+    assert sv_full[-1] > 1e-4 * sv_full[0]  # full column rank with the constraints
+
+
 # ------------------------------------------------------------------------------------------ linear limit
 def test_collapse_to_periodic_orbit(orbit, small_family):
     lam, _ = tm.centre_eigenpair(orbit)
