@@ -74,13 +74,18 @@ def _opening(md: str) -> tuple[str, str, str]:
         if line.startswith("# "):
             title = line[2:].strip()
             break
-    paras = [" ".join(p.split()) for p in re.split(r"\n\s*\n", md)]
+    raw = [p.strip() for p in re.split(r"\n\s*\n", md)]
+    paras = [" ".join(p.split()) for p in raw]
 
     def labelled(label):
-        for p in paras:
+        for i, p in enumerate(paras):
             m = re.match(r"\*\*" + label + r"[^*]*\*\*\s*(.*)", p, flags=re.IGNORECASE)
             if m:
-                return m.group(1).strip()
+                text = m.group(1).strip()
+                # A paragraph that announces a list ("...:") keeps the list that follows it.
+                if text.endswith(":") and i + 1 < len(raw) and re.match(r"[*+-] ", raw[i + 1]):
+                    text += "\n\n" + raw[i + 1]
+                return text
         return ""
 
     return title, labelled("What you will learn"), labelled("Paper sections? followed")
@@ -278,7 +283,8 @@ def _papers_markdown() -> str:
     cff = yaml.safe_load(cff_path.read_text())
 
     def names(authors):
-        return ", ".join(f"{a.get('given-names', '')} {a.get('family-names', '')}".strip() for a in authors)
+        return ", ".join(a.get("name") or f"{a.get('given-names', '')} {a.get('family-names', '')}".strip()
+                         for a in authors)
 
     lines = ["", "## The four papers", ""]
     for ref in cff.get("references", []):
@@ -295,9 +301,10 @@ def _papers_markdown() -> str:
         lines.append("- " + ", ".join(b for b in bits if b) + (f" ({'; '.join(ids)})" if ids else "") + ".")
         if ref.get("notes"):
             lines.append(f"  {ref['notes']}")
-    lines += ["", "## Citing this reproduction", "", "```text",
-              f"{names(cff.get('authors', []))}. {cff.get('title', '')}. Version {cff.get('version', '')}.",
-              "```", "", "The machine-readable form is `CITATION.cff` in the repository.", ""]
+    lines += ["", "## Citing this reproduction", "",
+              f"{names(cff.get('authors', []))}, *{cff.get('title', '')}*, version {cff.get('version', '')}. "
+              "Please cite the papers above as well; the machine-readable form of both is `CITATION.cff` in the "
+              "repository.", ""]
     return text + "\n".join(lines)
 
 

@@ -141,6 +141,22 @@ def _kernel_config():
         shutil.rmtree(sockets, ignore_errors=True)
 
 
+def _set_aside_failed(build: Path, name: str) -> Path:
+    """Move a failed run to ``<build>/notebooks/failed/`` and drop its stale report section.
+
+    ``<build>/notebooks`` then holds only notebooks that ran to the end, which is what the report and the book show.
+    """
+    failed = build / "notebooks" / "failed"
+    failed.mkdir(parents=True, exist_ok=True)
+    target = failed / f"{name}.ipynb"
+    executed = build / "notebooks" / f"{name}.ipynb"
+    if executed.is_file():
+        os.replace(executed, target)
+    (build / "report" / f"{name}.md").unlink(missing_ok=True)
+    assemble_report(build)
+    return target
+
+
 def run_notebook(source: Path, *, quick: bool, seed: int = 0, output_dir=None, kernel: str = "python3",
                  extra_parameters: dict | None = None) -> NotebookResult:
     """Convert ``source`` with jupytext, execute it with papermill and collect its report table.
@@ -197,15 +213,18 @@ def run_notebook(source: Path, *, quick: bool, seed: int = 0, output_dir=None, k
         done = nbformat.read(executed, as_version=4)
         cell = done.cells[exc.cell_index] if exc.cell_index < len(done.cells) else None
         head = (cell.source.strip().splitlines() or [""])[0] if cell is not None else ""
+        kept = _set_aside_failed(build, name)
         raise NotebookFailure(
             f"{name}: cell {exc.cell_index} (execution count {exc.exec_count}, starting {head!r}) raised "
-            f"{exc.ename}: {exc.evalue}"
+            f"{exc.ename}: {exc.evalue} (partly executed notebook: {kept})"
         ) from None
     seconds = time.perf_counter() - start
     done = nbformat.read(executed, as_version=4)
     report = _extract_report(done)
     if not report:
+        _set_aside_failed(build, name)
         raise NotebookFailure(f"{name}: no paper-vs-reproduction table was displayed (ComparisonTable.display())")
+    (build / "notebooks" / "failed" / f"{name}.ipynb").unlink(missing_ok=True)
     rep_dir = build / "report"
     rep_dir.mkdir(parents=True, exist_ok=True)
     mode = "quick" if quick else "full"
@@ -236,7 +255,9 @@ def assemble_report(output_dir=None) -> Path:
             "gives no number; computed here), *not in paper*, *beyond paper*.", ""]
     text += bodies
     out = build / "report.md"
-    out.write_text("\n".join(text))
+    tmp = out.with_name(f".report.md.{os.getpid()}")
+    tmp.write_text("\n".join(text))
+    os.replace(tmp, out)  # atomic: concurrent runs into one build directory never leave a half-written report
     return out
 
 

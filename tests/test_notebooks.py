@@ -1,20 +1,82 @@
-"""Every notebook runs end to end in quick mode through the same runner as ``make reproduce``."""
+"""Every notebook runs end to end in quick mode through the same runner as ``make reproduce``.
+
+The runs go to the session's temporary directory (``quick_runs`` in conftest.py), never to ``build/``, and each
+notebook runs once per session: the book tests (tests/test_book.py) render the same executed notebooks.
+"""
+
+import os
 
 import pytest
 
-from cislunar import notebooks
+from cislunar import notebooks, paths
 
 SOURCES = notebooks.discover()
 
 
 @pytest.mark.notebook
 @pytest.mark.parametrize("source", SOURCES, ids=[p.stem for p in SOURCES])
-def test_notebook_quick(source, tmp_path_factory):
-    result = notebooks.run_notebook(source, quick=True, seed=0)
-    assert result.report_markdown.count("|") > 10, "closing paper-vs-reproduction table is empty"
-    assert "| quantity | paper | reproduced | status |" in result.report_markdown
-    rows = [ln for ln in result.report_markdown.splitlines() if ln.startswith("| ") and "quantity" not in ln]
+def test_notebook_quick(source, quick_runs):
+    result = quick_runs.get(source)
+    assert result["ok"], result.get("error")
+    report = result["report"]
+    assert report.count("|") > 10, "closing paper-vs-reproduction table is empty"
+    assert "| quantity | paper | reproduced | status |" in report
+    rows = [ln for ln in report.splitlines() if ln.startswith("| ") and "quantity" not in ln]
     for row in rows:
         cells = [c.strip().lower() for c in row.strip("|").split(" | ")]
         assert "nan" not in cells[:3], f"{source.stem}: NaN in a table row: {row}"
         assert "failed" not in cells[3], f"{source.stem}: a check failed: {row}"
+    executed = quick_runs.build / "notebooks" / f"{source.stem}.ipynb"
+    assert executed.is_file()
+    assert (paths.repo_root() / "build").resolve() not in executed.resolve().parents
+
+
+def test_quick_runs_never_write_into_build(tmp_path):
+    full = paths.repo_root() / "build"
+    with pytest.raises(ValueError, match="output_dir"):
+        notebooks.resolve_build(full, quick=True)
+    with pytest.raises(ValueError, match="output_dir"):
+        notebooks.resolve_build("build", quick=True)
+    assert notebooks.resolve_build(None, quick=True) == paths.repo_root() / "build-quick"
+    assert notebooks.resolve_build(None, quick=False) == full
+    assert notebooks.resolve_build(tmp_path / "b", quick=True) == tmp_path / "b"
+    assert notebooks.main(["--quick", "--output-dir", str(full), "01"]) == 2
+
+
+def test_report_says_which_mode_made_it(tmp_path):
+    rep = tmp_path / "report"
+    rep.mkdir()
+    (rep / "01_a.md").write_text("## 01_a (full mode, 3 s)\n\n| quantity | paper | reproduced | status |\n")
+    text = notebooks.assemble_report(tmp_path).read_text()
+    assert "**Mode: full.**" in text
+    (rep / "02_b.md").write_text("## 02_b (quick mode, 1 s)\n\n| quantity | paper | reproduced | status |\n")
+    text = notebooks.assemble_report(tmp_path).read_text()
+    assert "**Mode: mixed.**" in text and "01_a (full mode" in text and "02_b (quick mode" in text
+    (rep / "01_a.md").unlink()
+    assert "**Mode: quick.**" in notebooks.assemble_report(tmp_path).read_text()
+
+
+def test_headless_kernel_environment(monkeypatch):
+    """Kernels run with plain-text progress bars (never widgets) unless bars are switched off, then restored."""
+    import os
+
+    monkeypatch.setenv("CISLUNAR_PROGRESS", "auto")
+    with notebooks._headless_environment():
+        assert os.environ["CISLUNAR_PROGRESS"] == "plain"
+    assert os.environ["CISLUNAR_PROGRESS"] == "auto"
+    monkeypatch.setenv("CISLUNAR_PROGRESS", "off")
+    with notebooks._headless_environment():
+        assert os.environ["CISLUNAR_PROGRESS"] == "off"
+    monkeypatch.delenv("CISLUNAR_PROGRESS")
+    with notebooks._headless_environment():
+        assert os.environ["CISLUNAR_PROGRESS"] == "plain"
+    assert "CISLUNAR_PROGRESS" not in os.environ
+
+
+def test_runner_kernel_uses_private_ipc_sockets():
+    with notebooks._kernel_config() as cfg:
+        assert cfg.KernelManager.transport == "ipc"
+        sockets = os.path.dirname(cfg.KernelManager.ip)
+        assert os.path.isdir(sockets)
+    assert not os.path.exists(sockets)
+
