@@ -731,7 +731,8 @@ def _parameter_value(torus: InvariantTorus, parameter: str) -> float:
 
 
 def continue_tori(torus: InvariantTorus, values, *, parameter: str = "size_km", progress: bool = True,
-                  max_halvings: int = 4, **solve_kw) -> list:
+                  max_halvings: int = 4, free_period: bool = False, hold: dict | None = None,
+                  **solve_kw) -> list:
     """Natural-parameter continuation of a torus family with a secant predictor and step halving.
 
     Parameters
@@ -746,6 +747,11 @@ def continue_tori(torus: InvariantTorus, values, *, parameter: str = "size_km", 
         Progress bar (:func:`cislunar.progress.progress`).
     max_halvings : int
         A failed step is retried with intermediate values up to this many halvings.
+    free_period : bool
+        Let the stroboscopic time vary; then ``hold`` must fix one more quantity.
+    hold : dict, optional
+        Constraints held fixed along the branch (e.g. ``{"jacobi": C}`` or ``{"period": T}`` with
+        ``free_period=True``), in the form of :func:`solve_torus`'s ``fix``.
     **solve_kw
         Passed to :func:`solve_torus`.
 
@@ -763,6 +769,9 @@ def continue_tori(torus: InvariantTorus, values, *, parameter: str = "size_km", 
         raise TypeError(f"torus must be an InvariantTorus; got {type(torus).__name__}")
     if parameter not in ("size_km", "size", "jacobi", "rho"):
         raise ValueError(f"parameter must be one of 'size_km', 'size', 'jacobi', 'rho'; got {parameter!r}")
+    hold = {} if hold is None else hold
+    if not isinstance(hold, dict) or parameter in hold:
+        raise ValueError(f"hold must be a dict of constraints other than {parameter!r}; got {hold!r}")
     values = _checks.as_array(values, "values", ndim=(0, 1)).reshape(-1)
     if parameter in ("size_km", "size") and np.any(values <= 0):
         raise ValueError("values must be positive sizes")
@@ -775,7 +784,8 @@ def continue_tori(torus: InvariantTorus, values, *, parameter: str = "size_km", 
         while True:
             try:
                 guess = _predict(prev, cur, p_prev, p_cur, p_new)
-                nxt = solve_torus(guess, fix={parameter: p_new}, label=f"torus {parameter}={p_new:g}", **solve_kw)
+                nxt = solve_torus(guess, fix={parameter: p_new, **hold}, free_period=free_period,
+                                  label=f"torus {parameter}={p_new:g}", **solve_kw)
             except TorusConvergenceError as exc:
                 if halvings >= max_halvings:
                     raise TorusConvergenceError(

@@ -238,6 +238,18 @@ def test_free_period_changes_the_frequency_ratio(big):
     assert abs(t2.jacobi - big.jacobi) > 1e-6
 
 
+def test_continuation_at_fixed_jacobi_with_free_period(big):
+    """Along the branch of constant Jacobi constant the period changes, and each member is invariant."""
+    fam = tm.continue_tori(big, [190.0, 180.0], free_period=True, hold={"jacobi": big.jacobi}, progress=False)
+    for t in fam:
+        assert abs(t.jacobi - big.jacobi) < 1e-11
+        assert t.invariance_error() < 1e-9
+    d1, d2 = (fam[0].period - big.period), (fam[1].period - big.period)
+    assert d1 != 0 and 1.5 < d2 / d1 < 2.5  # smooth branch: twice the step, about twice the change
+    with pytest.raises(ValueError, match="hold"):
+        tm.continue_tori(big, [190.0], hold={"size_km": 1.0}, progress=False)
+
+
 # ------------------------------------------------------------------------------------------ mean range
 def test_mean_range_definition(big):
     s1 = tm.mean_range(big, n_theta=24, n_t=401)
