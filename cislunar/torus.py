@@ -840,6 +840,17 @@ class RangeStats:
     min_at: tuple = (np.nan, np.nan)
     max_at: tuple = (np.nan, np.nan)
 
+    @property
+    def per_theta_mean_km(self) -> np.ndarray:
+        """Mean range over the time window for each initial ring angle (one agent trajectory each), km.
+
+        Their spread shows how much a finite-window average of a single trajectory can differ from the torus
+        average :attr:`mean_km` (which is their mean).
+        """
+        w = np.full(self.t.size, 1.0)
+        w[0] = w[-1] = 0.5
+        return self.range_km @ (w / w.sum())
+
 
 def mean_range(torus: InvariantTorus, *, n_theta: int = 48, n_t: int = 1201, periods: int = 1,
                tol: float = DEFAULT_TOL) -> RangeStats:

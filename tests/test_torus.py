@@ -259,6 +259,8 @@ def test_mean_range_definition(big):
     assert abs(s1.mean_km - fine.mean_km) < 1e-3 * fine.mean_km  # quadrature converged
     assert fine.min_km <= s1.range_km.min() + 1e-9 and fine.max_km >= s1.range_km.max() - 1e-9
     assert fine.min_km < fine.mean_km < fine.max_km
+    assert abs(fine.per_theta_mean_km.mean() - fine.mean_km) < 1e-9
+    assert fine.per_theta_mean_km.min() < fine.mean_km < fine.per_theta_mean_km.max()
     # brute force at the refined minimum
     th, t = fine.min_at
     agent = big.states([th], [t])[0, 0]
