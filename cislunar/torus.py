@@ -243,6 +243,14 @@ class InvariantTorus:
         """RMS distance of the ring's velocities from their mean, m/s."""
         return _rms_about_mean(self.circle[:, 3:]) * self.system.velocity_unit_km_s * 1e3
 
+    @property
+    def semi_axes_km(self) -> np.ndarray:
+        """Semi-axes of the ring's position ellipse, km, largest first: :math:`\\sqrt{2\\lambda_i}` of the covariance
+        of the ring positions over :math:`\\theta` (exact for a planar ellipse; the third is ~0 for a flat ring)."""
+        r = self.circle[:, :3] - self.circle[:, :3].mean(axis=0)
+        lam = np.linalg.eigvalsh(r.T @ r / self.N)[::-1]
+        return np.sqrt(2.0 * np.clip(lam, 0.0, None)) * self.system.length_unit_km
+
     def _dense_circle(self, n: int = 1440) -> np.ndarray:
         return self.circle_at(2.0 * np.pi * np.arange(n) / n)
 

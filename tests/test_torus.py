@@ -148,6 +148,10 @@ def test_collapse_to_periodic_orbit(orbit, small_family):
     for t in [tiny] + small_family:
         off = np.linalg.norm(t.circle[:, :3] - orbit.x0[:3], axis=1).max() * EARTH_MOON.length_unit_km
         assert off < 1.5 * t.size_km
+    # the tiny ring is the eigen-ellipse: semi-axes consistent with the RMS size, a flat (planar) ring
+    a = tiny.semi_axes_km
+    assert abs(np.sqrt(np.sum(a**2) / 2) - tiny.size_km) < 1e-9
+    assert a[2] < 1e-6 * a[0]
     cen = [np.linalg.norm(t.circle.mean(axis=0) - orbit.x0) for t in small_family]
     assert 3.5 < cen[2] / cen[1] < 4.5
     assert abs(tiny.jacobi - orbit.jacobi) < 1e-10
