@@ -89,6 +89,11 @@ def test_midpoint_check_bites_when_circle_is_under_resolved(orbit, big):
     assert coarse.invariance_error() > 1e-9  # ... but not invariant in between
 
 
+def test_torus_pickles(big):
+    again = pickle.loads(pickle.dumps(big))
+    assert np.array_equal(again.circle, big.circle) and again.rho == big.rho and again.period == big.period
+
+
 def test_quadratic_convergence_and_constant_jacobi(big):
     r = np.array(big.residuals)
     assert r[-1] < 1e-11
