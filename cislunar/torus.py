@@ -64,6 +64,7 @@ States are in LU and LU/TU in the barycentric rotating frame, times in TU, angle
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -77,6 +78,7 @@ from .propagation import DEFAULT_TOL, propagate, propagate_stm
 __all__ = [
     "InvariantTorus",
     "TorusConvergenceError",
+    "UnderResolvedWarning",
     "RangeStats",
     "centre_eigenpair",
     "torus_seed",
@@ -112,6 +114,10 @@ class TorusConvergenceError(ConvergenceError):
 
     def __reduce__(self):
         return (type(self), (self.message, list(self.residuals), np.asarray(self.last_guess)))
+
+
+class UnderResolvedWarning(UserWarning):
+    """A torus solved on its grid is not invariant between grid points: too few circle points N."""
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -611,7 +617,8 @@ class _Problem:
 
 
 def solve_torus(guess: InvariantTorus, *, fix: dict, free_period: bool = False, tol: float = 1e-11,
-                max_iter: int = 15, int_tol: float = DEFAULT_TOL, label: str = "") -> InvariantTorus:
+                max_iter: int = 15, int_tol: float = DEFAULT_TOL, label: str = "",
+                check_midpoints: bool = True) -> InvariantTorus:
     r"""Correct an approximate invariant circle to an invariant torus by Gauss-Newton (minimum-norm steps).
 
     Parameters
@@ -632,6 +639,9 @@ def solve_torus(guess: InvariantTorus, *, fix: dict, free_period: bool = False, 
         heyoka tolerance.
     label : str
         Name of the result.
+    check_midpoints : bool
+        After convergence, evaluate the invariance error between grid points (one more propagation of N states)
+        and warn with :class:`UnderResolvedWarning` if it exceeds ``1e3 * tol``.
 
     Returns
     -------
@@ -664,9 +674,16 @@ def solve_torus(guess: InvariantTorus, *, fix: dict, free_period: bool = False, 
                 break
             if err < tol:
                 U, rho, T = prob.unpack(X)
-                return InvariantTorus(orbit=guess.orbit, circle=U.copy(), period=float(T), rho=float(rho),
-                                      residuals=tuple(history), phase_component=guess.phase_component,
-                                      label=label or guess.label)
+                torus = InvariantTorus(orbit=guess.orbit, circle=U.copy(), period=float(T), rho=float(rho),
+                                       residuals=tuple(history), phase_component=guess.phase_component,
+                                       label=label or guess.label)
+                if check_midpoints:
+                    mid = torus.invariance_error(tol=int_tol)
+                    if mid > 1e3 * tol:
+                        warnings.warn(UnderResolvedWarning(
+                            f"torus solved on its {torus.N}-point grid but its invariance error between grid points "
+                            f"is {mid:.2e}: the circle is under-resolved, increase N"), stacklevel=2)
+                return torus
             if len(history) > max_iter:
                 break
             if len(history) >= 3 and err > 1e3 * min(history):
