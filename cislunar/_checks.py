@@ -74,10 +74,18 @@ def as_array(value, name: str, *, shape: tuple | None = None, ndim: tuple[int, .
     _reject_non_numeric(value, name, "numeric array-like")
     if isinstance(value, np.ndarray) and value.dtype.kind in "OUSV":
         raise ArgumentTypeError(f"{name} must be numeric array-like; got an array of dtype {value.dtype}")
-    if np.iscomplexobj(value) and np.dtype(dtype).kind != "c":
-        raise ArgumentTypeError(f"{name} must be real; got complex values")
     try:
-        arr = np.asarray(value, dtype=dtype)
+        raw = value if isinstance(value, np.ndarray) else np.asarray(value)
+    except (TypeError, ValueError) as exc:  # ragged nested sequences
+        raise ArgumentTypeError(f"{name} must be numeric array-like (a regular, non-ragged array); got "
+                                f"{_type_name(value)}") from exc
+    kind = np.dtype(dtype).kind
+    if raw.dtype.kind == "c" and kind != "c":
+        raise ArgumentTypeError(f"{name} must be real; got complex values")
+    if raw.dtype.kind == "b" and kind in "fc":
+        raise ArgumentTypeError(f"{name} must be numeric; got booleans {value!r:.60}")
+    try:
+        arr = np.asarray(raw, dtype=dtype)
     except (TypeError, ValueError) as exc:
         raise ArgumentTypeError(f"{name} must be numeric array-like; got {_type_name(value)}") from exc
     if shape is not None:

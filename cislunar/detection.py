@@ -868,6 +868,9 @@ def ml_threshold(z_h0, z_h1, *, bandwidth="scott") -> DetectionThreshold:
     """
     z0 = _checks.as_array(z_h0, "z_h0", ndim=(1,))
     z1 = _checks.as_array(z_h1, "z_h1", ndim=(1,))
+    for name, z in (("z_h0", z0), ("z_h1", z1)):
+        if z.size < 2 or np.std(z) == 0:
+            raise ValueError(f"{name} must hold at least two distinct values; got {z.size} value(s)")
     k0, k1 = fit_pdf(z0, bandwidth), fit_pdf(z1, bandwidth)
     lo, hi = min(z0.min(), z1.min()), max(z0.max(), z1.max())
     cross = pdf_crossings(k0, k1, lo, hi)

@@ -631,6 +631,10 @@ def angles_noise(observer, target, system: CR3BP, *, sigma_min_rad: float = AMOS
         Covariance in rad^2 (and (rad/TU)^2).
     """
     _check_system(system)
+    _checks.positive(sigma_min_rad, "sigma_min_rad", allow_zero=True)
+    _checks.positive(resolution_km, "resolution_km", allow_zero=True)
+    if rate_dt_s is not None:
+        _checks.positive(rate_dt_s, "rate_dt_s")
     rel = relative_state(observer, target)
     rho_km = np.linalg.norm(rel[..., 0:3], axis=-1) * system.length_unit_km
     sig = angular_sigma(rho_km, sigma_min_rad, resolution_km)

@@ -357,6 +357,8 @@ def map_tasks(fn, tasks, *, executor=None, progress: bool = True, desc: str = "s
     seed).
     """
     _checks.callable_(fn, "fn")
+    if isinstance(tasks, (str, bytes)):
+        raise _checks.ArgumentTypeError("tasks must be a sequence of tasks, not a str")
     try:
         tasks = list(tasks)
     except TypeError:

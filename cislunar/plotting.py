@@ -59,6 +59,10 @@ def save_figure(fig, name: str, *, output_dir=None, formats=("png",)) -> list[Pa
         raise TypeError(f"name must be a str; got {type(name).__name__}")
     if isinstance(formats, str):
         formats = (formats,)
+    try:
+        formats = tuple(formats)
+    except TypeError:
+        raise TypeError(f"formats must be a sequence of format names; got {type(formats).__name__}") from None
     if not formats:
         raise ValueError("formats must name at least one format")
     if not name or not all(c.isalnum() or c in "_-" for c in name):

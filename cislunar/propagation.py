@@ -110,12 +110,14 @@ class PropagationError(RuntimeError):
         return (type(self), (self.time, self.target, self.member, self.outcome))
 
 
-def check_outside_primaries(system: CR3BP, states, name: str = "x0", *, t0: float = 0.0) -> None:
+def check_outside_primaries(system: CR3BP, states, name: str = "states", *, t0: float = 0.0) -> None:
     """Raise :class:`ImpactError` if any state ``(6,)`` or ``(n, 6)`` lies on or inside the Earth or the Moon.
 
     The heyoka impact events only fire on a crossing of the surface from outside; a start inside a primary would
     otherwise integrate (through the singularity at its centre) without a warning.
     """
+    _checks.system(system)
+    states = _checks.as_state(states, name, batch=True)
     s = np.atleast_2d(states)
     r1, r2 = system.distances(s)
     for body, r, radius in (("Moon", r2, system.secondary_radius), ("Earth", r1, system.primary_radius)):
@@ -320,10 +322,12 @@ def _propagate_chunk(system: CR3BP, x0_chunk: np.ndarray, grid: np.ndarray, orde
     ta.state[:6, :] = padded.T
     ta.state[6:, :] = vic[:, None]
     res = ta.propagate_grid(np.repeat(grid[:, None], batch, axis=1))
-    for j, (outcome, tfinal) in enumerate(zip(ta.propagate_res, ta.time)):
-        if j < k:
-            _check_outcome(outcome[0], grid[-1], tfinal, None if first is None else first + j,
-                           np.array(ta.state[:6, j]))
+    # a terminal event in one lane interrupts the others (reported as plain "success"): report impacts first
+    lanes = [(j, res_j[0], tfinal) for j, (res_j, tfinal) in enumerate(zip(ta.propagate_res, ta.time)) if j < k]
+    hy = _heyoka()
+    lanes.sort(key=lambda lane: lane[1] in (hy.taylor_outcome.success, hy.taylor_outcome.time_limit))
+    for j, outcome, tfinal in lanes:
+        _check_outcome(outcome, grid[-1], tfinal, None if first is None else first + j, np.array(ta.state[:6, j]))
     arr = res[-1]  # (m, n_vars, batch)
     return np.transpose(arr, (2, 0, 1))[:k]
 

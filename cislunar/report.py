@@ -82,7 +82,9 @@ class ComparisonTable:
             raise ValueError("quantity must be a non-empty str")
         for name, v in (("paper", paper), ("reproduced", reproduced)):
             if isinstance(v, (bool, np.bool_)):
-                raise TypeError(f"{name} must be a number, a str or None; got bool")
+                raise TypeError(f"{name} must be a number, a str or None; got {type(v).__name__}")
+            if isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "iuf":
+                v = v.reshape(())[()]
             if isinstance(v, (int, float, np.number)) and not np.isfinite(float(v)):
                 raise ValueError(f"{name} must be finite (a table may not hold NaN or inf); got {v!r}; use a str "
                                  "such as 'not computed' with a note instead")

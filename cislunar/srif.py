@@ -246,12 +246,22 @@ def filter_smoother(x0, P0, Phis, Hs, ys, meas_covs, Gammas=None, Qs=None, *, sm
     """
     x0 = _checks.as_array(x0, "x0", ndim=(1,), min_size=1)
     n = x0.size
+    if np.shape(P0) != (n, n):
+        raise ValueError(f"P0 must be {n}x{n} to match x0 (length {n}); got shape {np.shape(P0)}")
     _checks.spd(P0, "P0", n=n)
     smooth = _checks.boolean(smooth, "smooth")
-    for name, seq in (("Phis", Phis), ("Hs", Hs), ("ys", ys), ("meas_covs", meas_covs)):
-        if not hasattr(seq, "__len__") or isinstance(seq, (str, bytes)):
+    for name, seq in (("Phis", Phis), ("Hs", Hs), ("ys", ys), ("meas_covs", meas_covs), ("Gammas", Gammas),
+                      ("Qs", Qs)):
+        if seq is None and name in ("Gammas", "Qs"):
+            continue
+        try:
+            len(seq)
+            ok = not isinstance(seq, (str, bytes))
+        except TypeError:
+            ok = False
+        if not ok:
             raise _checks.ArgumentTypeError(f"{name} must be a sequence (one entry per epoch); got "
-                                            f"{type(seq).__name__}")
+                                            f"{type(seq).__name__} {seq!r:.40}")
     Phis = _checks.as_array(Phis, "Phis", ndim=(3,)) if len(Phis) else np.zeros((0, n, n))
     N = Phis.shape[0] + 1
     if Phis.shape[1:] != (n, n):
