@@ -117,6 +117,20 @@ def _notebook_mode(nb: dict) -> tuple[str | None, float | None]:
     return mode, pm.get("duration")
 
 
+def _first_markdown_of_percent_source(path: Path) -> str:
+    """Text of the first ``# %% [markdown]`` cell of a jupytext py:percent file (without importing jupytext)."""
+    lines, inside = [], False
+    for line in path.read_text().splitlines():
+        if line.startswith("# %%"):
+            if inside:
+                break
+            inside = "[markdown]" in line
+            continue
+        if inside:
+            lines.append(line[2:] if line.startswith("# ") else line.lstrip("#"))
+    return "\n".join(lines)
+
+
 def read_entries(build: Path) -> list[NotebookEntry]:
     """One entry per notebook source in ``notebooks/`` and per executed notebook in ``<build>/notebooks``.
 
@@ -134,10 +148,7 @@ def read_entries(build: Path) -> list[NotebookEntry]:
             md = next((_source_text(c) for c in nb["cells"] if c["cell_type"] == "markdown"), "")
             mode, seconds = _notebook_mode(nb)
         else:
-            import jupytext
-
-            nb = jupytext.read(runner.notebooks_dir() / f"{name}.py")
-            md = next((c.source for c in nb.cells if c.cell_type == "markdown"), "")
+            md = _first_markdown_of_percent_source(runner.notebooks_dir() / f"{name}.py")
             mode, seconds = None, None
         title, learn, sections = _opening(md)
         rep = build / "report" / f"{name}.md"
@@ -385,6 +396,8 @@ def build_book(build_dir=None, *, out_dir=None, quiet: bool = True) -> Path:
     if proc.returncode != 0 or not index.is_file():
         raise BookError(f"sphinx-build failed (exit {proc.returncode}):\n{proc.stderr[-4000:]}")
     shutil.copytree(mathjax, out / "_static" / "mathjax", dirs_exist_ok=True)
+    for template in (out / "_static").glob("*macros.html"):
+        template.unlink()  # Jinja macro files the themes copy as static assets; no page uses them
     return index
 
 
