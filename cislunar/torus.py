@@ -73,7 +73,7 @@ from . import _checks
 from .dynamics import CR3BP
 from .orbits import ConvergenceError, PeriodicOrbit
 from .progress import progress as _progress
-from .propagation import DEFAULT_TOL, propagate, propagate_stm
+from .propagation import DEFAULT_TOL, ImpactError, PropagationError, propagate, propagate_stm
 
 __all__ = [
     "InvariantTorus",
@@ -98,22 +98,26 @@ class TorusConvergenceError(ConvergenceError):
 
     Attributes
     ----------
+    message : str
+        What went wrong (without the residual history).
     residuals : list of float
         Max-norm of the constraint vector at each Gauss-Newton iteration.
     last_guess : ndarray
         Unknown vector ``[U.ravel(), rho(, T)]`` at the last iteration.
+    reason : str
+        ``"max_iter"``, ``"diverged"``, ``"non_finite"``, ``"impact"`` (an iterate's trajectory reaches a
+        primary), ``"propagation"`` (the integrator stopped) or ``"other"``.
 
     Notes
     -----
     Survives pickling (process pools): ``__reduce__`` rebuilds it from the raw message and the history.
     """
 
-    def __init__(self, message: str, residuals, last_guess):
-        super().__init__(message, residuals, last_guess)
-        self.message = message
+    def __init__(self, message: str, residuals=(), last_guess=(), reason: str = "other"):
+        super().__init__(message, residuals, last_guess, reason)
 
     def __reduce__(self):
-        return (type(self), (self.message, list(self.residuals), np.asarray(self.last_guess)))
+        return (type(self), (self.message, list(self.residuals), np.asarray(self.last_guess), self.reason))
 
 
 class UnderResolvedWarning(UserWarning):
@@ -698,10 +702,17 @@ def solve_torus(guess: InvariantTorus, *, fix: dict, free_period: bool = False, 
                     break
                 step *= 0.5
             X, F, J = Xn, Fn, Jn
-    except RuntimeError as exc:  # heyoka stopped: an iterate reached a primary or blew up
-        raise TorusConvergenceError(f"torus solve failed, propagation error: {exc}", history, X) from None
-    raise TorusConvergenceError(f"torus solve did not converge to tol={tol:g} in {max_iter} iterations "
-                                f"(fix={dict(fix)}, N={guess.N})", history, X)
+    except (ImpactError, PropagationError) as exc:  # an iterate reached a primary or the integrator stopped
+        reason = "impact" if isinstance(exc, ImpactError) else "propagation"
+        raise TorusConvergenceError(f"torus solve failed (fix={dict(fix)}, N={guess.N}): {exc}", history, X,
+                                    reason) from None
+    if history and not np.isfinite(history[-1]):
+        reason, what = "non_finite", "produced a non-finite residual"
+    elif len(history) <= max_iter:
+        reason, what = "diverged", "diverged"
+    else:
+        reason, what = "max_iter", f"did not converge to tol={tol:g} in {max_iter} iterations"
+    raise TorusConvergenceError(f"torus solve {what} (fix={dict(fix)}, N={guess.N})", history, X, reason)
 
 
 def torus_from_orbit(orbit: PeriodicOrbit, N: int = 25, size_km: float = 10.0, *,  # noqa: N803
@@ -816,7 +827,7 @@ def continue_tori(torus: InvariantTorus, values, *, parameter: str = "size_km", 
                     raise TorusConvergenceError(
                         f"continuation in {parameter} failed from {p_cur:.10g} towards {float(target):.10g} after "
                         f"{max_halvings} step halvings (last try {p_new:.10g}): {exc.message}",
-                        exc.residuals, exc.last_guess) from None
+                        exc.residuals, exc.last_guess, exc.reason) from None
                 halvings += 1
                 p_new = 0.5 * (p_cur + p_new)
                 continue
@@ -1034,4 +1045,4 @@ def qpo_for_mean_range(orbit: PeriodicOrbit, target_km: float = 215.0, N: int = 
         if guess_km <= 0:
             break
     raise TorusConvergenceError(f"no torus member with {statistic} = {target_km} km found", history,
-                                np.array(sizes))
+                                np.array(sizes), "max_iter")

@@ -326,6 +326,7 @@ def test_non_convergence_raises_with_history_through_a_process_pool():
         _failing_solve()
     err = info.value
     assert isinstance(err, ConvergenceError)
+    assert err.reason in ("max_iter", "diverged")
     assert len(err.residuals) >= 2 and err.residuals[-1] > 1e-11
     again = pickle.loads(pickle.dumps(err))
     assert again.residuals == err.residuals and str(again) == str(err)
@@ -333,8 +334,15 @@ def test_non_convergence_raises_with_history_through_a_process_pool():
         fut = pool.submit(_failing_solve)
         with pytest.raises(tm.TorusConvergenceError) as remote:
             fut.result()
-    assert remote.value.residuals == err.residuals
+    assert remote.value.residuals == err.residuals and remote.value.reason == err.reason
     assert "residual history" in str(remote.value)
+
+
+def test_iterate_through_the_moon_is_an_impact_failure(orbit):
+    """A 20000-km seed ring sends trajectories into the Moon: the solve refuses instead of integrating through it."""
+    with pytest.raises(tm.TorusConvergenceError, match="Moon") as info:
+        tm.solve_torus(tm.torus_seed(orbit, 7, 20000.0), fix={"size_km": 20000.0})
+    assert info.value.reason == "impact"
 
 
 @pytest.mark.parametrize("n", [4, 3, 2.5, True, "9"])
