@@ -666,7 +666,15 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
         tb.pars[1] = qs[:, n]
         out = tb.propagate_grid(np.repeat(grid[:, None], B, axis=1))[-1]  # (n_sub, 156, B)
         if not np.allclose(tb.time, grid[-1], rtol=0, atol=1e-12) or not np.all(np.isfinite(out)):
-            raise RuntimeError(f"heyoka batch propagation failed on interval {n} (t = {grid[0]} TU)")
+            raise ocbe.FilterDivergenceError(n, float(grid[0]), "heyoka batch propagation failed (non-finite "
+                                             "state)")
+        # no impact events in the batch integrator (see ocbe.ocbe_transition): check every sub-grid state
+        r1, r2 = system.distances(np.moveaxis(out[:, :3], -1, 1))
+        if np.any(r2 <= system.secondary_radius) or np.any(r1 <= system.primary_radius):
+            member = int(np.flatnonzero(np.any((r2 <= system.secondary_radius) | (r1 <= system.primary_radius),
+                                               axis=0))[0])
+            raise ocbe.FilterDivergenceError(n, float(grid[0]), f"the reference of trial {member} of the batch "
+                                             "entered a primary")
         phi_all = np.moveaxis(out, -1, 0)[:, :, index]  # (B, n_sub, 12, 12)
         Phi = phi_all[:, -1]
         Phi_xx, Phi_xp = Phi[:, :6, :6], Phi[:, :6, 6:]

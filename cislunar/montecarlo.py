@@ -330,9 +330,10 @@ def run_monte_carlo(trial, n_trials: int, seed, *, args=(), kwargs=None, executo
         if chunk_size is not None:
             _checks.integer(chunk_size, "chunk_size", minimum=1)
 
-        def serial():
-            for i in range(n_trials):
-                yield _run_chunk(trial, root, [i], args, kwargs, None, collect)
+        def serial():  # chunks of up to 64 trials keep the bookkeeping off the per-trial cost
+            step = max(1, min(64, n_trials // 100))
+            for i in range(0, n_trials, step):
+                yield _run_chunk(trial, root, range(i, min(i + step, n_trials)), args, kwargs, None, collect)
 
         return _drive(None, n_trials, desc, progress, collect, serial)
     _check_executor(executor)

@@ -36,7 +36,8 @@ import numpy as np
 
 from . import _checks
 from .dynamics import CR3BP
-from .propagation import DEFAULT_TOL, _check_outcome, _check_tol, _grid_from, _heyoka, thread_local_copy
+from .propagation import (DEFAULT_TOL, _check_outcome, _check_tol, _grid_from, _heyoka, check_outside_primaries,
+                          thread_local_copy)
 
 __all__ = ["OCBETransition", "ocbe_transition", "ocbe_process_noise", "estimated_control", "OCBEResult",
            "ocbe_filter_smoother", "variational_system", "FilterDivergenceError"]
@@ -184,10 +185,19 @@ def ocbe_transition(system: CR3BP, x0, t, control_weight: float, *, tol: float =
         :math:`q > 0` of :math:`\\tilde Q = qI_3`, LU^2/TU^3.
     tol : float
         Integrator tolerance.
+
+    Notes
+    -----
+    The OCBE integrator carries no impact events (its reference is the filter's current estimate of a spacecraft
+    in orbit, re-linearised every interval).  Instead a start inside a primary raises
+    :class:`cislunar.propagation.ImpactError`, and so does any grid state inside a primary; a reference that
+    passes through a primary entirely between two grid points would not be seen, so keep the grid finer than a
+    perilune passage (the filters use several sub-steps per measurement interval).
     """
     _checks.system(system)
     x0 = _checks.as_state(x0, "x0", batch=False)
     grid = _grid_from(t)
+    check_outside_primaries(system, x0, "x0", t0=grid[0])
     q = _checks.positive(control_weight, "control_weight")
     tol = _check_tol(tol)
     _, index = _ocbe_template(tol)
@@ -199,6 +209,7 @@ def ocbe_transition(system: CR3BP, x0, t, control_weight: float, *, tol: float =
     res = ta.propagate_grid(grid)
     _check_outcome(res[0], grid[-1], ta.time, None, np.array(ta.state[:6]))
     out = res[-1]
+    check_outside_primaries(system, out[:, :6], "reference trajectory", t0=grid[0])
     return OCBETransition(t=grid, x=out[:, :6], phi=out[:, index], control_weight=q)
 
 

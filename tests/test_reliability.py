@@ -955,7 +955,7 @@ def test_monte_carlo_is_bit_identical_across_executors():
 def test_monte_carlo_is_bit_identical_on_a_dask_cluster():
     distributed = pytest.importorskip("distributed")
     serial = montecarlo.run_monte_carlo(_trial, 23, 4, args=(3.0,), progress=False)
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl, \
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cl, \
             distributed.Client(cl) as client:
         dask = montecarlo.run_monte_carlo(_trial, 23, 4, args=(3.0,), executor=client, chunk_size=5,
                                           progress=False)
