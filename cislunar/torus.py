@@ -394,6 +394,26 @@ class InvariantTorus:
         return out
 
 
+    def stability_multipliers(self, *, tol: float = DEFAULT_TOL) -> np.ndarray:
+        """Eigenvalues of the linearised invariant-circle map, sorted by decreasing modulus.
+
+        A perturbation :math:`\\delta u(\\theta)` of the circle maps to :math:`\\Phi_T(u(\\theta))\\,\\delta
+        u(\\theta)`, which belongs to the angle :math:`\\theta+\\rho`; rotating it back gives the :math:`6N\\times6N`
+        operator :math:`(W(\\theta_j-\\rho)\\otimes I)\\,\\mathrm{diag}(\\Phi_T(u_l))` (Olikara & Scheeres 2012),
+        whose eigenvalues come in sets :math:`\\lambda_i e^{ik\\rho}` of equal modulus.  Their largest modulus is the
+        per-period growth factor of deviations from the torus (the 9:2 NRHO's hyperbolic pair gives about 2.19).
+
+        Returns
+        -------
+        ndarray, shape (6N,), complex
+        """
+        n = self.N
+        stm = propagate_stm(self.system, self.circle, self.period, tol=tol).stm.reshape(n, 2, 6, 6)[:, -1]
+        W = fourier_weights(self.thetas - self.rho, n)
+        A = np.einsum("jl,lab->jalb", W, stm).reshape(6 * n, 6 * n)
+        lam = np.linalg.eigvals(A)
+        return lam[np.argsort(-np.abs(lam))]
+
     def closest_approach(self, body: str = "Moon", *, n_theta: int = 32, n_t: int = 1601,
                          tol: float = DEFAULT_TOL) -> tuple[float, tuple[float, float]]:
         """Smallest distance of the torus from a primary's centre, km, and where it occurs.

@@ -163,6 +163,23 @@ def test_collapse_to_periodic_orbit(orbit, small_family):
     assert abs(tiny.jacobi - orbit.jacobi) < 1e-10
 
 
+def test_stability_multipliers_inherit_the_orbit_hyperbolic_pair(orbit, small_family, big):
+    lam_max = np.abs(orbit.eigenvalues[0])
+    for t in (small_family[0], big):
+        m = t.stability_multipliers()
+        # N copies lambda e^{ik rho} of the unstable multiplier (same modulus), then the rest
+        assert np.allclose(np.abs(m[: t.N]), lam_max, rtol=1e-4)
+        assert np.abs(m[t.N]) < 1.01
+        assert abs(np.abs(m[0]) - lam_max) < 1e-6 * (t.size_km / 10.0) ** 2 + 1e-8
+    m = small_family[0].stability_multipliers()[: small_family[0].N]
+    assert np.min(np.abs(m - orbit.eigenvalues[0])) < 1e-5  # the k = 0 member is the orbit's multiplier
+    # the others are rotated by multiples of rho
+    rot = m / orbit.eigenvalues[0]
+    k = np.arange(-(small_family[0].N // 2), small_family[0].N // 2 + 1)
+    for kk in k:
+        assert np.min(np.abs(rot - np.exp(1j * kk * small_family[0].rho))) < 1e-5
+
+
 def test_rotation_number_and_jacobi_quadratic_in_size(orbit, small_family):
     alpha = np.angle(tm.centre_eigenpair(orbit)[0])
     d_rho = np.array([t.rho - alpha for t in small_family])
