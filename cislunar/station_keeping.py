@@ -58,6 +58,7 @@ __all__ = [
     "execution_sigma",
     "filter_scenario",
     "filter_trial",
+    "random_choice_trial",
 ]
 
 
@@ -366,11 +367,13 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
     sig = np.empty((nt, nth))
     sig_arr = np.empty((nt, nth))
     u_y = np.empty((nt, 3))
-    L = system.length_unit_km
+    if batched:
+        agent_x = np.empty((nt, nth, t.size, 6))
+        agent_stm = np.empty((nt, nth, t.size, 6, 6))
+    k_arr = np.searchsorted(t, t_arr, side="right") - 1
     for j in _progress(range(nt), total=nt, desc="station-keeping surface", enabled=progress):
         _, Ha, _ = AZIMUTH_ELEVATION.evaluate(nominal.x[0, j + 1], tgt_arr[j])
         u_y[j] = mmd_direction(mmd_matrix(nominal.stm[0, j + 1], Ha))
-        k_arr = int(np.searchsorted(t, t_arr[j], side="right")) - 1
         groups = [np.arange(nth)] if batched else [np.array([i]) for i in range(nth)]
         for g in groups:
             d1, d2, x1 = two_burn_transfer(system, xa0, t_burn, t_arr[j], goal[g, j])
@@ -378,9 +381,18 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
             miss[j, g] = np.linalg.norm(x1[:, :3] - goal[g, j, :3], axis=1)
             ag = propagate_with_impulses(system, np.broadcast_to(xa0, (g.size, 6)), t,
                                          [(t_burn, d1), (float(t_arr[j]), d2)])
+            if batched:  # one covariance analysis for the whole surface below
+                agent_x[j], agent_stm[j] = ag.x, ag.stm
+                continue
             cov = ssat_covariance(system, ag, target, P0, sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
             sig[j, g] = cov.final_range_sigma_km
-            sig_arr[j, g] = cov.range_sigma_km[:, k_arr]
+            sig_arr[j, g] = cov.range_sigma_km[:, k_arr[j]]
+    if batched:
+        ag = ImpulsiveTrajectory(t, agent_x.reshape(nt * nth, t.size, 6), agent_stm.reshape(nt * nth, t.size, 6, 6))
+        cov = ssat_covariance(system, ag, target, P0, sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
+        rs = cov.range_sigma_km.reshape(nt, nth, t.size)
+        sig[:] = rs[..., -1]
+        sig_arr[:] = rs[np.arange(nt), :, k_arr]
     norms = np.linalg.norm(dv1, axis=-1)
     with np.errstate(invalid="ignore", divide="ignore"):
         align = np.einsum("jik,jk->ji", dv1, u_y) / norms
@@ -565,3 +577,14 @@ def filter_trial(rng: np.random.Generator, scenario: FilterScenario, *, n_iter: 
     except (ValueError, RuntimeError, np.linalg.LinAlgError) as exc:
         return FilterTrialResult(nees, err, sdev, str(exc)[:200])
     return FilterTrialResult(nees, err, sdev)
+
+
+def random_choice_trial(rng: np.random.Generator, scenarios) -> FilterTrialResult:
+    """:func:`filter_trial` of a scenario drawn uniformly from ``scenarios`` with the trial's own generator.
+
+    Models an *uninformed* station-keeping choice: the target phase is picked without regard to information.
+    """
+    scenarios = tuple(scenarios)
+    if not scenarios:
+        raise ValueError("scenarios must hold at least one FilterScenario")
+    return filter_trial(rng, scenarios[int(rng.integers(len(scenarios)))])

@@ -1,0 +1,423 @@
+# ---
+# jupyter:
+#   jupytext:
+#     formats: py:percent
+#   kernelspec:
+#     display_name: Python 3
+#     language: python
+#     name: python3
+# ---
+
+# %% [markdown]
+# # 08 · Informed station keeping on a quasi-periodic orbit about the 9:2 NRHO
+#
+# **What you will learn.** How a quasi-periodic torus about the Gateway's 9:2 NRHO turns "station keeping" from a
+# single target point into a two-parameter *set* of acceptable states; how every point of that set is reached with
+# a two-burn transfer (position, then velocity); how Greaves & Scheeres pick, among all those maneuvers, the one most
+# aligned with the MMD information-gathering direction (the *informed* maneuver $\mathbf u^*$, Eq. 25); and whether
+# that choice really lands in the valley of range uncertainty and avoids the largest fuel costs, checked with numbers
+# over the full surface of maneuvers, each with its own covariance analysis. Beyond the paper (its own future work),
+# a full-filter Monte Carlo with maneuver execution errors tells us how much of the predicted range information
+# survives.
+#
+# **Paper sections followed.** Greaves & Scheeres (AMOS 2023), Secs. 4 (informed station keeping, Eq. 25,
+# Figs. 2-3) and 5 (simulation and results, Figs. 4-5). SSAT, $J_\rho$ and MMD are built in notebook 07; the
+# invariant-torus solver is :mod:`cislunar.torus`.
+
+# %% tags=["parameters"]
+QUICK = False
+SEED = 0
+OUTPUT_DIR = ""
+
+# %%
+# Sizes derived from QUICK: a coarser surface, fewer sweep points and fewer Monte Carlo trials in quick mode.
+N_SURF = 14 if QUICK else 40  # ring angles x arrival times of the station-keeping surface (paper: not given)
+N_SWEEP = 10 if QUICK else 20  # surface size in the sweep over the unstated scenario inputs
+N_TRIALS = 6 if QUICK else 40  # Monte Carlo trials per policy and execution-error level
+N_WORKERS = 1 if QUICK else 2  # process pool for the Monte Carlo (1 = serial)
+# Scenario choices the paper leaves open (stated, then swept in section 6):
+T_BURN_H = -24.0  # first burn, hours from the target's apoapsis
+T_ARRIVAL_H = (-12.0, 12.0)  # window of arrival times (second burn), hours from apoapsis
+T_FINAL_H = 24.0  # end of the covariance analysis, where sqrt(J_rho) is read, hours from apoapsis
+AGENT_THETA = 0.0  # the agent starts on the torus trajectory of this ring angle (rad)
+EXEC_ABS_M_S, EXEC_REL = 1e-3, 0.01  # execution errors (1 sigma per axis): 1 mm/s plus 1 % of the burn
+
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from cislunar import plotting, ssat
+from cislunar import station_keeping as sk
+from cislunar.dynamics import EARTH_MOON as em
+from cislunar.montecarlo import run_monte_carlo
+from cislunar.orbits import nrho_9_2
+from cislunar.propagation import propagate
+from cislunar.report import ComparisonTable
+from cislunar.torus import mean_range, qpo_for_mean_range
+
+plotting.use_style()
+out = OUTPUT_DIR or None
+table = ComparisonTable("08 QPO and informed station keeping (Greaves & Scheeres AMOS 2023, Secs. 4-5)")
+L, V = em.length_unit_km, em.velocity_unit_km_s
+HR = 3600.0 / em.time_unit_s
+t_start = time.perf_counter()
+
+# %% [markdown]
+# ## 1 · The QPO about the 9:2 NRHO and the 215 km member
+#
+# The target flies the 9:2 southern L2 NRHO; the agent flies a quasi-periodic orbit about it "with the same base
+# frequency" (Sec. 4). We compute 2-D invariant tori by the invariant-circle method (:mod:`cislunar.torus`): the
+# ring $u(\theta)$ at the NRHO's apolune is mapped onto itself by the flow over one NRHO period $T$, rotated by the
+# rotation number $\rho$, $\varphi_T(u(\theta)) = u(\theta+\rho)$; the stroboscopic time is fixed to $T$, which is
+# what "same base frequency" means. The paper gives one number for its member: "the average range between the
+# natural trajectories of the two spacecraft is 215 km".
+#
+# **Definition of the mean range (our reading).** Target on the NRHO from apolune, agent on the torus trajectory
+# through ring angle $\theta_0$ at the same epoch; the range averaged uniformly over all $\theta_0\in[0,2\pi)$ and
+# over one period $[0, T)$. For an irrational $\rho/2\pi$ this is the long-time average along any single agent
+# trajectory. We **select** the family member whose mean range is 215 km: the number is an *input* here, not a
+# prediction, and cannot be "reproduced".
+
+# %%
+nrho = nrho_9_2(em)
+torus, stats = qpo_for_mean_range(nrho, 215.0)
+ring_alt = {name: getattr(stats, name) for name in ("mean_km", "ring_mean_km", "rms_km")}
+print(f"9:2 NRHO: period {nrho.period_days:.4f} d, apolune radius {nrho.apolune_radius_km:.0f} km")
+print(f"QPO member: ring size (RMS about its centre) {torus.size_km:.2f} km and {torus.velocity_size_mps:.3f} m/s; "
+      f"largest offset from the NRHO apolune state {torus.max_offset_km:.1f} km, {torus.max_velocity_offset_mps:.2f} m/s")
+print(f"rotation number rho = {torus.rho:.6f} rad per period ({np.degrees(torus.rho):.3f} deg; "
+      f"rho/2pi = {torus.rho / (2 * np.pi):.6f}); Jacobi constant {torus.jacobi:.10f} (NRHO {nrho.jacobi:.10f})")
+print(f"invariance error at the circle midpoints {torus.invariance_error():.2e} (non-dimensional)")
+print(f"agent-target range: mean {stats.mean_km:.2f} km, min {stats.min_km:.2f} km, max {stats.max_km:.2f} km; "
+      f"mean over the apolune ring only {stats.ring_mean_km:.2f} km, RMS {stats.rms_km:.2f} km")
+
+# %% [markdown]
+# ## 2 · Fig. 2: the torus surface and the NRHO near apoapsis
+#
+# The QPO's surface for $\pm$1.5 days about apoapsis (the ring flowed in time), with the target's NRHO arc in black
+# and the initial ring at apoapsis in red; Moon-centred rotating frame, units of 1000 km.
+
+# %%
+th_plot = np.linspace(0, 2 * np.pi, 49)
+fig = plt.figure(figsize=(13, 6))
+for n_ax, (span_h, title) in enumerate(((36.0, "$\\pm$1.5 days about apoapsis"), (4.0, "zoom: $\\pm$4 h"))):
+    t_plot = np.linspace(-span_h, span_h, 61) * HR
+    surf = em.moon_centred(torus.states(th_plot[:-1], t_plot)) * L / 1e3
+    surf = np.concatenate([surf, surf[:1]], axis=0)
+    fwd = em.moon_centred(propagate(em, nrho.x0, t_plot[t_plot >= 0]).x) * L / 1e3
+    back = em.moon_centred(propagate(em, nrho.x0, -t_plot[t_plot >= 0]).x) * L / 1e3
+    ax = fig.add_subplot(1, 2, n_ax + 1, projection="3d")
+    ax.plot_surface(surf[..., 0], surf[..., 1], surf[..., 2], color="tab:red", alpha=0.3, lw=0, shade=True)
+    ring0 = em.moon_centred(torus.ring(0.0, 97)) * L / 1e3
+    ax.plot(ring0[:, 0], ring0[:, 1], ring0[:, 2], color="tab:red", lw=2, label="initial ring (apoapsis)")
+    for arc in (fwd, back):
+        ax.plot(arc[:, 0], arc[:, 1], arc[:, 2], color="k", lw=2)
+    ax.plot([], [], color="k", label="target: 9:2 NRHO")
+    ax.set_xlabel("x (1000 km)", labelpad=8)
+    ax.set_ylabel("y (1000 km)", labelpad=8)
+    ax.set_zlabel("z (1000 km)", labelpad=8)
+    ax.set_title(title)
+    ax.view_init(elev=18, azim=-60)
+    if n_ax == 0:
+        ax.legend(loc="upper left")
+fig.tight_layout()
+_ = plotting.save_figure(fig, "08_fig2_torus_and_nrho", output_dir=out)
+
+# %% [markdown]
+# ## 3 · The station-keeping set and the two-burn transfer
+#
+# A surface point is named by its **initial ring angle** $\theta_0$ (normalised phase $\theta_0/2\pi$, the paper's
+# axis) and its **time from apoapsis** $t_a$: the state at $t_a$ of the torus trajectory through $u(\theta_0)$. From
+# its state at the first-burn epoch $t_b$ the agent reaches the surface point's *position* at $t_a$ with a first
+# burn found by Newton's method on $\mathbf r(t_a) = \mathbf r^\star$ with the STM block $\Phi_{rv}$ (a Lambert
+# problem in the CR3BP, all ring angles of one arrival time in one heyoka batch), then matches its *velocity* with
+# the second burn. Every maneuver gets its own covariance analysis (notebook 07: hourly azimuth/elevation, Eq. 20
+# noise, initial 3-sigma 60 km / 60 cm/s, no execution errors as in the paper) from $t_b$ to $t_f$, where
+# $\sqrt{J_\rho}$ is read.
+#
+# **Open choices (the paper gives none of them; swept in section 6):** the agent starts on the torus trajectory of
+# ring angle 0 (so "do nothing" is one of the options, at phase 0); first burn 24 h before apoapsis; arrival times
+# from 12 h before to 12 h after apoapsis; $\sqrt{J_\rho}$ read 24 h after apoapsis, so that every maneuver has the
+# same measurements and the second burn's effect is included (the paper attributes a local peak to it).
+
+# %%
+theta = 2 * np.pi * np.arange(N_SURF) / N_SURF
+t_arr = np.linspace(*T_ARRIVAL_H, N_SURF) * HR
+t0 = time.perf_counter()
+S = sk.station_keeping_surface(em, torus, theta, t_arr, T_BURN_H * HR, T_FINAL_H * HR, agent_theta=AGENT_THETA)
+t_surface = time.perf_counter() - t0
+print(f"{N_SURF} x {N_SURF} = {N_SURF**2} maneuvers with covariance analyses ({S.t.size} measurement epochs each) "
+      f"in {t_surface:.1f} s")
+print(f"largest position miss of the first burn at arrival: {S.transfer_miss.max():.1e} LU "
+      f"({S.transfer_miss.max() * L * 1e6:.2f} mm)")
+print(f"first burn {S.dv1_m_s.min():.3f}-{S.dv1_m_s.max():.2f} m/s, second burn {S.dv2_m_s.min():.3f}-"
+      f"{S.dv2_m_s.max():.2f} m/s, total {S.fuel_m_s.min():.3f}-{S.fuel_m_s.max():.2f} m/s")
+print(f"sqrt(J_rho) at t_f: {S.range_sigma_km.min() * 1e3:.1f} m to {S.range_sigma_km.max():.2f} km "
+      f"(no maneuver: {S.range_sigma_km[0, 0]:.2f} km)")
+
+
+# %%
+def informed_segments():
+    """Index runs of the u* line without jumps of more than a quarter turn in phase."""
+    ph = S.phase[S.informed]
+    cuts = np.flatnonzero(np.abs(np.diff(ph)) > 0.25) + 1
+    return np.split(np.arange(ph.size), cuts)
+
+
+def surface_plot(ax, Z, title, zlabel, line=None, log=False, flip=False):
+    """3-D surface over (normalised phase, time from apoapsis) with the informed line in magenta."""
+    P, H = np.meshgrid(S.phase, S.t_arrival_hours)
+    Zp = np.log10(Z) if log else Z
+    ax.plot_surface(P, H, Zp, cmap="viridis", lw=0, alpha=0.85, rcount=60, ccount=60)
+    rows = np.arange(S.t_arrival.size)
+    zl = Zp[rows, S.informed] if line is None else line
+    for seg in informed_segments():  # break the line where u* jumps across phase 0 = 1
+        ax.plot(S.phase[S.informed][seg], S.t_arrival_hours[seg], zl[seg], color="magenta", lw=2.5, marker="o",
+                ms=3, zorder=10)
+    ax.set_xlabel("normalised phase $\\theta_0/2\\pi$", labelpad=6)
+    ax.set_ylabel("time from apoapsis (h)", labelpad=6)
+    ax.set_zlabel(zlabel, labelpad=6)
+    ax.set_title(title)
+    if flip:
+        ax.invert_yaxis()
+
+
+fig = plt.figure(figsize=(13, 5.5))
+ax1 = fig.add_subplot(1, 2, 1, projection="3d")
+surface_plot(ax1, S.dv1_m_s, "first burn (u* in magenta)", r"$\|\Delta v_1\|$ (m/s)")
+ax2 = fig.add_subplot(1, 2, 2, projection="3d")
+surface_plot(ax2, S.dv2_m_s, "second burn", r"$\|\Delta v_2\|$ (m/s)")
+fig.tight_layout()
+_ = plotting.save_figure(fig, "08_fig3_burn_surfaces", output_dir=out)
+
+# %% [markdown]
+# The first burn vanishes along phase 0 (the agent's own torus trajectory) and grows with the phase distance; it
+# also grows as the coast gets shorter (earlier arrival). The magenta line is $\mathbf u^*$: for each arrival time,
+# the MMD direction $\mathbf u_y$ of the coast $t_b\to t_a$ is computed on the unmaneuvered trajectory, the two
+# maneuvers with $\theta_u$ closest to 0 and to $\pi$ (Eq. 25) are the candidates, and the one with the smaller
+# $J_\rho$ wins.
+#
+# ## 4 · Fig. 4: range uncertainty over all maneuvers, and Fig. 5: fuel
+
+# %%
+fig = plt.figure(figsize=(13, 5.5))
+ax1 = fig.add_subplot(1, 2, 1, projection="3d")
+surface_plot(ax1, S.range_sigma_km * 1e3, "Fig. 4: range uncertainty at $t_f$", r"$\log_{10}\sqrt{J_\rho}$ (m)",
+             log=True)
+ax2 = fig.add_subplot(1, 2, 2, projection="3d")
+surface_plot(ax2, S.fuel_m_s, "Fig. 5: total fuel (time axis flipped)", r"$\|\Delta v_1\|+\|\Delta v_2\|$ (m/s)",
+             flip=True)
+fig.tight_layout()
+_ = plotting.save_figure(fig, "08_fig4_fig5_range_sigma_and_fuel", output_dir=out)
+
+# the same data as maps, easier to read quantitatively
+fig, axes = plt.subplots(1, 2, figsize=(12, 4.4))
+for ax, Z, lab in ((axes[0], np.log10(S.range_sigma_km * 1e3), r"$\log_{10}\sqrt{J_\rho}$ (m)"),
+                   (axes[1], S.fuel_m_s, "total fuel (m/s)")):
+    im = ax.pcolormesh(S.phase, S.t_arrival_hours, Z, shading="nearest", cmap="viridis")
+    fig.colorbar(im, ax=ax, label=lab)
+    for n_seg, seg in enumerate(informed_segments()):
+        ax.plot(S.phase[S.informed][seg], S.t_arrival_hours[seg], "o-", color="magenta", ms=3, lw=1.5,
+                label="u* (informed)" if n_seg == 0 else None)
+    best = np.argmin(S.range_sigma_km, axis=1)
+    ax.plot(S.phase[best], S.t_arrival_hours, "s", color="white", mec="k", ms=4, label="best of each slice")
+    ax.set_xlabel(r"normalised phase $\theta_0/2\pi$")
+    ax.set_ylabel("time from apoapsis (h)")
+axes[0].legend(loc="upper center", bbox_to_anchor=(1.1, -0.14), ncol=2, fontsize=8)
+fig.tight_layout()
+_ = plotting.save_figure(fig, "08_maps_range_sigma_fuel", output_dir=out)
+
+# %% [markdown]
+# ## 5 · The paper's claims, with numbers
+#
+# *"The informed station keeping maneuvers do in fact fall in the valley of range uncertainty"*: within each
+# time-of-arrival slice we rank $\mathbf u^*$ among all maneuvers of the slice by $\sqrt{J_\rho}$ (percentile
+# 0 = best). *"The guidance policy avoids the peak fuel cost"*: the percentage of the slice's maneuvers that use more
+# fuel than $\mathbf u^*$. We also compare $\mathbf u^*$ with the best maneuver of its slice and with the cheapest
+# maneuvers of at most its fuel.
+
+# %%
+pct = S.informed_percentile
+fpct = S.informed_fuel_percentile
+rows = np.arange(S.t_arrival.size)
+best_sig = S.range_sigma_km.min(axis=1)
+cheaper = np.array([S.range_sigma_km[j, S.fuel_m_s[j] <= S.informed_fuel_m_s[j] + 1e-12].min() for j in rows])
+print("arrival h | u* phase | u* sqrt(J) m | best m | best with <= fuel m | percentile | fuel m/s | more fuel %")
+for j in rows:
+    print(f" {S.t_arrival_hours[j]:8.2f} | {S.phase[S.informed[j]]:8.3f} | {S.informed_range_sigma_km[j] * 1e3:12.2f} | "
+          f"{best_sig[j] * 1e3:6.2f} | {cheaper[j] * 1e3:19.2f} | {pct[j]:10.1f} | {S.informed_fuel_m_s[j]:8.3f} | "
+          f"{fpct[j]:6.1f}")
+print(f"\nmedian percentile of u* in its slice: {np.median(pct):.1f} % (valley = low); "
+      f"slices with u* in the best quartile: {np.mean(pct < 25) * 100:.0f} %")
+print(f"median share of maneuvers using more fuel than u*: {np.median(fpct):.1f} %; u* at or below the slice's "
+      f"median fuel in {np.mean(S.informed_fuel_m_s <= np.median(S.fuel_m_s, axis=1)) * 100:.0f} % of slices")
+from scipy.stats import spearmanr
+
+valley_phase = np.median(S.phase[np.argmin(S.range_sigma_km, axis=1)])
+ustar_phase = np.median(S.phase[S.informed])
+moving = S.fuel_m_s > 1e-9
+rank_corr = np.median([spearmanr(S.fuel_m_s[j, moving[j]], S.range_sigma_km[j, moving[j]])[0] for j in rows])
+print(f"valley of sqrt(J_rho) at median phase {valley_phase:.3f}; u* at median phase {ustar_phase:.3f}; fuel peak at "
+      f"phase {np.median(S.phase[np.argmax(S.fuel_m_s, axis=1)]):.3f}; median rank correlation of fuel and "
+      f"sqrt(J_rho) within slices (maneuvers only) {rank_corr:.2f}")
+print(f"u* vs doing nothing: sqrt(J_rho) {np.median(S.informed_range_sigma_km) * 1e3:.1f} m vs "
+      f"{S.range_sigma_km[0, 0] * 1e3:.0f} m")
+
+# %% [markdown]
+# ## 6 · In which regime does the "valley" claim hold? A sweep over the unstated inputs
+#
+# Our baseline reading puts $\mathbf u^*$ where it is printed above. The paper's Figs. 3-5 do not give the burn
+# epoch, the arrival window, the agent's starting phase or where $J_\rho$ is read, so we sweep them: the first-burn
+# lead time before the arrival window, the agent's initial ring angle, and $\sqrt{J_\rho}$ read at $t_f$ (common
+# final time) or at each maneuver's own arrival. For each setting: the median percentile of $\mathbf u^*$ within its
+# slices and the share of slices where it is in the best quartile (a coarser `N_SWEEP` grid).
+
+# %%
+sweep = []
+theta_s = 2 * np.pi * np.arange(N_SWEEP) / N_SWEEP
+t_arr_s = np.linspace(*T_ARRIVAL_H, N_SWEEP) * HR
+for lead_h in (12.0, 24.0, 48.0):
+    for agent_theta in (0.0, np.pi / 2, np.pi, 3 * np.pi / 2):
+        s = sk.station_keeping_surface(em, torus, theta_s, t_arr_s, (T_ARRIVAL_H[0] - lead_h) * HR, T_FINAL_H * HR,
+                                       agent_theta=agent_theta, progress=False)
+        arr_pct = 100 * np.mean(s.range_sigma_at_arrival_km
+                                < s.range_sigma_at_arrival_km[rows_s := np.arange(s.t_arrival.size), s.informed][:, None],
+                                axis=1)
+        sweep.append(dict(lead_h=lead_h, agent_phase=agent_theta / (2 * np.pi), pct_tf=np.median(s.informed_percentile),
+                          q_tf=np.mean(s.informed_percentile < 25) * 100, pct_arr=np.median(arr_pct),
+                          q_arr=np.mean(arr_pct < 25) * 100, fuel_pct=np.median(s.informed_fuel_percentile)))
+print("lead h | agent phase | median pct (t_f) | best-quartile % (t_f) | median pct (arrival) | best-quartile % "
+      "(arrival) | more-fuel %")
+for r in sweep:
+    print(f" {r['lead_h']:5.0f} | {r['agent_phase']:11.2f} | {r['pct_tf']:16.1f} | {r['q_tf']:21.0f} | "
+          f"{r['pct_arr']:20.1f} | {r['q_arr']:26.0f} | {r['fuel_pct']:10.1f}")
+best_setting = min(sweep, key=lambda r: r["pct_tf"])
+print(f"\nmost favourable setting for the claim: lead {best_setting['lead_h']:.0f} h, agent phase "
+      f"{best_setting['agent_phase']:.2f}: median percentile {best_setting['pct_tf']:.1f} %")
+
+# %% [markdown]
+# ## 7 · Beyond the paper: a full-filter Monte Carlo with execution errors
+#
+# The paper's covariance analysis assumes perfectly executed burns and a filter that does not diverge; its
+# conclusions list both as future work. Here an iterated EKF (:func:`cislunar.station_keeping.filter_trial`;
+# 10 relinearisations per update, because a single-linearisation EKF is inconsistent at the start of an
+# angles-only track with 20 km of position uncertainty at a few hundred km range) processes simulated measurements
+# of the true trajectories, including execution errors of **1 mm/s plus 1 % of the burn (1 sigma per axis)** that
+# the filter knows statistically. Three policies for the arrival slice closest to apoapsis: the informed maneuver
+# $\mathbf u^*$, an *uninformed* choice (a ring angle drawn uniformly at random in each trial), and doing nothing;
+# each with and without execution errors. Consistency: mean NEES of the 12-dimensional SSAT state at $t_f$ against
+# its 95 % chi-square band; accuracy: RMS of the achieved range error along the line of sight at $t_f$.
+
+# %%
+from scipy.stats import chi2
+
+j_mc = int(np.argmin(np.abs(S.t_arrival_hours)))
+tgt_b = propagate(em, nrho.x0, np.array([0.0, S.t_burn])).x[-1]
+zero = int(np.argmin(S.fuel_m_s[j_mc]))  # phase 0: no maneuver
+policies = {}
+for exec_abs, exec_rel in ((0.0, 0.0), (EXEC_ABS_M_S, EXEC_REL)):
+    mk = lambda i, lab: sk.filter_scenario(S, j_mc, i, tgt_b, em, exec_sigma_abs_m_s=exec_abs,  # noqa: E731
+                                           exec_sigma_rel=exec_rel, label=lab)
+    tag = "exec" if exec_abs else "perfect"
+    policies[("informed u*", tag)] = (sk.filter_trial, (mk(S.informed[j_mc], "informed"),))
+    policies[("uninformed (random phase)", tag)] = (
+        sk.random_choice_trial, (tuple(mk(i, "random") for i in range(S.theta.size) if i != zero),))
+    policies[("no maneuver", tag)] = (sk.filter_trial, (mk(zero, "none"),))
+
+executor = ProcessPoolExecutor(max_workers=N_WORKERS) if N_WORKERS > 1 else None
+mc = {}
+t0 = time.perf_counter()
+for n_key, (key, (fn, args)) in enumerate(policies.items()):
+    mc[key] = run_monte_carlo(fn, N_TRIALS, [SEED, n_key], args=args, executor=executor, progress=False)
+if executor is not None:
+    executor.shutdown()
+t_mc = time.perf_counter() - t0
+lo, hi = chi2.ppf([0.025, 0.975], 12 * N_TRIALS) / N_TRIALS
+print(f"{len(policies)} x {N_TRIALS} filter runs in {t_mc:.1f} s; 95 % band of the mean NEES: [{lo:.2f}, {hi:.2f}]")
+print("policy                      | burns   | failed | mean NEES(t_f) | RMS range error m | filter sigma m | "
+      "cov. analysis m")
+summary = {}
+for (pol, tag), res in mc.items():
+    ok = [r for r in res if not r.failure]
+    nees_f = np.mean([r.nees[-1] for r in ok])
+    rms = np.sqrt(np.mean([r.range_error_km[-1] ** 2 for r in ok])) * 1e3
+    fsig = np.sqrt(np.mean([r.range_sigma_km[-1] ** 2 for r in ok])) * 1e3
+    ca = {"informed u*": S.informed_range_sigma_km[j_mc], "no maneuver": S.range_sigma_km[j_mc, zero],
+          "uninformed (random phase)": np.sqrt(np.mean(np.delete(S.range_sigma_km[j_mc], zero) ** 2))}[pol] * 1e3
+    summary[(pol, tag)] = dict(nees=nees_f, rms=rms, fsig=fsig, ca=ca, failed=len(res) - len(ok))
+    print(f"{pol:27s} | {tag:7s} | {len(res) - len(ok):6d} | {nees_f:14.2f} | {rms:17.1f} | {fsig:14.1f} | {ca:15.1f}")
+
+# %%
+fig, ax = plt.subplots(figsize=(8, 4.2))
+labels = list(dict.fromkeys(p for p, _ in mc))
+xpos = np.arange(len(labels))
+for off, tag, col in ((-0.18, "perfect", "tab:blue"), (0.18, "exec", "tab:orange")):
+    vals = [summary[(p, tag)]["rms"] for p in labels]
+    ax.bar(xpos + off, vals, width=0.34, color=col,
+           label="perfect burns" if tag == "perfect" else f"execution errors ({EXEC_ABS_M_S * 1e3:.0f} mm/s + "
+                                                          f"{EXEC_REL * 100:.0f} %)")
+    ax.plot(xpos + off, [summary[(p, tag)]["fsig"] for p in labels], "k_", ms=20, mew=2)
+ax.set_yscale("log")
+ax.set_xticks(xpos, labels)
+ax.set_ylabel("RMS range error at $t_f$ (m)")
+ax.set_title(f"iterated EKF, {N_TRIALS} runs each (black bars: filter 1-sigma)")
+ax.legend(loc="upper left", fontsize=8)
+fig.tight_layout()
+_ = plotting.save_figure(fig, "08_monte_carlo_range_errors", output_dir=out)
+
+# %% [markdown]
+# ## 8 · Paper vs reproduction
+
+# %%
+ia = summary[("informed u*", "exec")]
+ua = summary[("uninformed (random phase)", "exec")]
+ip = summary[("informed u*", "perfect")]
+nm = summary[("no maneuver", "exec")]
+table.add("QPO member: mean agent-target range", "215 km", f"{stats.mean_km:.2f} km", "derived: input",
+          "the 215 km was used to SELECT the member (torus average over ring angle and one period); an input, "
+          f"not a prediction. Same member read as apolune-ring mean: {stats.ring_mean_km:.1f} km, RMS {stats.rms_km:.1f} km")
+table.add("QPO ring size (RMS about centre)", "-", f"{torus.size_km:.2f} km / {torus.velocity_size_mps:.3f} m/s",
+          "not in paper", "the paper gives no torus parameters")
+table.add("QPO rotation number (rad per NRHO period)", "-", f"{torus.rho:.6f}", "not in paper",
+          "stroboscopic time = NRHO period (same base frequency)")
+table.add("agent-target range min / max on the torus", "-", f"{stats.min_km:.1f} / {stats.max_km:.1f} km",
+          "not in paper", "min/max over all ring angles and one period")
+table.add("Fig. 2: torus surface about the NRHO near apoapsis", "figure", "08_fig2_torus_and_nrho", "derived",
+          "closed viewing geometry: the torus surrounds the NRHO arc")
+table.add("two-burn transfer reaches the torus point", "-", f"{S.transfer_miss.max():.1e} LU",
+          "beyond paper", "test requires 1e-9 LU in position and velocity")
+table.add("Fig. 3: first / second burn ranges over the surface", "figure (values not printed)",
+          f"{S.dv1_m_s.min():.2f}-{S.dv1_m_s.max():.2f} / {S.dv2_m_s.min():.2f}-{S.dv2_m_s.max():.2f} m/s",
+          "not in paper", "depends on the unstated burn epoch and arrival window (section 3)")
+valley_ok = np.median(pct) < 25
+table.add("Fig. 4: u* lies in the valley of sqrt(J_rho) (median percentile within slices)", "in the valley",
+          f"{np.median(pct):.0f} % (best quartile in {np.mean(pct < 25) * 100:.0f} % of slices)",
+          "reproduced" if valley_ok else "differs: see note",
+          "tolerance fixed before comparing: median percentile < 25 %. Sweep (section 6) over burn lead 12-48 h, "
+          f"agent phase and read-out time: median percentile {min(r['pct_tf'] for r in sweep):.0f}-"
+          f"{max(r['pct_tf'] for r in sweep):.0f} % at t_f, {min(r['pct_arr'] for r in sweep):.0f}-"
+          f"{max(r['pct_arr'] for r in sweep):.0f} % at arrival. Valley at phase {valley_phase:.2f}, u* at "
+          f"{ustar_phase:.2f} (next to the agent's own phase 0, the smallest burns); rank correlation of fuel and "
+          f"sqrt(J_rho) within slices {rank_corr:.2f}")
+fuel_ok = np.mean(S.informed_fuel_m_s <= np.median(S.fuel_m_s, axis=1)) >= 0.9
+table.add("Fig. 5: guidance avoids the largest fuel costs", "avoids the peak",
+          f"u* below the slice median fuel in {np.mean(S.informed_fuel_m_s <= np.median(S.fuel_m_s, axis=1)) * 100:.0f} % "
+          f"of slices; median {np.median(fpct):.0f} % of maneuvers cost more",
+          "reproduced" if fuel_ok else "differs: see note",
+          "tolerance fixed before comparing: u* at or below the slice's median fuel in >= 90 % of slices. It does, "
+          "but because Eq. 25 picks maneuvers next to the agent's own phase, i.e. the smallest burns")
+table.add("u* improves range knowledge vs no maneuver (covariance analysis)", "'significantly improves'",
+          f"{np.median(S.informed_range_sigma_km) * 1e3:.1f} m vs {S.range_sigma_km[0, 0] * 1e3:.0f} m",
+          "reproduced" if np.median(S.informed_range_sigma_km) < 0.5 * S.range_sigma_km[0, 0] else "differs: see note",
+          "tolerance fixed before comparing: at least a factor 2; any maneuver does this in the linear analysis")
+table.add("full filter: NEES at t_f, informed, execution errors", "future work",
+          f"{ia['nees']:.2f} (band {lo:.1f}-{hi:.1f})", "beyond paper",
+          f"iterated EKF, {N_TRIALS} runs; perfect burns: {ip['nees']:.2f}")
+table.add("full filter: RMS range error at t_f, informed vs uninformed vs none (exec. errors)", "future work",
+          f"{ia['rms']:.0f} / {ua['rms']:.0f} / {nm['rms']:.0f} m", "beyond paper",
+          f"execution errors {EXEC_ABS_M_S * 1e3:.0f} mm/s + {EXEC_REL * 100:.0f} % per axis; perfect burns, informed: "
+          f"{ip['rms']:.1f} m (covariance analysis {ip['ca']:.1f} m)")
+print(f"notebook run time so far: {time.perf_counter() - t_start:.0f} s")
+table.display()
