@@ -20,7 +20,7 @@ extensions = [
 
 # Notebooks are executed by cislunar.notebooks (papermill); the book only renders them.
 nb_execution_mode = "off"
-nb_merge_streams = True
+nb_merge_streams = False  # cislunar.book merges consecutive writes itself, keeping the order of outputs
 nb_output_stderr = "show"  # shown, but styled as plain output (book/_static/cislunar-book.css)
 nb_render_markdown_format = "myst"  # the closing comparison tables are Markdown outputs, with math
 nb_ipywidgets_js = {}  # never load widget renderers from the internet

@@ -170,6 +170,29 @@ def _collapse_carriage_returns(text: str) -> str:
     return "\n".join(out)
 
 
+def _terminal_streams(outputs: list) -> list:
+    """Merge consecutive writes to the same stream and keep what a terminal would show of them.
+
+    A text progress bar arrives as many small writes, each starting with a carriage return; only its final state
+    survives.  The order of stdout, stderr and rich outputs is kept.
+    """
+    merged = []
+    for out in outputs:
+        if out.get("output_type") == "stream":
+            text = out.get("text", "")
+            text = "".join(text) if isinstance(text, list) else text
+            last = merged[-1] if merged else None
+            if last is not None and last.get("output_type") == "stream" and last.get("name") == out.get("name"):
+                last["text"] += text
+                continue
+            out = dict(out, text=text)
+        merged.append(out)
+    for out in merged:
+        if out.get("output_type") == "stream":
+            out["text"] = _collapse_carriage_returns(out["text"])
+    return [o for o in merged if o.get("output_type") != "stream" or o["text"].strip()]
+
+
 def _display_path(path: str, build: Path) -> str:
     """A path as the book shows it: relative to the repository when inside it, else ``<build>/...``."""
     root = paths.repo_root().resolve()
@@ -206,11 +229,8 @@ def clean_notebook(nb: dict, build: Path, *, source_name: str) -> dict:
             src = re.sub(r'(OUTPUT_DIR\s*=\s*)(["\'])(.+?)\2',
                          lambda m: f'{m.group(1)}"{_display_path(m.group(3), build)}"', src)
             cell["source"] = src
-        for out in cell.get("outputs", []):
-            if out.get("output_type") == "stream":
-                text = out.get("text", "")
-                text = "".join(text) if isinstance(text, list) else text
-                out["text"] = _collapse_carriage_returns(text)
+        if cell.get("outputs"):
+            cell["outputs"] = _terminal_streams(cell["outputs"])
     mode, seconds = _notebook_mode(nb)
     how = {"full": " at full fidelity", "quick": " in **quick mode**"}.get(mode, "")
     took = f" in {seconds:.0f} s" if seconds is not None else ""
