@@ -292,6 +292,18 @@ MATH_STATE = """
 """
 
 
+SEARCH_HITS = """
+(async () => {
+  for (let k = 0; k < 200; k++) {
+    const links = [...document.querySelectorAll('#search-results li a')].map(a => a.getAttribute('href'));
+    if (links.length) { return links; }
+    await new Promise(r => setTimeout(r, 100));
+  }
+  return [];
+})()
+"""
+
+
 # ------------------------------------------------------------------------------------------- checker self-tests
 def _plant_site(root: Path):
     (root / "sub").mkdir(parents=True)
@@ -331,6 +343,24 @@ def test_rendered_problem_checker_finds_tracebacks_and_widgets(tmp_path):
         {"output_type": "error", "ename": "ValueError", "evalue": "x", "traceback": []},
         {"output_type": "display_data", "data": {"application/vnd.jupyter.widget-view+json": {}}}]}]}
     assert len(notebook_problems(nb)) == 3
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="Chromium is not installed (apt-get install chromium)")
+def test_browser_probe_sees_network_requests_missing_files_and_untypeset_math(tmp_path):
+    _plant_site(tmp_path)
+    (tmp_path / "math.html").write_text('<html><body><span class="math">\\(x^2\\)</span>'
+                                        '<script src="https://cdn.example.com/mathjax.js"></script>'
+                                        '<img src="missing.png"></body></html>')
+    browser = Chromium(CHROMIUM)
+    try:
+        session = browser.open((tmp_path / "math.html").as_uri())
+        state = browser.evaluate(session, MATH_STATE)
+    finally:
+        browser.close()
+    assert state["source"] == 1 and state["typeset"] == 0 and not state["mathjax"]
+    assert "https://cdn.example.com/mathjax.js" in browser.requests()
+    errors = {f.get("errorText") for f in browser.failures()}
+    assert "net::ERR_FILE_NOT_FOUND" in errors and "net::ERR_NAME_NOT_RESOLVED" in errors
 
 
 def test_clean_notebook_hides_machine_paths_and_keeps_what_a_terminal_shows(tmp_path):
@@ -493,6 +523,11 @@ def test_headless_chromium_typesets_math_offline(built):
         browser.screenshot(session, shot)
         index_session = browser.open((out / "index.html").resolve().as_uri())
         browser.evaluate(index_session, MATH_STATE)
+        page_failures = browser.failures()  # the search page's snippet fetches fail on file:// by design
+        title = " ".join(parse(page).text).split("—")[0]
+        word = max(re.findall(r"[A-Za-z]{5,}", title), key=len)
+        search = browser.open((out / "search.html").resolve().as_uri() + f"?q={word}")
+        hits = browser.evaluate(search, SEARCH_HITS)
     finally:
         browser.close()
     print(f"\nscreenshot of {page.name}: {shot}; MathJax {state['version']}: {state['typeset']} of "
@@ -503,6 +538,8 @@ def test_headless_chromium_typesets_math_offline(built):
     assert state["errors"] == 0, f"{state['errors']} formulas failed to typeset"
     outside = [u for u in browser.requests() if not u.startswith(("file:", "data:", "blob:", "about:"))]
     assert outside == [], f"the pages asked the network for {outside}"
-    failed = [f"{f.get('type')}: {f.get('errorText')}" for f in browser.failures()]
+    failed = [f"{f.get('type')}: {f.get('errorText')}" for f in page_failures]
     assert failed == [], failed
     assert shot.stat().st_size > 20000
+    assert any(h.split("#")[0].endswith(f"notebooks/{page.name}") for h in hits), \
+        f"the search box does not find {page.name} for {word!r}: {hits}"
