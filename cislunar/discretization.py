@@ -41,8 +41,7 @@ from . import _checks
 from .dynamics import CR3BP
 from .propagation import DEFAULT_TOL, _check_outcome, _check_tol, _heyoka, thread_local_copy
 
-__all__ = ["sundman_nodes", "snap_nodes", "max_control_per_node", "coast_bounds", "FOHModel", "foh_discretize",
-           "propagate_foh"]
+__all__ = ["sundman_nodes", "max_control_per_node", "FOHModel", "foh_discretize", "propagate_foh"]
 
 
 @functools.lru_cache(maxsize=4)
@@ -165,77 +164,6 @@ def max_control_per_node(t_nodes, a_max: float) -> np.ndarray:
     M[idx, idx] = 1.0 / dt
     M[idx, idx + 1] = 1.0 / dt
     return np.linalg.lstsq(M, np.full(n - 1, 2.0 * a), rcond=None)[0]
-
-
-def snap_nodes(t_nodes, times) -> tuple[np.ndarray, np.ndarray]:
-    """Move the nodes nearest to ``times`` onto them (e.g. observation-window ends), keeping the node count.
-
-    Parameters
-    ----------
-    t_nodes : array_like (N,)
-        Strictly increasing node times, TU.
-    times : array_like (M,)
-        Times that must be nodes, strictly inside ``(t_nodes[0], t_nodes[-1])`` or equal to an end.
-
-    Returns
-    -------
-    t : ndarray (N,)
-        Node times with ``times`` among them.
-    index : ndarray of int (M,)
-        Index of each of ``times`` in ``t``.
-    """
-    t = _checks.time_grid(t_nodes, "t_nodes", increasing=True).copy()
-    tm = _checks.as_array(times, "times", ndim=(1,))
-    if np.any(tm < t[0]) or np.any(tm > t[-1]):
-        raise ValueError(f"times must lie within [{t[0]}, {t[-1]}]")
-    index = np.empty(tm.size, dtype=int)
-    used = set()
-    for j, s in enumerate(tm):
-        order = np.argsort(np.abs(t - s))
-        k = next((int(i) for i in order if int(i) not in used), None)
-        if k is None or (k in (0, t.size - 1) and not np.isclose(t[k], s, rtol=0, atol=1e-12)):
-            raise ValueError("times must be distinct and need interior nodes near them; use more nodes")
-        t[k] = s
-        used.add(k)
-        index[j] = k
-    if np.any(np.diff(t) <= 0):
-        raise ValueError("snapping times onto nodes broke the node order; use more nodes")
-    return t, index
-
-
-def coast_bounds(t_nodes, a_max: float, windows=()) -> np.ndarray:
-    """Per-node acceleration bounds: ``a_max`` everywhere, zero at every node of a coast window.
-
-    The node controls are accelerations with a first-order hold, so Eq. 40 on an interval,
-    :math:`(u_{max,k}+u_{max,k+1})/2 = a_{max}`, holds with the uniform bound (the acceleration reading of Eq. 41,
-    notebook 04); zero at both ends of every interval of a window makes the thrust zero across the window
-    (the paper's :math:`a_{max} = 0` in the observation window).  Window ends must be nodes
-    (:func:`snap_nodes`).
-
-    Parameters
-    ----------
-    t_nodes : array_like (N,)
-    a_max : float
-        LU/TU^2, >= 0.
-    windows : sequence of (t_start, t_end)
-        Closed coast windows, TU.
-
-    Returns
-    -------
-    ndarray (N,)
-    """
-    t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
-    a = _checks.positive(a_max, "a_max", allow_zero=True)
-    out = np.full(t.size, a)
-    for i, win in enumerate(windows):
-        w = _checks.as_array(win, f"windows[{i}]", shape=(2,))
-        if not w[0] < w[1]:
-            raise ValueError(f"windows[{i}] must have start < end; got {w}")
-        for end in w:
-            if not np.any(np.isclose(t, end, rtol=0, atol=1e-12)):
-                raise ValueError(f"windows[{i}] end {end} is not a node (use snap_nodes)")
-        out[(t >= w[0] - 1e-12) & (t <= w[1] + 1e-12)] = 0.0
-    return out
 
 
 @functools.lru_cache(maxsize=4)

@@ -32,7 +32,8 @@ What makes it converge (documented departures from the printed method)
 * **Convex quadratic information model**: :math:`\hat{\mathcal I}(x) = \mathcal I_0 + g^\top dx +
   \tfrac12 dx^\top H_-dx`, with :math:`H_-` the concave part of the Hessian (eigenvalues clipped to
   :math:`\le 0`), so :math:`-\alpha_h\hat{\mathcal I}` is convex and the subproblem has an interior minimum.  The
-  Hessian comes from the model's ``hessian`` method or central differences of its gradient.
+  Hessian comes from the model's ``hessian`` method or forward differences of its gradient, refreshed when
+  the window-start state has moved by more than ``hessian_refresh``.
   ``information_model="linear"`` gives the paper's Eq. 44.
 * A predicted decrease at the noise level of the subproblem solution counts as :math:`\rho = 1`; Clarabel runs
   with tight tolerances; the iteration stops only on an accepted step with defects below ``defect_tol``, a
@@ -44,7 +45,7 @@ The information model protocol
 ``info(x, order)`` with ``x`` the observer state (6,) at node ``info_node``: ``order=0`` returns the value
 (nats), ``order=1`` returns ``(value, gradient)``; value and gradient must describe the same function (e.g. the
 process noise held fixed).  An optional ``info.hessian(x)`` returns the (6, 6) Hessian.
-:func:`window_information_model` builds one from :mod:`cislunar.covariance` and :mod:`cislunar.information`.
+:class:`cislunar.wolf_jones.WindowInformation` implements it for the paper's test cases.
 
 Extra nonconvex inequality constraints (e.g. a keep-out) are objects with ``node``, ``size`` and
 ``__call__(x) -> (c, C)`` (values that must be :math:`\le 0` and their Jacobian with respect to the state at
@@ -54,6 +55,7 @@ Extra nonconvex inequality constraints (e.g. a keep-out) are objects with ``node
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field, fields
 
 import numpy as np
@@ -64,7 +66,7 @@ from .dynamics import CR3BP
 from .progress import progress as _progress
 
 __all__ = ["SCvxSettings", "SCvxResult", "SCvxError", "solve_scvx", "concave_part", "finite_difference_hessian",
-           "window_information_model", "SweepResult", "homotopy_sweep", "impulse"]
+           "SweepResult", "homotopy_sweep", "impulse"]
 
 METHODS = ("augmented_lagrangian", "penalty")
 INFORMATION_MODELS = ("quadratic", "linear")
@@ -163,7 +165,7 @@ class SCvxSettings:
     noise_tol: float = 1e-9
     solver_tol: float = 1e-10
     hessian_step: float = 1e-5
-    hessian_refresh: float = 1e-3
+    hessian_refresh: float = 5e-3
 
     def __post_init__(self):
         _checks.choice(self.method, "method", METHODS)
@@ -228,8 +230,8 @@ class SCvxResult:
         Largest multiple-shooting defect norm.
     history : list of dict
         Per iteration: ``iteration, cost, new_cost, predicted, actual, rho, eta, accepted, tr_active, step,
-        max_defect, model_error_defect, model_error_info, penalty_weight, multiplier_update, information,
-        t_discretize, t_info, t_solve`` (seconds).
+        max_defect, max_violation, model_error_defect, model_error_info, penalty_weight, multiplier_update,
+        information, impulse, status`` and the times ``t_discretize, t_info, t_hessian, t_solve`` (seconds).
     """
 
     t: np.ndarray
@@ -266,83 +268,33 @@ def concave_part(H) -> np.ndarray:
     return V * np.sqrt(np.clip(-lam, 0.0, None))[None, :]
 
 
-def finite_difference_hessian(gradient, x, step: float = 1e-5) -> np.ndarray:
-    """Symmetrised central-difference Hessian of a scalar function from its gradient ``gradient(x) -> (n,)``.
+def finite_difference_hessian(gradient, x, step: float = 1e-5, *, g0=None) -> np.ndarray:
+    """Symmetrised finite-difference Hessian of a scalar function from its gradient ``gradient(x) -> (n,)``.
 
-    The step of component ``i`` is ``step (1 + |x_i|)``.
+    Central differences (2n gradient calls, error O(h^2)), or forward differences from the gradient ``g0`` at
+    ``x`` when it is given (n calls, error O(h)).  The step of component ``i`` is ``step (1 + |x_i|)``.
     """
     x = _checks.as_array(x, "x", ndim=(1,))
     step = _checks.positive(step, "step")
     n = x.size
+    if g0 is not None:
+        g0 = _checks.as_array(g0, "g0", shape=(n,))
     H = np.empty((n, n))
     for i in range(n):
         h = step * (1.0 + abs(x[i]))
         e = np.zeros(n)
         e[i] = h
-        H[:, i] = (np.asarray(gradient(x + e)) - np.asarray(gradient(x - e))) / (2.0 * h)
+        if g0 is None:
+            H[:, i] = (np.asarray(gradient(x + e)) - np.asarray(gradient(x - e))) / (2.0 * h)
+        else:
+            H[:, i] = (np.asarray(gradient(x + e)) - g0) / h
     return 0.5 * (H + H.T)
-
-
-class window_information_model:  # noqa: N801 - used like a function that returns the callable
-    """Mutual information of one observation window as an SCvx information model (process noise held fixed).
-
-    Parameters
-    ----------
-    system : CR3BP
-    t_window : array_like (M,)
-        Measurement times, TU; ``t_window[0]`` is the time of the window-start node.
-    targets_x0 : array_like (N_T, 6)
-        Target states at ``t_window[0]``.
-    model : cislunar.measurements.MeasurementModel
-    noise : array_like (m, m) or callable
-        Measurement noise (see :func:`cislunar.covariance.linearize_augmented`).
-    P0 : array_like (n, n)
-        Augmented covariance at the window start.
-    Q : array_like (M-1, n, n)
-        Augmented process noise, held fixed (so value and gradient describe one function).
-
-    Notes
-    -----
-    ``model(x, 0)`` is the value, ``model(x, 1)`` the value and the gradient with respect to the observer state
-    ``x`` at ``t_window[0]`` (:func:`cislunar.information.window_information`, structured).
-    """
-
-    def __init__(self, system: CR3BP, t_window, targets_x0, model, noise, P0, Q):
-        from .covariance import linearize_augmented  # noqa: F401 - fail early if unavailable
-
-        self.system = _checks.system(system, "system")
-        self.t_window = _checks.time_grid(t_window, "t_window", increasing=True)
-        xt = _checks.as_array(targets_x0, "targets_x0", last=6)
-        self.targets_x0 = xt[None] if xt.ndim == 1 else xt
-        self.model = model
-        self.noise = noise
-        self.P0 = _checks.as_array(P0, "P0", ndim=(2,))
-        self.Q = _checks.as_array(Q, "Q", shape=(self.t_window.size - 1, self.P0.shape[0], self.P0.shape[0]))
-
-    def linearization(self, x, derivatives: bool = False):
-        """The :class:`cislunar.covariance.AugmentedLinearization` of the window for observer state ``x``."""
-        from .covariance import linearize_augmented
-
-        return linearize_augmented(self.system, x, self.targets_x0, self.t_window, self.model, self.noise, self.P0,
-                                   Q=self.Q, derivatives=derivatives)
-
-    def __call__(self, x, order: int = 0):
-        from .information import mutual_information, window_information
-
-        order = _checks.integer(order, "order", minimum=0, maximum=1)
-        lin = self.linearization(x, derivatives=order >= 1)
-        value = float(mutual_information(*lin.arrays))
-        if order == 0:
-            return value
-        # the value returned with the gradient carries ~1e-7 relative round-off noise; the plain structured
-        # evaluation is smooth, so the value is always taken from it (same linearisation, same function)
-        return value, window_information(lin, gradient=True)[1]
 
 
 class _Subproblem:
     """The convex subproblem, built once with cvxpy Parameters (DPP) and re-solved with new values."""
 
-    def __init__(self, n: int, has_terminal: bool, k_star: int | None, con_specs):
+    def __init__(self, n: int, has_terminal: bool, k_star: int | None, con_specs, coast=None):
         import cvxpy as cp
 
         self.n = n
@@ -371,6 +323,8 @@ class _Subproblem:
                         + self.r[k] + self.nu[k])
         unorm = cp.norm(self.u, 2, axis=1)
         cons.append(unorm <= self.umax)
+        if coast is not None and np.any(coast):  # zero bound: exactly zero (not zero to solver precision)
+            cons.append(self.u[np.flatnonzero(coast)] == 0)
         self.step = cp.norm(self.x - self.xbar, 2, axis=1) + cp.norm(self.u - self.ubar, 2, axis=1)
         cons.append(self.step <= self.eta)
         objective = (self.w_u @ unorm + cp.sum(cp.multiply(self.lam, self.nu)) + self.half_w * cp.sum_squares(self.nu)
@@ -492,7 +446,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
     use_info = info is not None and alpha > 0
     al = st.method == "augmented_lagrangian"
 
-    sub = _Subproblem(n, x_tc is not None, info_node if use_info else None, con_specs)
+    sub = _Subproblem(n, x_tc is not None, info_node if use_info else None, con_specs, coast=umax == 0)
     sub.x_ic.value = x_ref[0]
     sub.x_tc.value = x_ref[-1] if x_tc is None else x_tc
     sub.umax.value = umax
@@ -545,19 +499,19 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
         v = max([float(np.max(c)) for c, _ in ev["cons"]] + [0.0])
         return d, v
 
-    def hessian_factor(x):
+    def hessian_factor(x, g0):
         if st.information_model == "linear":
             return np.zeros((6, 6)), 0.0
         t0 = time.perf_counter()
         if hasattr(info, "hessian"):
             H = _checks.as_array(info.hessian(x), "info.hessian(x)", shape=(6, 6))
-        else:
-            H = finite_difference_hessian(lambda z: info(z, 1)[1], x, st.hessian_step)
+        else:  # forward differences of the gradient from the one just computed
+            H = finite_difference_hessian(lambda z: info(z, 1)[1], x, st.hessian_step, g0=g0)
         return concave_part(H), time.perf_counter() - t0
 
     ev = evaluate(x_ref, u_ref, 1)
     J_ref, obj_ref = cost_of(x_ref, u_ref, ev)
-    Lfac, t_hess = hessian_factor(x_ref[info_node]) if use_info else (None, 0.0)
+    Lfac, t_hess = hessian_factor(x_ref[info_node], ev["grad"]) if use_info else (None, 0.0)
     x_hess = x_ref[info_node].copy() if info_node is not None else None
     eta = st.eta0
     threshold = st.multiplier_threshold0
@@ -581,13 +535,18 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
                 c["c"].value, c["C"].value, c["mu"].value = cv, CJ, mu
             t0 = time.perf_counter()
             try:
-                sub.problem.solve(solver=solver, **solve_opts)
+                with warnings.catch_warnings():  # "inaccurate" is recorded in the history and judged by rho
+                    warnings.simplefilter("ignore", UserWarning)
+                    sub.problem.solve(solver=solver, **solve_opts)
             except cp.error.SolverError as exc:
                 raise SCvxError(f"convex subproblem failed at iteration {it}: {exc}", history) from exc
             t_solve = time.perf_counter() - t0
             if sub.problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
                 raise SCvxError(f"convex subproblem {sub.problem.status} at iteration {it} (eta = {eta:g})", history)
             x_new, u_new, nu = sub.x.value.copy(), sub.u.value.copy(), sub.nu.value
+            unew = np.linalg.norm(u_new, axis=1)  # onto the bounds (solver round-off only)
+            over = unew > umax
+            u_new[over] *= (umax[over] / unew[over])[:, None]
             step = float(np.max(sub.step.value))
             tr_active = step >= (1.0 - st.active_tol) * eta
             # model cost L at the new point (the same pieces as J, each replaced by its convex model)
@@ -617,7 +576,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
                        model_error_info=(-alpha * (ev_new["info"] - info_model)) if use_info else 0.0,
                        penalty_weight=w, multiplier_update=False, information=ev_new["info"],
                        impulse=impulse(t, u_new), t_discretize=ev_new["t_discretize"], t_info=ev_new["t_info"],
-                       t_solve=t_solve, t_hessian=0.0)
+                       t_solve=t_solve, t_hessian=0.0, status=str(sub.problem.status))
             history.append(rec)
             if rho < st.rho1:
                 eta = eta / st.beta_shrink
@@ -629,7 +588,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
                     ev_new["grad"] = _checks.as_array(info(x_new[info_node], 1)[1], "info(x, 1) gradient",
                                                       shape=(6,))
                     if np.linalg.norm(x_new[info_node] - x_hess) > st.hessian_refresh:
-                        Lfac, t_hess = hessian_factor(x_new[info_node])
+                        Lfac, t_hess = hessian_factor(x_new[info_node], ev_new["grad"])
                         x_hess = x_new[info_node].copy()
                     else:
                         t_hess = 0.0

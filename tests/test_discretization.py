@@ -82,3 +82,29 @@ def test_linearisation_error_is_second_order(nrho):
         lin = model.predict(truth, du)  # one-step predictions from the true node states
         errs.append(np.max(np.abs(lin - truth[1:])))
     assert 50 < errs[0] / errs[1] < 200  # ~100x for a 10x smaller perturbation
+
+
+def _falling_at_moon():
+    """A state 0.02 LU (7700 km) from the Moon's centre, at rest in the rotating frame: it falls onto the Moon."""
+    return np.array([1.0 - em.mu - 0.02, 0.0, 0.0, 0.0, 0.0, 0.0])
+
+
+def test_impact_with_the_moon_is_detected_not_integrated_through():
+    x0 = _falling_at_moon()
+    t = np.linspace(0.0, 0.2, 5)
+    with pytest.raises(RuntimeError, match="Moon"):
+        D.propagate_foh(em, x0, t, np.zeros((5, 3)))
+    with pytest.raises(RuntimeError, match="Moon"):
+        D.sundman_nodes(em, x0, 0.2, 5, 1.0)
+    with pytest.raises(RuntimeError, match="Moon"):
+        D.foh_discretize(em, t[:2], np.array([x0, x0]), np.zeros((2, 3)))
+    # a node state inside a primary is refused before integrating
+    inside = np.array([1.0 - em.mu + 0.5 * em.secondary_radius, 0, 0, 0, 0, 0])
+    with pytest.raises(ValueError, match="x_nodes"):
+        D.foh_discretize(em, t[:2], np.array([inside, x0]), np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="x0"):
+        D.propagate_foh(em, inside, t, np.zeros((5, 3)))
+    # the same fall stopped short of the surface is fine and agrees with the plain propagator
+    t_short = np.linspace(0.0, 0.01, 3)
+    assert np.allclose(D.propagate_foh(em, x0, t_short, np.zeros((3, 3)))[-1],
+                       propagate(em, x0, t_short).x[-1], atol=1e-12)
