@@ -44,7 +44,6 @@ from scipy.optimize import brentq
 
 from cislunar import plotting, ssat
 from cislunar.dynamics import EARTH_MOON as em
-from cislunar.measurements import AZIMUTH_ELEVATION
 from cislunar.orbits import nrho_9_2
 from cislunar.propagation import propagate
 from cislunar.report import ComparisonTable
