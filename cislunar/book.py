@@ -287,7 +287,8 @@ def _index_markdown(entries: list[NotebookEntry], build: Path) -> str:
     return "\n".join(lines)
 
 
-def _report_markdown(build: Path, executed: set) -> str:
+def _report_markdown(build: Path, titles: dict) -> str:
+    """``<build>/report.md`` with each section headed by its notebook's title, linked to the notebook's page."""
     rep = build / "report.md"
     if not rep.is_file():
         return "# Paper versus reproduction\n\nNo report in this build.\n"
@@ -295,8 +296,8 @@ def _report_markdown(build: Path, executed: set) -> str:
 
     def link(m):
         name = m.group(1)
-        if name in executed:
-            return f"## [{name}](notebooks/{name}.ipynb){m.group(2)}"
+        if name in titles:
+            return f"## [{titles[name]}](notebooks/{name}.ipynb){m.group(2)}"
         return m.group(0)
 
     return re.sub(r"^## (\d\d_\w+)(.*)$", link, text, flags=re.MULTILINE)
@@ -360,7 +361,7 @@ def stage(build: Path) -> Path:
         (src / "notebooks" / path.name).write_text(json.dumps(nb, indent=1))
     entries = read_entries(build)
     (src / "index.md").write_text(_index_markdown(entries, build))
-    (src / "report.md").write_text(_report_markdown(build, {p.stem for p in executed}))
+    (src / "report.md").write_text(_report_markdown(build, {e.name: e.title for e in entries if e.executed}))
     (src / "papers.md").write_text(_papers_markdown())
     return src
 
