@@ -55,6 +55,7 @@ are needed; the closed-form first derivatives are cross-checked against it and a
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Callable
 
@@ -96,6 +97,8 @@ __all__ = [
 MIN_RANGE = 1e-12
 #: Relative size of the horizontal line-of-sight component below which azimuth is undefined.
 _MIN_HORIZONTAL = 1e-12
+#: Below this horizontal/range ratio the azimuth Jacobians (1/ratio) are ill conditioned: a RuntimeWarning is issued.
+ILL_CONDITIONED_HORIZONTAL = 1e-6
 
 #: Wolf & Jones test case 1: relative position noise, 100 m per axis (Table 3).
 WOLF_JONES_RELPOS_SIGMA_KM = 0.1
@@ -240,6 +243,11 @@ def _check_horizontal(rel, rho, what):
     if np.any(s <= _MIN_HORIZONTAL * rho):
         raise ValueError(f"line of sight along the +-z axis (elevation +-90 deg): {what} and its Jacobian are "
                          "undefined there (azimuth has no meaning at the poles)")
+    ratio = float(np.min(s / rho)) if np.size(s) else 1.0
+    if ratio < ILL_CONDITIONED_HORIZONTAL:
+        warnings.warn(f"line of sight within {np.degrees(ratio):.2e} deg of the +-z axis: the {what} Jacobian "
+                      f"scales as 1/(horizontal range) and is ill conditioned (horizontal/range = {ratio:.1e})",
+                      RuntimeWarning, stacklevel=4)
     return s
 
 
