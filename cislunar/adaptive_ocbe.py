@@ -1,0 +1,564 @@
+r"""Adaptive OCBE tuning (Greaves & Scheeres 2021, "Adaptive OCBE Tuning", Figs. 6-9; Lubey & Scheeres 2014).
+
+The adaptive OCBE runs the extended square-root-information OCBE of :mod:`cislunar.ocbe` with a small ("ballistic")
+control weight and watches a statistical metric.  When the metric stays above its 99 % limit for three consecutive
+epochs, a maneuver is declared **at the first of them** and the control uncertainty of the interval ending at that
+epoch is raised until the metric there equals its mean; the filter is then re-run from that epoch on.
+
+The OCBE metric
+---------------
+At epoch :math:`n+1` the OCBE links the filtered state at :math:`t_n` to the new measurement with the cost
+(Lubey & Scheeres 2014, written as twice the OCBE cost so that it is a sum of squares)
+
+.. math::
+
+    M_{n+1} = \underbrace{\boldsymbol\delta_n^\top P_{n|n}^{-1}\boldsymbol\delta_n}_{\text{a priori}}
+      + \underbrace{\int_{t_n}^{t_{n+1}}\hat{\mathbf u}^\top\tilde Q^{-1}\hat{\mathbf u}\,dt}_{\text{control}}
+      + \underbrace{\mathbf r_{n+1}^\top R_{n+1}^{-1}\mathbf r_{n+1}}_{\text{measurement}},
+
+with :math:`\boldsymbol\delta_n = \mathbf x_{n|n+1}-\mathbf x_{n|n}` the single-step smoothed correction (Eqs.
+29-30), :math:`\hat{\mathbf u}` the estimated control (Eq. 32) and :math:`\mathbf r_{n+1} = \delta\mathbf y_{n+1}
+- H_{n+1}(\mathbf x_{n+1|n+1}-\mathbf x_{n+1|n})` the (linearised) post-fit residual.  The control term is
+exactly :math:`\mathbf w^\top Q^{-1}\mathbf w` with :math:`\mathbf w = \Phi_{xp}\mathbf p_{n|n+1}` the state
+change the control produces and :math:`Q = -\Phi_{xp}\Phi_{xx}^\top` (Eq. 17): the minimum-energy control that
+moves the state by :math:`\mathbf w` over the interval costs :math:`\mathbf w^\top Q^{-1}\mathbf w`.
+
+**Its law.** :math:`M_{n+1}` is the minimum over :math:`(\boldsymbol\delta_n, \mathbf w)` of a linear least-squares
+problem with 6 a-priori pseudo-observations, 6 control pseudo-observations and :math:`m` measurements
+(:math:`m` = measurement dimension at that epoch, e.g. 4 for angles and angle rates from one observer).  Completing
+the square gives the minimum as the squared Mahalanobis norm of the innovation,
+
+.. math:: M_{n+1} = \delta\mathbf y_{n+1}^\top\bigl(H(\Phi_{xx}P_{n|n}\Phi_{xx}^\top + Q)H^\top + R\bigr)^{-1}
+          \delta\mathbf y_{n+1} = \|\mathbf e_{n+1}\|^2,
+
+which in SRI form is the squared norm of the whitened residual :math:`\mathbf e_{x,n+1}` that the Householder
+triangularisation of the measurement update leaves below the information array (Eq. 27).  With a correct model
+(linear dynamics and measurements, Gaussian prior, process and measurement noise of the assumed covariances) the
+innovation is zero-mean Gaussian with exactly that covariance, hence
+
+.. math:: M_{n+1}\sim\chi^2_m,\qquad E[M] = m,\qquad \mathrm{Var}[M] = 2m,
+
+independently from epoch to epoch (innovations are white).  The 99 % limit is :math:`\chi^2_{m,0.99}` (13.28 for
+:math:`m = 4`).  Three consecutive exceedances then have probability :math:`10^{-6}` per epoch under the null
+hypothesis: over a 79-epoch track (one 9:2 NRHO period at a 2-hour cadence) the chance of any false reset is below
+:math:`10^{-4}`.  ``tests/test_adaptive_ocbe.py`` checks the three-term identity and the :math:`\chi^2_m` law
+(Kolmogorov-Smirnov) on linear systems.
+
+**The smoothed metric** (Fig. 7, right) is the same cost evaluated with the full smoother's estimates, per epoch
+:math:`M^s_{n+1} = \int\hat{\mathbf u}_s^\top\tilde Q^{-1}\hat{\mathbf u}_s\,dt + \mathbf r_{s,n+1}^\top
+R^{-1}\mathbf r_{s,n+1}` (plus the a-priori term at epoch 0).  Its per-epoch law is not :math:`\chi^2_m` (smoothed
+residuals are shrunk by an epoch-dependent amount), but its sum over the track is the batch least-squares minimum,
+which equals :math:`\sum_n M_n` in the linear case: its epoch average is :math:`m`, which is what the figures show
+as its "mean".
+
+The reset
+---------
+After a detection dated to epoch :math:`k` the control weight :math:`q_{k-1}` of the interval
+:math:`[t_{k-1}, t_k]` is multiplied by the factor :math:`\alpha \ge 1` that solves
+:math:`M_k(\alpha) = m` (the mean).  Because the OCBE reference has zero costate, :math:`\Phi_{xx}` does not depend
+on :math:`q` and :math:`Q` is linear in it, so :math:`M_k(\alpha)` is evaluated without re-propagation, in SRI form
+(time update with :math:`\alpha Q`, then the measurement update's residual); it decreases monotonically in
+:math:`\alpha` and is solved by bracketing in :math:`\log\alpha`.  The filter (and smoother) are then re-run with
+the new weight; epochs before :math:`k` are unchanged, and the search for the next detection resumes at
+:math:`k+1`.  This is "solving for a state covariance that sets the metric at that epoch equal to its mean" with the
+covariance change confined to the OCBE's own degree of freedom, its control uncertainty.
+
+Conventions: a detection needs three epochs *with measurements* in a row at or after epoch 1 (epoch 0 has no
+interval before it to reset); an epoch without any measurement has no metric (NaN) and breaks a run; a run still
+open at the end of the track is not a detection.  Times TU, states LU and LU/TU (rotating frame), control weights
+LU^2/TU^3.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import optimize, stats
+from scipy.integrate import simpson
+
+from . import _checks, ocbe, srif
+from .dynamics import CR3BP
+from .propagation import DEFAULT_TOL, _check_tol
+
+__all__ = ["DETECTION_PROBABILITY", "CONSECUTIVE_EPOCHS", "metric_law", "metric_limit", "MetricTerms",
+           "metric_terms", "forward_metric", "smoothed_metric", "first_detection", "Detection", "reset_factor",
+           "AdaptiveOCBEResult", "adaptive_ocbe", "adaptive_ocbe_batch", "ResetError"]
+
+#: Probability of the metric's detection limit (the paper's 99 %).
+DETECTION_PROBABILITY = 0.99
+#: Consecutive epochs above the limit that declare a maneuver (dated to the first of them).
+CONSECUTIVE_EPOCHS = 3
+
+
+class ResetError(RuntimeError):
+    """The covariance reset could not set the metric to its mean (picklable).
+
+    Attributes
+    ----------
+    epoch : int
+        Epoch of the detection.
+    metric : float
+        Metric at that epoch before the reset.
+    target : float
+        The mean it should be set to.
+    reason : str
+    """
+
+    def __init__(self, epoch: int, metric: float, target: float, reason: str):
+        super().__init__(f"covariance reset at epoch {epoch} failed (metric {metric:.6g}, target {target:.6g}): "
+                         f"{reason}")
+        self.epoch, self.metric, self.target, self.reason = int(epoch), float(metric), float(target), str(reason)
+
+    def __reduce__(self):
+        return (type(self), (self.epoch, self.metric, self.target, self.reason))
+
+
+def metric_law(dof: int):
+    """The OCBE metric's law under a correct model: ``scipy.stats.chi2(dof)`` (dof = measurement dimension)."""
+    return stats.chi2(_checks.integer(dof, "dof", minimum=1))
+
+
+def metric_limit(dof, probability: float = DETECTION_PROBABILITY):
+    """Detection limit :math:`\\chi^2_{m,p}` of the metric (elementwise for an array of dofs; NaN where dof = 0)."""
+    p = _checks.in_range(probability, "probability", 0.0, 1.0, closed=False)
+    d = _checks.as_array(dof, "dof", ndim=None)
+    if np.any(d < 0) or np.any(d != np.round(d)):
+        raise ValueError("dof must be non-negative integers")
+    out = np.where(d > 0, stats.chi2.ppf(p, np.maximum(d, 1)), np.nan)
+    return float(out) if out.ndim == 0 else out
+
+
+@dataclass(frozen=True)
+class MetricTerms:
+    """The three terms of the OCBE metric at one epoch and the whitened innovation they sum to.
+
+    Attributes
+    ----------
+    prior, control, measurement : float
+        A-priori, control and measurement terms (dimensionless squared Mahalanobis norms).
+    total : float
+        Their sum, the OCBE metric.
+    innovation : float
+        :math:`\\|\\mathbf e\\|^2` of the SRI measurement update (equal to ``total``).
+    delta : ndarray, shape (n,)
+        Single-step smoothed correction :math:`\\mathbf x_{n|n+1}-\\mathbf x_{n|n}`.
+    w : ndarray, shape (n,)
+        State change produced by the estimated control over the interval.
+    """
+
+    prior: float
+    control: float
+    measurement: float
+    total: float
+    innovation: float
+    delta: np.ndarray
+    w: np.ndarray
+
+
+def metric_terms(S, Phi, Q, H, dy, meas_cov) -> MetricTerms:
+    """Lubey's OCBE metric at one epoch from the SRI quantities of one time and measurement update.
+
+    Parameters
+    ----------
+    S : array_like, shape (n, n)
+        Upper-triangular square-root information matrix of the filtered state at :math:`t_n` (deviation form,
+        mean zero).
+    Phi : array_like, shape (n, n)
+        State transition :math:`\\Phi_{xx}(t_{n+1}, t_n)`.
+    Q : array_like, shape (n, n)
+        OCBE process-noise-like term :math:`-\\Phi_{xp}\\Phi_{xx}^\\top` (positive definite).
+    H : array_like, shape (m, n)
+        Measurement Jacobian at the predicted state.
+    dy : array_like, shape (m,)
+        Pre-fit residual :math:`\\mathbf y - h(\\mathbf x_{n+1|n})`.
+    meas_cov : array_like, shape (m, m)
+
+    Returns
+    -------
+    MetricTerms
+    """
+    S = _checks.upper_triangular(S, "S")
+    n = S.shape[0]
+    Phi = _checks.as_array(Phi, "Phi", shape=(n, n))
+    Q = _checks.spd(Q, "Q", n=n)
+    H = _checks.as_array(H, "H", ndim=(2,))
+    if H.shape[1] != n:
+        raise ValueError(f"H must have {n} columns; got shape {H.shape}")
+    dy = _checks.as_array(dy, "dy", shape=(H.shape[0],))
+    eye = np.eye(n)
+    S_bar, _, term = srif.time_update(S, np.zeros(n), Phi, eye, Q)
+    S_new, b_new, e = srif.measurement_update(S_bar, np.zeros(n), H, dy, meas_cov)
+    dx_next = srif.covariance_from_sri(S_new, b_new)[0]
+    S1, b1 = srif.smoother_step(S_new, b_new, Phi, eye, term)
+    delta = srif.covariance_from_sri(S1, b1)[0]
+    w = dx_next - Phi @ delta
+    Wq = srif.sri_from_covariance(np.zeros(n), Q, name="Q")[0]
+    Wr = srif.sri_from_covariance(np.zeros(H.shape[0]), meas_cov, name="meas_cov")[0]
+    prior = float(np.sum((S @ delta) ** 2))
+    control = float(np.sum((Wq @ w) ** 2))
+    meas = float(np.sum((Wr @ (dy - H @ dx_next)) ** 2))
+    return MetricTerms(prior, control, meas, prior + control + meas, e**2, delta, w)
+
+
+def _dof(model, available, N: int, K: int) -> np.ndarray:
+    if available is None:
+        return np.full(N, K * model.dim, dtype=int)
+    return np.asarray(available, bool).reshape(N, K).sum(axis=1) * model.dim
+
+
+def forward_metric(result, model, available=None):
+    """Forward OCBE metric per epoch and its degrees of freedom.
+
+    Parameters
+    ----------
+    result : cislunar.ocbe.OCBEResult or cislunar.detection.BatchOCBEResult
+        Filter output; the metric is the squared whitened innovation ``residual_norms**2`` (see the module
+        docstring for the identity with the three-term cost).
+    model : cislunar.measurements.MeasurementModel
+    available : array_like of bool, shape (N, K), optional
+        Observer availability used in the run (default: one observer, always).
+
+    Returns
+    -------
+    metric : ndarray, shape (N,) or (B, N)
+        NaN at epochs without measurements.
+    dof : ndarray of int, shape (N,)
+    """
+    model = ocbe.check_model(model)
+    r = np.asarray(result.residual_norms, float)
+    N = r.shape[-1]
+    K = 1 if available is None else int(np.asarray(available).size // N)
+    dof = _dof(model, available, N, K)
+    return np.where(dof > 0, r**2, np.nan), dof
+
+
+def smoothed_metric(result, y, observer_states, model, meas_cov, control_weight, *, available=None):
+    """Smoothed OCBE metric per epoch (control + measurement terms with the full smoother's estimates).
+
+    Parameters
+    ----------
+    result : cislunar.ocbe.OCBEResult
+        A run with ``smooth=True``.
+    y, observer_states, model, meas_cov, available
+        As passed to :func:`cislunar.ocbe.ocbe_filter_smoother`.
+    control_weight : float or array_like, shape (N-1,)
+        Per-interval :math:`q_n` of that run, LU^2/TU^3.
+
+    Returns
+    -------
+    ndarray, shape (N,)
+        Epoch 0 carries the a-priori term and its measurement term; the control integral uses Simpson's rule on
+        the run's sub-grid.  See the module docstring for its (epoch-averaged) mean.
+    """
+    if result.x_smooth is None:
+        raise ValueError("result must come from a run with smooth=True")
+    model = ocbe.check_model(model)
+    N = result.t.size
+    obs = np.asarray(observer_states, float)
+    obs = obs[:, None, :] if obs.ndim == 2 else obs
+    yy = np.asarray(y, float)
+    yy = yy[:, None, :] if yy.ndim == 2 else yy
+    K = obs.shape[1]
+    avail = np.ones((N, K), bool) if available is None else np.asarray(available, bool).reshape(N, K)
+    R = np.asarray(meas_cov, float)
+    W = srif.sri_from_covariance(np.zeros(model.dim), R, name="meas_cov")[0]
+    qs = ocbe.control_weights(control_weight, N - 1)
+    out = np.zeros(N)
+    for k in range(N):
+        vis = np.flatnonzero(avail[k])
+        if vis.size:
+            r = model.residual(yy[k, vis], model(obs[k, vis], result.x_smooth[k]))
+            out[k] = float(np.sum((r @ W.T) ** 2))
+        else:
+            out[k] = np.nan
+    u2 = np.sum(result.control_smooth**2, axis=-1) / qs[:, None]
+    out[1:] = np.where(np.isnan(out[1:]), 0.0, out[1:]) + simpson(u2, x=result.t_sub, axis=-1)
+    S0 = srif.sri_from_covariance(np.zeros(6), result.P_pred[0], name="P0")[0]
+    out[0] += float(np.sum((S0 @ (result.x_smooth[0] - result.x_pred[0])) ** 2))
+    return out
+
+
+def first_detection(metric, limit, *, start: int = 1, consecutive: int = CONSECUTIVE_EPOCHS):
+    """First epoch ``k >= start`` with ``metric > limit`` at ``k, ..., k + consecutive - 1`` (None if none).
+
+    NaN metrics (epochs without measurements) never exceed the limit.
+    """
+    m = _checks.as_array(metric, "metric", ndim=(1,), finite=False)
+    lim = np.broadcast_to(_checks.as_array(limit, "limit", ndim=None, finite=False), m.shape)
+    c = _checks.integer(consecutive, "consecutive", minimum=1)
+    s = _checks.integer(start, "start", minimum=0)
+    over = np.zeros(m.size, bool)
+    ok = np.isfinite(m) & np.isfinite(lim)
+    over[ok] = m[ok] > lim[ok]
+    run = 0
+    for k in range(s, m.size):
+        run = run + 1 if over[k] else 0
+        if run == c:
+            return k - c + 1
+    return None
+
+
+@dataclass(frozen=True)
+class Detection:
+    """One maneuver detection of the adaptive OCBE.
+
+    Attributes
+    ----------
+    epoch : int
+        Epoch the detection is dated to (first of the consecutive exceedances).
+    declared_epoch : int
+        Epoch at which the rule fired (``epoch + consecutive - 1``).
+    time : float
+        ``t[epoch]``, TU.
+    factor : float
+        Multiplier :math:`\\alpha` applied to the control weight of interval ``epoch - 1``.
+    metric_before, metric_after : float
+        Metric at ``epoch`` before the reset and in the re-run (equals the mean ``dof``).
+    """
+
+    epoch: int
+    declared_epoch: int
+    time: float
+    factor: float
+    metric_before: float
+    metric_after: float
+
+
+def reset_factor(system: CR3BP, t, k: int, x_filt_prev, P_filt_prev, y_k, observers_k, model, meas_cov,
+                 control_weight: float, *, target: float | None = None, n_sub: int = 9, tol: float = DEFAULT_TOL,
+                 max_factor: float = 1e40):
+    """Control-weight multiplier that sets the metric at epoch ``k`` to ``target`` (default: its mean, the dof).
+
+    Parameters
+    ----------
+    system : CR3BP
+    t : array_like, shape (N,)
+        Epochs, TU.
+    k : int
+        Detection epoch (>= 1).
+    x_filt_prev, P_filt_prev : array_like
+        Filtered state (6,) and covariance (6, 6) at ``t[k-1]``.
+    y_k, observers_k : array_like, shapes (K, m) and (K, 6)
+        Measurements and observer states at ``t[k]`` of the observers that measured.
+    model, meas_cov
+        Measurement model and one observer's covariance (m, m).
+    control_weight : float
+        :math:`q_{k-1}` used in the run, LU^2/TU^3.
+    target : float, optional
+        Metric value to reach (default ``K * model.dim``, the mean).
+
+    Returns
+    -------
+    factor : float
+        :math:`\\alpha \\ge 1`.
+    metric_at_one : float
+        Metric recomputed with :math:`\\alpha = 1` (equals the run's value; a consistency check).
+
+    Raises
+    ------
+    ResetError
+        When even ``max_factor`` leaves the metric above the target.
+    """
+    _checks.system(system)
+    t = _checks.time_grid(t, "t", increasing=True)
+    k = _checks.integer(k, "k", minimum=1, maximum=t.size - 1)
+    q = _checks.positive(control_weight, "control_weight")
+    P = _checks.spd(P_filt_prev, "P_filt_prev", n=6)
+    obs = _checks.as_array(observers_k, "observers_k", ndim=(1, 2), last=6).reshape(-1, 6)
+    yk = _checks.as_array(y_k, "y_k", ndim=(1, 2)).reshape(obs.shape[0], -1)
+    grid = np.linspace(t[k - 1], t[k], _checks.integer(n_sub, "n_sub", minimum=2))
+    tr = ocbe.ocbe_transition(system, x_filt_prev, grid, q, tol=_check_tol(tol))
+    Phi = tr.phi[-1, :6, :6]
+    Q = ocbe.ocbe_process_noise(tr.phi[-1])
+    val, _, Ht = model.evaluate(obs, tr.x[-1])
+    dy = model.residual(yk, val).reshape(-1)
+    H = Ht.reshape(-1, 6)
+    Rk = np.kron(np.eye(obs.shape[0]), np.asarray(meas_cov, float))
+    S = srif.sri_from_covariance(np.zeros(6), P, name="P_filt_prev")[0]
+    eye = np.eye(6)
+    target = float(H.shape[0]) if target is None else _checks.positive(target, "target")
+
+    def metric(log_alpha):
+        S_bar = srif.time_update(S, np.zeros(6), Phi, eye, np.exp(log_alpha) * Q)[0]
+        return srif.measurement_update(S_bar, np.zeros(6), H, dy, Rk)[2] ** 2
+
+    m1 = metric(0.0)
+    if m1 <= target:
+        return 1.0, m1
+    hi = np.log(_checks.positive(max_factor, "max_factor"))
+    if metric(hi) > target:
+        raise ResetError(k, m1, target, f"metric still {metric(hi):.3g} with the control weight x {max_factor:.0e}")
+    la = optimize.brentq(lambda a: metric(a) - target, 0.0, hi, xtol=1e-12, rtol=1e-12)
+    return float(np.exp(la)), m1
+
+
+@dataclass(frozen=True)
+class AdaptiveOCBEResult:
+    """Output of :func:`adaptive_ocbe`.
+
+    Attributes
+    ----------
+    result : cislunar.ocbe.OCBEResult
+        The final pass (with every reset applied).
+    control_weight : ndarray, shape (N-1,)
+        Final per-interval control weights, LU^2/TU^3.
+    metric : ndarray, shape (N,)
+        Forward OCBE metric of the final pass (NaN without measurements).
+    dof : ndarray of int, shape (N,)
+        Its degrees of freedom (= its mean).
+    limit : ndarray, shape (N,)
+        Detection limit per epoch.
+    metric_first_pass : ndarray, shape (N,)
+        Forward metric of the first (non-adaptive) pass.
+    smoothed_metric : ndarray or None, shape (N,)
+    detections : tuple of Detection
+    passes : int
+        Filter runs made (detections + 1).
+    """
+
+    result: ocbe.OCBEResult
+    control_weight: np.ndarray
+    metric: np.ndarray
+    dof: np.ndarray
+    limit: np.ndarray
+    metric_first_pass: np.ndarray
+    smoothed_metric: np.ndarray | None
+    detections: tuple = field(default_factory=tuple)
+    passes: int = 1
+
+    @property
+    def normalized_metric(self) -> np.ndarray:
+        """Metric divided by the detection limit (the paper's "normalized OCBE metric")."""
+        return self.metric / self.limit
+
+    @property
+    def normalized_smoothed_metric(self):
+        return None if self.smoothed_metric is None else self.smoothed_metric / self.limit
+
+
+def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *, available=None,
+                  probability: float = DETECTION_PROBABILITY, consecutive: int = CONSECUTIVE_EPOCHS,
+                  n_sub: int = 9, smooth: bool = True, tol: float = DEFAULT_TOL,
+                  max_resets: int = 50) -> AdaptiveOCBEResult:
+    """Adaptive extended SRI OCBE: detection by the metric rule and covariance reset (module docstring).
+
+    Parameters are those of :func:`cislunar.ocbe.ocbe_filter_smoother` (``control_weight`` is the starting, usually
+    ballistic, tuning: scalar or per interval, LU^2/TU^3), plus
+
+    probability : float
+        Probability of the metric limit (0.99 in the paper).
+    consecutive : int
+        Exceedances in a row that declare a maneuver (3 in the paper).
+    max_resets : int
+        Safety bound on the number of resets.
+    """
+    _checks.system(system)
+    model = ocbe.check_model(model)
+    t = _checks.time_grid(t, "t", increasing=True)
+    N = t.size
+    q = ocbe.control_weights(control_weight, N - 1).copy()
+    obs = _checks.as_array(observer_states, "observer_states", ndim=(2, 3), last=6)
+    obs3 = obs[:, None, :] if obs.ndim == 2 else obs
+    yy = np.asarray(y, float)
+    y3 = yy[:, None, :] if yy.ndim == 2 else yy
+    K = obs3.shape[1]
+    avail = np.ones((N, K), bool) if available is None else np.asarray(available, bool).reshape(N, K)
+    R = np.asarray(meas_cov, float)
+    R = np.broadcast_to(R, (N, model.dim, model.dim)) if R.shape == (model.dim, model.dim) else R
+    consecutive = _checks.integer(consecutive, "consecutive", minimum=1)
+    max_resets = _checks.integer(max_resets, "max_resets", minimum=0)
+
+    def run():
+        return ocbe.ocbe_filter_smoother(system, t, y, observer_states, model, meas_cov, x0, P0, q,
+                                         available=available, n_sub=n_sub, smooth=smooth, tol=tol)
+
+    res = run()
+    metric, dof = forward_metric(res, model, avail)
+    limit = metric_limit(dof, probability)
+    first = metric.copy()
+    detections, start = [], 1
+    while True:
+        k = first_detection(metric, limit, start=start, consecutive=consecutive)
+        if k is None:
+            break
+        if len(detections) >= max_resets:
+            raise ResetError(k, metric[k], dof[k], f"more than max_resets = {max_resets} resets")
+        vis = np.flatnonzero(avail[k])
+        factor, m1 = reset_factor(system, t, k, res.x_filt[k - 1], res.P_filt[k - 1], y3[k, vis], obs3[k, vis],
+                                  model, R[k], q[k - 1], n_sub=n_sub, tol=tol)
+        before = metric[k]
+        q[k - 1] *= factor
+        res = run()
+        metric = forward_metric(res, model, avail)[0]
+        detections.append(Detection(k, k + consecutive - 1, float(t[k]), factor, float(before), float(metric[k])))
+        start = k + 1
+    sm = smoothed_metric(res, y, observer_states, model, meas_cov, q, available=available) if smooth else None
+    return AdaptiveOCBEResult(res, q, metric, dof, limit, first, sm, tuple(detections), len(detections) + 1)
+
+
+def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *,
+                        probability: float = DETECTION_PROBABILITY, consecutive: int = CONSECUTIVE_EPOCHS,
+                        n_sub: int = 9, tol: float = DEFAULT_TOL, max_resets: int = 50):
+    """The adaptive OCBE for B trials in lockstep on :func:`cislunar.detection.ocbe_batch` (one observer).
+
+    Same rule and reset as :func:`adaptive_ocbe`, trial by trial; each pass re-runs the whole batch with the
+    updated per-trial weights (trials without a new detection reproduce their previous pass).
+
+    Parameters
+    ----------
+    y : array_like, shape (B, N, m)
+    x0 : array_like, shape (B, 6)
+    P0 : array_like, shape (6, 6) or (B, 6, 6)
+    control_weight : scalar or array_like, shape (N-1,) or (B, N-1)
+    Others as in :func:`cislunar.detection.ocbe_batch`.
+
+    Returns
+    -------
+    result : cislunar.detection.BatchOCBEResult
+        Final pass.
+    control_weight : ndarray, shape (B, N-1)
+    metric : ndarray, shape (B, N)
+    detections : list of tuple of Detection
+        Per trial.
+    """
+    from . import detection
+
+    _checks.system(system)
+    model = ocbe.check_model(model)
+    t = _checks.time_grid(t, "t", increasing=True)
+    N = t.size
+    yy = _checks.as_array(y, "y", ndim=(3,))
+    B = yy.shape[0]
+    q = ocbe.control_weights(control_weight, N - 1, batch=B).copy()
+    obs = _checks.as_array(observer_states, "observer_states", shape=(N, 6))
+    consecutive = _checks.integer(consecutive, "consecutive", minimum=1)
+
+    def run():
+        return detection.ocbe_batch(system, t, yy, obs, model, meas_cov, x0, P0, q, n_sub=n_sub, tol=tol)
+
+    res = run()
+    metric, dof = forward_metric(res, model)
+    limit = metric_limit(dof, probability)
+    start = np.ones(B, int)
+    dets = [[] for _ in range(B)]
+    while True:
+        ks = [first_detection(metric[b], limit, start=int(start[b]), consecutive=consecutive) for b in range(B)]
+        todo = [b for b in range(B) if ks[b] is not None]
+        if not todo:
+            break
+        before = {}
+        for b in todo:
+            k = ks[b]
+            if len(dets[b]) >= max_resets:
+                raise ResetError(k, metric[b, k], dof[k], f"trial {b}: more than max_resets = {max_resets} resets")
+            factor, _ = reset_factor(system, t, k, res.x_filt[b, k - 1], res.P_filt[b, k - 1], yy[b, k], obs[k],
+                                     model, meas_cov, q[b, k - 1], n_sub=n_sub, tol=tol)
+            q[b, k - 1] *= factor
+            before[b] = (k, factor, float(metric[b, k]))
+        res = run()
+        metric = forward_metric(res, model)[0]
+        for b, (k, factor, m0) in before.items():
+            dets[b].append(Detection(k, k + consecutive - 1, float(t[k]), factor, m0, float(metric[b, k])))
+            start[b] = k + 1
+    return res, q, metric, [tuple(d) for d in dets]

@@ -1,0 +1,251 @@
+"""Adaptive OCBE: the metric's three-term identity and chi-square law, the detection rule, the reset, batch = single."""
+
+import pickle
+
+import numpy as np
+import pytest
+from scipy import stats
+from scipy.integrate import simpson
+
+from cislunar import adaptive_ocbe as ad
+from cislunar import detection as det
+from cislunar import ocbe, orbits, srif, tracking
+from cislunar.dynamics import EARTH_MOON as em
+
+
+def _random_spd(rng, n, scale=1.0):
+    A = rng.standard_normal((n, n))
+    return scale * (A @ A.T + n * np.eye(n))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The metric: identity and law
+# ---------------------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("m", [2, 4, 7])
+def test_metric_terms_sum_to_the_whitened_innovation(m):
+    rng = np.random.default_rng(m)
+    for _ in range(20):
+        P, Q, R = _random_spd(rng, 6), _random_spd(rng, 6, 0.1), _random_spd(rng, m, 0.01)
+        Phi = np.eye(6) + 0.3 * rng.standard_normal((6, 6))
+        H = rng.standard_normal((m, 6))
+        dy = rng.standard_normal(m) * 3
+        S = srif.sri_from_covariance(np.zeros(6), P)[0]
+        mt = ad.metric_terms(S, Phi, Q, H, dy, R)
+        C = H @ (Phi @ P @ Phi.T + Q) @ H.T + R
+        nis = dy @ np.linalg.solve(C, dy)
+        assert mt.total == pytest.approx(nis, rel=1e-9)
+        assert mt.innovation == pytest.approx(nis, rel=1e-9)
+        assert min(mt.prior, mt.control, mt.measurement) >= 0
+        # the minimiser: delta and w are the joint least-squares solution (gradient of the cost vanishes)
+        Pinv, Qinv, Rinv = np.linalg.inv(P), np.linalg.inv(Q), np.linalg.inv(R)
+        r = dy - H @ (Phi @ mt.delta + mt.w)
+        assert np.allclose(Pinv @ mt.delta - Phi.T @ H.T @ Rinv @ r, 0, atol=1e-8 * np.abs(Pinv @ mt.delta).max())
+        assert np.allclose(Qinv @ mt.w - H.T @ Rinv @ r, 0, atol=1e-8 * np.abs(Qinv @ mt.w).max())
+
+
+def test_control_term_is_the_control_energy_of_the_ocbe():
+    """w^T Q^{-1} w = int u^T Qt^{-1} u dt for u = -q B^T Phi_pp p, p = Phi_xp^{-1} w (Eq. 32), on the 9:2 NRHO."""
+    o = orbits.nrho_9_2(em)
+    q = 1e-6
+    grid = np.linspace(0.3, 0.3 + 2 * 3600 / em.time_unit_s, 201)
+    x0 = tracking.simulate_truth(em, o.x0, [0.0, 0.3])[-1]
+    tr = ocbe.ocbe_transition(em, x0, grid, q)
+    Q = ocbe.ocbe_process_noise(tr.phi[-1])
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        w = np.linalg.cholesky(Q) @ rng.standard_normal(6)
+        p = np.linalg.solve(tr.phi_xp[-1], w)
+        u = ocbe.estimated_control(q, tr.phi_pp, p)
+        energy = simpson(np.sum(u**2, axis=-1) / q, x=grid)
+        assert energy == pytest.approx(w @ np.linalg.solve(Q, w), rel=1e-7)
+
+
+def _linear_run(rng, N=600, n=6, m=4):
+    """A linear time-varying system with Gaussian noise of exactly the assumed covariances, SRI-filtered."""
+    P0 = np.diag([1.0, 1, 1, 0.1, 0.1, 0.1])
+    Phis, Qs, Hs, Rs, ys = [], [], [], [], []
+    x = rng.multivariate_normal(np.zeros(n), P0)
+    x0_est = np.zeros(n)
+    for k in range(N):
+        if k:
+            dt = 0.1 + 0.05 * np.sin(k)
+            Phi = np.eye(n)
+            Phi[:3, 3:] = dt * np.eye(3)
+            Phi[3:, :3] = -0.2 * dt * np.eye(3)
+            Q = np.diag([dt**3 / 3] * 3 + [dt] * 3) * 1e-2
+            Q[:3, 3:] = Q[3:, :3] = np.eye(3) * dt**2 / 2 * 1e-2
+            x = Phi @ x + rng.multivariate_normal(np.zeros(n), Q)
+            Phis.append(Phi)
+            Qs.append(Q)
+        H = rng.standard_normal((m, n))
+        R = np.diag(rng.uniform(0.01, 0.1, m))
+        ys.append(H @ x + rng.multivariate_normal(np.zeros(m), R))
+        Hs.append(H)
+        Rs.append(R)
+    res = srif.filter_smoother(x0_est, P0, np.array(Phis), Hs, ys, Rs, [np.eye(n)] * (N - 1), Qs, smooth=False)
+    return res, Phis, Qs, Hs, Rs, ys
+
+
+def test_metric_law_is_chi_square_m_kolmogorov_smirnov():
+    m = 4
+    res, Phis, Qs, Hs, Rs, ys = _linear_run(np.random.default_rng(20261122), m=m)
+    metric = res.residuals**2
+    # the three-term form gives the same numbers (checked at a sample of epochs)
+    for k in range(1, 600, 97):
+        S = srif.sri_from_covariance(np.zeros(6), res.P_filt[k - 1])[0]
+        dy = ys[k] - Hs[k] @ res.x_pred[k]
+        assert ad.metric_terms(S, Phis[k - 1], Qs[k - 1], Hs[k], dy, Rs[k]).total == pytest.approx(metric[k],
+                                                                                                     rel=1e-7)
+    assert stats.kstest(metric, ad.metric_law(m).cdf).pvalue > 0.01
+    # the test has power against the nearby wrong laws (one dof more or less, a factor of two)
+    assert stats.kstest(metric, stats.chi2(m + 1).cdf).pvalue < 1e-3
+    assert stats.kstest(metric, stats.chi2(m - 1).cdf).pvalue < 1e-3
+    assert stats.kstest(metric / 2, ad.metric_law(m).cdf).pvalue < 1e-3
+    # the 99 % limit is exceeded about 1 % of the time (binomial, 4 sigma)
+    frac = np.mean(metric > ad.metric_limit(m))
+    assert abs(frac - 0.01) < 4 * np.sqrt(0.01 * 0.99 / metric.size)
+
+
+def test_metric_limit_values():
+    assert ad.metric_limit(4) == pytest.approx(13.2767, abs=1e-4)
+    assert ad.metric_limit(2) == pytest.approx(9.2103, abs=1e-4)
+    lim = ad.metric_limit(np.array([4, 0, 2]))
+    assert np.isnan(lim[1]) and lim[0] == pytest.approx(13.2767, abs=1e-4)
+    with pytest.raises(ValueError, match="probability"):
+        ad.metric_limit(4, 1.0)
+    with pytest.raises(ValueError, match="dof"):
+        ad.metric_limit(-1)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The detection rule
+# ---------------------------------------------------------------------------------------------------------------
+def test_three_consecutive_epochs_dated_to_the_first():
+    L = 10.0
+    m = np.array([1, 20, 20, 1, 20, 20, 20, 20, 1.0])
+    assert ad.first_detection(m, L) == 4
+    assert ad.first_detection(m, L, start=5) == 5
+    assert ad.first_detection(m, L, start=6) is None  # 20, 20 then 1: only two
+    assert ad.first_detection(m, L, consecutive=2) == 1
+    assert ad.first_detection(np.array([1, 20, np.nan, 20, 20]), L) is None  # NaN breaks a run
+    assert ad.first_detection(np.array([20, 20, 20, 1.0]), L, start=0) == 0
+    assert ad.first_detection(np.array([20, 20, 20, 1.0]), L, start=1) is None  # epoch 0 excluded by default
+    assert ad.first_detection(np.array([1, 1, 20, 20.0]), L) is None  # an open run at the end is no detection
+    assert ad.first_detection(np.array([1, 10, 20, 20, 20.0]), L) == 2  # strictly above the limit
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The adaptive filter on the paper's scenario (9:2 NRHO, start at periapsis, L2 observer, 2 h)
+# ---------------------------------------------------------------------------------------------------------------
+Q_BASE_KM2_S3 = 1e-18
+
+
+@pytest.fixture(scope="module")
+def setup():
+    return det.make_setup(em, orbits.nrho_9_2(em), Q_BASE_KM2_S3, Q_BASE_KM2_S3)
+
+
+def _adaptive(setup, inputs, **kw):
+    sc = setup.scenario
+    return ad.adaptive_ocbe(em, sc.t, inputs.y, setup.observer_states, sc.model, sc.meas_cov, inputs.x0, inputs.P0,
+                            setup.control_weight, **kw)
+
+
+def test_no_maneuver_never_resets(setup):
+    """Three fixed seeds: no reset, and the metric behaves like chi2(4) (mean, exceedance rate).
+
+    Deterministic (fixed seeds).  Under the derived law a false reset has probability < 1e-4 per track, single
+    exceedances 1 %; a mis-scaled metric (e.g. twice the cost, or a wrong dof) fails the mean or the rate check.
+    """
+    pooled = []
+    for seed in (1, 2, 3):
+        inp = det.draw_trial(np.random.default_rng(seed), setup, None)
+        a = _adaptive(setup, inp, smooth=False)
+        assert a.detections == () and a.passes == 1
+        assert np.array_equal(a.control_weight, setup.control_weight)
+        assert np.all(a.dof == 4)
+        pooled.append(a.metric)
+    pooled = np.concatenate(pooled)
+    assert abs(pooled.mean() - 4.0) < 4 * np.sqrt(8.0 / pooled.size)
+    assert np.mean(pooled > ad.metric_limit(4)) < 0.04
+    assert stats.kstest(pooled, ad.metric_law(4).cdf).pvalue > 1e-3
+
+
+@pytest.fixture(scope="module")
+def big_burn(setup):
+    inp = det.draw_trial(np.random.default_rng(1), setup, magnitude_m_s=3.0)
+    return inp, _adaptive(setup, inp)
+
+
+def test_large_maneuver_detected_within_three_epochs(setup, big_burn):
+    inp, a = big_burn
+    k_burn = int(np.searchsorted(setup.scenario.t, setup.t_maneuver, side="right"))  # first epoch after the burn
+    assert len(a.detections) >= 1
+    d = a.detections[0]
+    assert k_burn <= d.epoch <= k_burn + 2
+    assert d.declared_epoch == d.epoch + 2
+    assert d.metric_before > ad.metric_limit(4)
+    assert d.metric_after == pytest.approx(4.0, rel=1e-6)  # the reset sets the metric to its mean
+    assert a.metric[d.epoch] == pytest.approx(4.0, rel=1e-6)
+    assert d.factor > 1e4  # a 3 m/s burn against a ~0.1 mm/s ballistic tuning
+    assert a.control_weight[d.epoch - 1] == pytest.approx(setup.control_weight[d.epoch - 1] * d.factor)
+    assert a.passes == len(a.detections) + 1
+    assert np.array_equal(a.metric[:d.epoch], a.metric_first_pass[:d.epoch])  # the past is untouched
+
+
+def test_reset_restores_nees_consistency(setup, big_burn):
+    from scipy.stats import chi2
+
+    inp, a = big_burn
+    k = a.detections[0].epoch
+    lim = chi2.ppf(tracking.NEES_PROBABILITY, 6)
+    after = slice(k, None)
+    n_f = tracking.nees(a.result.x_filt, a.result.P_filt, inp.truth)
+    n_s = tracking.nees(a.result.x_smooth, a.result.P_smooth, inp.truth)
+    assert np.mean(n_f[after] > lim) <= tracking.DIVERGED_FRACTION
+    assert np.mean(n_s > lim) <= tracking.DIVERGED_FRACTION
+    # the same data through the non-adaptive filter: inconsistent after the burn (so this test can fail)
+    sc = setup.scenario
+    plain = ocbe.ocbe_filter_smoother(em, sc.t, inp.y, setup.observer_states, sc.model, sc.meas_cov, inp.x0, inp.P0,
+                                      setup.control_weight, smooth=False)
+    assert np.mean(tracking.nees(plain.x_filt, plain.P_filt, inp.truth)[after] > lim) > 0.5
+
+
+def test_batched_adaptive_equals_single_trial(setup):
+    sc = setup.scenario
+    inputs = [det.draw_trial(np.random.default_rng(7), setup, magnitude_m_s=3.0),
+              det.draw_trial(np.random.default_rng(8), setup, None)]
+    res, q, metric, dets = ad.adaptive_ocbe_batch(em, sc.t, np.array([i.y for i in inputs]), setup.observer_states,
+                                                  sc.model, sc.meas_cov, np.array([i.x0 for i in inputs]),
+                                                  inputs[0].P0, setup.control_weight)
+    assert len(dets[0]) >= 1 and dets[1] == ()
+    for b, inp in enumerate(inputs):
+        one = _adaptive(setup, inp)
+        assert [d.epoch for d in dets[b]] == [d.epoch for d in one.detections]
+        for d1, d2 in zip(dets[b], one.detections):
+            assert d1.factor == pytest.approx(d2.factor, rel=1e-7)
+        assert np.allclose(q[b], one.control_weight, rtol=1e-7, atol=0)
+        assert np.allclose(metric[b], one.metric, rtol=1e-6, atol=1e-9)
+        assert np.max(np.abs(res.x_filt[b] - one.result.x_filt)) < 1e-9 * np.max(np.abs(one.result.x_filt))
+        assert np.max(np.abs(res.x_smooth[b] - one.result.x_smooth)) < 1e-9 * np.max(np.abs(one.result.x_smooth))
+
+
+def test_reset_factor_consistency_and_errors(setup, big_burn):
+    inp, a = big_burn
+    sc = setup.scenario
+    d = a.detections[0]
+    first = ocbe.ocbe_filter_smoother(em, sc.t, inp.y, setup.observer_states, sc.model, sc.meas_cov, inp.x0,
+                                      inp.P0, setup.control_weight, smooth=False)
+    k = d.epoch
+    factor, m1 = ad.reset_factor(em, sc.t, k, first.x_filt[k - 1], first.P_filt[k - 1], inp.y[k],
+                                 setup.observer_states[k], sc.model, sc.meas_cov, setup.control_weight[k - 1])
+    assert m1 == pytest.approx(first.residual_norms[k] ** 2, rel=1e-6)  # the run's metric, recomputed
+    assert factor == pytest.approx(d.factor, rel=1e-9)
+    with pytest.raises(ad.ResetError) as err:
+        ad.reset_factor(em, sc.t, k, first.x_filt[k - 1], first.P_filt[k - 1], inp.y[k], setup.observer_states[k],
+                        sc.model, sc.meas_cov, setup.control_weight[k - 1], max_factor=10.0)
+    e2 = pickle.loads(pickle.dumps(err.value))
+    assert (e2.epoch, e2.reason) == (err.value.epoch, err.value.reason)
+    with pytest.raises(ValueError, match="k"):
+        ad.reset_factor(em, sc.t, 0, first.x_filt[0], first.P_filt[0], inp.y[1], setup.observer_states[1],
+                        sc.model, sc.meas_cov, 1.0)
