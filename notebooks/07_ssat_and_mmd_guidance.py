@@ -284,7 +284,41 @@ for dv, r in results.items():
 # projects on the final line of sight; the two agree in direction only roughly. This is the honest form of the
 # paper's "nearly optimal" (stated there for its Ref. [8] scenarios, which are not given).
 
+# %% [markdown]
+# ### Does the verdict depend on the demonstration pair?
+#
+# The pair above is one choice among many. As a second, independent geometry we put the agent on the quasi-periodic
+# torus of notebook 08 (the member about the 9:2 NRHO whose mean range to the target is 215 km, :mod:`cislunar.torus`)
+# at four initial ring angles, burn 1 day before apolune, and repeat the comparison with the 1 m/s burn. The torus
+# relative motion is not along-track: the line of sight sweeps around the target.
+
 # %%
+from cislunar.torus import qpo_for_mean_range
+
+qpo, _ = qpo_for_mean_range(nrho, 215.0)
+pairs = {}
+for ring_angle in (0.0, np.pi / 2, np.pi, 3 * np.pi / 2):
+    xa_q = qpo.states([ring_angle], [-t_lead])[0, 0]
+    pairs[ring_angle] = ssat.compare_burn_policies(em, xa_q, xt0, t, coast_idx, DV_M_S[-1] * 1e-3 / V, P0,
+                                                   n_grid=N_GRID, n_perp=N_PERP)
+print(f"agent on the 215-km QPO, burn {DV_M_S[-1]} m/s, coast times {COAST_HOURS} h")
+for ang, r in pairs.items():
+    print(f"ring angle {np.degrees(ang):5.0f} deg: MMD excess {np.round(r.mmd_excess_percent, 0)} %;"
+          f" directions better than MMD {np.round(r.mmd_percentile, 0)} %")
+pct_all = np.concatenate([r.mmd_percentile for r in pairs.values()])
+exc_all = np.concatenate([r.mmd_excess_percent for r in pairs.values()])
+print(f"over all QPO pairs and coasts: median percentile {np.median(pct_all):.0f} %, median excess "
+      f"{np.median(exc_all):.0f} %, MMD in the best 10 % of directions in {np.mean(pct_all < 10) * 100:.0f} % of cases")
+
+# %% [markdown]
+# **Reading.** The verdict is geometry- and horizon-dependent: for some torus pairs MMD is essentially optimal for
+# coasts of a few hours, and in every pair its excess over the optimum grows with the coast time, because the
+# surrogate looks at the measurement change at $\tau_f$ only while $J_\rho$ accumulates all measurements of the
+# coast. "Nearly optimal" holds for short coasts in favourable geometries, not in general.
+
+# %%
+near = np.concatenate([r.mmd_excess_percent for r in pairs.values()]) <= 5.0
+coast_all = np.concatenate([r.coast_hours for r in pairs.values()])
 r1 = results[DV_M_S[-1]]
 r0 = results[DV_M_S[0]]
 short = 0
@@ -311,10 +345,16 @@ table.add("Ref. [8]: perpendicular-to-LOS set contains the optimum for short coa
 table.add("MMD near-optimal (excess over the true minimiser, range over coast times)", "'nearly optimal'",
           f"{r1.mmd_excess_percent.min():.0f}-{r1.mmd_excess_percent.max():.0f} % ({DV_M_S[-1]} m/s); "
           f"{r0.mmd_excess_percent.min():.0f}-{r0.mmd_excess_percent.max():.0f} % ({DV_M_S[0]} m/s)",
-          "differs: see note" if r1.mmd_excess_percent.max() > 5 else "beyond paper",
+          "differs: see note" if r1.mmd_excess_percent.max() > 5 else "reproduced",
           f"directions better than MMD: {r1.mmd_percentile.min():.0f}-{r1.mmd_percentile.max():.0f} %; gain captured "
           f"{r1.mmd_gain_fraction.min() + 0.0:.2f} to {r1.mmd_gain_fraction.max() + 0.0:.2f}; paper's claim rests on Ref. [8] "
           "scenarios not given here")
+table.add("MMD near-optimal, second geometry (agent on the 215-km QPO, 4 ring angles, 1 m/s)", "'nearly optimal'",
+          f"median excess {np.median(exc_all):.0f} %, median percentile {np.median(pct_all):.0f} %",
+          "differs: see note" if np.median(exc_all) > 5 else "beyond paper",
+          f"MMD in the best 10 % of burn directions in {np.mean(pct_all < 10) * 100:.0f} % of the "
+          f"{pct_all.size} (pair, coast) cases; within 5 % of the optimum (tolerance) in {near.sum()} cases, "
+          f"all with coasts <= {coast_all[near].max() if near.any() else 0:.0f} h")
 table.add("+/- sign choice by quick covariance analysis", "needed",
           f"rejected sign worse by {np.min(100 * (r1.mmd_other / r1.mmd - 1)):.1f}-"
           f"{np.max(100 * (r1.mmd_other / r1.mmd - 1)):.1f} %", "beyond paper")
