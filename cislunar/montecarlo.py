@@ -14,8 +14,9 @@ A trial that raises does not lose the run.  With ``on_error="raise"`` (default) 
 first failing trial and its seed, carries the original exception (and its traceback text) and every result that
 completed, and the queued work is cancelled.  With ``on_error="collect"`` the run continues and the failed entries
 of the result list are :class:`TrialFailure` records.  ``KeyboardInterrupt`` cancels the queued work and stops the
-chunks still running in this process (threads) after their current trial.  All of these objects pickle, so they
-cross process pools intact.
+chunks still running in this process (threads) after their current trial; chunks already running in worker
+processes finish (at most ``chunk_size`` trials each) since a process cannot be interrupted from outside without
+killing the pool.  All of these objects pickle, so they cross process pools intact.
 """
 
 from __future__ import annotations
@@ -62,7 +63,10 @@ def trial_rng(seed, i: int) -> np.random.Generator:
 def spawn_rngs(seed, n: int) -> list:
     """``n`` independent generators, child ``i`` of ``SeedSequence(seed)`` for trial ``i``."""
     n = _checks.integer(n, "n", minimum=0)
-    return [np.random.default_rng(s) for s in _root(seed).spawn(n)]
+    root = _root(seed)  # children built directly: a SeedSequence passed in is not advanced
+    base, offset = tuple(root.spawn_key), root.n_children_spawned
+    return [np.random.default_rng(np.random.SeedSequence(root.entropy, spawn_key=base + (offset + i,),
+                                                         pool_size=root.pool_size)) for i in range(n)]
 
 
 def _describe_seed(seed, i) -> str:
@@ -323,6 +327,8 @@ def run_monte_carlo(trial, n_trials: int, seed, *, args=(), kwargs=None, executo
     if not isinstance(kwargs, dict):
         raise _checks.ArgumentTypeError(f"kwargs must be a dict of keyword arguments; got {type(kwargs).__name__}")
     _checks.boolean(progress, "progress")
+    if not isinstance(desc, str):
+        raise _checks.ArgumentTypeError(f"desc must be a str; got {type(desc).__name__}")
     _checks.choice(on_error, "on_error", ("raise", "collect"))
     collect = on_error == "collect"
     args = tuple(args)
