@@ -53,6 +53,7 @@ __all__ = [
     "target_trajectory",
     "StationKeepingSurface",
     "station_keeping_surface",
+    "informed_choice",
     "FilterScenario",
     "FilterTrialResult",
     "execution_sigma",
@@ -297,6 +298,44 @@ def _torus_states(torus, theta, t):
     return out
 
 
+def informed_choice(dv1, u_y, cost):
+    r"""Eq. 25 selection of the informed maneuver in each row (time-of-arrival slice).
+
+    Parameters
+    ----------
+    dv1 : array_like (n_t, n_theta, 3)
+        First burns of the station-keeping set.
+    u_y : array_like (n_t, 3)
+        MMD directions (any sign, any non-zero length).
+    cost : array_like (n_t, n_theta)
+        Result of the quick covariance analysis used to choose between the two candidates (smaller is better).
+
+    Returns
+    -------
+    alignment : ndarray (n_t, n_theta)
+        :math:`\cos\theta_u = \mathbf u_y^T\Delta\mathbf v_1/(\|\mathbf u_y\|\|\Delta\mathbf v_1\|)` (0 for a
+        zero burn).
+    candidates : ndarray (n_t, 2) of int
+        Indices with :math:`\theta_u` closest to 0 and closest to :math:`\pi`.
+    informed : ndarray (n_t,) of int
+        The candidate with the smaller ``cost``.
+    """
+    dv1 = _checks.as_array(dv1, "dv1", ndim=(3,), last=3)
+    u_y = _checks.as_array(u_y, "u_y", shape=(dv1.shape[0], 3))
+    cost = _checks.as_array(cost, "cost", shape=dv1.shape[:2])
+    un = np.linalg.norm(u_y, axis=-1)
+    if np.any(un == 0):
+        raise ValueError("u_y must hold non-zero directions")
+    norms = np.linalg.norm(dv1, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        align = np.einsum("jik,jk->ji", dv1, u_y / un[:, None]) / norms
+    align = np.where(norms > 0, align, 0.0)
+    cand = np.stack([np.argmax(align, axis=1), np.argmin(align, axis=1)], axis=1)
+    rows = np.arange(dv1.shape[0])
+    pick = np.where(cost[rows, cand[:, 0]] <= cost[rows, cand[:, 1]], cand[:, 0], cand[:, 1])
+    return align, cand, pick
+
+
 def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: float, t_final: float, *,
                             cadence: float | None = None, agent_theta: float = 0.0, agent_offset=None, P0=None,
                             sigma_min_rad: float = AMOS_SIGMA_MIN_RAD, resolution_km: float = AMOS_RESOLUTION_KM,
@@ -393,13 +432,7 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
         rs = cov.range_sigma_km.reshape(nt, nth, t.size)
         sig[:] = rs[..., -1]
         sig_arr[:] = rs[np.arange(nt), :, k_arr]
-    norms = np.linalg.norm(dv1, axis=-1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        align = np.einsum("jik,jk->ji", dv1, u_y) / norms
-    align = np.where(norms > 0, align, 0.0)
-    cand = np.stack([np.argmax(align, axis=1), np.argmin(align, axis=1)], axis=1)
-    rows = np.arange(nt)
-    pick = np.where(sig[rows, cand[:, 0]] <= sig[rows, cand[:, 1]], cand[:, 0], cand[:, 1])
+    align, cand, pick = informed_choice(dv1, u_y, sig)
     return StationKeepingSurface(theta=theta, t_arrival=t_arr, t_burn=t_burn, t=t, agent_x0=xa0, dv1=dv1, dv2=dv2,
                                  range_sigma_km=sig, range_sigma_at_arrival_km=sig_arr, u_y=u_y, alignment=align,
                                  candidates=cand, informed=pick, transfer_miss=miss,

@@ -112,6 +112,26 @@ def test_informed_selection_follows_eq25(torus, surface):
     assert np.all(s.informed_percentile >= 0) and np.all(s.informed_percentile <= 100)
 
 
+def test_informed_choice_brute_force():
+    """Eq. 25 on synthetic burns: both signs of u_y are candidates and the covariance analysis decides."""
+    rng = np.random.default_rng(4)
+    dv1 = rng.standard_normal((5, 30, 3))
+    u_y = rng.standard_normal((5, 3)) * 7.0
+    cost = rng.random((5, 30))
+    align, cand, pick = sk.informed_choice(dv1, u_y, cost)
+    for j in range(5):
+        ang = [np.arccos(np.clip(d @ u_y[j] / np.linalg.norm(d) / np.linalg.norm(u_y[j]), -1, 1)) for d in dv1[j]]
+        assert cand[j, 0] == int(np.argmin(ang)) and cand[j, 1] == int(np.argmax(ang))
+        assert pick[j] == cand[j, int(np.argmin(cost[j, cand[j]]))]
+    # make the minus candidate win in row 0 and the plus candidate in row 1
+    cost[0, cand[0, 1]], cost[0, cand[0, 0]] = 0.0, 1.0
+    cost[1, cand[1, 0]], cost[1, cand[1, 1]] = 0.0, 1.0
+    _, _, pick = sk.informed_choice(dv1, u_y, cost)
+    assert pick[0] == cand[0, 1] and pick[1] == cand[1, 0]
+    with pytest.raises(ValueError, match="u_y"):
+        sk.informed_choice(dv1, np.zeros((5, 3)), cost)
+
+
 def test_zero_maneuver_point_is_natural_motion(torus):
     theta = np.array([0.0, 1.0])
     s = sk.station_keeping_surface(em, torus, theta, np.array([-2 * HR]), -14 * HR, 6 * HR, agent_theta=0.0,
