@@ -372,6 +372,9 @@ def propagate_with_impulses(system: CR3BP, x0, t, impulses=(), *, threads: int |
         if not last:
             xs[:, 3:6] += dv
         a = b
+    if k == N - 1 and t[-1] == a:  # an impulse exactly at the last grid time: report the post-impulse state
+        X[:, k], S[:, k] = xs, phi
+        k += 1
     if k != N:  # pragma: no cover - bookkeeping guard
         raise RuntimeError(f"internal error: filled {k} of {N} grid points")
     return ImpulsiveTrajectory(t=t, x=X, stm=S)

@@ -130,6 +130,19 @@ def test_impulses_between_grid_points_and_stm(pair):
     assert np.allclose(tr.stm[0, 0], np.eye(6))
 
 
+def test_impulses_on_grid_times_are_post_impulse(pair):
+    xa, _ = pair
+    t = np.linspace(0, 4 * HR, 5)
+    dv = np.array([1e-4, 0, 0])
+    for k in (2, 4):
+        tr = ssat.propagate_with_impulses(em, xa, t, [(t[k], dv)])
+        plain = ssat.propagate_with_impulses(em, xa, t)
+        assert np.allclose(tr.x[0, :k], plain.x[0, :k], atol=1e-15)
+        assert np.allclose(tr.x[0, k, 3:6] - plain.x[0, k, 3:6], dv, atol=1e-14)
+        assert np.allclose(tr.x[0, k, :3], plain.x[0, k, :3], atol=1e-15)
+        assert np.allclose(tr.stm[0, k], plain.stm[0, k], atol=1e-12)
+
+
 def test_impulse_validation(pair):
     xa, _ = pair
     t = np.linspace(0, 1, 3)
