@@ -63,6 +63,15 @@ the new weight; epochs before :math:`k` are unchanged, and the search for the ne
 :math:`k+1`.  This is "solving for a state covariance that sets the metric at that epoch equal to its mean" with the
 covariance change confined to the OCBE's own degree of freedom, its control uncertainty.
 
+Where the literal rule breaks, and the alternative.  When some measurement components carry no information about
+the state (in this package's tracking scenario the angle rates: their 1-s differencing noise is about
+:math:`10^5` times their state-driven spread), their whitened noise stays in :math:`M_k(\alpha)` for every
+:math:`\alpha`; if it alone exceeds the mean (for two such components, probability :math:`e^{-2}` = 13.5 %) the mean
+rule drives :math:`\alpha` up by many orders of magnitude beyond what the burn needs, and the re-linearised filter
+then diverges through a chain of further resets.  ``reset="likelihood"`` instead chooses the :math:`\alpha` that
+maximises the Gaussian likelihood of the innovation (covariance matching), which inflates only as far as the
+explainable part of the innovation asks.  Notebook 09b measures both rules.
+
 Conventions: a detection needs three epochs *with measurements* in a row at or after epoch 1 (epoch 0 has no
 interval before it to reset); an epoch without any measurement has no metric (NaN) and breaks a run; a run still
 open at the end of the track is not a detection.  Times TU, states LU and LU/TU (rotating frame), control weights
@@ -82,13 +91,15 @@ from .dynamics import CR3BP
 from .propagation import DEFAULT_TOL, _check_tol
 
 __all__ = ["DETECTION_PROBABILITY", "CONSECUTIVE_EPOCHS", "metric_law", "metric_limit", "MetricTerms",
-           "metric_terms", "forward_metric", "smoothed_metric", "first_detection", "Detection", "reset_factor",
+           "RESET_RULES", "metric_terms", "forward_metric", "smoothed_metric", "first_detection", "Detection", "reset_factor",
            "AdaptiveOCBEResult", "adaptive_ocbe", "adaptive_ocbe_batch", "ResetError"]
 
 #: Probability of the metric's detection limit (the paper's 99 %).
 DETECTION_PROBABILITY = 0.99
 #: Consecutive epochs above the limit that declare a maneuver (dated to the first of them).
 CONSECUTIVE_EPOCHS = 3
+#: Reset rules of :func:`reset_factor`: the paper's ("mean") and maximum likelihood ("likelihood").
+RESET_RULES = ("mean", "likelihood")
 
 
 class ResetError(RuntimeError):
@@ -314,7 +325,7 @@ class Detection:
     factor : float
         Multiplier :math:`\\alpha` applied to the control weight of interval ``epoch - 1``.
     metric_before, metric_after : float
-        Metric at ``epoch`` before the reset and in the re-run (equals the mean ``dof``).
+        Metric at ``epoch`` before the reset and in the re-run (equal to the mean ``dof`` under the mean rule).
     """
 
     epoch: int
@@ -326,9 +337,18 @@ class Detection:
 
 
 def reset_factor(system: CR3BP, t, k: int, x_filt_prev, P_filt_prev, y_k, observers_k, model, meas_cov,
-                 control_weight: float, *, target: float | None = None, n_sub: int = 9, tol: float = DEFAULT_TOL,
-                 max_factor: float = 1e40):
-    """Control-weight multiplier that sets the metric at epoch ``k`` to ``target`` (default: its mean, the dof).
+                 control_weight: float, *, rule: str = "mean", target: float | None = None, n_sub: int = 9,
+                 tol: float = DEFAULT_TOL, max_factor: float = 1e40):
+    """Control-weight multiplier :math:`\\alpha` of the reset at epoch ``k``.
+
+    ``rule="mean"`` (the paper's): the metric at ``k`` becomes ``target`` (default: its mean, the dof).
+    ``rule="likelihood"``: :math:`\\alpha` maximises the likelihood of the innovation,
+    :math:`\\min_\\alpha \\log\\det C(\\alpha) + \\delta\\mathbf y^\\top C(\\alpha)^{-1}\\delta\\mathbf y`
+    with :math:`C(\\alpha) = H(\\Phi P\\Phi^\\top + \\alpha Q)H^\\top + R` (covariance matching; clipped at 1).  It
+    differs from the mean rule when some measurement components cannot be explained by any state error (here the
+    angle rates, whose noise dwarfs their signal): their noise stays in the metric whatever :math:`\\alpha`, and
+    when it alone exceeds the mean (for two such dofs, probability :math:`e^{-2}` = 13.5 %) the mean rule needs an
+    absurd :math:`\\alpha`; the likelihood rule inflates only as far as the explainable part asks.
 
     Parameters
     ----------
@@ -378,15 +398,35 @@ def reset_factor(system: CR3BP, t, k: int, x_filt_prev, P_filt_prev, y_k, observ
     S = srif.sri_from_covariance(np.zeros(6), P, name="P_filt_prev")[0]
     eye = np.eye(6)
     target = float(H.shape[0]) if target is None else _checks.positive(target, "target")
+    _checks.choice(rule, "rule", RESET_RULES)
+
+    def update(log_alpha):
+        S_bar = srif.time_update(S, np.zeros(6), Phi, eye, np.exp(log_alpha) * Q)[0]
+        S_new, _, e = srif.measurement_update(S_bar, np.zeros(6), H, dy, Rk)
+        return S_bar, S_new, e**2
 
     def metric(log_alpha):
-        S_bar = srif.time_update(S, np.zeros(6), Phi, eye, np.exp(log_alpha) * Q)[0]
-        return srif.measurement_update(S_bar, np.zeros(6), H, dy, Rk)[2] ** 2
+        return update(log_alpha)[2]
 
     m1 = metric(0.0)
+    hi = np.log(_checks.positive(max_factor, "max_factor"))
+    if rule == "likelihood":
+        # log det C = log det R + 2 sum log diag S_new - 2 sum log diag S_bar (determinant lemma, SRI form)
+        def nll(la):
+            S_bar, S_new, m = update(la)
+            return 2 * np.sum(np.log(np.abs(np.diag(S_new)))) - 2 * np.sum(np.log(np.abs(np.diag(S_bar)))) + m
+
+        grid = np.linspace(0.0, hi, 161)
+        vals = np.array([nll(g) for g in grid])
+        i = int(np.argmin(vals))
+        if i == 0:
+            return 1.0, m1
+        lo_b, hi_b = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+        la = optimize.minimize_scalar(nll, bounds=(lo_b, hi_b), method="bounded",
+                                      options={"xatol": 1e-10}).x
+        return float(np.exp(la)), m1
     if m1 <= target:
         return 1.0, m1
-    hi = np.log(_checks.positive(max_factor, "max_factor"))
     if metric(hi) > target:
         raise ResetError(k, m1, target, f"metric still {metric(hi):.3g} with the control weight x {max_factor:.0e}")
     la = optimize.brentq(lambda a: metric(a) - target, 0.0, hi, xtol=1e-12, rtol=1e-12)
@@ -439,7 +479,7 @@ class AdaptiveOCBEResult:
 
 def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *, available=None,
                   probability: float = DETECTION_PROBABILITY, consecutive: int = CONSECUTIVE_EPOCHS,
-                  n_sub: int = 9, smooth: bool = True, tol: float = DEFAULT_TOL,
+                  reset: str = "mean", n_sub: int = 9, smooth: bool = True, tol: float = DEFAULT_TOL,
                   max_resets: int = 50) -> AdaptiveOCBEResult:
     """Adaptive extended SRI OCBE: detection by the metric rule and covariance reset (module docstring).
 
@@ -450,6 +490,8 @@ def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0,
         Probability of the metric limit (0.99 in the paper).
     consecutive : int
         Exceedances in a row that declare a maneuver (3 in the paper).
+    reset : {"mean", "likelihood"}
+        Reset rule (:func:`reset_factor`): the paper's (metric set to its mean) or maximum likelihood.
     max_resets : int
         Safety bound on the number of resets.
     """
@@ -468,6 +510,7 @@ def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0,
     R = np.broadcast_to(R, (N, model.dim, model.dim)) if R.shape == (model.dim, model.dim) else R
     consecutive = _checks.integer(consecutive, "consecutive", minimum=1)
     max_resets = _checks.integer(max_resets, "max_resets", minimum=0)
+    _checks.choice(reset, "reset", RESET_RULES)
 
     def run():
         return ocbe.ocbe_filter_smoother(system, t, y, observer_states, model, meas_cov, x0, P0, q,
@@ -486,7 +529,7 @@ def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0,
             raise ResetError(k, metric[k], dof[k], f"more than max_resets = {max_resets} resets")
         vis = np.flatnonzero(avail[k])
         factor, m1 = reset_factor(system, t, k, res.x_filt[k - 1], res.P_filt[k - 1], y3[k, vis], obs3[k, vis],
-                                  model, R[k], q[k - 1], n_sub=n_sub, tol=tol)
+                                  model, R[k], q[k - 1], rule=reset, n_sub=n_sub, tol=tol)
         before = metric[k]
         q[k - 1] *= factor
         res = run()
@@ -499,7 +542,7 @@ def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0,
 
 def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *,
                         probability: float = DETECTION_PROBABILITY, consecutive: int = CONSECUTIVE_EPOCHS,
-                        n_sub: int = 9, tol: float = DEFAULT_TOL, max_resets: int = 50):
+                        reset: str = "mean", n_sub: int = 9, tol: float = DEFAULT_TOL, max_resets: int = 50):
     """The adaptive OCBE for B trials in lockstep on :func:`cislunar.detection.ocbe_batch` (one observer).
 
     Same rule and reset as :func:`adaptive_ocbe`, trial by trial; each pass re-runs the whole batch with the
@@ -553,7 +596,7 @@ def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x
             if len(dets[b]) >= max_resets:
                 raise ResetError(k, metric[b, k], dof[k], f"trial {b}: more than max_resets = {max_resets} resets")
             factor, _ = reset_factor(system, t, k, res.x_filt[b, k - 1], res.P_filt[b, k - 1], yy[b, k], obs[k],
-                                     model, meas_cov, q[b, k - 1], n_sub=n_sub, tol=tol)
+                                     model, meas_cov, q[b, k - 1], rule=reset, n_sub=n_sub, tol=tol)
             q[b, k - 1] *= factor
             before[b] = (k, factor, float(metric[b, k]))
         res = run()

@@ -249,3 +249,36 @@ def test_reset_factor_consistency_and_errors(setup, big_burn):
     with pytest.raises(ValueError, match="k"):
         ad.reset_factor(em, sc.t, 0, first.x_filt[0], first.P_filt[0], inp.y[1], setup.observer_states[1],
                         sc.model, sc.meas_cov, 1.0)
+
+
+def test_likelihood_reset_is_stationary_and_avoids_the_mean_rule_blow_up():
+    """1 m/s burn whose angle-rate noise alone exceeds the mean: the mean rule needs alpha ~ 1e14, ML ~ 1e7-1e8."""
+    s = det.make_setup(em, orbits.nrho_9_2(em), Q_BASE_KM2_S3, Q_BASE_KM2_S3, periods=1.5)
+    sc = s.scenario
+    inp = det.draw_trial(np.random.default_rng(100), s, magnitude_m_s=1.0)
+    run = ocbe.ocbe_filter_smoother(em, sc.t, inp.y, s.observer_states, sc.model, sc.meas_cov, inp.x0, inp.P0,
+                                    s.control_weight, smooth=False)
+    metric, dof = ad.forward_metric(run, sc.model)
+    k = ad.first_detection(metric, ad.metric_limit(dof))
+    assert k == 40
+    args = (em, sc.t, k, run.x_filt[k - 1], run.P_filt[k - 1], inp.y[k], s.observer_states[k], sc.model,
+            sc.meas_cov, s.control_weight[k - 1])
+    f_mean, _ = ad.reset_factor(*args, rule="mean")
+    f_ml, _ = ad.reset_factor(*args, rule="likelihood")
+    assert f_mean > 1e4 * f_ml and 1e6 < f_ml < 1e9
+    # stationarity of the innovation likelihood at f_ml (covariance form, independent of the SRI code)
+    grid = np.linspace(sc.t[k - 1], sc.t[k], 9)
+    tr = ocbe.ocbe_transition(em, run.x_filt[k - 1], grid, s.control_weight[k - 1])
+    Phi, Q = tr.phi[-1, :6, :6], ocbe.ocbe_process_noise(tr.phi[-1])
+    val, _, Ht = sc.model.evaluate(s.observer_states[k][None], tr.x[-1])
+    dy = sc.model.residual(inp.y[k][None], val).reshape(-1)
+    H = Ht.reshape(-1, 6)
+
+    def nll(a):
+        C = H @ (Phi @ run.P_filt[k - 1] @ Phi.T + a * Q) @ H.T + sc.meas_cov
+        return np.linalg.slogdet(C)[1] + dy @ np.linalg.solve(C, dy)
+
+    for a in (f_ml * 0.7, f_ml * 1.4):
+        assert nll(a) > nll(f_ml)
+    with pytest.raises(ValueError, match="rule"):
+        ad.reset_factor(*args, rule="median")
