@@ -433,6 +433,9 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
         raise _checks.ArgumentTypeError(f"constraints must be a list or tuple; got {type(constraints).__name__}")
     con_specs = [_check_constraint(c, i, n) for i, c in enumerate(constraints)]
     _checks.boolean(progress, "progress")
+    if not isinstance(solver, str) or solver.upper() not in cp.installed_solvers():
+        raise ValueError(f"solver must be the name of an installed cvxpy solver {cp.installed_solvers()}; got "
+                         f"{solver!r}")
     norms = np.linalg.norm(u_ref, axis=1)
     over = norms > umax
     u_ref[over] *= (umax[over] / norms[over])[:, None]

@@ -242,6 +242,8 @@ def test_bad_arguments_name_the_argument():
         scvx.solve_scvx("earth-moon", t, x, u, um)
     with pytest.raises(ValueError, match="x_guess"):
         scvx.solve_scvx(em, t, x[:-1], u, um)
+    with pytest.raises(ValueError, match="solver"):
+        scvx.solve_scvx(em, t, x, u, um, solver="NO_SUCH_SOLVER")
     with pytest.raises(TypeError, match=r"constraints\[0\]"):
         scvx.solve_scvx(em, t, x, u, um, constraints=[object()])
     with pytest.raises(scvx.SCvxError, match="infeasible|collapsed|no convergence"):
