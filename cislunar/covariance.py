@@ -24,10 +24,12 @@ Gauss-Legendre quadrature with STMs from heyoka (:math:`\Phi(t_{k+1},\tau) = \Ph
 :func:`van_loan` is the classical matrix-exponential form for a constant :math:`A`.
 
 Units of the PSD.  The PSD of an acceleration has units (km/s^2)^2 / Hz = km^2/s^3.  Wolf & Jones print
-"Q [km/s^3] = 1e-11" (Tables 3 and 5); we read it as :math:`q = 10^{-11}` km^2/s^3 (the only dimensionally
-consistent reading) and convert with :func:`psd_to_nondimensional`:
-:math:`q_{nd} = q\,T^3/L^2` (LU^2/TU^3), i.e. 1e-11 km^2/s^3 = 3.574e-6 LU^2/TU^3 for the Earth-Moon units.
-Over one day this gives a velocity standard deviation of about :math:`\sqrt{q\Delta t}` = 0.93 m/s per axis.
+"Q [km/s^3] = 1e-11" (Tables 3 and 5).  Read literally with the square restored (1e-11 km^2/s^3, a one-day
+velocity random walk of 0.93 m/s) the CRLB of their test case 1 grows without bound over the window, against their
+text; the adopted reading is the same number in normalised units, :math:`q = 10^{-11}` LU^2/TU^3
+= 2.80e-17 km^2/s^3 (:data:`WOLF_JONES_PSD_KM2_S3`; the evidence and the other readings are in
+:mod:`cislunar.wolf_jones` and notebook 06).  :func:`psd_to_nondimensional` converts km^2/s^3 to LU^2/TU^3:
+:math:`q_{nd} = q\,T^3/L^2`.
 
 EKF covariance analysis (Performance Evaluation section)
 --------------------------------------------------------
@@ -87,8 +89,9 @@ __all__ = [
 WOLF_JONES_SIGMA_POS_KM = 100.0
 #: Wolf & Jones Tables 3 and 5: initial 1-sigma velocity per axis, km/s.
 WOLF_JONES_SIGMA_VEL_KM_S = 1e-2
-#: Wolf & Jones Tables 3 and 5: process-noise PSD, read as km^2/s^3 (printed "km/s^3").
-WOLF_JONES_PSD_KM2_S3 = 1e-11
+#: Wolf & Jones Tables 3 and 5: process-noise PSD in km^2/s^3, the adopted reading of the printed "1e-11 km/s^3"
+#: (1e-11 LU^2/TU^3 in the classical Earth-Moon units, 2.80e-17 km^2/s^3; see :mod:`cislunar.wolf_jones`).
+WOLF_JONES_PSD_KM2_S3 = 1e-11 * 384400.0**2 / 375190.25852**3
 
 
 # --------------------------------------------------------------------------------------------------------------

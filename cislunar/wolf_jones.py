@@ -74,6 +74,10 @@ __all__ = [
     "evaluate_crlb",
     "impulse",
     "node_times_with_window",
+    "ScenarioSolver",
+    "sweep_both_ways",
+    "fly",
+    "terminal_miss_km",
 ]
 
 #: Process-noise PSD adopted for Tables 3 and 5: 1e-11 in LU^2/TU^3 (see the module docstring).
@@ -401,7 +405,7 @@ class WindowInformation:
     """
 
     def __init__(self, system: CR3BP, t, targets_x0, model, noise, P0, *, q: float, x_reference,
-                 hessian_step: float = 1e-6, hessian_scheme: str = "forward"):
+                 hessian_step: float = 1e-6, hessian_scheme: str = "central"):
         if not isinstance(system, CR3BP):
             raise ValueError(f"system must be a CR3BP; got {type(system).__name__}")
         if not isinstance(model, meas.MeasurementModel):
@@ -450,11 +454,12 @@ class WindowInformation:
         return float(value), grad
 
     def hessian(self, x) -> np.ndarray:
-        """Symmetrised finite differences of the adjoint gradient, (6, 6), nats per unit^2.
+        """Symmetrised finite differences of the (square-root, forward-mode) gradient, (6, 6), nats per unit^2.
 
-        ``hessian_scheme="central"`` uses twelve perturbed observers (error O(h^2)); ``"forward"`` six plus the
-        gradient at ``x`` (error O(h), half the cost; the default, since SCvx only needs a curvature model).
-        The perturbed observers are propagated in one batch (heyoka batch mode).
+        ``hessian_scheme="central"`` (default) uses twelve perturbed observers (error O(h^2)); ``"forward"`` six
+        plus the gradient at ``x`` (error O(h), half the cost, but on test case 2 its error made SCvx creep: the
+        MI is log-like in the out-of-plane amplitude, with curvature up to 1e12 nats/LU^2 at the plane).  The
+        perturbed observers are propagated in one batch (heyoka batch mode).
         """
         x = _checks.as_state(x, "x", batch=False)
         h = self.hessian_step
@@ -588,3 +593,110 @@ def evaluate_crlb(scenario: Scenario, x_window_start, *, q: float | None = None)
     sig = np.stack([np.sqrt(diag[:, 6 * i:6 * i + 3]) for i in range(n_obj)]) * sysm.length_unit_km
     rms = np.sqrt(np.sum(sig**2, axis=-1))
     return CRLBResult(t=t, sigma_axes_km=sig, rms_km=rms, mutual_information=info.mutual_information(*lin.arrays))
+
+
+# --------------------------------------------------------------------------------------------------------------
+# solving: one alpha, homotopy sweeps (optionally in parallel), re-flight
+# --------------------------------------------------------------------------------------------------------------
+class ScenarioSolver:
+    """``solver(alpha, x_guess, u_guess) -> SCvxResult`` for one scenario and node grid (picklable, for
+    :func:`cislunar.scvx.homotopy_sweep` and process pools).
+
+    Parameters
+    ----------
+    scenario : Scenario
+    t_nodes : array_like (N,)
+        Node times with the window ends on nodes (:meth:`Scenario.node_times`).
+    k_window : int
+        Index of the window-start node.
+    information : WindowInformation, optional
+        Default: :meth:`Scenario.information_model` (process noise fixed along the ballistic window arc).
+    keep_out : bool
+        Impose :meth:`Scenario.keep_out` (test case 2).
+    settings : cislunar.scvx.SCvxSettings, optional
+    """
+
+    def __init__(self, scenario: Scenario, t_nodes, k_window: int, *, information=None, keep_out: bool = False,
+                 settings=None):
+        if not isinstance(scenario, Scenario):
+            raise ValueError(f"scenario must be a Scenario; got {type(scenario).__name__}")
+        self.scenario = scenario
+        self.t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
+        self.k_window = int(k_window)
+        if not 0 < self.k_window < self.t.size - 1 or not np.isclose(self.t[self.k_window], scenario.window[0]):
+            raise ValueError(f"k_window must index the window-start node; got {k_window}")
+        self.information = scenario.information_model() if information is None else information
+        self.constraints = (scenario.keep_out(self.k_window),) if keep_out else ()
+        self.settings = settings
+        self.u_max = scenario.control_bounds(self.t)
+
+    def __call__(self, alpha: float, x_guess, u_guess):
+        from .scvx import solve_scvx
+
+        sc = self.scenario
+        return solve_scvx(sc.system, self.t, x_guess, u_guess, self.u_max, x_final=sc.observer_xf,
+                          info=self.information, info_node=self.k_window, constraints=self.constraints,
+                          alpha=float(alpha), settings=self.settings)
+
+
+def _sweep_task(solver, alphas, x_guess, u_guess, direction):
+    from .scvx import homotopy_sweep
+
+    return homotopy_sweep(solver, alphas, x_guess, u_guess, directions=(direction,))
+
+
+def sweep_both_ways(solver: ScenarioSolver, alphas, x_guess, u_guess, *, executor=None):
+    """Upward and downward homotopy sweeps from the same guess, best cost kept per alpha.
+
+    The upward sweep starts at the smallest alpha, the downward at the largest, both from ``(x_guess,
+    u_guess)`` and each warm-started along its way; they are independent, so an executor (``submit``) can run them
+    side by side.  Returns ``(best, sweeps)``: a :class:`cislunar.scvx.SweepResult` whose ``best``/``source`` merge
+    the two, and the two sweep results.
+    """
+    from .scvx import SweepResult
+
+    a = np.asarray(alphas, dtype=float)
+    if executor is None:
+        up = _sweep_task(solver, a, x_guess, u_guess, "up")
+        down = _sweep_task(solver, a, x_guess, u_guess, "down")
+    else:
+        if not callable(getattr(executor, "submit", None)):
+            raise ValueError(f"executor must have a submit method; got {type(executor).__name__}")
+        futs = [executor.submit(_sweep_task, solver, a, x_guess, u_guess, d) for d in ("up", "down")]
+        up, down = (f.result() for f in futs)
+    best, source = [], []
+    for i in range(a.size):
+        cands = [(r.best[i], r.source[i]) for r in (up, down) if r.best[i] is not None]
+        if not cands:
+            best.append(None)
+            source.append("")
+            continue
+        b, s = min(cands, key=lambda c: c[0].cost)
+        best.append(b)
+        source.append(s)
+    return SweepResult(a, best, source, up.attempts + down.attempts), (up, down)
+
+
+def fly(scenario: Scenario, t_nodes, u_nodes, *, refine: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """Single-shooting re-flight from :attr:`Scenario.observer_x0` with the first-order-hold control.
+
+    The FOH control is linear between nodes, so interpolating it onto a grid refined ``refine`` times reproduces
+    it exactly: the returned dense trajectory is the nonlinear flight of the converged control (for plots and the
+    terminal miss).  Returns ``(t_fine, x_fine)``.
+    """
+    from .discretization import propagate_foh
+
+    t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
+    u = _checks.as_array(u_nodes, "u_nodes", shape=(t.size, 3))
+    r = int(refine)
+    if r < 1:
+        raise ValueError(f"refine must be >= 1; got {refine}")
+    tf = np.concatenate([np.linspace(t[k], t[k + 1], r + 1)[:-1] for k in range(t.size - 1)] + [t[-1:]])
+    uf = np.stack([np.interp(tf, t, u[:, i]) for i in range(3)], axis=1)
+    return tf, propagate_foh(scenario.system, scenario.observer_x0, tf, uf)
+
+
+def terminal_miss_km(scenario: Scenario, t_nodes, u_nodes) -> float:
+    """Position miss (km) at :math:`t_f` of the single-shooting re-flight against :attr:`Scenario.observer_xf`."""
+    _, x = fly(scenario, t_nodes, u_nodes, refine=1)
+    return float(np.linalg.norm(x[-1, :3] - scenario.observer_xf[:3]) * scenario.system.length_unit_km)

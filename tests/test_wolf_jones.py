@@ -57,6 +57,7 @@ def test_process_noise_readings_and_constants():
     nd = r["1e-11 LU^2/TU^3 (normalised units, adopted)"]
     assert C.psd_to_nondimensional(nd, em) == pytest.approx(W.PROCESS_NOISE_PSD_ND, rel=1e-12)
     assert nd == pytest.approx(2.80e-17, rel=0.01)
+    assert C.WOLF_JONES_PSD_KM2_S3 == pytest.approx(nd, rel=1e-12)
     assert W.A_MAX_READINGS_CASE2_KM_S2["literal 5^-7"] == pytest.approx(1.28e-5)
     assert W.keep_out_radius_km() == pytest.approx(300 * np.sqrt(2))
 
