@@ -83,10 +83,19 @@ __all__ = [
     "ResonantOrbit",
     "Scenario",
     "paper_scenario",
+    "SIN_THETA3_MIN",
+    "DISTURBANCE_STRUCTURES",
+    "disturbance_model",
+    "guaranteed_error_rms",
+    "RESONANT_CANDIDATES",
+    "SensitivityStudy",
+    "sensitivity_study",
 ]
 
 #: Names of the scheduling parameters rho_1..rho_6.
 RHO_NAMES = ("1/r13^3", "1/r23^3", "1/r13", "1/r23", "x", "y")
+#: Smallest :math:`|\\sin\\theta_3|` accepted by :meth:`CR3BPLPV.rho_from_angles` (float pi is not exact).
+SIN_THETA3_MIN = 1e-12
 #: Names of the six sensors of Eq. 22.
 SENSOR_NAMES = ("sin th1", "cos th1", "sin th2", "cos th2", "r13^2", "r23^2")
 
@@ -179,9 +188,12 @@ class CR3BPLPV:
         """
         t1 = _checks.as_array(theta1, "theta1")
         t2 = _checks.as_array(theta2, "theta2")
+        if t1.shape != t2.shape:
+            raise ValueError(f"theta1 and theta2 must have the same shape; got {t1.shape} and {t2.shape}")
         s3 = np.sin(t1 + t2)  # sin(pi - t1 - t2)
-        if np.any(s3 == 0):
-            raise ValueError("theta1 + theta2 is a multiple of pi: triangulation is singular")
+        if np.any(np.abs(s3) < SIN_THETA3_MIN):
+            raise ValueError(f"theta1 + theta2 is a multiple of pi (|sin theta3| < {SIN_THETA3_MIN:g}): the "
+                             "triangulation is singular (spacecraft on the Earth-Moon line)")
         r13 = np.sin(t2) / s3
         r23 = np.sin(t1) / s3
         x = -self.mu + r13 * np.cos(t1)
@@ -349,9 +361,8 @@ class ParameterBox:
 
     def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
         """``n`` points drawn uniformly in the box (n, dim), with the generator ``rng``."""
-        if not isinstance(rng, np.random.Generator):
-            raise ValueError(f"rng must be a numpy.random.Generator; got {type(rng).__name__}")
-        n = int(_checks.positive(n, "n"))
+        rng = _checks.rng(rng, "rng")
+        n = _checks.integer(n, "n", minimum=1)
         return self.lower + (self.upper - self.lower) * rng.random((n, self.dim))
 
     def contains(self, rho, *, rtol: float = 1e-12) -> np.ndarray:
@@ -410,7 +421,7 @@ class ResonantOrbit:
         """Times (n,) and states (n, 6) over ``periods`` periods, propagated with :func:`propagate`."""
         from .propagation import propagate
 
-        n = int(_checks.positive(n, "n"))
+        n = _checks.integer(n, "n", minimum=2)
         t = np.linspace(0.0, _checks.positive(periods, "periods") * self.period, max(n, 2))
         return t, propagate(self.system, self.x0, t).x
 
@@ -437,9 +448,10 @@ def resonant_orbit(system: CR3BP = EARTH_MOON, p: int = 3, q: int = 1, perigee_r
     -------
     ResonantOrbit
     """
-    if not isinstance(system, CR3BP):
-        raise ValueError(f"system must be a cislunar.dynamics.CR3BP; got {type(system).__name__}")
-    if int(p) != p or int(q) != q or p < 1 or q < 1 or p <= q:
+    system = _checks.system(system, "system")
+    p = _checks.integer(p, "p", minimum=2)
+    q = _checks.integer(q, "q", minimum=1)
+    if p <= q:
         raise ValueError(f"p and q must be positive integers with p > q; got p={p}, q={q}")
     rp = _checks.in_range(perigee_radius, "perigee_radius", 0.05, 0.9)
     mu = system.mu
@@ -481,30 +493,64 @@ def noise_deg_to_precision(noise_deg) -> np.ndarray:
     return 1.0 / np.sin(np.radians(n))
 
 
-def default_disturbance(sigma_acc: float = 1e-3):
-    r"""Disturbance channel used in this reproduction (the paper never states :math:`B_d, S_d, D_d`).
+#: Disturbance structures offered by :func:`disturbance_model` (the paper never states :math:`B_d, S_d, D_d`).
+DISTURBANCE_STRUCTURES = ("acceleration", "state")
 
-    Unmodelled accelerations of size ``sigma_acc`` (LU/TU^2 per unit normalised input) on both velocity
-    components: :math:`B_d = [0; I_2]`, :math:`S_d = \sigma_{acc} I_2`, :math:`D_d = 0` (the disturbance does not
-    enter the sensors).
+
+def disturbance_model(structure: str = "acceleration", level: float = 1e-3):
+    r"""Disturbance channel :math:`(B_d, S_d, D_d)` of Eq. 5 (the paper states none of them).
+
+    Parameters
+    ----------
+    structure : {"acceleration", "state"}
+        ``"acceleration"``: unmodelled accelerations on both velocity components, :math:`B_d = [0; I_2]`
+        (:math:`n_d = 2`).  ``"state"``: independent perturbations of every state component, :math:`B_d = I_4`
+        (:math:`n_d = 4`; position entries in LU/TU per unit input, velocity entries in LU/TU^2).
+        In both the disturbance does not enter the sensors, :math:`D_d = 0`.
+    level : float
+        :math:`S_d = \mathrm{level}\,I` (>= 0; 0 switches the disturbance off).
+
+    Returns
+    -------
+    tuple of ndarray
+        ``(Bd (4, nd), Sd (nd, nd), Dd (6, nd))``.
+    """
+    structure = _checks.choice(structure, "structure", DISTURBANCE_STRUCTURES)
+    s = _checks.positive(level, "level", allow_zero=True)
+    Bd = np.vstack([np.zeros((2, 2)), np.eye(2)]) if structure == "acceleration" else np.eye(4)
+    nd = Bd.shape[1]
+    return Bd, s * np.eye(nd), np.zeros((6, nd))
+
+
+def default_disturbance(sigma_acc: float = 1e-3):
+    r"""Disturbance channel used in this reproduction: ``disturbance_model("acceleration", sigma_acc)``.
+
+    Unmodelled accelerations of size ``sigma_acc`` (LU/TU^2 per unit normalised input; 1e-3 LU/TU^2 is about
+    2.7e-9 km/s^2, the order of the solar tide the CR3BP ignores) on both velocity components:
+    :math:`B_d = [0; I_2]`, :math:`S_d = \sigma_{acc} I_2`, :math:`D_d = 0`.
 
     Returns
     -------
     tuple of ndarray
         ``(Bd (4, 2), Sd (2, 2), Dd (6, 2))``.
     """
-    s = _checks.positive(sigma_acc, "sigma_acc", allow_zero=True)
-    Bd = np.vstack([np.zeros((2, 2)), np.eye(2)])
-    return Bd, s * np.eye(2), np.zeros((6, 2))
+    return disturbance_model("acceleration", _checks.positive(sigma_acc, "sigma_acc", allow_zero=True))
 
 
 class InfeasibleLMIError(RuntimeError):
-    """The precision LMI has no solution (or the solver failed); the message names gamma and the status."""
+    """The precision LMI has no solution (or the solver failed); the message names gamma and the status.
 
-    def __init__(self, message: str, gamma: float, status: str):
+    Attributes ``gamma`` (LU) and ``status`` (solver status) survive pickling (process pools).
+    """
+
+    def __init__(self, message: str, gamma: float = float("nan"), status: str = "unknown"):
         super().__init__(message)
+        self.message = str(message)
         self.gamma = gamma
         self.status = status
+
+    def __reduce__(self):
+        return (type(self), (self.message, self.gamma, self.status))
 
 
 @dataclass(frozen=True)
@@ -521,11 +567,13 @@ class ObserverDesign:
         Observer gain :math:`L = X^{-1}Y` of Eq. 3a (sign convention of the paper: the observer is
         :math:`\\dot{\\hat x} = (A + LC)\\hat x - Ly + b + Ld`).
     X : ndarray (4, 4)
-        Lyapunov matrix (:math:`P^{-1}`).
+        Lyapunov matrix of the scaled problem, :math:`\\gamma^2 P^{-1}` (dimensionless; see :class:`PrecisionLMI`).
     beta : ndarray (6,)
         :math:`\\beta_i = \\kappa_i^2`.
     kappa : ndarray (6,)
         Precision of each sensor (inverse of its admissible noise, :math:`\\kappa_i = \\sqrt{\\beta_i}`).
+        For H2 the admissible noise :math:`1/\\kappa_i` is a white-noise intensity (units of the sensor times
+        TU^1/2); for H-infinity an energy (L2) bound.
     noise_deg : ndarray (6,)
         Eq. 24 applied to each :math:`\\kappa_i` (meaningful for the four angle sensors), deg.
     used : ndarray of bool (6,)
@@ -536,6 +584,12 @@ class ObserverDesign:
         Wall-clock seconds of the solve (including canonicalisation on the first call).
     objective : float
         Optimal :math:`\\|\\beta\\|_p`.
+    Bw, Dd : ndarray
+        :math:`B_dS_d` (4, nd) and :math:`D_dS_d` (6, nd) of the error system, with the disturbance level used.
+    pole_radius : float or None
+        Bandwidth bound imposed (:math:`|\\lambda(A+LC)| < R`, 1/TU), ``None`` if none.
+    variable_scale : float
+        Magnitude of the scaled Lyapunov variables with which the solver ended (see :class:`PrecisionLMI`).
     """
 
     norm: str
@@ -552,11 +606,36 @@ class ObserverDesign:
     objective: float
     Bw: np.ndarray = None
     Dd: np.ndarray = None
+    pole_radius: float | None = None
+    variable_scale: float = 1.0
+
+    @property
+    def gain_norm(self) -> float:
+        """Spectral norm of the full observer gain :math:`\\|L\\|_2` (mixed units, LU and LU/TU per sensor unit)."""
+        return float(np.linalg.norm(self.L, 2))
+
+    @property
+    def optimal(self) -> bool:
+        """The solver reported ``optimal`` (not ``optimal_inaccurate``)."""
+        return self.status == "optimal"
 
     def noise_std(self) -> np.ndarray:
         """Admissible noise level of each sensor :math:`1/\\kappa_i` (inf for removed sensors)."""
         with np.errstate(divide="ignore"):
             return np.where(self.used, 1.0 / self.kappa, np.inf)
+
+    def noise_per_sample_deg(self, dt: float) -> np.ndarray:
+        r"""H2 only: admissible per-sample angle noise (deg) of a sensor sampled every ``dt`` TU.
+
+        A white-noise intensity :math:`1/\kappa^2` equals the variance :math:`\sigma^2 = 1/(\kappa^2\Delta t)` of
+        independent samples held over :math:`\Delta t` (the standard continuous/discrete equivalence), so Eq. 24
+        becomes :math:`\delta\theta = \sin^{-1}(1/(\kappa\sqrt{\Delta t}))`.
+        """
+        if self.norm != "h2":
+            raise ValueError("noise_per_sample_deg applies to H2 designs (an intensity); this design is "
+                             f"{self.norm!r}")
+        dt = _checks.positive(dt, "dt")
+        return precision_to_noise_deg(self.kappa * np.sqrt(dt))
 
     def gain(self, *, drop_unused: bool = True) -> np.ndarray:
         """Observer gain (4, 6); with ``drop_unused`` the columns of removed sensors are set to zero."""
@@ -567,6 +646,8 @@ class ObserverDesign:
 
 
 _SOLVERS = ("CLARABEL", "SCS")
+#: Variable magnitudes tried in turn by :meth:`PrecisionLMI.solve` until the solver reports ``optimal``.
+RETRY_SCALES = (1.0, 10.0, 100.0, 3.0, 30.0, 0.3)
 _NORMS = ("h2", "hinf")
 _OBJECTIVES = {"l1": 1, "l2": 2, "linf": np.inf}
 
@@ -591,34 +672,42 @@ class PrecisionLMI:
     .. math:: \begin{bmatrix} \mathrm{sym}(XA_v + YC_v) & (XB_d + YD_d)S_d & C_z^T & Y\\ \star & -\gamma^2 I & 0 & 0\\
               \star & 0 & -I & 0\\ \star & 0 & 0 & -\gamma^2\mathrm{diag}(\beta)\end{bmatrix} \prec 0 ,
 
-    Scaling.  With :math:`\gamma = 0.0013` the printed forms mix entries from :math:`\gamma^2 \sim 10^{-6}` to
-    :math:`\beta \sim 10^{6}`; Clarabel then fails (H-infinity) or returns "optimal" points that violate
-    :math:`\mathrm{tr}\,Q < \gamma^2` by a factor of two (H2).  Both problems are therefore solved in the
-    equivalent variables :math:`\tilde X = \gamma^2 X`, :math:`\tilde Y = \gamma^2 Y` (same
-    :math:`L = \tilde X^{-1}\tilde Y`), :math:`\tilde\beta = \gamma^2\beta`, :math:`\tilde Q = Q/\gamma^2`
-    (congruence transformations with :math:`\mathrm{diag}(\gamma I, I, \gamma I)`), in which :math:`\gamma`
-    only scales the disturbance, :math:`S_d \to S_d/\gamma`, and :math:`\mathrm{tr}\,\tilde Q < 1`:
+    Scaling (three congruences that leave the solution set unchanged).
 
-    .. math:: \begin{bmatrix} \mathrm{sym}(\tilde XA_v + \tilde YC_v) & (\tilde XB_d + \tilde YD_d)S_d/\gamma &
-              [C_z^T] & \tilde Y\\ \star & -I & & 0\\ & & [-I] & \\ \star & 0 & & -\mathrm{diag}
-              (\tilde\beta)\end{bmatrix} \prec 0
+    1. :math:`\gamma`.  With :math:`\gamma = 0.0013` the printed forms mix :math:`\gamma^2 \sim 10^{-6}` and
+       :math:`\beta \sim 10^{6}`.  Both problems are solved in :math:`\tilde X = \gamma^2 X`,
+       :math:`\tilde Y = \gamma^2 Y` (same :math:`L`), :math:`\tilde\beta = \gamma^2\beta`, :math:`\tilde Q =
+       Q/\gamma^2`, in which :math:`\gamma` only scales the disturbance, :math:`S_d \to S_d/\gamma`, and
+       :math:`\mathrm{tr}\,\tilde Q < 1`.  The ratio ``disturbance_scale / gamma`` is one ``cp.Parameter``, so
+       sweeps over gamma and over the disturbance level re-use the canonicalised problem.
+    2. State coordinates (optional).  The error may be written :math:`e = T\hat e` with :math:`T =
+       \mathrm{diag}(\mathrm{state\_scale})`; default :math:`T = I`.
+    3. Variable magnitude.  :math:`\tilde X = s\hat X`, :math:`\tilde Y = s\hat Y` with ``variable_scale`` s
+       (default 10 with a pole radius, else 1), so that the bandwidth-bounded problems, whose :math:`\tilde X`
+       is of order :math:`10^{-4}`-:math:`10^{-2}`, end ``optimal`` in Clarabel.
 
-    (bracketed blocks for H-infinity only).  A consequence worth knowing: without disturbance
-    (:math:`S_d = 0`) the optimal precision scales exactly as :math:`\kappa \propto 1/\gamma`.
+    Caution, found while building this: the strictness margin :math:`\hat X \succeq \epsilon I` is a bound on
+    :math:`X` and thus on the gain; a scaling that makes it bind (e.g. a velocity scaling with a large s) returns
+    an ``optimal`` but different answer.  The tests therefore check that the precisions do not move when
+    ``eps`` changes tenfold, when the tolerance is tightened and when SCS is used.
 
-    Optional pole region (beyond the paper).  The H-infinity optimum is approached only as the gain grows
-    without bound (the observer then simply inverts the :math:`\theta_1` measurement); ``pole_radius`` R adds
-    at each vertex :math:`\begin{bmatrix}-R\tilde X & \tilde X A_{cl}\\ \star & -R\tilde X\end{bmatrix}
-    \prec 0`, i.e. the eigenvalues of :math:`A+LC` inside the disc :math:`|\lambda| < R` with the same
-    Lyapunov matrix, which bounds the gain so that the observer can be integrated.
+    Well-posedness.  The H-infinity infimum is approached only as the gain grows without bound (the observer
+    then inverts the :math:`\theta_1` measurement, and the least precision tends to :math:`\max r_{13}/\gamma`):
+    without a bound on the gain the minimum is not attained and solvers stop "inaccurate" with a gain that
+    depends on the strictness margin.  ``pole_radius`` R (beyond the paper) adds at each vertex
+    :math:`\begin{bmatrix}-\hat X & \hat X\hat A_{cl}/R\\ \star & -\hat X\end{bmatrix} \prec 0`, i.e. the
+    eigenvalues of :math:`A+LC` inside the disc :math:`|\lambda| < R` with the same Lyapunov matrix: an observer
+    bandwidth bound that makes the minimum attained and the gain finite.  The precision then tends to the
+    unbounded-gain limit as R grows (shown in notebook 11).  H2 needs no such bound (its optimum has a moderate
+    gain).
 
     In both, the noise enters through :math:`S_n = \mathrm{diag}(1/\kappa_i)` (the scaling from the normalised
     to the physical noise; the paper's text writes :math:`S_n = \mathrm{diag}(\kappa_i)`, which contradicts its
     own definition :math:`\kappa_i = 1/\|n_i\|`) so :math:`(S_nS_n^T)^{-1} = \mathrm{diag}(\beta)` and the
     precision is :math:`\kappa_i = \sqrt{\beta_i}` for *both* theorems (the printed H-infinity formula
     :math:`\sqrt{\beta_i/\gamma}` does not follow from Eq. 18-19).  Strict inequalities are imposed with a margin
-    ``eps`` (:math:`\preceq -\epsilon I`).  :math:`\gamma^2` is a ``cp.Parameter`` so sweeps reuse the
-    canonicalised problem.
+    ``eps`` (:math:`\preceq -\epsilon I` in the scaled variables).  Vertices with identical
+    :math:`(A_v, C_v)` restricted to the offered sensors give identical LMIs and are imposed once.
 
     Parameters
     ----------
@@ -628,21 +717,33 @@ class PrecisionLMI:
         :math:`C_y(\rho_v)`.
     norm : {"h2", "hinf"}
     disturbance : tuple
-        ``(Bd (nx, nd), Sd (nd, nd), Dd (ny, nd))``; see :func:`default_disturbance`.
+        ``(Bd (nx, nd), Sd (nd, nd), Dd (ny, nd))``; see :func:`disturbance_model`.  ``solve`` may scale
+        :math:`S_d` by ``disturbance_scale``.
     Cz : array_like (nz, nx), optional
         Performance output; default the first two states (position ``[I2 0]`` for the CR3BP).
     objective : {"l1", "l2", "linf"}
         Norm of :math:`\beta` minimised (``"l1"`` promotes sparse sensor selection).
     eps : float
-        Margin for the strict LMIs.
+        Margin for the strict LMIs (scaled variables).
     sensors : sequence of int, optional
         Subset of sensors offered to the design (others get zero gain); default all six.
+    pole_radius : float, optional
+        Bound R on the closed-loop eigenvalue moduli, 1/TU (see Well-posedness).
+    state_scale : array_like (nx,), optional
+        Diagonal of the coordinate scaling T (default ones; :meth:`for_cr3bp` balances it).
+    variable_scale : float, optional
+        Magnitude s of the scaled Lyapunov variables (default ``max(1, R/10)`` or 1).
     """
 
     def __init__(self, A_vertices, C_vertices, norm: str = "h2", *, disturbance, Cz=None,
-                 objective: str = "l1", eps: float = 1e-8, sensors=None, pole_radius: float | None = None):
+                 objective: str = "l1", eps: float = 1e-8, sensors=None, pole_radius: float | None = None,
+                 state_scale=None, variable_scale: float | None = None):
         import cvxpy as cp
 
+        self._init = dict(A_vertices=A_vertices, C_vertices=C_vertices, norm=norm, disturbance=disturbance, Cz=Cz,
+                          objective=objective, eps=eps, sensors=sensors, pole_radius=pole_radius,
+                          state_scale=state_scale)
+        self._rescaled = {}
         A_v = _checks.as_array(A_vertices, "A_vertices", ndim=(3,))
         nx = A_v.shape[1]
         if A_v.shape[0] < 1 or A_v.shape[2] != nx:
@@ -651,10 +752,8 @@ class PrecisionLMI:
         if C_all.shape[0] != A_v.shape[0] or C_all.shape[2] != nx:
             raise ValueError(f"C_vertices must have shape ({A_v.shape[0]}, ny, {nx}); got {C_all.shape}")
         ny = C_all.shape[1]
-        if norm not in _NORMS:
-            raise ValueError(f"norm must be one of {_NORMS}; got {norm!r}")
-        if objective not in _OBJECTIVES:
-            raise ValueError(f"objective must be one of {tuple(_OBJECTIVES)}; got {objective!r}")
+        norm = _checks.choice(norm, "norm", _NORMS)
+        objective = _checks.choice(objective, "objective", tuple(_OBJECTIVES))
         self.eps = _checks.positive(eps, "eps")
         self.pole_radius = None if pole_radius is None else _checks.positive(pole_radius, "pole_radius")
         if not isinstance(disturbance, tuple) or len(disturbance) != 3:
@@ -667,48 +766,68 @@ class PrecisionLMI:
         Sd = _checks.as_array(Sd, "disturbance Sd", shape=(nd, nd))
         Dd = _checks.as_array(Dd, "disturbance Dd", shape=(ny, nd))
         Cz = np.eye(min(2, nx), nx) if Cz is None else _checks.as_array(Cz, "Cz", ndim=(2,), last=nx)
-        sensors = list(range(ny)) if sensors is None else sorted(int(i) for i in sensors)
+        if sensors is None:
+            sensors = list(range(ny))
+        else:
+            try:
+                sensors = sorted(_checks.integer(i, "sensors") for i in sensors)
+            except TypeError as exc:
+                raise _checks.ArgumentTypeError(f"sensors must be a sequence of sensor indices; got "
+                                                f"{type(sensors).__name__}") from exc
         if not sensors or any(i < 0 or i >= ny for i in sensors) or len(set(sensors)) != len(sensors):
             raise ValueError(f"sensors must be distinct indices in [0, {ny}); got {sensors}")
+        tvec = np.ones(nx) if state_scale is None else _checks.as_array(state_scale, "state_scale", shape=(nx,))
+        if np.any(tvec <= 0):
+            raise ValueError(f"state_scale must be positive; got {tvec}")
+        if variable_scale is None:
+            variable_scale = 10.0 if self.pole_radius else 1.0
+        xs = _checks.positive(variable_scale, "variable_scale")
         self.n_x, self.n_y = nx, ny
         self.A_vertices, self.C_vertices, self.norm, self.objective = A_v, C_all, norm, objective
         self.Bd, self.Sd, self.Dd, self.Cz, self.sensors = Bd, Sd, Dd, Cz, sensors
+        self.state_scale, self.variable_scale = tvec, xs
         ns, nz = len(sensors), Cz.shape[0]
-        C_v = C_all[:, sensors, :]
-        Dd_s = Dd[sensors]
+        # exact de-duplication: vertices that differ only in parameters the offered sensors do not see
+        flat = np.concatenate([A_v.reshape(A_v.shape[0], -1), C_all[:, sensors, :].reshape(A_v.shape[0], -1)], 1)
+        _, keep = np.unique(flat, axis=0, return_index=True)
+        keep = np.sort(keep)
+        self.n_unique_vertices = keep.size
+        T, Ti = np.diag(tvec), np.diag(1.0 / tvec)
+        A_h = Ti @ A_v[keep] @ T
+        C_h = C_all[keep][:, sensors, :] @ T
+        Bd_h, Cz_h, Dd_s = Ti @ Bd, Cz @ T, Dd[sensors]
 
-        # scaled variables (see class notes): X~ = gamma^2 X, Y~ = gamma^2 Y, beta~ = gamma^2 beta, Q~ = Q/gamma^2
-        X = cp.Variable((nx, nx), symmetric=True, name="X")
-        Y = cp.Variable((nx, ns), name="Y")
+        Xh = cp.Variable((nx, nx), symmetric=True, name="X_hat")
+        Yh = cp.Variable((nx, ns), name="Y_hat")
         beta = cp.Variable(ns, nonneg=True, name="beta_scaled")
-        self.inv_gamma = cp.Parameter(nonneg=True, name="inv_gamma", value=1.0)
+        self.dist_over_gamma = cp.Parameter(nonneg=True, name="disturbance_over_gamma", value=1.0)
+        X, Y = xs * Xh, xs * Yh
         eps = self.eps
-        cons = [X >> eps * np.eye(nx)]
+        cons = [Xh >> eps * np.eye(nx)]
         Ind = np.eye(nd)
-        for Av, Cv in zip(A_v, C_v):
-            M11 = X @ Av + Y @ Cv
-            XAcl = M11
-            M11 = M11 + M11.T
-            M12 = self.inv_gamma * ((X @ Bd + Y @ Dd_s) @ Sd)
+        for Av, Cv in zip(A_h, C_h):
+            XAcl = X @ Av + Y @ Cv
+            M11 = XAcl + XAcl.T
+            M12 = self.dist_over_gamma * ((X @ Bd_h + Y @ Dd_s) @ Sd)
             if norm == "h2":
                 blk = cp.bmat([[M11, M12, Y],
                                [M12.T, -Ind, np.zeros((nd, ns))],
                                [Y.T, np.zeros((ns, nd)), -cp.diag(beta)]])
             else:
-                blk = cp.bmat([[M11, M12, Cz.T, Y],
+                blk = cp.bmat([[M11, M12, Cz_h.T, Y],
                                [M12.T, -Ind, np.zeros((nd, nz)), np.zeros((nd, ns))],
-                               [Cz, np.zeros((nz, nd)), -np.eye(nz), np.zeros((nz, ns))],
+                               [Cz_h, np.zeros((nz, nd)), -np.eye(nz), np.zeros((nz, ns))],
                                [Y.T, np.zeros((ns, nd)), np.zeros((ns, nz)), -cp.diag(beta)]])
             size = blk.shape[0]
             cons.append(0.5 * (blk + blk.T) << -eps * np.eye(size))
             if self.pole_radius is not None:
                 R = self.pole_radius
-                disk = cp.bmat([[-R * X, XAcl], [XAcl.T, -R * X]])
+                disk = cp.bmat([[-X, XAcl / R], [XAcl.T / R, -X]])
                 cons.append(0.5 * (disk + disk.T) << -eps * np.eye(2 * nx))
         Q = None
         if norm == "h2":
             Q = cp.Variable((nz, nz), symmetric=True, name="Q_scaled")
-            cons.append(cp.bmat([[Q, Cz], [Cz.T, X]]) >> eps * np.eye(nz + nx))
+            cons.append(cp.bmat([[Q, Cz_h], [Cz_h.T, X]]) >> eps * np.eye(nz + nx))
             cons.append(cp.trace(Q) <= 1.0)
         self._X, self._Y, self._beta, self._Q = X, Y, beta, Q
         self.problem = cp.Problem(cp.Minimize(cp.norm(beta, _OBJECTIVES[objective])), cons)
@@ -719,8 +838,7 @@ class PrecisionLMI:
 
         ``disturbance`` defaults to :func:`default_disturbance`; other keywords go to the constructor.
         """
-        if not isinstance(model, CR3BPLPV):
-            raise ValueError(f"model must be a CR3BPLPV; got {type(model).__name__}")
+        model = _checks.instance(model, "model", CR3BPLPV)
         V = _checks.as_array(vertices, "vertices", ndim=(2,), last=model.n_rho)
         if V.shape[0] < 1:
             raise ValueError("vertices must hold at least one vertex")
@@ -729,8 +847,57 @@ class PrecisionLMI:
         lmi.vertices = V
         return lmi
 
-    def solve(self, gamma: float, *, solver: str = "CLARABEL", sparsity_tol: float = 1e-4,
+    def with_variable_scale(self, variable_scale: float) -> "PrecisionLMI":
+        """The same problem built with another ``variable_scale`` (cached)."""
+        xs = _checks.positive(variable_scale, "variable_scale")
+        if xs == self.variable_scale:
+            return self
+        if xs not in self._rescaled:
+            other = PrecisionLMI(**self._init, variable_scale=xs)
+            if hasattr(self, "vertices"):
+                other.vertices = self.vertices
+            self._rescaled[xs] = other
+        return self._rescaled[xs]
+
+    def solve(self, gamma: float, *, solver: str = "CLARABEL", disturbance_scale: float = 1.0,
+              tol: float | None = None, sparsity_tol: float = 1e-4, retry_scales=RETRY_SCALES,
               **solver_options) -> ObserverDesign:
+        """Solve for the bound ``gamma`` (LU); if the solver does not end ``optimal``, re-solve the same problem
+        built with each of ``retry_scales`` (variable magnitudes, see the class notes) until one does.
+
+        The first ``optimal`` design is returned; if none is, the first solution (``optimal_inaccurate``, with a
+        warning) or, if every attempt failed, :class:`InfeasibleLMIError`.  ``retry_scales=()`` solves once.
+        Other parameters: see :meth:`solve_once`.
+        """
+        try:
+            scales = [float(x) for x in retry_scales]
+        except TypeError as exc:
+            raise _checks.ArgumentTypeError("retry_scales must be a sequence of positive numbers") from exc
+        first, first_exc = None, None
+        for xs in [self.variable_scale] + [x for x in scales if x != self.variable_scale]:
+            lmi = self.with_variable_scale(xs)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                try:
+                    d = lmi.solve_once(gamma, solver=solver, disturbance_scale=disturbance_scale, tol=tol,
+                                       sparsity_tol=sparsity_tol, **solver_options)
+                except InfeasibleLMIError as exc:
+                    if exc.status == "infeasible":  # a certificate, not a numerical accident
+                        raise
+                    first_exc = first_exc or exc
+                    continue
+            if d.optimal:
+                return d
+            first = first or d
+        if first is None:
+            raise first_exc
+        warnings.warn(f"{self.norm} precision LMI at gamma = {first.gamma:g}: no variable scale in "
+                      f"{[self.variable_scale, *scales]} gave 'optimal'; returning the {first.status!r} solution "
+                      "(verify it with verify_observer)", stacklevel=2)
+        return first
+
+    def solve_once(self, gamma: float, *, solver: str = "CLARABEL", disturbance_scale: float = 1.0,
+                   tol: float | None = None, sparsity_tol: float = 1e-4, **solver_options) -> ObserverDesign:
         """Solve for the bound ``gamma`` (LU) and return the design.
 
         Parameters
@@ -738,6 +905,11 @@ class PrecisionLMI:
         gamma : float
             Bound on the H2 or H-infinity norm from the normalised exogenous input to the position error, LU.
         solver : {"CLARABEL", "SCS"}
+        disturbance_scale : float
+            Multiplies the constructor's :math:`S_d` (>= 0) without rebuilding the problem.
+        tol : float, optional
+            Solver tolerance (Clarabel ``tol_gap_abs``, ``tol_gap_rel``, ``tol_feas``; SCS ``eps_abs``,
+            ``eps_rel``); default the solver's (Clarabel 1e-8) or 1e-9 for SCS.
         sparsity_tol : float
             A sensor is reported unused when its :math:`\\beta_i` is below this fraction of the largest.
         **solver_options
@@ -753,13 +925,18 @@ class PrecisionLMI:
         import cvxpy as cp
 
         gamma = _checks.positive(gamma, "gamma")
-        solver = str(solver).upper()
-        if solver not in _SOLVERS:
-            raise ValueError(f"solver must be one of {_SOLVERS}; got {solver!r}")
+        solver = _checks.choice(str(solver).upper() if isinstance(solver, str) else solver, "solver", _SOLVERS)
+        dscale = _checks.positive(disturbance_scale, "disturbance_scale", allow_zero=True)
         sparsity_tol = _checks.in_range(sparsity_tol, "sparsity_tol", 0.0, 1.0)
+        if tol is not None:
+            tol = _checks.positive(tol, "tol")
         if solver == "SCS":
-            solver_options = {"eps_abs": 1e-9, "eps_rel": 1e-9, "max_iters": 200000, **solver_options}
-        self.inv_gamma.value = 1.0 / gamma
+            t = 1e-9 if tol is None else tol
+            solver_options = {"eps_abs": t, "eps_rel": t, "max_iters": 200000, **solver_options}
+        elif tol is not None:
+            solver_options = {"tol_gap_abs": tol, "tol_gap_rel": tol, "tol_feas": tol, "max_iter": 400,
+                              **solver_options}
+        self.dist_over_gamma.value = dscale / gamma
         t0 = time.perf_counter()
         try:
             self.problem.solve(solver=solver, **solver_options)
@@ -771,12 +948,14 @@ class PrecisionLMI:
         if status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or self._X.value is None:
             raise InfeasibleLMIError(
                 f"{self.norm} precision LMI infeasible or unsolved at gamma = {gamma:g}: solver {solver} status "
-                f"{status!r} ({self.A_vertices.shape[0]} vertices)", gamma, str(status))
+                f"{status!r} ({self.n_unique_vertices} distinct vertices)", gamma, str(status))
         if status == cp.OPTIMAL_INACCURATE:
             warnings.warn(f"{self.norm} precision LMI at gamma = {gamma:g}: solver {solver} returned "
-                          "optimal_inaccurate; verify the design (verify_design) before trusting it", stacklevel=2)
-        Xv = 0.5 * (self._X.value + self._X.value.T)
-        Ls = np.linalg.solve(Xv, self._Y.value)
+                          "optimal_inaccurate; verify the design (verify_observer) before trusting it", stacklevel=2)
+        T = np.diag(self.state_scale)
+        Xh = 0.5 * (self._X.value + self._X.value.T)
+        Ls = T @ np.linalg.solve(Xh, self._Y.value)
+        Xv = np.diag(1.0 / self.state_scale) @ Xh @ np.diag(1.0 / self.state_scale)
         L = np.zeros((self.n_x, self.n_y))
         L[:, self.sensors] = Ls
         beta = np.zeros(self.n_y)
@@ -784,10 +963,12 @@ class PrecisionLMI:
         kappa = np.sqrt(beta)
         used = np.zeros(self.n_y, dtype=bool)
         used[self.sensors] = beta[self.sensors] > sparsity_tol * beta.max()
+        Sd = dscale * self.Sd
         return ObserverDesign(norm=self.norm, gamma=gamma, L=L, X=Xv, beta=beta, kappa=kappa,
                               noise_deg=precision_to_noise_deg(kappa), used=used, status=str(status),
                               solver=solver, solve_time=elapsed, objective=float(self.problem.value) / gamma**2,
-                              Bw=self.Bd @ self.Sd, Dd=self.Dd @ self.Sd)
+                              Bw=self.Bd @ Sd, Dd=self.Dd @ Sd, pole_radius=self.pole_radius,
+                              variable_scale=self.variable_scale)
 
 
 def design_observer(model: CR3BPLPV, vertices, gamma: float, norm: str = "h2", *, solver: str = "CLARABEL",
@@ -803,7 +984,8 @@ def design_observer(model: CR3BPLPV, vertices, gamma: float, norm: str = "h2", *
 
 def gamma_sweep(lmi: PrecisionLMI, gammas, *, solver: str = "CLARABEL") -> list:
     """Solve ``lmi`` for each gamma (re-using the canonicalised problem); infeasible points give ``None``."""
-    g = _checks.as_array(gammas, "gammas", ndim=(1,))
+    lmi = _checks.instance(lmi, "lmi", PrecisionLMI)
+    g = _checks.as_array(gammas, "gammas", ndim=(1,), min_size=1)
     out = []
     for gamma in g:
         try:
@@ -814,6 +996,18 @@ def gamma_sweep(lmi: PrecisionLMI, gammas, *, solver: str = "CLARABEL") -> list:
 
 
 # ------------------------------------------------------------------------------------------ verification
+def _check_abc(A, B, C):
+    A = _checks.square(A, "A")
+    n = A.shape[0]
+    B = _checks.as_array(B, "B", ndim=(2,))
+    C = _checks.as_array(C, "C", ndim=(2,))
+    if B.shape[0] != n:
+        raise ValueError(f"B must have {n} rows (the order of A); got shape {B.shape}")
+    if C.shape[1] != n:
+        raise ValueError(f"C must have {n} columns (the order of A); got shape {C.shape}")
+    return A, B, C
+
+
 def h2_norm(A, B, C) -> float:
     r"""H2 norm of :math:`C(sI-A)^{-1}B` from the controllability Gramian (Lyapunov equation).
 
@@ -821,11 +1015,7 @@ def h2_norm(A, B, C) -> float:
     """
     from scipy.linalg import solve_continuous_lyapunov
 
-    A = _checks.as_array(A, "A", ndim=(2,))
-    B = _checks.as_array(B, "B", ndim=(2,))
-    C = _checks.as_array(C, "C", ndim=(2,))
-    if A.shape[0] != A.shape[1] or B.shape[0] != A.shape[0] or C.shape[1] != A.shape[0]:
-        raise ValueError(f"A must be square and conform with B and C; got {A.shape}, {B.shape}, {C.shape}")
+    A, B, C = _check_abc(A, B, C)
     if np.max(np.linalg.eigvals(A).real) >= 0:
         return np.inf
     P = solve_continuous_lyapunov(A, -B @ B.T)
@@ -847,9 +1037,9 @@ def hinf_norm(A, B, C, *, rtol: float = 1e-9, max_iter: int = 50) -> float:
     frequencies where :math:`\sigma_{max} > \gamma`, whose midpoints give the next lower bound.  Returns
     ``inf`` if A is not Hurwitz.
     """
-    A = _checks.as_array(A, "A", ndim=(2,))
-    B = _checks.as_array(B, "B", ndim=(2,))
-    C = _checks.as_array(C, "C", ndim=(2,))
+    A, B, C = _check_abc(A, B, C)
+    rtol = _checks.positive(rtol, "rtol")
+    max_iter = _checks.integer(max_iter, "max_iter", minimum=1)
     eig = np.linalg.eigvals(A)
     if np.max(eig.real) >= 0:
         return np.inf
@@ -931,6 +1121,8 @@ def error_system(model: CR3BPLPV, design: ObserverDesign, rho, *, L=None):
 
     :math:`S_n = \mathrm{diag}(1/\kappa_i)` (zero for sensors whose gain column is zero).
     """
+    model = _checks.instance(model, "model", CR3BPLPV)
+    design = _checks.instance(design, "design", ObserverDesign)
     r = _checks.as_array(rho, "rho", shape=(model.n_rho,))
     L = design.gain() if L is None else _checks.as_array(L, "L", shape=(model.n_x, model.n_y))
     with np.errstate(divide="ignore"):
@@ -962,8 +1154,15 @@ def verify_observer(model: CR3BPLPV, design: ObserverDesign, box: ParameterBox, 
     -------
     Verification
     """
-    if not isinstance(box, ParameterBox):
-        raise ValueError(f"box must be a ParameterBox; got {type(box).__name__}")
+    model = _checks.instance(model, "model", CR3BPLPV)
+    design = _checks.instance(design, "design", ObserverDesign)
+    box = _checks.instance(box, "box", ParameterBox)
+    n_samples = _checks.integer(n_samples, "n_samples", minimum=1)
+    rng = _checks.rng(rng, "rng")
+    if box.dim != model.n_rho:
+        raise ValueError(f"box must bound the {model.n_rho} scheduling parameters; got dim {box.dim}")
+    if L is not None:
+        L = _checks.as_array(L, "L", shape=(model.n_x, model.n_y))
     V = box.vertices()
     S = box.sample(n_samples, rng)
     pts = np.vstack([V, S])
@@ -1015,12 +1214,237 @@ def paper_scenario(system: CR3BP = EARTH_MOON, *, p: int = 2, q: int = 1, perige
     ``n_samples`` points over one period bound :math:`\\rho`; ``margin`` widens the box by that fraction of
     each range (0 by default: the samples are dense enough that the extrema are resolved to ~1e-5).
     """
-    model = CR3BPLPV(system)
+    model = CR3BPLPV(_checks.system(system, "system"))
     orbit = resonant_orbit(system, p, q, perigee_radius)
-    t, x = orbit.sample(int(_checks.positive(n_samples, "n_samples")))
+    t, x = orbit.sample(_checks.integer(n_samples, "n_samples", minimum=2))
     s = model.planar(x)
     rho = model.rho(s)
     box = ParameterBox.from_samples(rho, margin=margin,
                                     source=f"planar {p}:{q} resonant orbit, x0 = {orbit.x0[0]:.6f} LU, "
                                            f"vy0 = {orbit.x0[4]:.6f} LU/TU, T = {orbit.period:.6f} TU")
     return Scenario(model, orbit, t, s, rho, box)
+
+
+# ------------------------------------------------------------------------------------ Fig. 3 criterion
+def guaranteed_error_rms(design: ObserverDesign, noise_rms_deg: float, dt: float | None = None) -> float:
+    r"""Position-error RMS (LU) that the LMI certifies for angle noise of RMS ``noise_rms_deg`` on :math:`\theta_1`.
+
+    The error system is linear in the normalised input :math:`\bar w_i = \kappa_i n_i`.  An angle error
+    :math:`\delta\theta` gives :math:`n_{\sin} = \cos\theta\,\delta\theta`, :math:`n_{\cos} = -\sin\theta\,
+    \delta\theta`, so :math:`|\bar w| \le \kappa_{max}|\delta\theta|` with :math:`\kappa_{max}` the largest
+    precision of the used :math:`\theta_1` channels.  Hence, with :math:`\rho` known exactly:
+
+    * H2 (Theorem 1): white noise of intensity :math:`\sigma^2\Delta t` (samples of variance :math:`\sigma^2` held
+      over :math:`\Delta t`) gives a steady-state :math:`E|\epsilon|^2 \le \gamma^2\kappa_{max}^2\sigma^2\Delta t`
+      (the common Lyapunov matrix bounds the error covariance of the LPV system);
+    * H-infinity (Theorem 2): :math:`\|\epsilon\|_{L_2} \le \gamma\|\bar w\|_{L_2}`, so over a long window the
+      time-RMS error is at most :math:`\gamma\kappa_{max}\,\mathrm{RMS}(\delta\theta)` (plus a transient term
+      from the initial error, negligible after settling).
+
+    Parameters
+    ----------
+    design : ObserverDesign
+    noise_rms_deg : float
+        RMS of the angle noise, deg (per sample for H2).
+    dt : float, optional
+        Sampling interval, TU (required for H2).
+
+    Returns
+    -------
+    float
+        Bound on the RMS position error, LU.
+    """
+    design = _checks.instance(design, "design", ObserverDesign)
+    sig = np.radians(_checks.positive(noise_rms_deg, "noise_rms_deg", allow_zero=True))
+    used = design.used[:2]
+    if not used.any():
+        raise ValueError("design must use a theta1 sensor (sin th1 or cos th1)")
+    kmax = float(np.max(design.kappa[:2][used]))
+    if design.norm == "h2":
+        if dt is None:
+            raise ValueError("dt (the sampling interval, TU) is required for an H2 design")
+        return design.gamma * kmax * sig * np.sqrt(_checks.positive(dt, "dt"))
+    return design.gamma * kmax * sig
+
+
+# ------------------------------------------------------------------------------- sensitivity study
+#: Planar Earth-Moon resonant orbits tried by the sensitivity study: (p, q, perigee radius in LU).  Each is an
+#: x-axis symmetric orbit that :func:`resonant_orbit` corrects (5:3, 3:2 and 7:4 guesses do not converge with the
+#: Keplerian start and are left out).
+RESONANT_CANDIDATES = ((4, 1, 0.2), (3, 1, 0.2), (3, 1, 0.3), (5, 2, 0.35), (2, 1, 0.2), (2, 1, 0.3),
+                       (2, 1, 0.4), (2, 1, 0.5))
+
+
+@dataclass(frozen=True)
+class SensitivityStudy:
+    r"""Allowable :math:`\theta_1` noise at one gamma over orbits, disturbance structures and levels.
+
+    Array axes are ``(orbit, structure, level)``.  The precisions come from the :math:`\theta_1`-only problems
+    (``sensors=[0, 1]``, the channels Eq. 24 uses and the :math:`\|\beta\|_1` optimum selects), whose LMIs depend
+    only on :math:`\rho_1, \rho_2, \rho_3` (8 distinct vertices).  The sampling interval enters afterwards, through
+    :meth:`h2_per_sample_deg`.
+
+    Attributes
+    ----------
+    orbits : tuple of (p, q, perigee_radius)
+    r13_max, period : ndarray (n_orbit,)
+        Largest Earth distance (LU) and period (TU) of each orbit.
+    structures : tuple of str
+    levels : ndarray (n_level,)
+        Disturbance levels :math:`S_d = \mathrm{level}\,I`.
+    gamma, pole_radius : float
+        Bound (LU) and the H-infinity bandwidth bound R (1/TU).
+    h2_kappa, hinf_kappa : ndarray
+        Precision of the :math:`\theta_1` channels (the smaller of sin and cos; NaN where infeasible).
+    h2_status, hinf_status : ndarray of str
+    h2_gain, hinf_gain : ndarray
+        :math:`\|L\|_2` of each design.
+    seconds : float
+        Wall-clock time of the study.
+    """
+
+    orbits: tuple
+    r13_max: np.ndarray
+    period: np.ndarray
+    structures: tuple
+    levels: np.ndarray
+    gamma: float
+    pole_radius: float
+    h2_kappa: np.ndarray
+    hinf_kappa: np.ndarray
+    h2_status: np.ndarray
+    hinf_status: np.ndarray
+    h2_gain: np.ndarray
+    hinf_gain: np.ndarray
+    seconds: float
+
+    @property
+    def h2_intensity_deg(self) -> np.ndarray:
+        """H2 allowance read directly through Eq. 24 (a white-noise intensity, deg TU^1/2)."""
+        return precision_to_noise_deg(np.nan_to_num(self.h2_kappa, nan=np.inf))
+
+    @property
+    def hinf_deg(self) -> np.ndarray:
+        """H-infinity allowance through Eq. 24, deg."""
+        return precision_to_noise_deg(np.nan_to_num(self.hinf_kappa, nan=np.inf))
+
+    def h2_per_sample_deg(self, dt) -> np.ndarray:
+        """H2 allowance per sample for sampling interval(s) ``dt`` (TU); broadcasts ``dt`` on a new last axis."""
+        dt = _checks.as_array(dt, "dt")
+        if np.any(dt <= 0):
+            raise ValueError("dt must be positive (TU)")
+        k = np.nan_to_num(self.h2_kappa, nan=np.inf)[..., None] * np.sqrt(dt)
+        out = precision_to_noise_deg(k)
+        return out[..., 0] if dt.ndim == 0 else out
+
+    def dt_for_h2(self, target_deg: float = 0.1) -> np.ndarray:
+        """Sampling interval (TU) at which the H2 per-sample allowance equals ``target_deg``."""
+        s = np.sin(np.radians(_checks.in_range(target_deg, "target_deg", 0.0, 90.0, closed=False)))
+        return 1.0 / (self.h2_kappa * s) ** 2
+
+    @property
+    def all_optimal(self) -> bool:
+        """Every solve ended ``optimal``."""
+        return bool(np.all(self.h2_status == "optimal") and np.all(self.hinf_status == "optimal"))
+
+
+def _study_orbit(task):
+    """One orbit of :func:`sensitivity_study` (module-level so process pools can pickle it)."""
+    system, (p, q, rp), structures, levels, gamma, R, n_samples = task
+    sc = paper_scenario(system, p=p, q=q, perigee_radius=rp, n_samples=n_samples)
+    V = sc.box.vertices()
+    shape = (len(structures), len(levels))
+    res = {f"{n}_{k}": np.full(shape, np.nan) for n in _NORMS for k in ("kappa", "gain")}
+    res.update({f"{n}_status": np.full(shape, "not_run", dtype=object) for n in _NORMS})
+    for i, structure in enumerate(structures):
+        dist = disturbance_model(structure, 1.0)
+        for norm in _NORMS:
+            lmi = PrecisionLMI.for_cr3bp(sc.model, V, norm, disturbance=dist, sensors=[0, 1],
+                                         pole_radius=R if norm == "hinf" else None)
+            for j, level in enumerate(levels):
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    try:
+                        d = lmi.solve(gamma, disturbance_scale=float(level))
+                    except InfeasibleLMIError as exc:
+                        res[f"{norm}_status"][i, j] = exc.status
+                        continue
+                res[f"{norm}_kappa"][i, j] = float(np.min(d.kappa[:2]))
+                res[f"{norm}_gain"][i, j] = d.gain_norm
+                res[f"{norm}_status"][i, j] = d.status
+    res["r13_max"] = float(1.0 / sc.box.lower[2])
+    res["period"] = sc.orbit.period
+    return res
+
+
+def sensitivity_study(gamma: float = 0.0013, *, orbits=RESONANT_CANDIDATES, structures=DISTURBANCE_STRUCTURES,
+                      levels=(0.0, 1e-4, 1e-3, 1e-2), pole_radius: float = 1000.0, n_samples: int = 1000,
+                      system: CR3BP = EARTH_MOON, executor=None, progress: bool = False) -> SensitivityStudy:
+    r"""Where do the paper's 0.1 deg (H2) and 0.08 deg (H-infinity) come from?  Solve both theorems over the inputs
+    the paper leaves unstated.
+
+    For every resonant orbit (its :math:`\rho` box from ``n_samples`` points over one period), disturbance
+    structure (:func:`disturbance_model`) and level, the :math:`\theta_1`-only H2 problem and the
+    bandwidth-bounded H-infinity problem are solved at ``gamma``.  Each (orbit, structure, norm) problem is built
+    once; the level is a ``cp.Parameter``.
+
+    Parameters
+    ----------
+    gamma : float
+        Bound, LU.
+    orbits : sequence of (p, q, perigee_radius)
+        Planar resonances (see :data:`RESONANT_CANDIDATES`).
+    structures : sequence of str
+        Disturbance structures.
+    levels : array_like
+        Disturbance levels (>= 0).
+    pole_radius : float
+        H-infinity bandwidth bound R, 1/TU (makes the minimum attained; see :class:`PrecisionLMI`).
+    n_samples : int
+        Samples per orbit period bounding :math:`\rho`.
+    system : CR3BP
+    executor : concurrent.futures.Executor, optional
+        Runs the orbits (one task each) with ``executor.map``; default serial.  Results do not depend on it.
+    progress : bool
+        Show a progress bar over the orbits.
+
+    Returns
+    -------
+    SensitivityStudy
+    """
+    gamma = _checks.positive(gamma, "gamma")
+    system = _checks.system(system, "system")
+    try:
+        orbits = tuple((_checks.integer(o[0], "orbits p"), _checks.integer(o[1], "orbits q"),
+                        _checks.positive(o[2], "orbits perigee_radius")) for o in orbits)
+    except (TypeError, IndexError) as exc:
+        raise _checks.ArgumentTypeError("orbits must be a sequence of (p, q, perigee_radius) tuples") from exc
+    if not orbits:
+        raise ValueError("orbits must hold at least one (p, q, perigee_radius)")
+    if isinstance(structures, str):
+        structures = (structures,)
+    structures = tuple(_checks.choice(s, "structures", DISTURBANCE_STRUCTURES) for s in structures)
+    if not structures:
+        raise ValueError("structures must name at least one disturbance structure")
+    lv = _checks.as_array(levels, "levels", ndim=(1,), min_size=1)
+    if np.any(lv < 0):
+        raise ValueError(f"levels must be >= 0; got {lv}")
+    R = _checks.positive(pole_radius, "pole_radius")
+    n_samples = _checks.integer(n_samples, "n_samples", minimum=10)
+    progress = _checks.boolean(progress, "progress")
+    tasks = [(system, o, structures, tuple(lv), gamma, R, n_samples) for o in orbits]
+    t0 = time.perf_counter()
+    mapper = map if executor is None else executor.map
+    results = mapper(_study_orbit, tasks)
+    if progress:
+        from .progress import progress as _progress
+
+        results = _progress(results, total=len(tasks), desc="sensitivity study (orbits)")
+    results = list(results)
+    stack = {k: np.stack([r[k] for r in results]) for k in results[0] if k not in ("r13_max", "period")}
+    return SensitivityStudy(orbits=orbits, r13_max=np.array([r["r13_max"] for r in results]),
+                            period=np.array([r["period"] for r in results]), structures=structures, levels=lv,
+                            gamma=gamma, pole_radius=R, h2_kappa=stack["h2_kappa"], hinf_kappa=stack["hinf_kappa"],
+                            h2_status=stack["h2_status"].astype(str), hinf_status=stack["hinf_status"].astype(str),
+                            h2_gain=stack["h2_gain"], hinf_gain=stack["hinf_gain"],
+                            seconds=time.perf_counter() - t0)
