@@ -211,3 +211,51 @@ def test_bad_input(case1):
                             x_reference=model.x_reference, hessian_scheme="exact")
     with pytest.raises(ValueError, match="q"):
         W.test_case_1(q=-1.0)
+
+
+# ------------------------------------------------------------------------------------------------ re-flight, solutions
+def test_fly_reproduces_first_order_hold(case1):
+    """Interpolating the FOH control onto a refined grid must not change the flight (FOH is linear in time)."""
+    from cislunar.discretization import propagate_foh
+
+    t = np.linspace(0.0, case1.window[0], 6)
+    u = 0.3 * case1.a_max * np.random.default_rng(3).normal(size=(6, 3))
+    tf, xf = W.fly(case1, t, u, refine=5)
+    assert tf.size == 5 * 5 + 1 and np.all(np.isin(t, tf))
+    coarse = propagate_foh(em, case1.observer_x0, t, u)
+    np.testing.assert_allclose(xf[np.isin(tf, t)], coarse, rtol=0, atol=1e-11)
+    # zero control is the ballistic DRO
+    _, x0 = W.fly(case1, t, np.zeros((6, 3)), refine=2)
+    np.testing.assert_allclose(x0[-1], propagate(em, case1.observer_x0, [0.0, t[-1]]).x[-1], atol=1e-11)
+
+
+@pytest.fixture(scope="module")
+def case2_sweep(case2):
+    t, ks, ke = case2.node_times(20)
+    solver = W.ScenarioSolver(case2, t, ks, keep_out=True)
+    x, u = case2.ballistic_guess(t)
+    best, _ = W.sweep_both_ways(solver, [0.0, 1e-3], x, u)
+    return t, ks, ke, solver, best
+
+
+def test_case2_solutions_are_feasible_and_monotone(case2, case2_sweep):
+    """Converged test-case-2 solutions: defects, single-shooting miss, Eq. 41 bounds, zero thrust in the window,
+    keep-out, and MI/impulse non-decreasing along the (small) homotopy grid; alpha_h > 0 leaves the plane."""
+    t, ks, ke, solver, best = case2_sweep
+    assert all(r is not None for r in best.best)
+    for r in best.best:
+        assert r.max_defect <= 1e-9
+        assert W.terminal_miss_km(case2, t, r.u) <= 1.0
+        u = np.linalg.norm(r.u, axis=1)
+        assert np.all(u <= solver.u_max * (1 + 1e-6) + 1e-12)
+        assert np.all(u[ks:ke + 1] <= 1e-12)
+        c, _ = solver.constraints[0](r.x[ks])
+        assert np.max(c) <= 1e-9
+        assert r.information == pytest.approx(solver.information(r.x[ks]), rel=1e-9)
+    imp = best.column("impulse")
+    mi = best.column("information")
+    assert imp[1] >= imp[0] and mi[1] >= mi[0]
+    assert np.max(np.abs(best.best[1].x[:, 2])) * em.length_unit_km > 10.0  # out of plane
+    # the information trajectory is far better determined than the minimum-impulse one
+    rms = [W.evaluate_crlb(case2, r.x[ks]).terminal_rms_km[0] for r in best.best]
+    assert rms[1] < 0.5 * rms[0]
