@@ -36,8 +36,8 @@ import numpy as np
 
 from . import _checks
 from .dynamics import CR3BP
-from .propagation import (DEFAULT_TOL, _check_outcome, _check_tol, _grid_from, _heyoka, check_outside_primaries,
-                          thread_local_copy)
+from .propagation import (DEFAULT_TOL, _check_outcome, _check_tol, _grid_from, _heyoka, _inside_primaries,
+                          check_outside_primaries, thread_local_copy)
 
 __all__ = ["OCBETransition", "ocbe_transition", "ocbe_process_noise", "estimated_control", "OCBEResult",
            "ocbe_filter_smoother", "variational_system", "FilterDivergenceError"]
@@ -200,6 +200,11 @@ def ocbe_transition(system: CR3BP, x0, t, control_weight: float, *, tol: float =
     check_outside_primaries(system, x0, "x0", t0=grid[0])
     q = _checks.positive(control_weight, "control_weight")
     tol = _check_tol(tol)
+    return _transition(system, x0, grid, q, tol)
+
+
+def _transition(system, x0, grid, q, tol) -> OCBETransition:
+    """:func:`ocbe_transition` without argument checks (the filters' inner loop)."""
     _, index = _ocbe_template(tol)
     ta = _ocbe_integrator(tol)
     ta.pars[:] = [system.mu, q]
@@ -209,7 +214,8 @@ def ocbe_transition(system: CR3BP, x0, t, control_weight: float, *, tol: float =
     res = ta.propagate_grid(grid)
     _check_outcome(res[0], grid[-1], ta.time, None, np.array(ta.state[:6]))
     out = res[-1]
-    check_outside_primaries(system, out[:, :6], "reference trajectory", t0=grid[0])
+    if _inside_primaries(system, out[:, :3]):
+        check_outside_primaries(system, out[:, :6], "reference trajectory", t0=grid[0])
     return OCBETransition(t=grid, x=out[:, :6], phi=out[:, index], control_weight=q)
 
 
@@ -397,8 +403,8 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
         val, _, Ht = model.evaluate(obs[k, vis], x_ref)
         dy = model.residual(y[k, vis], val).reshape(-1)
         Rk = np.kron(np.eye(vis.size), R[k])
-        S_new, b, e = srif.measurement_update(S, np.zeros(6), Ht.reshape(-1, 6), dy, Rk)
-        return S_new, x_ref + srif.covariance_from_sri(S_new, b)[0], e
+        S_new, b, e = srif._measurement_update(S, np.zeros(6), Ht.reshape(-1, 6), dy, Rk)
+        return S_new, x_ref + srif._cov_of_sri(S_new, b)[0], e
 
     epoch = [0]
 
@@ -406,27 +412,27 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
         x_pred, P_pred, x_filt, P_filt, S_filt, resid = [], [], [], [], [], []
         phis, terms, Qs, t_sub, phi_pp_sub, p_step = [], [], [], [], [], []
         x_pred.append(x.copy())
-        P_pred.append(srif.covariance_from_sri(S))
+        P_pred.append(srif._cov_of_sri(S))
         S, x, e = update(S, x, 0)
         x_filt.append(x.copy())
-        P_filt.append(srif.covariance_from_sri(S))
+        P_filt.append(srif._cov_of_sri(S))
         S_filt.append(S)
         resid.append(e)
         for n in range(N - 1):
             epoch[0] = n + 1
             grid = np.linspace(t[n], t[n + 1], n_sub)
-            tr = ocbe_transition(system, x, grid, qs[n], tol=tol)
+            tr = _transition(system, x, grid, qs[n], tol)
             Phi = tr.phi[-1]
             Phi_xx, Phi_xp = Phi[:6, :6], Phi[:6, 6:]
             Q = ocbe_process_noise(Phi)
-            S_bar, _, term = srif.time_update(S, np.zeros(6), Phi_xx, eye6, Q)  # Eq. 23 (b_x,n|n = 0)
+            S_bar, _, term = srif._time_update(S, np.zeros(6), Phi_xx, eye6, Q)  # Eq. 23 (b_x,n|n = 0)
             x_prior = tr.x[-1]
             x_pred.append(x_prior.copy())
-            P_pred.append(srif.covariance_from_sri(S_bar))
+            P_pred.append(srif._cov_of_sri(S_bar))
             S_new, x_new, e = update(S_bar, x_prior, n + 1)  # Eqs. 24-28
             # single-step smoother (Eqs. 29-30) and costate (Eq. 31)
-            S1, b1 = srif.smoother_step(S_new, S_new @ (x_new - x_prior), Phi_xx, eye6, term)
-            dx_n = srif.covariance_from_sri(S1, b1)[0]
+            S1, b1 = srif._smoother_step(S_new, S_new @ (x_new - x_prior), Phi_xx, eye6, term)
+            dx_n = srif._cov_of_sri(S1, b1)[0]
             p_step.append(-(S.T @ S) @ dx_n)
             phis.append(Phi)
             terms.append(term)
@@ -435,7 +441,7 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
             phi_pp_sub.append(tr.phi_pp)
             S, x = S_new, x_new
             x_filt.append(x.copy())
-            P_filt.append(srif.covariance_from_sri(S))
+            P_filt.append(srif._cov_of_sri(S))
             S_filt.append(S)
             resid.append(e)
         p_step = np.array(p_step)
@@ -451,8 +457,8 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
             for n in range(N - 2, -1, -1):
                 Phi_xx = phis[n][:6, :6]
                 z_next = bs + Rs @ (x_filt[n + 1] - x_pred[n + 1])  # info about the deviation from x_{n+1|n}
-                Rs, bs = srif.smoother_step(Rs, z_next, Phi_xx, eye6, terms[n])
-                dx, Ps[n] = srif.covariance_from_sri(Rs, bs)
+                Rs, bs = srif._smoother_step(Rs, z_next, Phi_xx, eye6, terms[n])
+                dx, Ps[n] = srif._cov_of_sri(Rs, bs)
                 xs[n] = x_filt[n] + dx
             x_s, P_s = np.array(xs), np.array(Ps)
             p_s = np.empty((N - 1, 6))

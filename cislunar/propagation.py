@@ -110,6 +110,15 @@ class PropagationError(RuntimeError):
         return (type(self), (self.time, self.target, self.member, self.outcome))
 
 
+def _inside_primaries(system: CR3BP, positions) -> bool:
+    """True if any position ``(..., 3)`` lies on or inside a primary (fast, unchecked)."""
+    p = positions[..., :3]
+    d2 = p - system.secondary_position
+    d1 = p - system.primary_position
+    return bool(np.any(np.einsum("...i,...i->...", d2, d2) <= system.secondary_radius ** 2)
+                or np.any(np.einsum("...i,...i->...", d1, d1) <= system.primary_radius ** 2))
+
+
 def check_outside_primaries(system: CR3BP, states, name: str = "states", *, t0: float = 0.0) -> None:
     """Raise :class:`ImpactError` if any state ``(6,)`` or ``(n, 6)`` lies on or inside the Earth or the Moon.
 

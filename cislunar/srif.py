@@ -41,11 +41,52 @@ def householder_triangularize(A) -> np.ndarray:
 
     Row signs are normalised so that the diagonal is non-negative (the factor is then unique for full rank).
     """
-    A = _checks.as_array(A, "A", ndim=(2,))
+    return _triangularize(_checks.as_array(A, "A", ndim=(2,)))
+
+
+# Unchecked kernels: the public functions below validate their arguments and call these; filters built on this
+# module (cislunar.ocbe) validate once at their own boundary and call the kernels in their inner loops.
+def _triangularize(A):
     r = np.linalg.qr(A, mode="r")
     d = np.sign(np.diag(r))
     d[d == 0] = 1.0
     return r * d[:, None]
+
+
+def _sri_of_cov(C):
+    """W upper triangular with W^T W = C^{-1}; raises LinAlgError if C is not positive definite."""
+    L = np.linalg.cholesky(0.5 * (C + C.T))
+    return _triangularize(solve_triangular(L, np.eye(C.shape[0]), lower=True))
+
+
+def _cov_of_sri(R, z=None):
+    Rinv = solve_triangular(R, np.eye(R.shape[0]), lower=False)
+    P = Rinv @ Rinv.T
+    return P if z is None else (Rinv @ z, P)
+
+
+def _measurement_update(R, z, H, y, meas_cov):
+    n = R.shape[0]
+    W = _sri_of_cov(meas_cov)
+    U = _triangularize(np.block([[R, z[:, None]], [W @ H, (W @ y)[:, None]]]))
+    return U[:n, :n], U[:n, n], float(abs(U[n, n]))
+
+
+def _time_update(R, z, Phi, Gamma, Q):
+    n = R.shape[0]
+    Rt = np.linalg.solve(Phi.T, R.T).T  # R Phi^{-1}
+    r = Gamma.shape[1]
+    A = np.block([[_sri_of_cov(Q), np.zeros((r, n)), np.zeros((r, 1))], [-Rt @ Gamma, Rt, z[:, None]]])
+    U = _triangularize(A)
+    return U[r:, r:r + n], U[r:, r + n], (U[:r, :r], U[:r, r:r + n], U[:r, r + n])
+
+
+def _smoother_step(Rs_next, zs_next, Phi, Gamma, smoother_terms):
+    Rw, Rwx, zw = smoother_terms
+    r, n = Rw.shape[0], Rs_next.shape[0]
+    A = np.block([[Rw + Rwx @ Gamma, Rwx @ Phi, zw[:, None]], [Rs_next @ Gamma, Rs_next @ Phi, zs_next[:, None]]])
+    U = _triangularize(A)
+    return U[r:r + n, r:r + n], U[r:r + n, r + n]
 
 
 def _chol_upper_inverse(C, name):
@@ -61,7 +102,7 @@ def _chol_upper_inverse(C, name):
         raise ValueError(f"{name} must be symmetric positive definite") from None
     # C = L L^T  ->  C^{-1} = L^{-T} L^{-1}; W = L^{-1} is lower; use QR to make it upper triangular
     W = solve_triangular(L, np.eye(C.shape[0]), lower=True)
-    return householder_triangularize(W)
+    return _triangularize(W)
 
 
 def sri_from_covariance(x, P, *, name: str = "P") -> tuple[np.ndarray, np.ndarray]:
@@ -79,11 +120,9 @@ def sri_from_covariance(x, P, *, name: str = "P") -> tuple[np.ndarray, np.ndarra
 def covariance_from_sri(R, z=None):
     """Covariance :math:`R^{-1}R^{-\\top}` (and mean :math:`R^{-1}z` if ``z`` is given) of an SRI pair."""
     R = _checks.upper_triangular(R, "R")
-    Rinv = solve_triangular(R, np.eye(R.shape[0]), lower=False)
-    P = Rinv @ Rinv.T
     if z is None:
-        return P
-    return Rinv @ _checks.as_array(z, "z", ndim=(1,)), P
+        return _cov_of_sri(R)
+    return _cov_of_sri(R, _checks.as_array(z, "z", shape=(R.shape[0],)))
 
 
 def measurement_update(R, z, H, y, meas_cov):
@@ -110,7 +149,7 @@ def measurement_update(R, z, H, y, meas_cov):
     if W.shape[0] != H.shape[0]:
         raise ValueError(f"meas_cov must be {H.shape[0]}x{H.shape[0]}; got {np.shape(meas_cov)}")
     A = np.block([[R, z[:, None]], [W @ H, (W @ y)[:, None]]])
-    U = householder_triangularize(A)  # (n + 1, n + 1): [R_new z_new; 0 e]
+    U = _triangularize(A)  # (n + 1, n + 1): [R_new z_new; 0 e]
     return U[:n, :n], U[:n, n], float(abs(U[n, n]))
 
 
@@ -151,9 +190,12 @@ def time_update(R, z, Phi, Gamma=None, Q=None):
     n = R.shape[0]
     z = _checks.as_array(z, "z", shape=(n,))
     Phi = _checks.as_array(Phi, "Phi", shape=(n, n))
-    if np.linalg.cond(Phi) > 1e15:
-        raise ValueError(f"Phi must be an invertible transition matrix; condition number {np.linalg.cond(Phi):.3e}")
-    Rt = np.linalg.solve(Phi.T, R.T).T  # R Phi^{-1}
+    try:
+        Rt = np.linalg.solve(Phi.T, R.T).T  # R Phi^{-1}
+    except np.linalg.LinAlgError:
+        raise ValueError("Phi must be an invertible transition matrix; it is singular") from None
+    if not np.all(np.isfinite(Rt)):
+        raise ValueError("Phi must be an invertible transition matrix; it is numerically singular")
     if Gamma is None and Q is None:
         U = householder_triangularize(np.hstack([Rt, z[:, None]]))
         return U[:, :n], U[:, n], None
@@ -167,7 +209,7 @@ def time_update(R, z, Phi, Gamma=None, Q=None):
     if Rw.shape[0] != r:
         raise ValueError(f"Q must be {r}x{r} to match Gamma; got {np.shape(Q)}")
     A = np.block([[Rw, np.zeros((r, n)), np.zeros((r, 1))], [-Rt @ Gamma, Rt, z[:, None]]])
-    U = householder_triangularize(A)
+    U = _triangularize(A)
     return U[r:, r:r + n], U[r:, r + n], (U[:r, :r], U[:r, r:r + n], U[:r, r + n])
 
 
@@ -194,9 +236,7 @@ def smoother_step(Rs_next, zs_next, Phi, Gamma, smoother_terms):
     zw = _checks.as_array(smoother_terms[2], "smoother_terms[2]", shape=(r,))
     if Gamma.shape[1] != r:
         raise ValueError(f"Gamma must have {r} columns to match smoother_terms; got shape {Gamma.shape}")
-    A = np.block([[Rw + Rwx @ Gamma, Rwx @ Phi, zw[:, None]], [Rs_next @ Gamma, Rs_next @ Phi, zs_next[:, None]]])
-    U = householder_triangularize(A)
-    return U[r:r + n, r:r + n], U[r:r + n, r + n]
+    return _smoother_step(Rs_next, zs_next, Phi, Gamma, (Rw, Rwx, zw))
 
 
 @dataclass(frozen=True)

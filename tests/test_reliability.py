@@ -1009,7 +1009,7 @@ def test_filter_trial_separates_divergence_from_configuration_errors(monkeypatch
         tracking.filter_trial(rng, "scenario", 1e-8)
 
     # a numerical failure inside the filter is reported as a diverged trial (with the failure text)
-    real_update = srif.measurement_update
+    real_update = srif._measurement_update
     calls = {"n": 0}
 
     def failing_update(*a, **k):
@@ -1018,7 +1018,7 @@ def test_filter_trial_separates_divergence_from_configuration_errors(monkeypatch
             raise np.linalg.LinAlgError("update lost positive definiteness")
         return real_update(*a, **k)
 
-    monkeypatch.setattr(srif, "measurement_update", failing_update)
+    monkeypatch.setattr(srif, "_measurement_update", failing_update)
     res = tracking.filter_trial(np.random.default_rng(0), sc, 1e-8)
     assert res.diverged and "epoch" in res.failure and "positive definiteness" in res.failure
 
