@@ -647,6 +647,46 @@ def test_random_malformed_scalars_are_refused_by_name(case):
     assert outcome == "named", f"{label}({arg}={bad!r:.80}): {outcome}"
 
 
+MATRIX_SPECS = [(s.label, a) for s in SPECS for a, k in s.kinds.items() if k in ("spd", "spd_batch", "upper")]
+
+
+@st.composite
+def _malformed_matrix(draw):
+    """A random indefinite symmetric matrix, an asymmetric one, or an 'SRI factor' with entries below the diagonal."""
+    label, arg = draw(st.sampled_from(MATRIX_SPECS))
+    spec = SPEC_BY_LABEL[label]
+    valid = spec.kwargs[arg]
+    valid = np.asarray(valid() if getattr(valid, "_lazy", False) else valid, dtype=float)
+    n = valid.shape[-1]
+    seed = draw(st.integers(0, 2**32 - 1))
+    rng = np.random.default_rng(seed)
+    if spec.kinds[arg] == "upper":
+        R = valid.copy()
+        i = draw(st.integers(1, n - 1))
+        j = draw(st.integers(0, i - 1))
+        R[i, j] = draw(st.floats(1e-6, 1e3)) * draw(st.sampled_from([-1.0, 1.0]))
+        return label, arg, R
+    Q, _ = np.linalg.qr(rng.standard_normal((n, n)))
+    lam = np.abs(rng.standard_normal(n)) + 0.1
+    if draw(st.booleans()):  # indefinite: one eigenvalue negative
+        lam[draw(st.integers(0, n - 1))] *= -1.0
+        M = Q @ np.diag(lam) @ Q.T
+        M = 0.5 * (M + M.T)
+    else:  # clearly asymmetric
+        M = Q @ np.diag(lam) @ Q.T
+        M[0, n - 1] += 0.5 * (1.0 + abs(M[0, n - 1]))
+    M = M * float(np.max(np.abs(valid)))
+    return label, arg, np.broadcast_to(M, valid.shape).copy()
+
+
+@settings(max_examples=120, deadline=None)
+@given(_malformed_matrix())
+def test_random_non_spd_covariances_and_non_triangular_factors_are_refused_by_name(case):
+    label, arg, bad = case
+    outcome = classify(SPEC_BY_LABEL[label], arg, bad)
+    assert outcome == "named", f"{label}({arg}): {outcome}"
+
+
 def test_the_audits_examples():
     x = X_DRO
     for call, name in [
