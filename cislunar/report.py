@@ -11,19 +11,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import _checks
+
 __all__ = ["ComparisonTable", "Row", "REPORT_METADATA_KEY", "STATUSES", "fmt"]
 
 #: Key placed in the display metadata of a rendered table.
 REPORT_METADATA_KEY = "cislunar_report"
-#: Allowed status words; "differs" and "not in paper" need a reason.
-STATUSES = ("reproduced", "differs", "derived", "not in paper", "beyond paper")
+#: Allowed status words (the guide's rule); "differs" and "not in paper" need a reason.  "consistent (tuned)": agrees
+#: only after a choice made while looking at the paper's number.
+STATUSES = ("reproduced", "consistent (tuned)", "differs", "derived", "not in paper", "beyond paper")
 
 
 def fmt(value, digits: int = 6) -> str:
     """Format numbers compactly for tables (strings pass through)."""
-    if isinstance(digits, bool) or not isinstance(digits, int) or not 1 <= digits <= 17:
-        raise (TypeError if not isinstance(digits, int) or isinstance(digits, bool) else ValueError)(
-            f"digits must be an integer in [1, 17]; got {digits!r}")
+    digits = _checks.integer(digits, "digits", minimum=1, maximum=17)
     if value is None:
         return "-"
     if isinstance(value, str):

@@ -73,3 +73,14 @@ def test_every_notebook_source_follows_the_conventions():
             assert f"\n{name} = " in text, (src, name)
         assert ".display()" in text, f"{src.name} does not display its closing table"
     assert not list((paths.repo_root() / "notebooks").glob("*.ipynb")) or os.environ.get("CI") is None
+
+
+def test_status_words_follow_the_guide():
+    from cislunar.report import STATUSES, ComparisonTable
+
+    assert STATUSES == ("reproduced", "consistent (tuned)", "differs", "derived", "not in paper", "beyond paper")
+    t = ComparisonTable("t").add("z_lim", 0.1, 0.11, "consistent (tuned)", "window weight chosen to match")
+    assert "consistent (tuned)" in t.to_markdown()
+    for bad_status in ("agrees", "consistent"):
+        with pytest.raises(ValueError, match="status"):
+            ComparisonTable("t").add("x", 1, 2, bad_status)
