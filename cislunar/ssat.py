@@ -585,17 +585,28 @@ def mmd_direction(Q) -> np.ndarray:
     return v * sgn
 
 
-def mmd_policy(system: CR3BP, agent_x0, target_x0, t, dv_magnitude: float, P0, *,
+def _burn_index(burn_index, t, name="burn_index"):
+    if isinstance(burn_index, bool) or not isinstance(burn_index, (int, np.integer)):
+        raise ValueError(f"{name} must be an integer grid index; got {burn_index!r}")
+    b = int(burn_index)
+    if not 0 <= b < t.size - 1:
+        raise ValueError(f"{name} must index a grid time before the last one (0..{t.size - 2}); got {b}")
+    return b
+
+
+def mmd_policy(system: CR3BP, agent_x0, target_x0, t, dv_magnitude: float, P0, *, burn_index: int = 0,
                sigma_min_rad: float = AMOS_SIGMA_MIN_RAD, resolution_km: float = AMOS_RESOLUTION_KM):
-    """MMD impulse at ``t[0]`` for the coast ``t[0] -> t[-1]``, sign chosen by a quick covariance analysis.
+    """MMD impulse at ``t[burn_index]`` for the coast to ``t[-1]``, sign chosen by a quick covariance analysis.
+
+    Measurements cover the whole grid (those before the burn are a tracking arc that ends at the burn).
 
     Parameters
     ----------
     system : CR3BP
     agent_x0, target_x0 : array_like (6,)
-        States at ``t[0]``.
+        States at ``t[0]`` (before the burn).
     t : array_like (N,)
-        Measurement grid; :math:`\\tau_0 = t_0`, :math:`\\tau_f = t_{N-1}`.
+        Measurement grid; :math:`\\tau_0 = t_b`, :math:`\\tau_f = t_{N-1}`.
     dv_magnitude : float
         :math:`\\upsilon`, LU/TU.
     P0 : array_like (12, 12)
@@ -613,13 +624,15 @@ def mmd_policy(system: CR3BP, agent_x0, target_x0, t, dv_magnitude: float, P0, *
     t = _checks.time_grid(t, "t", increasing=True)
     xa0 = _checks.as_state(agent_x0, "agent_x0", batch=False)
     xt0 = _checks.as_state(target_x0, "target_x0", batch=False)
+    b = _burn_index(burn_index, t)
     nominal = propagate_with_impulses(system, np.vstack([xa0, xt0]), t)
     _, Ha, _ = AZIMUTH_ELEVATION.evaluate(nominal.x[0, -1], nominal.x[1, -1])
-    Q = mmd_matrix(nominal.stm[0, -1], Ha)
+    phi_fb = nominal.stm[0, -1] @ np.linalg.inv(nominal.stm[0, b])  # Phi(tau_f, tau_0)
+    Q = mmd_matrix(phi_fb, Ha)
     e = mmd_direction(Q)
     target = ImpulsiveTrajectory(t, nominal.x[1:], nominal.stm[1:])
     cand = np.vstack([e, -e]) * v
-    ag = propagate_with_impulses(system, np.vstack([xa0, xa0]), t, [(t[0], cand)])
+    ag = propagate_with_impulses(system, np.vstack([xa0, xa0]), t, [(t[b], cand)])
     J = ssat_covariance(system, ag, target, P0, sigma_min_rad=sigma_min_rad, resolution_km=resolution_km).J_rho[:, -1]
     return cand[int(np.argmin(J))], Q, J
 
@@ -656,10 +669,11 @@ def perpendicular_directions(line_of_sight, n: int) -> np.ndarray:
 
 
 def range_sigma_over_directions(system: CR3BP, agent_x0, target_x0, t, dv_magnitude: float, directions, P0, *,
-                                target: ImpulsiveTrajectory | None = None, threads: int | None = None,
+                                burn_index: int = 0, target: ImpulsiveTrajectory | None = None,
+                                threads: int | None = None,
                                 sigma_min_rad: float = AMOS_SIGMA_MIN_RAD,
                                 resolution_km: float = AMOS_RESOLUTION_KM) -> SSATCovariance:
-    """Covariance analyses of impulses ``dv_magnitude * directions`` applied at ``t[0]`` (batched).
+    """Covariance analyses of impulses ``dv_magnitude * directions`` applied at ``t[burn_index]`` (batched).
 
     ``J_rho[:, k]`` of the result is the cost for the coast :math:`\\tau_f = t_k` (measurements are a prefix of
     the grid), so one call covers every coast time of the grid.  ``directions`` (m, 3) need not be unit vectors
@@ -676,13 +690,14 @@ def range_sigma_over_directions(system: CR3BP, agent_x0, target_x0, t, dv_magnit
     if target is None:
         xt0 = _checks.as_state(target_x0, "target_x0", batch=False)
         target = propagate_with_impulses(system, xt0, t)
-    ag = propagate_with_impulses(system, np.broadcast_to(xa0, D.shape[:1] + (6,)), t, [(t[0], v * D)],
+    b = _burn_index(burn_index, t)
+    ag = propagate_with_impulses(system, np.broadcast_to(xa0, D.shape[:1] + (6,)), t, [(t[b], v * D)],
                                  threads=threads)
     return ssat_covariance(system, ag, target, P0, sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
 
 
 def minimize_range_sigma(system: CR3BP, agent_x0, target_x0, t, dv_magnitude: float, P0, *, n_grid: int = 2000,
-                         refine: bool = True, target: ImpulsiveTrajectory | None = None,
+                         refine: bool = True, burn_index: int = 0, target: ImpulsiveTrajectory | None = None,
                          grid_result: SSATCovariance | None = None):
     """True minimiser of the final :math:`J_\\rho` over burn directions of fixed magnitude.
 
@@ -704,7 +719,8 @@ def minimize_range_sigma(system: CR3BP, agent_x0, target_x0, t, dv_magnitude: fl
         target = propagate_with_impulses(system, _checks.as_state(target_x0, "target_x0", batch=False), t)
     D = fibonacci_sphere(int(n_grid))
     if grid_result is None:
-        grid_result = range_sigma_over_directions(system, agent_x0, None, t, dv_magnitude, D, P0, target=target)
+        grid_result = range_sigma_over_directions(system, agent_x0, None, t, dv_magnitude, D, P0, target=target,
+                                                  burn_index=burn_index)
     Jg = grid_result.J_rho[:, -1]
     if Jg.size != D.shape[0]:
         raise ValueError(f"grid_result must hold {D.shape[0]} directions (n_grid); got {Jg.size}")
@@ -720,7 +736,8 @@ def minimize_range_sigma(system: CR3BP, agent_x0, target_x0, t, dv_magnitude: fl
     p0 = np.array([np.arctan2(best[1], best[0]), np.arcsin(np.clip(best[2], -1, 1))])
 
     def cost(p):
-        r = range_sigma_over_directions(system, agent_x0, None, t, dv_magnitude, to_vec(p)[None], P0, target=target)
+        r = range_sigma_over_directions(system, agent_x0, None, t, dv_magnitude, to_vec(p)[None], P0, target=target,
+                                        burn_index=burn_index)
         return r.J_rho[0, -1] / Jbest
 
     step = np.sqrt(4 * np.pi / D.shape[0])
@@ -782,13 +799,14 @@ class PolicyComparison:
 
 
 def compare_burn_policies(system: CR3BP, agent_x0, target_x0, t, coast_indices, dv_magnitude: float, P0, *,
-                          n_grid: int = 2000, n_perp: int = 72, refine: bool = True,
+                          n_grid: int = 2000, n_perp: int = 72, refine: bool = True, burn_index: int = 0,
                           sigma_min_rad: float = AMOS_SIGMA_MIN_RAD,
                           resolution_km: float = AMOS_RESOLUTION_KM) -> PolicyComparison:
     """MMD against the true minimiser of :math:`J_\\rho` and the perpendicular heuristic, for several coast times.
 
-    A single impulse of magnitude ``dv_magnitude`` (LU/TU) at ``t[0]``; measurements at every grid time up to the
-    end of the coast :math:`\\tau_f = t_k`, ``k`` in ``coast_indices``.  The sphere grid and the perpendicular
+    A single impulse of magnitude ``dv_magnitude`` (LU/TU) at ``t[burn_index]``; measurements at every grid time
+    up to the end of the coast :math:`\\tau_f = t_k`, ``k`` in ``coast_indices`` (grid times before the burn are a
+    tracking arc).  The sphere grid and the perpendicular
     circle are propagated once for the longest coast (the measurement sets of shorter coasts are prefixes).
 
     Parameters
@@ -810,8 +828,10 @@ def compare_burn_policies(system: CR3BP, agent_x0, target_x0, t, coast_indices, 
     """
     t = _checks.time_grid(t, "t", increasing=True)
     ks = np.asarray(coast_indices, dtype=int)
-    if ks.ndim != 1 or ks.size == 0 or np.any(ks < 1) or np.any(ks >= t.size):
-        raise ValueError(f"coast_indices must be grid indices in 1..{t.size - 1}; got {coast_indices!r}")
+    b = _burn_index(burn_index, t)
+    if ks.ndim != 1 or ks.size == 0 or np.any(ks <= b) or np.any(ks >= t.size):
+        raise ValueError(f"coast_indices must be grid indices in {b + 1}..{t.size - 1} (after the burn); "
+                         f"got {coast_indices!r}")
     xa0 = _checks.as_state(agent_x0, "agent_x0", batch=False)
     xt0 = _checks.as_state(target_x0, "target_x0", batch=False)
     v = _checks.positive(dv_magnitude, "dv_magnitude")
@@ -822,24 +842,26 @@ def compare_burn_policies(system: CR3BP, agent_x0, target_x0, t, coast_indices, 
     nominal = propagate_with_impulses(system, xa0, tt)
     none = ssat_covariance(system, nominal, target, P0, sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
     D = fibonacci_sphere(int(n_grid))
-    grid = range_sigma_over_directions(system, xa0, None, tt, v, D, P0, target=target,
+    grid = range_sigma_over_directions(system, xa0, None, tt, v, D, P0, target=target, burn_index=b,
                                        sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
-    los = xt0[:3] - xa0[:3]
+    los = target.x[0, b, :3] - nominal.x[0, b, :3]  # line of sight at the burn
     los = los / np.linalg.norm(los)
     perp = range_sigma_over_directions(system, xa0, None, tt, v, perpendicular_directions(los, int(n_perp)), P0,
-                                       target=target, sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
+                                       target=target, burn_index=b, sigma_min_rad=sigma_min_rad,
+                                       resolution_km=resolution_km)
     out = {k: [] for k in ("none", "mmd", "mmd_other", "optimum", "grid_median", "grid_max", "perp_best",
                            "perp_median", "perp_worst", "mmd_percentile", "mmd_direction", "optimum_direction",
                            "angle_mmd_optimum_deg", "optimum_perp_angle_deg")}
     for k in ks:
         tk = tt[:k + 1]
-        u, Q, Jpm = mmd_policy(system, xa0, xt0, tk, v, P0, sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
+        u, Q, Jpm = mmd_policy(system, xa0, xt0, tk, v, P0, burn_index=b, sigma_min_rad=sigma_min_rad,
+                               resolution_km=resolution_km)
         Jg = grid.J_rho[:, k]
         sub = SSATCovariance(tk, grid.J_rho[:, :k + 1], grid.P_final, grid.range_km[:, :k + 1],
                              grid.sigma_theta_rad[:, :k + 1], L)
         tgt_k = ImpulsiveTrajectory(tk, target.x[:, :k + 1], target.stm[:, :k + 1])
         d_opt, J_opt = minimize_range_sigma(system, xa0, None, tk, v, P0, n_grid=int(n_grid), refine=refine,
-                                            target=tgt_k, grid_result=sub)
+                                            burn_index=b, target=tgt_k, grid_result=sub)
         J_mmd = float(Jpm.min())
         e = u / v
         out["none"].append(np.sqrt(none.J_rho[0, k]) * L)
@@ -857,5 +879,5 @@ def compare_burn_policies(system: CR3BP, agent_x0, target_x0, t, coast_indices, 
         out["optimum_direction"].append(d_opt)
         out["angle_mmd_optimum_deg"].append(np.degrees(np.arccos(min(1.0, abs(float(e @ d_opt))))))
         out["optimum_perp_angle_deg"].append(np.degrees(np.arcsin(min(1.0, abs(float(d_opt @ los))))))
-    hours = (tt[ks] - tt[0]) * system.time_unit_s / 3600.0
+    hours = (tt[ks] - tt[b]) * system.time_unit_s / 3600.0
     return PolicyComparison(coast_hours=hours, **{k: np.asarray(v_) for k, v_ in out.items()})

@@ -289,3 +289,26 @@ def test_direction_helpers():
         ssat.perpendicular_directions(np.zeros(3), 4)
     with pytest.raises(ValueError, match="dv_magnitude"):
         ssat.mmd_policy(em, np.ones(6), np.ones(6), [0, 1], -1.0, np.eye(12))
+
+
+def test_burn_after_a_tracking_arc(pair):
+    """burn_index: MMD uses Phi(tau_f, tau_b) (same Q as starting at the burn) and a mid-arc burn is informative."""
+    xa, xt = pair
+    t = np.arange(0, 13) * HR
+    b = 6
+    P0 = ssat.initial_covariance(em)
+    v = 1e-3 / em.velocity_unit_km_s
+    _, Q_b, _ = ssat.mmd_policy(em, xa, xt, t, v, P0, burn_index=b)
+    xb = propagate(em, np.vstack([xa, xt]), t[:b + 1]).x[:, -1]
+    _, Q_0, _ = ssat.mmd_policy(em, xb[0], xb[1], t[b:], v, P0)
+    assert np.allclose(Q_b, Q_0, rtol=1e-7, atol=1e-9 * np.max(np.abs(Q_0)))
+    # a known burn in the middle of a tracking arc breaks the angles-only scaling symmetry: large information gain
+    D = ssat.fibonacci_sphere(50)
+    tg = ssat.propagate_with_impulses(em, xt, t)
+    mid = ssat.range_sigma_over_directions(em, xa, None, t, v, D, P0, burn_index=b, target=tg)
+    none = ssat.ssat_covariance(em, ssat.propagate_with_impulses(em, xa, t), tg, P0)
+    assert np.median(mid.J_rho[:, -1]) < 0.1 * none.J_rho[0, -1]
+    with pytest.raises(ValueError, match="burn_index"):
+        ssat.mmd_policy(em, xa, xt, t, v, P0, burn_index=12)
+    with pytest.raises(ValueError, match="coast_indices"):
+        ssat.compare_burn_policies(em, xa, xt, t, [3], v, P0, burn_index=b, n_grid=10, n_perp=4)
