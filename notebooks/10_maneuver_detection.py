@@ -63,6 +63,7 @@ plotting.use_style()
 out = OUTPUT_DIR or None
 rng = np.random.default_rng(SEED)
 executor = ProcessPoolExecutor(WORKERS, mp_context=mp.get_context("spawn")) if WORKERS > 1 else None
+TUNED = "consistent (tuned)"  # agreement that rests on a choice made while looking at the paper
 table = ComparisonTable("10 Maneuver detection (Greaves & Scheeres 2021, Eqs. 3-5, 33-35, Figs. 12-22, Tables 5-8)")
 ORBITS = {"9:2 NRHO": orbits.nrho_9_2(em), "stable NRHO": orbits.stable_nrho(em)}
 POLICIES = {"active": det.ACTIVE_POLICY, "quiet": det.QUIET_POLICY}
@@ -108,7 +109,7 @@ ax[2].axhline(0.5, color="C3", ls="--", label="uniform sphere")
 ax[2].set(xlabel=r"$\hat k$ component of the impulse direction", ylabel="PDF", ylim=(0, 3), title="pointing")
 ax[0].legend()
 ax[2].legend(fontsize=8)
-plotting.save_figure(fig, "10_station_keeping_policy", output_dir=out)
+_ = plotting.save_figure(fig, "10_station_keeping_policy", output_dir=out)
 ks_sphere = stats.kstest(uz, stats.uniform(-1, 2).cdf).pvalue
 print(f"KS test of u_z against a uniform sphere: p = {ks_sphere:.1e}; against arcsine: "
       f"p = {stats.kstest(uz, stats.arcsine(-1, 2).cdf).pvalue:.2f}")
@@ -120,6 +121,11 @@ table.add("Eqs. 3-4 pointing", "'random pointing', U[-pi,pi] x U[-pi/2,pi/2]",
 
 # %% [markdown]
 # ## 2 · Tuning the OCBE: constant versus an apoapsis window
+#
+# Why not let the filter tune itself? Notebook 09b runs the paper's adaptive OCBE (metric test, three strikes,
+# covariance reset): a 3 m/s burn is caught at once, but a 50 mm/s burn, the size of the quiet policy, is caught
+# only tens of hours later or not within the period, and the filter is inconsistent meanwhile. That is why the
+# paper, and this notebook, raise the control uncertainty where the burns happen instead.
 #
 # The OCBE absorbs mismodelling in an estimated control $\hat{\mathbf u} = -\tilde Q B^\top\mathbf p$ whose
 # uncertainty is the control weight $\tilde Q = qI_3$ (an acceleration power spectral density, km$^2$/s$^3$). Over
@@ -180,24 +186,24 @@ to_um_s2 = em.length_unit_km / em.time_unit_s**2 * 1e9  # LU/TU^2 -> micro-m/s^2
 fig, ax = plt.subplots(2, 2, figsize=(13, 7), sharex=True)
 for j, (name, r) in enumerate(runs.items()):
     th = r.t_sub.ravel() * em.time_unit_s / 3600
-    ax[0, j].plot(th, np.linalg.norm(r.control_step, axis=-1).ravel() * to_um_s2, label=f"forward, z = "
-                  f"{r.z_step * em.velocity_unit_km_s * 1e6:.1f} mm/s")
-    ax[0, j].plot(th, np.linalg.norm(r.control_smooth, axis=-1).ravel() * to_um_s2, label=f"smoothed, z = "
-                  f"{r.z_smooth * em.velocity_unit_km_s * 1e6:.1f} mm/s")
-    ax[0, j].axvline(s_q.t_maneuver * em.time_unit_s / 3600, color="k", ls=":", lw=1)
-    ax[0, j].set(title=f"{name} tuning", ylabel=r"$\|\hat u\|$ ($\mu$m/s$^2$)")
-    ax[0, j].legend(fontsize=8)
+    ax[0, j].plot(th, np.linalg.norm(r.control_step, axis=-1).ravel() * to_um_s2, label="forward control")
+    ax[0, j].plot(th, np.linalg.norm(r.control_smooth, axis=-1).ravel() * to_um_s2, label="smoothed control")
+    ax[0, j].axvline(s_q.t_maneuver * em.time_unit_s / 3600, color="k", ls=":", lw=1, label="burn")
+    ax[0, j].set(title=f"{name} tuning: z forward {r.z_step * em.velocity_unit_km_s * 1e6:.1f}, smoothed "
+                 f"{r.z_smooth * em.velocity_unit_km_s * 1e6:.1f} mm/s", ylabel=r"$\|\hat u\|$ ($\mu$m/s$^2$)")
     for xs, Ps, lab, c in ((r.x_filt, r.P_filt, "forward", "C0"), (r.x_smooth, r.P_smooth, "smoothed", "C1")):
         err = np.linalg.norm(xs[:, :3] - demo.truth[:, :3], axis=1) * em.length_unit_km
         sig = 3 * np.sqrt(np.trace(Ps[:, :3, :3], axis1=1, axis2=2)) * em.length_unit_km
         ax[1, j].semilogy(hours, err, c, label=f"{lab} error")
         ax[1, j].semilogy(hours, sig, c + "--", lw=1, label=f"{lab} 3-sigma")
     ax[1, j].set(xlabel="hours since periapsis hand-off", ylabel="position error (km)")
-    ax[1, j].legend(fontsize=7, ncol=2)
     nees = tracking.nees(r.x_smooth, r.P_smooth, demo.truth)
     print(f"{name:16s}: z_smooth = {r.z_smooth * em.velocity_unit_km_s * 1e6:6.2f} mm/s, z_forward = "
           f"{r.z_step * em.velocity_unit_km_s * 1e6:6.2f} mm/s, mean smoothed NEES = {nees.mean():.1f} (6 if consistent)")
-plotting.save_figure(fig, "10_tuning_control_spike", output_dir=out)
+fig.legend(*ax[0, 0].get_legend_handles_labels(), loc="upper center", ncol=3, fontsize=8, bbox_to_anchor=(0.5, 1.0))
+fig.legend(*ax[1, 0].get_legend_handles_labels(), loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, 0.0))
+fig.tight_layout(rect=(0, 0.05, 1, 0.96))
+_ = plotting.save_figure(fig, "10_tuning_control_spike", output_dir=out)
 
 # %% [markdown]
 # ## 3 · Control-policy distributions (Eq. 33) and the maximum-likelihood test (Eqs. 34-35)
@@ -229,19 +235,22 @@ for col, (key, st) in enumerate(studies.items()):
     ulab = "m/s" if key[1] == "active" else "mm/s"
     lo, hi = 0.0, max(st.h0.z.max(), st.h1.z.max()) * unit * 1.05
     bins = np.linspace(lo, hi, 50)
-    ax[0, col].hist(st.h0.z * unit, bins=bins, alpha=0.6, label=f"no maneuver ({len(st.h0)})")
-    ax[0, col].hist(st.h1.z * unit, bins=bins, alpha=0.6, label=f"maneuver ({len(st.h1)})")
+    ax[0, col].hist(st.h0.z * unit, bins=bins, alpha=0.6, label="no maneuver (H0)")
+    ax[0, col].hist(st.h1.z * unit, bins=bins, alpha=0.6, label="maneuver (H1)")
     zz = np.linspace(lo, hi, 600)
     ax[1, col].plot(zz, st.threshold.pdf0(zz / unit) / unit, label=r"$PDF_{H0}$")
     ax[1, col].plot(zz, st.threshold.pdf1(zz / unit) / unit, label=r"$PDF_{H1}$")
     for a in ax[:, col]:
         a.axvline(st.threshold.z_lim * unit, color="k", ls=":", lw=1)
-    ax[0, col].set(title=f"{key[0]}, {key[1]}", ylabel="count")
+    ax[0, col].set(title=f"{key[0]}, {key[1]}\n{len(st.h0)} H0 + {len(st.h1)} H1 runs", ylabel="count")
     ax[1, col].set(xlabel=f"z ({ulab})", ylabel=f"PDF (1/({ulab}))",
                    title=f"z_lim = {st.threshold.z_lim * unit:.4g} {ulab}")
-    ax[0, col].legend(fontsize=7)
-    ax[1, col].legend(fontsize=7)
-plotting.save_figure(fig, "10_control_integral_pdfs", output_dir=out)
+h0h, h0l = ax[0, 0].get_legend_handles_labels()
+h1h, h1l = ax[1, 0].get_legend_handles_labels()
+fig.legend(h0h + h1h + [plt.Line2D([], [], color="k", ls=":", lw=1)], h0l + h1l + ["z_lim"], loc="lower center",
+           ncol=5, fontsize=8, bbox_to_anchor=(0.5, 0.0))
+fig.tight_layout(rect=(0, 0.05, 1, 1))
+_ = plotting.save_figure(fig, "10_control_integral_pdfs", output_dir=out)
 
 print("Tables 5-6 (expected rates from the PDFs)")
 print(f"{'orbit':12s} {'policy':7s} {'z_lim':>12s} {'false pos.':>11s} {'missed det.':>12s} {'crossings':>9s} "
@@ -274,8 +283,9 @@ for row, p in enumerate(POLICIES):
     mm = np.array([0, h1.magnitude.max() * unit])
     ax[row, 2].plot(mm, mm, "k--", lw=1, label="z = magnitude")
     ax[row, 2].set(xlabel=f"impulse magnitude ({ulab})", ylabel=f"z ({ulab})")
-    ax[row, 2].legend(fontsize=8)
-plotting.save_figure(fig, "10_z_vs_maneuver", output_dir=out)
+    ax[row, 2].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0), markerscale=3)
+fig.tight_layout()
+_ = plotting.save_figure(fig, "10_z_vs_maneuver", output_dir=out)
 
 
 def azimuth_contrast(h1):
@@ -340,7 +350,7 @@ ax[2].hist(ref.h0.z, bins=40, alpha=0.6, label="quiet H0")
 ax[2].axvline(z_h, color="C3", label=f"this run: z = {z_h:.3f} m/s")
 ax[2].set(xscale="log", xlabel="z (m/s)", ylabel="count")
 ax[2].legend(fontsize=8)
-plotting.save_figure(fig, "10_health_metric", output_dir=out)
+_ = plotting.save_figure(fig, "10_health_metric", output_dir=out)
 print(f"impulse 0.5 m/s (azimuth {np.degrees(health.azimuth):.0f} deg, elevation {np.degrees(health.elevation):.0f} deg):"
       f" z = {z_h:.4f} m/s = {sig_h1:.0f} sigma of quiet H1, {sig_h0:.0f} sigma of quiet H0")
 print(f"smoothed NEES mean {nees_h.mean():.0f} (6 if consistent); residual norms: median {np.median(rh.residual_norms):.2f},"
@@ -350,7 +360,9 @@ print(f"smoothed NEES mean {nees_h.mean():.0f} (6 if consistent); residual norms
 # %% [markdown]
 # ## Paper versus reproduction
 #
-# Statuses: *reproduced* only when close; *differs* with the reason otherwise. Two inputs are our choices because
+# Statuses follow the guide's rule: *reproduced* only for an independent prediction within a tolerance fixed before
+# comparing; *consistent (tuned)* where agreement rests on a choice made while looking at the paper (here the
+# window-weight factor behind $z_{lim}$); *differs* with the reason otherwise. Two inputs are our choices because
 # the paper's tables are missing: the measurement noise (10 micro-rad angles, Eq. 13 rates with 1 s differencing)
 # and the tuning ($q_w = 0.1\,E[u_{mag}^2]/(3T)$ in the 8-hour window, $10^{-18}$ km$^2$/s$^3$ elsewhere). The
 # thresholds scale with the tuning, so they are a consistency check, not an independent prediction.
@@ -369,16 +381,19 @@ table.add("OCBE tuning (8-h apoapsis window)", "values missing",
           f"{setups['9:2 NRHO', 'quiet'].q_window_km2_s3:.2e} km^2/s^3; base 1e-18", "not in paper",
           "factor 0.1 chosen from the pilot sweep in Section 2")
 table.add("Monte Carlo sizes (H0 / H1 / tests per hypothesis)", "500 / 3000 / 100", f"{N_H0} / {N_H1} / {N_TEST}",
-          "reproduced" if not QUICK else "differs: quick mode", "per policy and orbit")
+          "derived: the paper's sizes" if not QUICK else "differs: quick mode", "per policy and orbit; an input")
 table.add("Smoothed control spike at apoapsis with window tuning (Figs. 12-13)", "spike in smoothed control only",
           f"z smoothed {runs['apoapsis window'].z_smooth * em.velocity_unit_km_s * 1e6:.1f} mm/s vs forward "
-          f"{runs['apoapsis window'].z_step * em.velocity_unit_km_s * 1e6:.1f} mm/s for a 50 mm/s burn", "reproduced")
+          f"{runs['apoapsis window'].z_step * em.velocity_unit_km_s * 1e6:.1f} mm/s for a 50 mm/s burn",
+          "reproduced" if runs["apoapsis window"].z_smooth > 2 * runs["apoapsis window"].z_step else
+          "differs: the forward control sees the burn as much as the smoothed one",
+          "criterion fixed in advance: smoothed z above twice the forward z")
 for key, paper, tol in ((("9:2 NRHO", "active"), 0.4106, 0.25), (("9:2 NRHO", "quiet"), 0.01722, 0.25)):
     zl = studies[key].threshold.z_lim
-    st_ = "reproduced" if close(zl, paper, tol) else \
+    st_ = TUNED if close(zl, paper, tol) else \
         f"differs: {100 * (zl / paper - 1):+.0f} %; z_lim scales with the unpublished tuning and noise"
     table.add(f"z_lim, {key[0]}, {key[1]} (Eq. 35)", f"{paper * 1e3:.2f} mm/s", f"{zl * 1e3:.2f} mm/s", st_,
-              f"{100 * (zl / paper - 1):+.0f} %; within 25 % counts as reproduced; conditional on the window weight "
+              f"{100 * (zl / paper - 1):+.0f} %; within 25 % counts as agreement; conditional on the window weight "
               "factor f = 0.1 chosen from the pilot sweep (Section 2): z_lim scales with f, so this is a consistency "
               "check, not an independent prediction")
 for key in (("stable NRHO", "active"), ("stable NRHO", "quiet")):
@@ -398,7 +413,8 @@ for key, paper in ((("9:2 NRHO", "active"), 1.00), (("9:2 NRHO", "quiet"), 0.97)
     ok = abs(a - paper) <= max(0.02, 2 * np.sqrt(paper * (1 - paper) / N_TEST / 2) + 1 / (2 * N_TEST))
     table.add(f"Detection accuracy, {key[0]}, {key[1]} (Table 7)", f"{100 * paper:.0f} %", f"{100 * a:.1f} %",
               "reproduced" if ok else "differs: see FP/MD; depends on the unpublished tuning and noise",
-              f"{2 * N_TEST} test runs")
+              f"{2 * N_TEST} test runs; tolerance: 2 binomial standard errors (at least 2 points), fixed in advance; "
+              "conditional on the tuning f = 0.1, chosen for low pilot error, not to match this number")
 for p in POLICIES:
     a_s, a_n = acc["stable NRHO", p], acc["9:2 NRHO", p]
     table.add(f"Detection accuracy, stable NRHO, {p} (Table 8)",
@@ -423,7 +439,8 @@ table.add("Health metric: z for 0.5 m/s burn, quiet tuning", "0.4761 m/s", f"{z_
           "reproduced" if close(z_h, 0.4761, 0.25) else "differs: depends on the pointing and tuning",
           "one run, random pointing")
 table.add("Health metric: sigma level in the quiet H1 distribution", "about 30 sigma", f"{sig_h1:.0f} sigma",
-          "reproduced" if 20 <= sig_h1 <= 45 else "differs: our quiet H1 spread differs from the paper's")
+          TUNED if 20 <= sig_h1 <= 45 else "differs: our quiet H1 spread differs from the paper's",
+          "the quiet H1 spread scales with the window-weight factor f = 0.1 chosen in Section 2")
 table.add("Health metric: residuals benign while the estimate diverges (Fig. 22)", "yes",
           f"NEES mean {nees_h.mean():.0f}; residual median {np.median(rh.residual_norms):.2f}",
           "reproduced" if nees_h.mean() > 20 and np.median(rh.residual_norms) < 3 else
