@@ -491,8 +491,14 @@ def run_detection_monte_carlo(setup: DetectionSetup, policy: StationKeepingPolic
     progress : bool
     desc : str, optional
         Progress-bar label.
+
+    Raises
+    ------
+    cislunar.montecarlo.MonteCarloError
+        A trial failed; with batches it names the first trial of the failing batch, the batch's seed and its
+        trial range, and ``completed`` holds the finished trials by trial index.
     """
-    from .montecarlo import run_monte_carlo
+    from .montecarlo import MonteCarloError, TrialFailure, run_monte_carlo
 
     _check_setup(setup)
     _check_policy(policy, optional=True)
@@ -505,8 +511,15 @@ def run_detection_monte_carlo(setup: DetectionSetup, policy: StationKeepingPolic
                               progress=progress, desc=label)
     else:
         n_batches = -(-n // B)
-        chunks = run_monte_carlo(detection_trial_batch, n_batches, seed, args=(setup, policy, B),
-                                 executor=executor, chunk_size=1, progress=progress, desc=label)
+        try:
+            chunks = run_monte_carlo(detection_trial_batch, n_batches, seed, args=(setup, policy, B),
+                                     executor=executor, chunk_size=1, progress=progress, desc=label)
+        except MonteCarloError as exc:  # name the trials of the failing batch; keep completed trials by index
+            k = exc.trial_index
+            f = exc.failure
+            where = f"{f.seed}; batch {k} of {B} trials: trials {k * B}-{min(k * B + B, n) - 1}"
+            done = {b * B + j: r for b, rs in exc.completed.items() for j, r in enumerate(rs) if b * B + j < n}
+            raise MonteCarloError(TrialFailure(k * B, where, f.error, f.traceback), done, n) from exc
         res = [r for chunk in chunks for r in chunk][:n]
     return MonteCarloSample.from_results(res)
 

@@ -1207,3 +1207,20 @@ if __name__ == "__main__":  # audit-style counts of the deterministic sweep
         print(f"  {k}: {v} ({100 * v / total:.1f} %)")
     for b in bad:
         print("  ", b)
+
+
+def test_detection_monte_carlo_failure_names_the_batch_trials(monkeypatch):
+    real = detection.ocbe_batch
+    calls = {"n": 0}
+
+    def flaky(*a, **k):
+        calls["n"] += 1
+        if calls["n"] == 2:
+            raise ocbe.FilterDivergenceError(3, 0.5, "injected")
+        return real(*a, **k)
+
+    monkeypatch.setattr(detection, "ocbe_batch", flaky)
+    with pytest.raises(montecarlo.MonteCarloError, match="batch 1 of 2 trials: trials 2-3") as info:
+        detection.run_detection_monte_carlo(setup(), None, 5, 0, batch_size=2, progress=False)
+    assert info.value.trial_index == 2 and sorted(info.value.completed) == [0, 1]
+    assert isinstance(info.value.failure.error, ocbe.FilterDivergenceError)
