@@ -282,3 +282,33 @@ def test_likelihood_reset_is_stationary_and_avoids_the_mean_rule_blow_up():
         assert nll(a) > nll(f_ml)
     with pytest.raises(ValueError, match="rule"):
         ad.reset_factor(*args, rule="median")
+
+
+def test_smoothed_costs_sum_to_the_forward_metrics():
+    """Batch least-squares minimum = sum of squared innovations: linear system exactly, the OCBE on the NRHO closely."""
+    rng = np.random.default_rng(4)
+    res, Phis, Qs, Hs, Rs, ys = _linear_run(rng, N=60)
+    sm = srif.filter_smoother(np.zeros(6), np.diag([1.0, 1, 1, 0.1, 0.1, 0.1]), np.array(Phis), Hs, ys, Rs,
+                              [np.eye(6)] * 59, Qs, smooth=True)
+    x = sm.x_smooth
+    total = float(x[0] @ np.linalg.solve(np.diag([1.0, 1, 1, 0.1, 0.1, 0.1]), x[0]))
+    for k in range(60):
+        r = ys[k] - Hs[k] @ x[k]
+        total += r @ np.linalg.solve(Rs[k], r)
+        if k:
+            w = x[k] - Phis[k - 1] @ x[k - 1]
+            total += w @ np.linalg.solve(Qs[k - 1], w)
+    assert total == pytest.approx(np.sum(sm.residuals**2), rel=1e-8)
+
+
+def test_smoothed_metric_on_the_ocbe(setup):
+    sc = setup.scenario
+    inp = det.draw_trial(np.random.default_rng(5), setup, None)
+    a = _adaptive(setup, inp)
+    assert a.smoothed_metric.shape == a.metric.shape and np.all(a.smoothed_metric >= 0)
+    # the smoothed costs redistribute the forward ones: equal sums up to linearisation and quadrature
+    assert np.sum(a.smoothed_metric) == pytest.approx(np.sum(a.metric), rel=0.02)
+    with pytest.raises(ValueError, match="smooth=True"):
+        plain = ocbe.ocbe_filter_smoother(em, sc.t[:5], inp.y[:5], setup.observer_states[:5], sc.model,
+                                          sc.meas_cov, inp.x0, inp.P0, 1e-6, smooth=False)
+        ad.smoothed_metric(plain, inp.y[:5], setup.observer_states[:5], sc.model, sc.meas_cov, 1e-6)
