@@ -202,7 +202,7 @@ class StationKeepingSurface:
     t : ndarray (N,)
         Measurement grid of the covariance analyses, TU from apoapsis.
     agent_x0 : ndarray (6,)
-        Agent state at ``t_burn`` before the first burn.
+        Agent state at ``t[0]`` (start of tracking, before the first burn).
     dv1, dv2 : ndarray (n_t, n_theta, 3)
         First and second burns, LU/TU.
     range_sigma_km : ndarray (n_t, n_theta)
@@ -337,7 +337,8 @@ def informed_choice(dv1, u_y, cost):
 
 
 def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: float, t_final: float, *,
-                            cadence: float | None = None, agent_theta: float = 0.0, agent_offset=None, P0=None,
+                            cadence: float | None = None, t_track_start: float | None = None,
+                            agent_theta: float = 0.0, agent_offset=None, P0=None,
                             sigma_min_rad: float = AMOS_SIGMA_MIN_RAD, resolution_km: float = AMOS_RESOLUTION_KM,
                             batched: bool = True, progress: bool = True) -> StationKeepingSurface:
     """All two-burn maneuvers from the agent's state at ``t_burn`` to the torus surface, with covariance analyses.
@@ -357,12 +358,15 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
         End of the covariance analysis (where :math:`J_\\rho` is read), TU, not before ``t_arrival[-1]``.
     cadence : float, optional
         Measurement interval, TU (default one hour).
+    t_track_start : float, optional
+        Start of tracking (first measurement, where ``P0`` applies), TU from apoapsis, not after ``t_burn``
+        (default ``t_burn``: the covariance analysis starts with the first burn).
     agent_theta : float
-        The agent starts on the torus trajectory of ring angle ``agent_theta`` (rad) at ``t_burn``.
+        The agent is on the torus trajectory of ring angle ``agent_theta`` (rad) until the first burn.
     agent_offset : array_like (6,), optional
-        Added to that state (a station-keeping error to correct); default none.
+        Added to the agent state at ``t_track_start`` (a station-keeping error to correct); default none.
     P0 : array_like (12, 12), optional
-        Covariance at ``t_burn`` (default :func:`cislunar.ssat.initial_covariance`).
+        Covariance at ``t_track_start`` (default :func:`cislunar.ssat.initial_covariance`).
     sigma_min_rad, resolution_km : float
         Eq. 20 noise parameters.
     batched : bool
@@ -386,19 +390,25 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
     if t_final < t_arr[-1]:
         raise ValueError(f"t_final must not precede the last arrival {t_arr[-1]}; got {t_final}")
     dt = 3600.0 / system.time_unit_s if cadence is None else _checks.positive(cadence, "cadence")
-    n_meas = int(np.floor((t_final - t_burn) / dt + 1e-9)) + 1
-    t = t_burn + dt * np.arange(n_meas)
+    t_start = t_burn if t_track_start is None else float(_checks.as_array(t_track_start, "t_track_start", ndim=(0,)))
+    if t_start > t_burn:
+        raise ValueError(f"t_track_start must not be after t_burn = {t_burn}; got {t_start}")
+    n_meas = int(np.floor((t_final - t_start) / dt + 1e-9)) + 1
+    t = t_start + dt * np.arange(n_meas)
     if t[-1] < t_final - 1e-12:
         t = np.r_[t, t_final]
     P0 = initial_covariance(system) if P0 is None else P0
-    xa0 = _torus_states(torus, np.array([float(agent_theta)]), np.array([t_burn]))[0, 0]
+    xa0 = _torus_states(torus, np.array([float(agent_theta)]), np.array([t_start]))[0, 0]
     if agent_offset is not None:
         xa0 = xa0 + _checks.as_array(agent_offset, "agent_offset", shape=(6,))
+    xa_burn = xa0 if t_start == t_burn else propagate(system, xa0, np.array([t_start, t_burn])).x[-1]
     goal = _torus_states(torus, theta, t_arr)  # (n_theta, n_t, 6)
     target = target_trajectory(system, torus.orbit.x0, t)
     # unmaneuvered agent and target at the arrival times for MMD (Eq. 24)
-    nominal = propagate_with_impulses(system, xa0, np.r_[t_burn, t_arr])
-    tgt_arr = propagate(system, target.x[0, 0], np.r_[t_burn, t_arr]).x[1:]
+    nominal = propagate_with_impulses(system, xa_burn, np.r_[t_burn, t_arr])
+    tgt_burn = (target.x[0, 0] if t_start == t_burn
+                else propagate(system, target.x[0, 0], np.array([t_start, t_burn])).x[-1])
+    tgt_arr = propagate(system, tgt_burn, np.r_[t_burn, t_arr]).x[1:]
     nt, nth = t_arr.size, theta.size
     dv1 = np.empty((nt, nth, 3))
     dv2 = np.empty((nt, nth, 3))
@@ -415,7 +425,7 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
         u_y[j] = mmd_direction(mmd_matrix(nominal.stm[0, j + 1], Ha))
         groups = [np.arange(nth)] if batched else [np.array([i]) for i in range(nth)]
         for g in groups:
-            d1, d2, x1 = two_burn_transfer(system, xa0, t_burn, t_arr[j], goal[g, j])
+            d1, d2, x1 = two_burn_transfer(system, xa_burn, t_burn, t_arr[j], goal[g, j])
             dv1[j, g], dv2[j, g] = d1, d2
             miss[j, g] = np.linalg.norm(x1[:, :3] - goal[g, j, :3], axis=1)
             ag = propagate_with_impulses(system, np.broadcast_to(xa0, (g.size, 6)), t,
@@ -489,7 +499,7 @@ def filter_scenario(surface: StationKeepingSurface, j: int, i: int, target_x0, s
                     label: str = "") -> FilterScenario:
     """The :class:`FilterScenario` of surface maneuver ``[j, i]`` (arrival ``t_arrival[j]``, ring angle ``theta[i]``).
 
-    ``target_x0`` is the target state at ``surface.t[0]``; execution errors: ``exec_sigma_abs_m_s`` (m/s) and
+    ``target_x0`` is the target state at ``surface.t[0]`` (start of tracking); execution errors: ``exec_sigma_abs_m_s`` (m/s) and
     ``exec_sigma_rel`` (fraction of the burn) per axis.
     """
     _system(system)

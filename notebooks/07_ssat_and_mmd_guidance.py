@@ -278,13 +278,42 @@ for dv, r in results.items():
 # several percent in $\sqrt{J_\rho}$. For short coasts the best burn lies (nearly) in the plane perpendicular to the
 # line of sight, as Ref. [8] states, and the best direction on that circle is essentially the optimum; but the
 # circle also contains the worst directions, so the heuristic is a *set* that contains the answer, not a policy.
-# MMD is a policy, but in this scenario it is clearly suboptimal: it captures only part of the achievable range
+# MMD is a policy, but with the burn at the first epoch (where $P_0$ applies) it is clearly suboptimal: it captures only part of the achievable range
 # information and a sizeable fraction of random directions beat it (numbers above). The surrogate maximises the
 # size of the measurement change at $\tau_f$ alone, whereas $J_\rho$ integrates all measurements of the coast and
 # projects on the final line of sight; the two agree in direction only roughly. This is the honest form of the
 # paper's "nearly optimal" (stated there for its Ref. [8] scenarios, which are not given).
 
 # %% [markdown]
+# ### A burn in the middle of a tracking arc
+#
+# So far the burn happens at the first epoch of the covariance analysis, where $P_0$ applies. In a linear covariance
+# analysis a burn at that instant only moves the initial state: its information comes from the changed geometry
+# alone. A burn *during* tracking adds a kink that angles-only measurements before and after it can see, and that
+# kink breaks the scaling symmetry that makes range unobservable. The paper does not say which case its Ref. [8]
+# comparison uses, so we repeat the 1 m/s comparison with `PRE_ARC_H` = 24 h of tracking before the burn ($P_0$ at
+# the start of the arc).
+
+# %%
+PRE_ARC_H = 24
+xa_pre = propagate(em, xa0, np.array([0.0, -PRE_ARC_H * HR])).x[-1]
+xt_pre = propagate(em, xt0, np.array([0.0, -PRE_ARC_H * HR])).x[-1]
+t_pre = np.arange(0, PRE_ARC_H + int(max(COAST_HOURS)) + 1) * HR
+res_pre = ssat.compare_burn_policies(em, xa_pre, xt_pre, t_pre, [PRE_ARC_H + k for k in coast_idx],
+                                     DV_M_S[-1] * 1e-3 / V, P0, burn_index=PRE_ARC_H, n_grid=N_GRID, n_perp=N_PERP)
+print(f"burn of {DV_M_S[-1]} m/s after {PRE_ARC_H} h of tracking")
+print(" coast h | none   | MMD    | optimum | median dir | perp best/worst | MMD pct | MMD excess")
+for i, h in enumerate(res_pre.coast_hours):
+    print(f" {h:7.0f} | {res_pre.none[i]:6.2f} | {res_pre.mmd[i]:6.2f} | {res_pre.optimum[i]:7.3f} | "
+          f"{res_pre.grid_median[i]:10.3f} | {res_pre.perp_best[i]:6.3f}/{res_pre.perp_worst[i]:6.2f} | "
+          f"{res_pre.mmd_percentile[i]:6.1f}% | {res_pre.mmd_excess_percent[i]:6.0f} %")
+
+# %% [markdown]
+# **Reading.** With a tracking arc before it, the same burn is worth far more (compare "none" with any burn: the
+# kink, not the geometry, carries the information), and for coasts of up to about half a day MMD is then essentially
+# the optimal direction, as the paper states; for longer coasts its excess grows again. The setting in which
+# "nearly optimal" holds is therefore: a burn during tracking and a short coast.
+#
 # ### Does the verdict depend on the demonstration pair?
 #
 # The pair above is one choice among many. As a second, independent geometry we put the agent on the quasi-periodic
@@ -317,6 +346,9 @@ print(f"over all QPO pairs and coasts: median percentile {np.median(pct_all):.0f
 # coast. "Nearly optimal" holds for short coasts in favourable geometries, not in general.
 
 # %%
+within = res_pre.mmd_excess_percent <= 5.0
+n_ok = within.size if within.all() else int(np.argmin(within))  # leading run of coasts within the tolerance
+ok_coast = res_pre.coast_hours[n_ok - 1] if n_ok else 0.0
 near = np.concatenate([r.mmd_excess_percent for r in pairs.values()]) <= 5.0
 coast_all = np.concatenate([r.coast_hours for r in pairs.values()])
 r1 = results[DV_M_S[-1]]
@@ -355,6 +387,13 @@ table.add("MMD near-optimal, second geometry (agent on the 215-km QPO, 4 ring an
           f"MMD in the best 10 % of burn directions in {np.mean(pct_all < 10) * 100:.0f} % of the "
           f"{pct_all.size} (pair, coast) cases; within 5 % of the optimum (tolerance) in {near.sum()} cases, "
           f"all with coasts <= {coast_all[near].max() if near.any() else 0:.0f} h")
+table.add(f"MMD near-optimal, burn after {PRE_ARC_H} h of tracking (first pair, {DV_M_S[-1]} m/s)", "'nearly optimal'",
+          f"excess {res_pre.mmd_excess_percent.min():.0f}-{res_pre.mmd_excess_percent.max():.0f} %, percentile "
+          f"{res_pre.mmd_percentile.min():.0f}-{res_pre.mmd_percentile.max():.0f} %",
+          "differs: see note" if np.median(res_pre.mmd_excess_percent) > 5 else "reproduced: short coasts",
+          f"tolerance: within 5 % of the optimum; met for coasts <= {ok_coast:.0f} h, not beyond; "
+          f"a mid-arc burn cuts sqrt(J_rho) from {res_pre.none[-1]:.1f} km (no burn) to "
+          f"{res_pre.optimum[-1]:.2f} km (best) after {res_pre.coast_hours[-1]:.0f} h")
 table.add("+/- sign choice by quick covariance analysis", "needed",
           f"rejected sign worse by {np.min(100 * (r1.mmd_other / r1.mmd - 1)):.1f}-"
           f"{np.max(100 * (r1.mmd_other / r1.mmd - 1)):.1f} %", "beyond paper")

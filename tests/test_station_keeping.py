@@ -145,6 +145,22 @@ def test_zero_maneuver_point_is_natural_motion(torus):
     assert s.range_sigma_km[0, 1] < s.range_sigma_km[0, 0]
 
 
+def test_tracking_arc_before_the_burn(torus):
+    theta = np.array([0.0, 1.0, 2.5])
+    kw = dict(agent_theta=0.0, progress=False)
+    late = sk.station_keeping_surface(em, torus, theta, np.array([-2 * HR]), -14 * HR, 6 * HR, **kw)
+    early = sk.station_keeping_surface(em, torus, theta, np.array([-2 * HR]), -14 * HR, 6 * HR,
+                                       t_track_start=-20 * HR, **kw)
+    assert np.isclose(early.t[0], -20 * HR) and np.isclose(early.t[-1], 6 * HR)
+    assert np.allclose(early.agent_x0, torus.states([0.0], [-20 * HR])[0, 0])
+    # same maneuvers (the agent coasts on the torus until the burn), more tracking -> no worse range knowledge
+    assert np.allclose(early.dv1, late.dv1, atol=1e-11)
+    assert early.transfer_miss.max() < 1e-9
+    assert np.all(early.range_sigma_km <= late.range_sigma_km * (1 + 1e-9))
+    with pytest.raises(ValueError, match="t_track_start"):
+        sk.station_keeping_surface(em, torus, theta, np.array([-2 * HR]), -14 * HR, 6 * HR, t_track_start=-10 * HR)
+
+
 def test_surface_validation(torus):
     th = np.array([0.0, 1.0])
     with pytest.raises(ValueError, match="t_arrival must be later than t_burn"):
