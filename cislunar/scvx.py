@@ -33,7 +33,8 @@ What makes it converge (documented departures from the printed method)
   \tfrac12 dx^\top H_-dx`, with :math:`H_-` the concave part of the Hessian (eigenvalues clipped to
   :math:`\le 0`), so :math:`-\alpha_h\hat{\mathcal I}` is convex and the subproblem has an interior minimum.  The
   Hessian comes from the model's ``hessian`` method or forward differences of its gradient, refreshed when
-  the window-start state has moved by more than ``hessian_refresh``.
+  the window-start state has moved by more than ``hessian_refresh`` or when the information part of the model
+  error was large (``hessian_error_ratio``).
   ``information_model="linear"`` gives the paper's Eq. 44.
 * A predicted decrease at the noise level of the subproblem solution counts as :math:`\rho = 1`; Clarabel runs
   with tight tolerances; the iteration stops only on an accepted step with defects below ``defect_tol``, a
@@ -140,6 +141,12 @@ class SCvxSettings:
         this (2-norm, non-dimensional; >= 0, 0 = every accepted step) since it was last computed.  A stale
         curvature only regularises the step: value and gradient are always current, and the ratio test
         judges the model.
+    hessian_error_ratio : float
+        ... or when the information part of the last model error exceeded this fraction of the predicted
+        decrease (> 0; an accepted step refreshes at the new point, a rejected one at the reference).
+    curvature_floor : float
+        Smallest concave curvature of the information model, relative to the largest Hessian eigenvalue
+        magnitude (:func:`concave_part`; >= 0).
     """
 
     method: str = "augmented_lagrangian"
@@ -166,6 +173,8 @@ class SCvxSettings:
     solver_tol: float = 1e-10
     hessian_step: float = 1e-5
     hessian_refresh: float = 5e-3
+    hessian_error_ratio: float = 0.3
+    curvature_floor: float = 0.0
 
     def __post_init__(self):
         _checks.choice(self.method, "method", METHODS)
@@ -190,6 +199,8 @@ class SCvxSettings:
             _checks.positive(getattr(self, name), name)
         _checks.positive(self.noise_tol, "noise_tol", allow_zero=True)
         _checks.positive(self.hessian_refresh, "hessian_refresh", allow_zero=True)
+        _checks.positive(self.curvature_floor, "curvature_floor", allow_zero=True)
+        _checks.positive(self.hessian_error_ratio, "hessian_error_ratio")
         if not self.eta_min <= self.eta0:
             raise ValueError(f"eta0 must be >= eta_min ({self.eta_min}); got {self.eta0}")
         if not self.eta0 <= self.eta_max:
@@ -255,17 +266,27 @@ def impulse(t, u) -> float:
     return float(np.sum(np.diff(t) * (nrm[:-1] + nrm[1:]) / 2.0))
 
 
-def concave_part(H) -> np.ndarray:
+def concave_part(H, floor: float = 0.0) -> np.ndarray:
     """Factor ``L`` with ``-L L^T`` the concave (negative semi-definite) part of a symmetric matrix ``H``.
+
+    Parameters
+    ----------
+    H : array_like (n, n)
+    floor : float
+        Every eigenvalue is clipped to at most ``-floor max|lambda|`` (0: the plain concave part; > 0 keeps a
+        little concave curvature in the directions where ``H`` is convex or flat, so a model built on it has an
+        interior maximum there too).
 
     Returns
     -------
     ndarray (n, n)
-        ``L = V diag(sqrt(max(-lambda, 0)))`` from the eigendecomposition ``H = V diag(lambda) V^T``.
+        ``L = V diag(sqrt(max(-lambda, floor max|lambda|)))`` from ``H = V diag(lambda) V^T``.
     """
     H = _checks.square(H, "H")
+    floor = _checks.positive(floor, "floor", allow_zero=True)
     lam, V = np.linalg.eigh(0.5 * (H + H.T))
-    return V * np.sqrt(np.clip(-lam, 0.0, None))[None, :]
+    lo = floor * float(np.max(np.abs(lam))) if lam.size else 0.0
+    return V * np.sqrt(np.maximum(-lam, lo))[None, :]
 
 
 def finite_difference_hessian(gradient, x, step: float = 1e-5, *, g0=None) -> np.ndarray:
@@ -510,7 +531,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
             H = _checks.as_array(info.hessian(x), "info.hessian(x)", shape=(6, 6))
         else:  # forward differences of the gradient from the one just computed
             H = finite_difference_hessian(lambda z: info(z, 1)[1], x, st.hessian_step, g0=g0)
-        return concave_part(H), time.perf_counter() - t0
+        return concave_part(H, st.curvature_floor), time.perf_counter() - t0
 
     ev = evaluate(x_ref, u_ref, 1)
     J_ref, obj_ref = cost_of(x_ref, u_ref, ev)
@@ -585,16 +606,22 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
                 eta = eta / st.beta_shrink
             elif rho >= st.rho2:
                 eta = min(eta * st.beta_grow, st.eta_max)
+            # the curvature model is refreshed when the window-start state moved, or when the information part
+            # of the model error was a sizeable share of the predicted decrease (the curvature has changed)
+            poor_model = use_info and abs(rec["model_error_info"]) > st.hessian_error_ratio * abs(predicted)
+            if use_info and not accepted and poor_model and np.any(x_hess != x_ref[info_node]):
+                Lfac, t_hess = hessian_factor(x_ref[info_node], ev["grad"])
+                x_hess = x_ref[info_node].copy()
+                rec["t_hessian"] = t_hess
             if accepted:
                 t0 = time.perf_counter()
+                t_hess = 0.0
                 if use_info:  # gradient (and Hessian) at the new reference; the value is info(x, 0)'s
                     ev_new["grad"] = _checks.as_array(info(x_new[info_node], 1)[1], "info(x, 1) gradient",
                                                       shape=(6,))
-                    if np.linalg.norm(x_new[info_node] - x_hess) > st.hessian_refresh:
+                    if poor_model or np.linalg.norm(x_new[info_node] - x_hess) > st.hessian_refresh:
                         Lfac, t_hess = hessian_factor(x_new[info_node], ev_new["grad"])
                         x_hess = x_new[info_node].copy()
-                    else:
-                        t_hess = 0.0
                     rec["t_hessian"] = t_hess
                 rec["t_info"] += time.perf_counter() - t0 - t_hess
                 x_ref, u_ref, ev = x_new, u_new, ev_new

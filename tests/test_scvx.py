@@ -202,6 +202,8 @@ def test_concave_part_and_finite_difference_hessian():
     H = (V * lam) @ V.T
     L = scvx.concave_part(H)
     assert np.allclose(-L @ L.T, (V * np.minimum(lam, 0)) @ V.T, atol=1e-12)
+    L = scvx.concave_part(H, floor=0.1)  # every eigenvalue at most -0.1 * 7
+    assert np.allclose(-L @ L.T, (V * np.minimum(lam, -0.7)) @ V.T, atol=1e-12)
     grad = lambda x: H @ x + np.sin(x[0]) * np.eye(6)[0]  # noqa: E731
     x = rng.standard_normal(6)
     exact = H.copy()
@@ -216,7 +218,8 @@ def test_concave_part_and_finite_difference_hessian():
     ("max_iter", 2.5, ValueError), ("tol", None, TypeError), ("defect_tol", 0.0, ValueError),
     ("method", "exact", ValueError), ("information_model", "cubic", ValueError), ("penalty_growth", 0.5, ValueError),
     ("multiplier_threshold_decay", 0.0, ValueError), ("active_tol", 1.0, ValueError), ("noise_tol", -1.0, ValueError),
-    ("hessian_refresh", float("nan"), ValueError), ("penalty_weight_max", 1.0, ValueError)])
+    ("hessian_refresh", float("nan"), ValueError), ("penalty_weight_max", 1.0, ValueError),
+    ("hessian_error_ratio", 0.0, ValueError), ("curvature_floor", -1.0, ValueError)])
 def test_settings_validate_every_field(field, value, exc):
     with pytest.raises(exc, match=field):
         scvx.SCvxSettings(**{field: value})
