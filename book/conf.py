@@ -26,6 +26,7 @@ nb_render_markdown_format = "myst"  # the closing comparison tables are Markdown
 nb_ipywidgets_js = {}  # never load widget renderers from the internet
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence"]
 myst_heading_anchors = 3
+myst_dmath_double_inline = True  # "$$...$$" inside a paragraph, as Jupyter renders it
 suppress_warnings = ["myst.header", "mystnb.unknown_mime_type"]
 
 # MathJax 3 from a Python package, never a CDN.  The files are copied into _static/mathjax after the build.

@@ -6,7 +6,7 @@ Usage::
     python -m cislunar.book --build-dir DIR      # another build directory (the tests use a temporary one)
 
 Nothing is executed again: the executed notebooks written by :mod:`cislunar.notebooks` are copied into a staging
-source tree ``<build>/book_src/`` together with a generated index page (title, paper sections and summary of each
+source tree ``<build>/.book/src/`` together with a generated index page (title, paper sections and summary of each
 notebook, read from the notebook's own opening cell, plus the status counts of its closing table), the
 paper-vs-reproduction report and a page citing the four papers; Sphinx with myst-nb (``nb_execution_mode = "off"``)
 and sphinx-book-theme then renders it to ``<build>/book/``, configured by ``book/conf.py``.
@@ -341,7 +341,7 @@ def _papers_markdown() -> str:
 
 
 def stage(build: Path) -> Path:
-    """Write the book's source tree ``<build>/book_src/`` from the executed notebooks; returns its path.
+    """Write the book's source tree ``<build>/.book/src/`` from the executed notebooks; returns its path.
 
     Raises
     ------
@@ -352,7 +352,7 @@ def stage(build: Path) -> Path:
     if not executed:
         raise BookError(f"no executed notebooks in {build / 'notebooks'}; run `make reproduce` (or "
                         "`python -m cislunar.notebooks`) first")
-    src = build / "book_src"
+    src = _work_dir(build) / "src"
     if src.exists():
         shutil.rmtree(src)
     (src / "notebooks").mkdir(parents=True)
@@ -364,6 +364,11 @@ def stage(build: Path) -> Path:
     (src / "report.md").write_text(_report_markdown(build, {e.name: e.title for e in entries if e.executed}))
     (src / "papers.md").write_text(_papers_markdown())
     return src
+
+
+def _work_dir(build: Path) -> Path:
+    """``<build>/.book``: the staged sources, Sphinx's doctrees and myst-nb's output files (kept for debugging)."""
+    return build / ".book"
 
 
 def _mathjax_dir() -> Path:
@@ -402,10 +407,11 @@ def build_book(build_dir=None, *, out_dir=None, quiet: bool = True) -> Path:
     out = Path(out_dir) if out_dir is not None else build / "book"
     mathjax = _mathjax_dir()
     src = stage(build)
-    if out.exists():
-        shutil.rmtree(out)
+    html = _work_dir(build) / "html"  # myst-nb writes its files next to Sphinx's output directory
+    if html.exists():
+        shutil.rmtree(html)
     cmd = [sys.executable, "-m", "sphinx", "-b", "html", "-c", str(book_config_dir()), "-d",
-           str(build / "book_doctrees"), "-E", "--keep-going", str(src), str(out)]
+           str(_work_dir(build) / "doctrees"), "-E", "--keep-going", str(src), str(html)]
     if quiet:
         cmd.insert(3, "-q")
     proc = subprocess.run(cmd, capture_output=True, text=True)
@@ -413,13 +419,21 @@ def build_book(build_dir=None, *, out_dir=None, quiet: bool = True) -> Path:
         print(proc.stdout, end="")
     if proc.stderr.strip():
         print(proc.stderr, end="", file=sys.stderr)
-    index = out / "index.html"
-    if proc.returncode != 0 or not index.is_file():
+    if proc.returncode != 0 or not (html / "index.html").is_file():
         raise BookError(f"sphinx-build failed (exit {proc.returncode}):\n{proc.stderr[-4000:]}")
-    shutil.copytree(mathjax, out / "_static" / "mathjax", dirs_exist_ok=True)
-    for template in (out / "_static").glob("*macros.html"):
+    shutil.copytree(mathjax, html / "_static" / "mathjax", dirs_exist_ok=True)
+    for template in (html / "_static").glob("*macros.html"):
         template.unlink()  # Jinja macro files the themes copy as static assets; no page uses them
-    return index
+    for leftover in (html / ".doctrees", html / ".buildinfo"):
+        if leftover.is_dir():
+            shutil.rmtree(leftover)
+        elif leftover.exists():
+            leftover.unlink()
+    if out.exists():
+        shutil.rmtree(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    shutil.move(str(html), str(out))
+    return out / "index.html"
 
 
 def main(argv=None) -> int:

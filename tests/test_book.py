@@ -75,6 +75,44 @@ class _Page(HTMLParser):
         self.text.append(data)
 
 
+class _Prose(HTMLParser):
+    """The running text of a page: everything but code, outputs, scripts and (typeset) math."""
+
+    SKIP_TAGS = {"pre", "code", "script", "style", "textarea"}
+    SKIP_CLASSES = {"math", "highlight", "output", "cell_input"}
+    VOID = {"br", "img", "hr", "meta", "link", "input", "wbr", "col", "area", "base", "source", "embed", "param",
+            "track"}
+
+    def __init__(self):
+        super().__init__(convert_charrefs=True)
+        self.stack = []
+        self.out = []
+
+    def handle_starttag(self, tag, attrs):
+        if tag in self.VOID:
+            return
+        classes = set((dict(attrs).get("class") or "").split())
+        self.stack.append((tag, tag in self.SKIP_TAGS or bool(classes & self.SKIP_CLASSES)))
+
+    def handle_endtag(self, tag):
+        for k in range(len(self.stack) - 1, -1, -1):
+            if self.stack[k][0] == tag:
+                del self.stack[k:]
+                break
+
+    def handle_data(self, data):
+        if not any(skip for _, skip in self.stack):
+            self.out.append(data)
+
+
+def untypeset_tex(path: Path) -> list[str]:
+    """TeX commands or dollar delimiters left in a page's running text: Markdown math that was not parsed."""
+    prose = _Prose()
+    prose.feed(path.read_text(encoding="utf-8", errors="replace"))
+    text = "".join(prose.out)
+    return [text[max(0, m.start() - 30):m.end() + 30] for m in re.finditer(r"\\[a-zA-Z]{2,}|\$\$?[^$\s]", text)]
+
+
 def parse(path: Path) -> _Page:
     page = _Page()
     page.feed(path.read_text(encoding="utf-8", errors="replace"))
@@ -363,6 +401,15 @@ def test_browser_probe_sees_network_requests_missing_files_and_untypeset_math(tm
     assert "net::ERR_FILE_NOT_FOUND" in errors and "net::ERR_NAME_NOT_RESOLVED" in errors
 
 
+def test_untypeset_tex_checker(tmp_path):
+    page = tmp_path / "p.html"
+    page.write_text('<p>With <span class="math notranslate">\\(\\rho_1\\)</span> fine, costs 5 $ each.</p>'
+                    '<pre>x = "$\\alpha$"</pre><div class="output"><pre>\\mu</pre></div>')
+    assert untypeset_tex(page) == []
+    page.write_text("<p>the terms in $x$ and $$\\ddot x = a\\,x$$ left as text</p>")
+    assert len(untypeset_tex(page)) >= 2
+
+
 def test_clean_notebook_hides_machine_paths_and_keeps_what_a_terminal_shows(tmp_path):
     build = tmp_path / "somewhere" / "build"
     nb = {"metadata": {"papermill": {"input_path": str(build / "x.ipynb"), "output_path": str(build / "y.ipynb"),
@@ -494,6 +541,15 @@ def test_no_error_or_widget_output_is_rendered(built):
 
 @pytest.mark.notebook
 @pytest.mark.xdist_group("book")
+def test_markdown_math_is_parsed_on_every_page(built):
+    """No TeX command or dollar delimiter is left in the running text (e.g. a "$$...$$" the parser missed)."""
+    _, out, _, _ = built
+    problems = [f"{p.relative_to(out)}: {hit!r}" for p in sorted(out.rglob("*.html")) for hit in untypeset_tex(p)]
+    assert problems == [], "\n".join(problems[:30])
+
+
+@pytest.mark.notebook
+@pytest.mark.xdist_group("book")
 def test_no_page_shows_a_machine_path(built):
     """Parameters cells and outputs show no absolute path of this machine (e.g. a printed save_figure result)."""
     build, out, _, _ = built
@@ -501,10 +557,11 @@ def test_no_page_shows_a_machine_path(built):
     problems = []
     for page in sorted(out.rglob("*.html")):
         text = "".join(parse(page).text)
-        for s in private:
+        for s in sorted(private, key=len, reverse=True):
             at = text.find(s)
             if at >= 0:
                 problems.append(f"{page.relative_to(out)}: {text[max(0, at - 60):at + 80]!r}")
+                break
     assert problems == [], "pages show machine paths:\n" + "\n".join(problems[:30])
 
 
@@ -519,6 +576,9 @@ def test_headless_chromium_typesets_math_offline(built):
     try:
         session = browser.open(page.resolve().as_uri())
         state = browser.evaluate(session, MATH_STATE)
+        browser.evaluate(session, "(() => { const m = document.querySelector('mjx-container[display=\"true\"]') "
+                                  "|| document.querySelector('mjx-container'); "
+                                  "if (m) { m.scrollIntoView({block: 'center'}); } return !!m; })()")
         shot = build / f"book-screenshot-{page.stem}.png"
         browser.screenshot(session, shot)
         index_session = browser.open((out / "index.html").resolve().as_uri())
