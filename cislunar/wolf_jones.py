@@ -639,42 +639,69 @@ class ScenarioSolver:
                           alpha=float(alpha), settings=self.settings)
 
 
-def _sweep_task(solver, alphas, x_guess, u_guess, direction):
-    from .scvx import homotopy_sweep
+def _chain(solver, alphas, x_guess, u_guess, direction):
+    """One warm-started homotopy chain; a warm start that fails is retried from the cold guess."""
+    from .scvx import SCvxError
 
-    return homotopy_sweep(solver, alphas, x_guess, u_guess, directions=(direction,))
+    order = range(len(alphas)) if direction == "up" else range(len(alphas) - 1, -1, -1)
+    results = [None] * len(alphas)
+    attempts = []
+    guess = (x_guess, u_guess)
+    for i in order:
+        starts = [("warm", guess)] if guess[0] is x_guess else [("warm", guess), ("cold", (x_guess, u_guess))]
+        for kind, g in starts:
+            try:
+                res = solver(float(alphas[i]), g[0], g[1])
+            except SCvxError as exc:
+                attempts.append(dict(alpha=float(alphas[i]), direction=direction, start=kind, converged=False,
+                                     cost=np.nan, iterations=len(exc.history), error=exc.reason))
+                continue
+            attempts.append(dict(alpha=float(alphas[i]), direction=direction, start=kind, converged=True,
+                                 cost=res.cost, iterations=res.iterations, error=""))
+            results[i] = res
+            guess = (res.x, res.u)
+            break
+    return results, attempts
 
 
 def sweep_both_ways(solver: ScenarioSolver, alphas, x_guess, u_guess, *, executor=None):
     """Upward and downward homotopy sweeps from the same guess, best cost kept per alpha.
 
-    The upward sweep starts at the smallest alpha, the downward at the largest, both from ``(x_guess,
-    u_guess)`` and each warm-started along its way; they are independent, so an executor (``submit``) can run them
-    side by side.  Returns ``(best, sweeps)``: a :class:`cislunar.scvx.SweepResult` whose ``best``/``source`` merge
-    the two, and the two sweep results.
+    The upward chain starts at the smallest alpha, the downward at the largest, both from ``(x_guess,
+    u_guess)``, each warm-started from its previous solution; a warm start that fails (:class:`SCvxError`) is
+    retried from ``(x_guess, u_guess)`` (on test case 2 warm starts from a neighbouring optimum with an active
+    keep-out sometimes creep where the cold start converges).  The two chains are independent, so an executor
+    (``submit``) can run them side by side.
+
+    Returns
+    -------
+    cislunar.scvx.SweepResult
+        ``best``/``source`` merge the chains (``source`` is ``"up"`` or ``"down"``); ``attempts`` lists every run
+        with its ``direction``, ``start`` (warm or cold), convergence, cost, iterations and error.
     """
     from .scvx import SweepResult
 
-    a = np.asarray(alphas, dtype=float)
+    a = _checks.as_array(alphas, "alphas", ndim=(1,))
+    if a.size < 1 or np.any(np.diff(a) <= 0) or a[0] < 0 or a[-1] > 1:
+        raise ValueError("alphas must be strictly increasing within [0, 1]")
     if executor is None:
-        up = _sweep_task(solver, a, x_guess, u_guess, "up")
-        down = _sweep_task(solver, a, x_guess, u_guess, "down")
+        chains = [_chain(solver, a, x_guess, u_guess, d) for d in ("up", "down")]
     else:
         if not callable(getattr(executor, "submit", None)):
             raise ValueError(f"executor must have a submit method; got {type(executor).__name__}")
-        futs = [executor.submit(_sweep_task, solver, a, x_guess, u_guess, d) for d in ("up", "down")]
-        up, down = (f.result() for f in futs)
+        futs = [executor.submit(_chain, solver, a, x_guess, u_guess, d) for d in ("up", "down")]
+        chains = [f.result() for f in futs]
     best, source = [], []
     for i in range(a.size):
-        cands = [(r.best[i], r.source[i]) for r in (up, down) if r.best[i] is not None]
+        cands = [(res[i], d) for (res, _), d in zip(chains, ("up", "down")) if res[i] is not None]
         if not cands:
             best.append(None)
             source.append("")
             continue
-        b, s = min(cands, key=lambda c: c[0].cost)
+        b, d = min(cands, key=lambda c: c[0].cost)
         best.append(b)
-        source.append(s)
-    return SweepResult(a, best, source, up.attempts + down.attempts), (up, down)
+        source.append(d)
+    return SweepResult(a, best, source, chains[0][1] + chains[1][1])
 
 
 def fly(scenario: Scenario, t_nodes, u_nodes, *, refine: int = 8) -> tuple[np.ndarray, np.ndarray]:

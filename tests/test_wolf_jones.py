@@ -234,7 +234,7 @@ def case2_sweep(case2):
     t, ks, ke = case2.node_times(20)
     solver = W.ScenarioSolver(case2, t, ks, keep_out=True)
     x, u = case2.ballistic_guess(t)
-    best, _ = W.sweep_both_ways(solver, [0.0, 1e-3], x, u)
+    best = W.sweep_both_ways(solver, [0.0, 1e-3], x, u)
     return t, ks, ke, solver, best
 
 
