@@ -184,7 +184,11 @@ class PeriodicOrbit:
         return bool(self.x0[2] == 0.0 and self.x0[5] == 0.0)
 
     def sample(self, n: int = 400, periods: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-        """Times (TU) and states ``(n, 6)`` on a uniform grid over ``periods`` periods."""
+        """Times (TU) and states ``(n, 6)`` on a uniform grid over ``periods`` periods.
+
+        Impact detection is off here (and in :attr:`apses`): a corrected orbit was already propagated over its
+        period with impact detection on (orbits through a primary are refused by the corrector).
+        """
         n = _checks.integer(n, "n", minimum=2)
         periods = _checks.positive(periods, "periods")
         t = np.linspace(0.0, periods * self.period, n)

@@ -500,8 +500,27 @@ def _unit_trial(rng):
     return float(rng.random())
 
 
-SPECS = _specs()
+def _plugin_specs():
+    """Specs contributed by other modules' owners: ``tests/reliability_specs_*.py`` defining ``specs(Spec, lazy)``.
+
+    Each returns a list of :class:`Spec` for its module's public functions (same kinds as :func:`bad_values`), so
+    the whole package is swept by the same test without editing this file.
+    """
+    import importlib.util
+    from pathlib import Path
+
+    out = []
+    for path in sorted(Path(__file__).parent.glob("reliability_specs_*.py")):
+        spec = importlib.util.spec_from_file_location(path.stem, path)
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        out += list(mod.specs(Spec, lazy))
+    return out
+
+
+SPECS = _specs() + _plugin_specs()
 SPEC_BY_LABEL = {s.label: s for s in SPECS}
+assert len(SPEC_BY_LABEL) == len(SPECS), "duplicate spec labels"
 
 
 def _resolve(spec):
