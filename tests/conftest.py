@@ -18,6 +18,18 @@ except ImportError:  # pragma: no cover
     pass
 
 
+def selected_notebooks():
+    """Notebook sources the notebook and book tests use: all, or those named in ``CISLUNAR_TEST_NOTEBOOKS``.
+
+    ``CISLUNAR_TEST_NOTEBOOKS=01,04 pytest tests/test_book.py`` builds and checks a book of two notebooks only (for
+    working on the book); ``make test`` leaves it unset and covers every notebook.
+    """
+    from cislunar import notebooks
+
+    names = [n.strip() for n in os.environ.get("CISLUNAR_TEST_NOTEBOOKS", "").split(",") if n.strip()]
+    return notebooks.discover(names or None)
+
+
 class QuickRuns:
     """Every notebook executed in quick mode at most once per pytest session, shared by all xdist workers.
 

@@ -27,8 +27,9 @@ from urllib.parse import unquote, urlsplit
 import pytest
 
 from cislunar import book, notebooks, paths
+from conftest import selected_notebooks
 
-SOURCES = notebooks.discover()
+SOURCES = selected_notebooks()
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 EXTERNAL = re.compile(r"^\s*(?:[a-zA-Z][a-zA-Z0-9+.-]*:)?//|^\s*(?:https?|ftp|wss?):", re.IGNORECASE)
 LOCAL_SCHEMES = ("data:", "javascript:", "mailto:", "blob:", "about:")
@@ -439,7 +440,7 @@ def test_clean_notebook_hides_machine_paths_and_keeps_what_a_terminal_shows(tmp_
 
 def test_index_entries_come_from_every_notebooks_opening_cell(tmp_path):
     entries = book.read_entries(tmp_path)
-    assert [e.name for e in entries] == [p.stem for p in SOURCES]
+    assert [e.name for e in entries] == [p.stem for p in notebooks.discover()]
     for e in entries:
         assert e.title.startswith(e.name[:2]), f"{e.name}: the opening cell's '# NN · title' heading is missing"
         assert e.sections, f"{e.name}: no '**Paper sections followed.**' paragraph in the opening cell"

@@ -9,8 +9,9 @@ import os
 import pytest
 
 from cislunar import notebooks, paths
+from conftest import selected_notebooks
 
-SOURCES = notebooks.discover()
+SOURCES = selected_notebooks()
 
 
 @pytest.mark.notebook
