@@ -421,9 +421,16 @@ def build_book(build_dir=None, *, out_dir=None, quiet: bool = True) -> Path:
         print(proc.stderr, end="", file=sys.stderr)
     if proc.returncode != 0 or not (html / "index.html").is_file():
         raise BookError(f"sphinx-build failed (exit {proc.returncode}):\n{proc.stderr[-4000:]}")
-    shutil.copytree(mathjax, html / "_static" / "mathjax", dirs_exist_ok=True)
+    # MathJax's TeX-to-HTML component and what it loads on demand (TeX extensions, fonts, accessibility, menu);
+    # the other bundles (SVG output, MathML input, speech rules, node) are never loaded by the book.
+    shutil.copytree(mathjax, html / "_static" / "mathjax", dirs_exist_ok=True,
+                    ignore=shutil.ignore_patterns("sre", "svg", "*-svg*.js", "mml-*.js", "tex-mml-*.js",
+                                                  "tex-chtml-full*.js", "node-main.js", "asciimath.js", "mml"))
     for template in (html / "_static").glob("*macros.html"):
         template.unlink()  # Jinja macro files the themes copy as static assets; no page uses them
+    sources = html / "_sources"
+    if sources.is_dir() and not any(sources.iterdir()):
+        sources.rmdir()
     for leftover in (html / ".doctrees", html / ".buildinfo"):
         if leftover.is_dir():
             shutil.rmtree(leftover)
