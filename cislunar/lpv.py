@@ -646,8 +646,10 @@ class ObserverDesign:
 
 
 _SOLVERS = ("CLARABEL", "SCS")
-#: Variable magnitudes tried in turn by :meth:`PrecisionLMI.solve` until the solver reports ``optimal``.
-RETRY_SCALES = (1.0, 10.0, 100.0, 3.0, 30.0, 0.3)
+#: Scalings (variable magnitude, velocity-balanced state scale?) tried in turn by :meth:`PrecisionLMI.solve`
+#: until the solver reports ``optimal``; all describe the same problem.
+RETRY_SCALINGS = ((100.0, True), (1.0, False), (10.0, False), (100.0, False), (30.0, True), (3.0, False),
+                  (0.3, False))
 _NORMS = ("h2", "hinf")
 _OBJECTIVES = {"l1": 1, "l2": 2, "linf": np.inf}
 
@@ -681,7 +683,9 @@ class PrecisionLMI:
        :math:`\mathrm{tr}\,\tilde Q < 1`.  The ratio ``disturbance_scale / gamma`` is one ``cp.Parameter``, so
        sweeps over gamma and over the disturbance level re-use the canonicalised problem.
     2. State coordinates (optional).  The error may be written :math:`e = T\hat e` with :math:`T =
-       \mathrm{diag}(\mathrm{state\_scale})`; default :math:`T = I`.
+       \mathrm{diag}(\mathrm{state\_scale})`; default :math:`T = I`.  :meth:`for_cr3bp` also records the
+       velocity-balanced :math:`T = \mathrm{diag}(1, 1, v, v)`, :math:`v = 1/\sqrt{\max|a(\rho)|}` (inverse
+       of the fastest frozen frequency), one of the scalings :meth:`solve` retries with.
     3. Variable magnitude.  :math:`\tilde X = s\hat X`, :math:`\tilde Y = s\hat Y` with ``variable_scale`` s
        (default 10 with a pole radius, else 1), so that the bandwidth-bounded problems, whose :math:`\tilde X`
        is of order :math:`10^{-4}`-:math:`10^{-2}`, end ``optimal`` in Clarabel.
@@ -842,40 +846,54 @@ class PrecisionLMI:
         V = _checks.as_array(vertices, "vertices", ndim=(2,), last=model.n_rho)
         if V.shape[0] < 1:
             raise ValueError("vertices must hold at least one vertex")
-        lmi = cls(model.A(V), model.C(V), norm, disturbance=default_disturbance() if disturbance is None
+        A = model.A(V)
+        lmi = cls(A, model.C(V), norm, disturbance=default_disturbance() if disturbance is None
                   else disturbance, **kwargs)
         lmi.vertices = V
+        v = 1.0 / np.sqrt(max(1.0, float(np.max(np.abs(A[:, 2, 0])))))  # inverse of the fastest frozen frequency
+        lmi.balanced_state_scale = np.array([1.0, 1.0, v, v])
         return lmi
 
-    def with_variable_scale(self, variable_scale: float) -> "PrecisionLMI":
-        """The same problem built with another ``variable_scale`` (cached)."""
+    def rescaled(self, variable_scale: float, state_scale=None) -> "PrecisionLMI":
+        """The same problem built with another ``variable_scale`` and ``state_scale`` (cached)."""
         xs = _checks.positive(variable_scale, "variable_scale")
-        if xs == self.variable_scale:
+        ss = self.state_scale if state_scale is None else _checks.as_array(state_scale, "state_scale",
+                                                                             shape=(self.n_x,))
+        if xs == self.variable_scale and np.array_equal(ss, self.state_scale):
             return self
-        if xs not in self._rescaled:
-            other = PrecisionLMI(**self._init, variable_scale=xs)
-            if hasattr(self, "vertices"):
-                other.vertices = self.vertices
-            self._rescaled[xs] = other
-        return self._rescaled[xs]
+        key = (xs, tuple(ss))
+        if key not in self._rescaled:
+            other = PrecisionLMI(**{**self._init, "state_scale": ss}, variable_scale=xs)
+            for attr in ("vertices", "balanced_state_scale"):
+                if hasattr(self, attr):
+                    setattr(other, attr, getattr(self, attr))
+            self._rescaled[key] = other
+        return self._rescaled[key]
 
     def solve(self, gamma: float, *, solver: str = "CLARABEL", disturbance_scale: float = 1.0,
-              tol: float | None = None, sparsity_tol: float = 1e-4, retry_scales=RETRY_SCALES,
+              tol: float | None = None, sparsity_tol: float = 1e-4, retry: bool = True,
               **solver_options) -> ObserverDesign:
-        """Solve for the bound ``gamma`` (LU); if the solver does not end ``optimal``, re-solve the same problem
-        built with each of ``retry_scales`` (variable magnitudes, see the class notes) until one does.
+        """Solve for the bound ``gamma`` (LU); if the solver does not end ``optimal`` and ``retry``, re-solve the
+        same problem built with the scalings of :data:`RETRY_SCALINGS` (variable magnitude, and for
+        :meth:`for_cr3bp` problems the velocity-balanced state scale) until one does.
 
         The first ``optimal`` design is returned; if none is, the first solution (``optimal_inaccurate``, with a
-        warning) or, if every attempt failed, :class:`InfeasibleLMIError`.  ``retry_scales=()`` solves once.
-        Other parameters: see :meth:`solve_once`.
+        warning) or, if every attempt failed, :class:`InfeasibleLMIError`.  Parameters: see :meth:`solve_once`.
         """
-        try:
-            scales = [float(x) for x in retry_scales]
-        except TypeError as exc:
-            raise _checks.ArgumentTypeError("retry_scales must be a sequence of positive numbers") from exc
-        first, first_exc = None, None
-        for xs in [self.variable_scale] + [x for x in scales if x != self.variable_scale]:
-            lmi = self.with_variable_scale(xs)
+        retry = _checks.boolean(retry, "retry")
+        balanced = getattr(self, "balanced_state_scale", None)
+        configs = [(self.variable_scale, None)]
+        if retry:
+            for xs, bal in RETRY_SCALINGS:
+                if bal and balanced is None:
+                    continue
+                configs.append((xs, balanced if bal else np.ones(self.n_x)))
+        first, first_exc, tried = None, None, []
+        for xs, ss in configs:
+            lmi = self.rescaled(xs, ss)
+            if lmi in tried:
+                continue
+            tried.append(lmi)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 try:
@@ -891,9 +909,9 @@ class PrecisionLMI:
             first = first or d
         if first is None:
             raise first_exc
-        warnings.warn(f"{self.norm} precision LMI at gamma = {first.gamma:g}: no variable scale in "
-                      f"{[self.variable_scale, *scales]} gave 'optimal'; returning the {first.status!r} solution "
-                      "(verify it with verify_observer)", stacklevel=2)
+        warnings.warn(f"{self.norm} precision LMI at gamma = {first.gamma:g}: none of {len(tried)} scalings gave "
+                      f"'optimal'; returning the {first.status!r} solution (verify it with verify_observer)",
+                      stacklevel=2)
         return first
 
     def solve_once(self, gamma: float, *, solver: str = "CLARABEL", disturbance_scale: float = 1.0,

@@ -83,9 +83,9 @@ class ObserverRun:
 
 def make_measurements(model: CR3BPLPV, t, truth, sigma_deg: float, rng: np.random.Generator) -> Measurements:
     """Angles :math:`\\theta_1, \\theta_2` of planar ``truth`` (m, 4) plus N(0, sigma^2) noise (``sigma_deg`` in deg)."""
-    if not isinstance(rng, np.random.Generator):
-        raise ValueError(f"rng must be a numpy.random.Generator; got {type(rng).__name__}")
-    t = _checks.time_grid(t, "t")
+    model = _checks.instance(model, "model", CR3BPLPV)
+    rng = _checks.rng(rng, "rng")
+    t = _checks.time_grid(t, "t", increasing=True)
     x = _checks.as_array(truth, "truth", shape=(t.size, 4))
     sigma = np.radians(_checks.positive(sigma_deg, "sigma_deg", allow_zero=True))
     t1, t2 = model.angles(x)
@@ -93,15 +93,18 @@ def make_measurements(model: CR3BPLPV, t, truth, sigma_deg: float, rng: np.rando
     return Measurements(t, t1 + n[0], t2 + n[1], float(sigma))
 
 
-def _measurement_vector(model: CR3BPLPV, th1, th2):
-    rho = model.rho_from_angles(th1, th2)
+def _measurement_vector(model: CR3BPLPV, th1, th2, singular):
+    """Measurement vector and triangulated rho; NaN where ``singular`` (the caller uses the estimate there)."""
+    rho = np.full(th1.shape + (6,), np.nan)
+    ok = ~singular
+    rho[ok] = model.rho_from_angles(th1[ok], th2[ok])
     r13, r23 = 1.0 / rho[..., 2], 1.0 / rho[..., 3]
     y = np.stack([np.sin(th1), np.cos(th1), np.sin(th2), np.cos(th2), r13**2, r23**2], axis=-1)
     return y, rho
 
 
 def simulate_lpv_observer(model: CR3BPLPV, L, meas: Measurements, x_hat0, truth, *, sin3_threshold: float = 0.04,
-                          substeps: int = 4) -> ObserverRun:
+                          substeps: int | None = None) -> ObserverRun:
     """Run the LPV observer (Eq. 3a) on noisy measurements.
 
     Parameters
@@ -116,16 +119,24 @@ def simulate_lpv_observer(model: CR3BPLPV, L, meas: Measurements, x_hat0, truth,
         True planar states on ``meas.t`` (only used to report errors).
     sin3_threshold : float
         Below this :math:`|\\sin\\theta_3|` the scheduling parameters come from the estimate.
-    substeps : int
-        RK4 steps per measurement interval.
+    substeps : int, optional
+        RK4 steps per measurement interval; default enough that :math:`h\\,\\|LC\\| \\le 1` with the largest
+        measurement matrix on the run (RK4 is stable for :math:`|h\\lambda| < 2.78`), at least 4.
     """
+    model = _checks.instance(model, "model", CR3BPLPV)
+    meas = _checks.instance(meas, "meas", Measurements)
     L = _checks.as_array(L, "L", shape=(4, 6))
     xh = _checks.as_array(x_hat0, "x_hat0", shape=(4,)).copy()
     truth = _checks.as_array(truth, "truth", shape=(meas.t.size, 4))
     thr = _checks.in_range(sin3_threshold, "sin3_threshold", 0.0, 1.0)
-    substeps = int(_checks.positive(substeps, "substeps"))
-    y_all, rho_all = _measurement_vector(model, meas.theta1, meas.theta2)
-    singular = np.abs(np.sin(meas.theta1 + meas.theta2)) < thr
+    singular = np.abs(np.sin(meas.theta1 + meas.theta2)) < max(thr, 1e-9)
+    y_all, rho_all = _measurement_vector(model, meas.theta1, meas.theta2, singular)
+    if substeps is None:
+        rho_ok = rho_all[~singular] if np.any(~singular) else model.rho(truth)
+        rate = np.linalg.norm(L, 2) * np.max(np.linalg.norm(model.C(rho_ok), 2, axis=(-2, -1))) + 10.0
+        dt_max = float(np.max(np.diff(meas.t))) if meas.t.size > 1 else 0.0
+        substeps = max(4, int(np.ceil(dt_max * rate)))
+    substeps = _checks.integer(substeps, "substeps", minimum=1)
     coef = model.affine_coefficients()
     A0, Ai, b0, bi = coef["A"][0], coef["A"][1:], coef["b"][0], coef["b"][1:]
     C0, Ci, d0, di = coef["C"][0], coef["C"][1:], coef["d"][0], coef["d"][1:]
@@ -182,11 +193,13 @@ def simulate_ekf(model: CR3BPLPV, meas: Measurements, x_hat0, P0, truth, *, sigm
     substeps : int
         RK4 steps per measurement interval.
     """
+    model = _checks.instance(model, "model", CR3BPLPV)
+    meas = _checks.instance(meas, "meas", Measurements)
     xh = _checks.as_array(x_hat0, "x_hat0", shape=(4,)).copy()
-    P = _checks.as_array(P0, "P0", shape=(4, 4)).copy()
+    P = _checks.spd(P0, "P0", n=4).copy()
     truth = _checks.as_array(truth, "truth", shape=(meas.t.size, 4))
     q = _checks.positive(sigma_acc, "sigma_acc", allow_zero=True)
-    substeps = int(_checks.positive(substeps, "substeps"))
+    substeps = _checks.integer(substeps, "substeps", minimum=1)
     sys = model.system
     idx = [0, 1, 3, 4]
     R = np.eye(2) * meas.sigma**2
