@@ -29,8 +29,8 @@ covariance analysis of the two picks the informed maneuver :math:`\mathbf u^*`.
 Every maneuver of the surface gets its own linear covariance analysis (:func:`cislunar.ssat.ssat_covariance`:
 hourly azimuth/elevation, Eq. 20 noise, both burns, no execution errors), so the surfaces of
 :math:`\sqrt{J_\rho}` and of total fuel :math:`\|\Delta\mathbf v_1\| + \|\Delta\mathbf v_2\|` can be compared with
-the informed line.  :func:`filter_trial` runs a full EKF on simulated measurements with maneuver execution errors
-(beyond the paper: its stated future work).
+the informed line.  :func:`filter_trial` runs an iterated EKF on simulated measurements with maneuver execution
+errors (beyond the paper: its stated future work).
 """
 
 from __future__ import annotations
@@ -575,6 +575,8 @@ def filter_trial(rng: np.random.Generator, scenario: FilterScenario, *, n_iter: 
     burn the *planned* :math:`\\Delta\\mathbf v` is added to the estimate and the execution covariance to
     :math:`P` (the filter knows the error model); azimuth/elevation updates every grid time (Joseph form).
     """
+    if not isinstance(scenario, FilterScenario):
+        raise ValueError(f"scenario must be a FilterScenario; got {type(scenario).__name__}")
     sc = scenario
     sys_ = sc.system
     t = sc.t

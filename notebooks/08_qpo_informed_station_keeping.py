@@ -403,7 +403,7 @@ executor = ProcessPoolExecutor(max_workers=N_WORKERS) if N_WORKERS > 1 else None
 mc = {}
 t0 = time.perf_counter()
 for n_key, (key, (fn, args)) in enumerate(policies.items()):
-    mc[key] = run_monte_carlo(fn, N_TRIALS, [SEED, n_key], args=args, executor=executor, progress=False)
+    mc[key] = run_monte_carlo(fn, N_TRIALS, [SEED, n_key], args=args, executor=executor, desc=f"{key[0]}, {key[1]}")
 if executor is not None:
     executor.shutdown()
 t_mc = time.perf_counter() - t0
