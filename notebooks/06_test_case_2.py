@@ -33,11 +33,12 @@ SEED = 0
 OUTPUT_DIR = ""
 
 # %%
-# Sizes derived from QUICK: quick mode uses fewer SCvx nodes; the alpha grid, the seeds and every study still run.
-N_NODES = 20 if QUICK else 36  # Sundman nodes over the three periods (window ends moved onto nodes)
+# Sizes derived from QUICK: quick mode uses fewer SCvx nodes and alphas; the seeds and every study still run.
+N_NODES = 20 if QUICK else 30  # Sundman nodes over the three periods (window ends moved onto nodes)
 MAX_ITER = 100 if QUICK else 150  # SCvx iteration limit per run
 SIGMA = 1.0  # Sundman exponent (notebook 04)
-ALPHAS = [0.0, 5e-4, 1e-3, 2e-3, 5e-3, 7e-3, 1e-2, 2e-2]  # homotopy grid (>= 8 values, includes Figs. 6-8's)
+# homotopy grid: 8 values including 0 and the weights of Figs. 6-8 (quick mode: 5)
+ALPHAS = [0.0, 1e-3, 5e-3, 1e-2, 2e-2] if QUICK else [0.0, 5e-4, 1e-3, 2e-3, 5e-3, 7e-3, 1e-2, 2e-2]
 WORKERS = 2  # processes for the independent upward/downward sweeps and the seeded runs
 
 import multiprocessing
@@ -166,7 +167,7 @@ ax.semilogx(d_scan, mi_scan - I0, "o-")
 ax.axvline(sc.keep_out_km, color="C3", ls="--", label=f"keep-out {sc.keep_out_km:.0f} km (3 prior sigma)")
 ax.set(xlabel="closest approach to target 1 at the middle measurement [km]",
        ylabel=r"$\mathcal{I} - \mathcal{I}_{ballistic}$ [nats]", title="The MI rewards flying through a target")
-ax.legend(loc="upper right")
+ax.legend(loc="lower left")
 _ = plotting.save_figure(fig, "06_keep_out_motivation", output_dir=out)
 for d_show in (1000.0, 424.0, 1.0, 0.1, 1e-3, 1e-6):
     print(f"pass at {d_show:8.0e} km: MI gain {np.interp(np.log(d_show), np.log(d_scan), mi_scan) - I0:+.2f} nats")
@@ -276,7 +277,7 @@ for n_, r in enumerate(ok):
                 label=rf"$\alpha_h$ = {r['alpha']:g}" if plane == "xy" else None)
         ax.plot(rel[0, i], rel[0, j], "o", color="green", ms=5)
         ax.plot(rel[-1, i], rel[-1, j], "o", color="red", ms=5)
-        ax.set(xlabel=f"{'xyz'[i]} - x_ref [km]", ylabel=f"{'xyz'[j]} - x_ref [km]")
+        ax.set(xlabel=f"{'xyz'[i]} - {'xyz'[i]}_ref [km]", ylabel=f"{'xyz'[j]} - {'xyz'[j]}_ref [km]")
 fig.legend(loc="lower center", ncol=len(ok), fontsize=8, bbox_to_anchor=(0.5, -0.04))
 fig.suptitle("Fig. 7 analogue: observer relative to the reference DRO (green: start, red: end)")
 fig.tight_layout(rect=(0, 0.05, 1, 1))
@@ -321,18 +322,20 @@ for a in seed_alphas:
           f"{m.x[k_we, 2] * em.length_unit_km:+.0f} km (-z seed); relative cost difference {dcost:.1e}; "
           f"largest distance between one and the mirror of the other {mis_km:.2f} km; "
           f"cost {min(p.cost, m.cost):.6f} vs best of sweeps {best_sweep:.6f}")
-fig, axes = plt.subplots(1, 2, figsize=(11, 4))
-for ax, plane in zip(axes, ("xz", "yz")):
-    i, j = {"xz": (0, 2), "yz": (1, 2)}[plane]
-    for (a, s), res in seeded.items():
-        if isinstance(res, Exception):
-            continue
-        _, xf = wj.fly(sc, t, res.u, refine=4)
-        ax.plot(xf[:, i] * em.length_unit_km, xf[:, j] * em.length_unit_km, lw=1,
-                ls="-" if s > 0 else "--", color="C0" if a == seed_alphas[0] else "C1",
-                label=rf"$\alpha_h$ = {a:g}, {'+' if s > 0 else '-'}z seed")
-    ax.set(xlabel=f"{'xyz'[i]} [km]", ylabel=f"{'xyz'[j]} [km]")
-axes[0].legend(fontsize=8, loc="upper left")
+fig, axes = plt.subplots(1, 2, figsize=(12, 4))
+for (a, s), res in seeded.items():
+    if isinstance(res, Exception):
+        continue
+    tf, xf = wj.fly(sc, t, res.u, refine=4)
+    style = dict(lw=1.2, ls="-" if s > 0 else "--", color="C0" if a == seed_alphas[0] else "C1",
+                 label=rf"$\alpha_h$ = {a:g}, {'+' if s > 0 else '-'}z seed")
+    axes[0].plot(em.tu_to_days(tf), xf[:, 2] * em.length_unit_km, **style)
+    axes[1].plot(xf[:, 1] * em.length_unit_km, xf[:, 2] * em.length_unit_km, **style)
+axes[0].axvspan(ws_d, we_d, color="0.9", zorder=0)
+axes[0].set(xlabel="time [days] (window shaded)", ylabel="z [km]")
+axes[1].set(xlabel="y [km]", ylabel="z [km]")
+fig.legend(*axes[0].get_legend_handles_labels(), loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, -0.02))
+fig.tight_layout(rect=(0, 0.07, 1, 0.95))
 fig.suptitle("Seeded +z / -z solutions: exact mirror images with equal cost")
 _ = plotting.save_figure(fig, "06_z_mirror", output_dir=out)
 
@@ -355,7 +358,8 @@ for ax, a_want in zip(axes, (5e-3, 2e-2)):
     ax.axvspan(ws_d, we_d, color="0.9", zorder=0, label="observation window")
     ax.set(xlabel="time [days]", title=rf"$\alpha_h$ = {a:g}")
 axes[0].set_ylabel("thrust acceleration [mm/s$^2$]")
-axes[1].legend(fontsize=8, loc="lower right")
+fig.legend(*axes[0].get_legend_handles_labels(), loc="lower center", ncol=6, fontsize=8, bbox_to_anchor=(0.5, -0.02))
+fig.tight_layout(rect=(0, 0.08, 1, 1))
 _ = plotting.save_figure(fig, "06_fig8_thrust_profiles", output_dir=out)
 
 # %% [markdown]
@@ -377,7 +381,8 @@ for i, ax in enumerate(axes):
         ax.semilogy(em.tu_to_days(c.t), c.rms_km[i], "o-", ms=2.5, color=color, label=rf"$\alpha_h$ = {a:g}")
     ax.set(xlabel="time [days]", title=names[i])
 axes[0].set_ylabel("position RMS (CRLB) [km]")
-axes[-1].legend(fontsize=8, loc="upper right")
+fig.legend(*axes[0].get_legend_handles_labels(), loc="lower center", ncol=3, fontsize=8, bbox_to_anchor=(0.5, -0.02))
+fig.tight_layout(rect=(0, 0.08, 1, 1))
 _ = plotting.save_figure(fig, "06_fig9_crlb", output_dir=out)
 obs_mean = {a: float(np.mean(by_alpha[a]["crlb"].rms_km[0])) for a in fig9_alphas[1:]}
 tgt_mean = {a: float(np.mean(by_alpha[a]["crlb"].rms_km[1:])) for a in fig9_alphas[1:]}
@@ -442,6 +447,8 @@ axes[2].semilogy(mis, rms_tgt.mean(axis=1), "s--", label="targets (mean)")
 axes[2].set(xlabel="mutual information of the window [nats]", ylabel="terminal position RMS [km]",
             title="MI against CRLB")
 axes[2].legend(fontsize=8, loc="upper right")
+for ax in axes[:2]:
+    ax.xaxis.set_minor_formatter(plt.NullFormatter())
 _ = plotting.save_figure(fig, "06_fig10_pareto", output_dir=out)
 rank_obs = spearmanr(mis, rms_obs).statistic
 rank_tgt = spearmanr(mis, rms_tgt.mean(axis=1)).statistic
