@@ -500,14 +500,6 @@ def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0,
     t = _checks.time_grid(t, "t", increasing=True)
     N = t.size
     q = ocbe.control_weights(control_weight, N - 1).copy()
-    obs = _checks.as_array(observer_states, "observer_states", ndim=(2, 3), last=6)
-    obs3 = obs[:, None, :] if obs.ndim == 2 else obs
-    yy = np.asarray(y, float)
-    y3 = yy[:, None, :] if yy.ndim == 2 else yy
-    K = obs3.shape[1]
-    avail = np.ones((N, K), bool) if available is None else np.asarray(available, bool).reshape(N, K)
-    R = np.asarray(meas_cov, float)
-    R = np.broadcast_to(R, (N, model.dim, model.dim)) if R.shape == (model.dim, model.dim) else R
     consecutive = _checks.integer(consecutive, "consecutive", minimum=1)
     max_resets = _checks.integer(max_resets, "max_resets", minimum=0)
     _checks.choice(reset, "reset", RESET_RULES)
@@ -516,7 +508,15 @@ def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0,
         return ocbe.ocbe_filter_smoother(system, t, y, observer_states, model, meas_cov, x0, P0, q,
                                          available=available, n_sub=n_sub, smooth=smooth, tol=tol)
 
-    res = run()
+    res = run()  # validates every remaining argument by name
+    obs = np.asarray(observer_states, float)
+    obs3 = obs[:, None, :] if obs.ndim == 2 else obs
+    yy = np.asarray(y, float)
+    y3 = yy[:, None, :] if yy.ndim == 2 else yy
+    K = obs3.shape[1]
+    avail = np.ones((N, K), bool) if available is None else np.asarray(available, bool).reshape(N, K)
+    R = np.asarray(meas_cov, float)
+    R = np.broadcast_to(R, (N, model.dim, model.dim)) if R.shape == (model.dim, model.dim) else R
     metric, dof = forward_metric(res, model, avail)
     limit = metric_limit(dof, probability)
     first = metric.copy()

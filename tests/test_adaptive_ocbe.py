@@ -312,3 +312,17 @@ def test_smoothed_metric_on_the_ocbe(setup):
         plain = ocbe.ocbe_filter_smoother(em, sc.t[:5], inp.y[:5], setup.observer_states[:5], sc.model,
                                           sc.meas_cov, inp.x0, inp.P0, 1e-6, smooth=False)
         ad.smoothed_metric(plain, inp.y[:5], setup.observer_states[:5], sc.model, sc.meas_cov, 1e-6)
+
+
+def test_bad_arguments_are_named(setup):
+    sc = setup.scenario
+    inp = det.draw_trial(np.random.default_rng(9), setup, None)
+    args = (em, sc.t, inp.y, setup.observer_states, sc.model, sc.meas_cov, inp.x0, inp.P0, setup.control_weight)
+    with pytest.raises(ValueError, match="reset"):
+        ad.adaptive_ocbe(*args, reset="median")
+    with pytest.raises(ValueError, match="consecutive"):
+        ad.adaptive_ocbe(*args, consecutive=0)
+    with pytest.raises(ValueError, match="available"):
+        ad.adaptive_ocbe(*args, available=np.ones((3, 1), bool))
+    with pytest.raises(ValueError, match="control_weight"):
+        ad.adaptive_ocbe(*args[:-1], -1.0)
