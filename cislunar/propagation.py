@@ -350,7 +350,7 @@ def _pars(system: CR3BP, impact: bool = True) -> np.ndarray:
 
 def _check_outcome(outcome, t_target, t_reached, member=None, state=None):
     hy = _heyoka()
-    if outcome == hy.taylor_outcome.time_limit and np.isclose(t_reached, t_target, rtol=0, atol=1e-12):
+    if outcome == hy.taylor_outcome.time_limit and abs(float(t_reached) - float(t_target)) <= 1e-12:
         return
     code = int(outcome)
     event = -(code + 1) if -3 <= code < 0 else code  # heyoka: terminal event i without callback -> -(i + 1)
