@@ -385,15 +385,15 @@ print("cells where both angles only and angles + rates (1 s) mostly diverge: "
 
 # %% [markdown]
 # **Fig. 4 analogue: a typical divergence, in a regime where it happens.** We take the angles-only cell with the
-# largest diverged fraction in the map and show one of its diverged runs.
+# largest diverged fraction in the map and show the clearest of its diverged runs (largest mean NEES of ten draws).
 
 # %%
 worst = max((k for k in regime if k[3] == "angles"), key=lambda k: (regime[k], k[4]))
 w_orbit, w_cad, w_sig, _, w_h = worst
 scn_w = tracking.make_scenario(em, ORBITS[w_orbit], w_cad, start="apoapsis", rates=False, sigma_angle_rad=w_sig)
 truth_w = tracking.simulate_truth(em, scn_w.x_start, scn_w.t)
-shown = None
-for k_w in range(20):
+shown, shown_nees = None, 0.0  # of up to 10 completed draws, the diverged one with the largest mean NEES
+for k_w in range(10):
     rng_w = np.random.default_rng([SEED, 404, k_w])
     y_w = tracking.simulate_measurements(scn_w, truth_w, rng_w)
     x0_w, P0_w = tracking.initial_estimate(em, scn_w.x_start, rng_w, scale=w_h)
@@ -402,9 +402,9 @@ for k_w in range(20):
                                           Q_QUIET, available=scn_w.available, smooth=False)
     except ocbe.FilterDivergenceError:
         continue
-    if tracking.summarize(em, run_w.x_filt, run_w.P_filt, truth_w).diverged:
-        shown = run_w
-        break
+    summ_w = tracking.summarize(em, run_w.x_filt, run_w.P_filt, truth_w)
+    if summ_w.diverged and summ_w.nees_mean > shown_nees:
+        shown, shown_nees, shown_k = run_w, summ_w.nees_mean, k_w
 if shown is not None:
     fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
     error_panels(axes[0], axes[1], scn_w.t, shown.x_filt, shown.P_filt, truth_w, "forward filter")
@@ -413,7 +413,8 @@ if shown is not None:
                  f"{10 * w_h:g} km (analogue of Fig. 4)", fontsize=10)
     fig.tight_layout()
     _ = plotting.save_figure(fig, "09_fig4_typical_divergence", output_dir=out)
-    print(f"shown: draw {k_w}; {100 * regime[worst]:.0f} % of this cell's runs diverged")
+    print(f"shown: draw {shown_k} (mean NEES {shown_nees:.0f}); {100 * regime[worst]:.0f} % of this cell's runs "
+          "diverged in the map")
 else:
     print(f"no completed diverged run found in the worst cell ({100 * regime[worst]:.0f} % diverged)")
 
