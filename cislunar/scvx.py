@@ -28,7 +28,8 @@ What makes it converge (documented departures from the printed method)
   :math:`\lambda\leftarrow\lambda + w\delta`, the weight grows :math:`w\leftarrow\min(\beta w, w_{max})` and the
   threshold shrinks.  The paper's L1 exact penalty :math:`\gamma\sum_k\Delta t_k\|\nu_k\|_1` stays available as
   ``method="penalty"``; with a linear reward it creeps (every step sits on the trust-region boundary and the
-  second-order defects of a step of size :math:`\eta` eat the predicted gain).
+  second-order defects of a step of size :math:`\eta` eat the predicted gain), and on test case 1 it still
+  creeps with the quadratic information model (notebook 05: rho ~ 0.1-0.2, eta ~ 1e-3 after 80 iterations).
 * **Convex quadratic information model**: :math:`\hat{\mathcal I}(x) = \mathcal I_0 + g^\top dx +
   \tfrac12 dx^\top H_-dx`, with :math:`H_-` the concave part of the Hessian (eigenvalues clipped to
   :math:`\le 0`), so :math:`-\alpha_h\hat{\mathcal I}` is convex and the subproblem has an interior minimum.  The
@@ -45,7 +46,9 @@ The information model protocol
 ------------------------------
 ``info(x, order)`` with ``x`` the observer state (6,) at node ``info_node``: ``order=0`` returns the value
 (nats), ``order=1`` returns ``(value, gradient)``; value and gradient must describe the same function (e.g. the
-process noise held fixed).  An optional ``info.hessian(x)`` returns the (6, 6) Hessian.
+process noise held fixed).  SCvx takes every value from ``order=0`` and only the gradient from ``order=1`` (a
+value computed alongside a gradient may carry different round-off).  An optional ``info.hessian(x)`` returns the
+(6, 6) Hessian.
 :class:`cislunar.wolf_jones.WindowInformation` implements it for the paper's test cases.
 
 Extra nonconvex inequality constraints (e.g. a keep-out) are objects with ``node``, ``size`` and
