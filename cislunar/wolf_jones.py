@@ -17,6 +17,9 @@ What is here
   d_{min}` at every measurement time, linearised through the observer STM (the ``constraints`` protocol of SCvx).
 * :func:`evaluate_crlb`: the CRLB (EKF covariance recursion along the true trajectories, process noise recomputed
   along them) with per-axis and RMS position errors, for Figs. 4, 5, 9 and 10.
+* :class:`ScenarioSolver` (one SCvx solve per alpha_h, picklable), :func:`sweep_both_ways` (upward and downward
+  warm-started homotopy chains, optionally in two processes, best cost kept per alpha_h), :func:`fly` and
+  :func:`terminal_miss_km` (single-shooting re-flight of a first-order-hold control).
 
 Process-noise units (Tables 3 and 5)
 ------------------------------------
