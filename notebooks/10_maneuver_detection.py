@@ -44,7 +44,9 @@ N_TEST = 20 if QUICK else 100  # test runs per hypothesis, policy and orbit (pap
 N_PILOT = 16 if QUICK else 64  # runs per hypothesis in the tuning sweep
 N_POLICY_DRAWS = 20000 if QUICK else 200000  # draws to check the station-keeping distributions
 TUNING_FACTORS = [0.01, 0.1, 1.0]  # sweep of the window control weight, in units of the variance-matched value
+PM_J_SEEDS = 1 if QUICK else 3  # noise draws per azimuth in the +-j sweep (Section 4)
 BATCH = 8  # trials run in lockstep by the batched OCBE
+N_NEES = 4 if QUICK else 24  # runs per (orbit, policy, hypothesis) of the consistency check of the window tuning
 WORKERS = 1 if QUICK else 2  # processes for the Monte Carlo
 
 import time
@@ -295,6 +297,50 @@ for (o, p), st in studies.items():
           f"{th.crossings.size:9d} {st.h0.z.mean() * 1e3:7.2f} mm/s {st.h1.z.mean() * 1e3:7.2f} mm/s")
 
 # %% [markdown]
+# ## 3b · Is the window-tuned OCBE consistent? (beyond the paper's figures)
+#
+# The paper shows single runs (Figs. 12-13) whose errors stay inside their 3-sigma bounds. We check the tuning
+# statistically: fresh runs with and without a burn for each orbit and policy, through the batched OCBE, and the
+# NEES of the forward and the smoothed estimates against the truth (criterion of notebook 09: a run is
+# inconsistent when more than 5 % of its epochs exceed the 99.9 % quantile of $\chi^2_6$, 22.5).
+
+# %%
+nees_lim = stats.chi2.ppf(tracking.NEES_PROBABILITY, 6)
+nees_study = {}
+for io, o in enumerate(ORBITS):
+    for ip, p in enumerate(POLICIES):
+        s_ = setups[o, p]
+        sc_ = s_.scenario
+        for hyp, pol in (("H0", None), ("H1", POLICIES[p])):
+            rng_n = np.random.default_rng([SEED, 55, io, ip, int(hyp == "H1")])
+            inputs = [det.draw_trial(rng_n, s_, pol) for _ in range(N_NEES)]
+            nf, ns = [], []
+            for i0 in range(0, N_NEES, BATCH):
+                chunk = inputs[i0:i0 + BATCH]
+                rb = det.ocbe_batch(em, sc_.t, np.array([c.y for c in chunk]), s_.observer_states, sc_.model,
+                                    sc_.meas_cov, np.array([c.x0 for c in chunk]), chunk[0].P0, s_.control_weight,
+                                    n_sub=s_.n_sub, tol=s_.tol)
+                for b, c in enumerate(chunk):
+                    nf.append(tracking.nees(rb.x_filt[b], rb.P_filt[b], c.truth))
+                    ns.append(tracking.nees(rb.x_smooth[b], rb.P_smooth[b], c.truth))
+            nf, ns = np.array(nf), np.array(ns)
+            nees_study[o, p, hyp] = dict(
+                mean_f=float(nf.mean()), mean_s=float(ns.mean()),
+                runs_f=float(np.mean(np.mean(nf > nees_lim, axis=1) > tracking.DIVERGED_FRACTION)),
+                runs_s=float(np.mean(np.mean(ns > nees_lim, axis=1) > tracking.DIVERGED_FRACTION)))
+print(f"{'orbit':12s} {'policy':7s} {'hyp':4s} {'NEES fwd':>9s} {'NEES smo':>9s} {'inconsistent runs fwd / smo':>28s}")
+for (o, p, hyp), v in nees_study.items():
+    print(f"{o:12s} {p:7s} {hyp:4s} {v['mean_f']:9.2f} {v['mean_s']:9.2f} "
+          f"{100 * v['runs_f']:13.0f} % / {100 * v['runs_s']:.0f} %")
+
+# %% [markdown]
+# A mean NEES near or below 6 without a burn (H0) says the window tuning costs no consistency when nothing happens.
+# With a burn (H1) the forward filter can be inconsistent for a few epochs after apoapsis: the factor $f = 0.1$ of
+# Section 2 gives the window a velocity uncertainty of only $\sqrt{0.1}\approx0.32$ of the burn's RMS size, a
+# choice made for detection (it keeps H0's $z$ small), not for consistency. The smoothed estimate, which sees the
+# data after the burn, is the one that should stay consistent; the table records both.
+
+# %% [markdown]
 # ## 4 · Sensitivity of $z$ to the maneuver (Figs. 16-17, 20-21)
 #
 # The paper finds $z$ nearly linear in the impulse magnitude (so it could estimate it) and, for the active policy,
@@ -338,6 +384,34 @@ for (o, p), st in studies.items():
     lin[o, p] = (slope, np.corrcoef(h1.magnitude, h1.z)[0, 1], azimuth_contrast(h1), stats.skew(h1.z))
     print(f"{o:12s} {p:7s}: z vs magnitude slope {slope:.2f}, corr {lin[o, p][1]:.3f}; z/|dv| at azimuth +-90 "
           f"over 0/180 (|el| < 45 deg) = {lin[o, p][2]:.2f}; skewness of H1 z = {lin[o, p][3]:.2f}")
+
+# %% [markdown]
+# **Looking for the $\pm\hat j$ pattern.** Where could the paper's bimodality come from? We fire 1 m/s burns in
+# the orbit plane at azimuths 0°, 90°, 180° and 270° (same noise draws for every azimuth) on the 9:2 NRHO and
+# vary the two unpublished inputs that shape how a burn shows up in $z$: the window weight factor $f$ and the
+# angle noise. The contrast is mean $z$ at $\pm90°$ over mean $z$ at 0°/180° (1 = no preference).
+
+# %%
+pmj = {}
+AZ = np.radians([0.0, 90.0, 180.0, 270.0])
+for f_ in (0.1, 1.0):
+    for sig_ in (10e-6, 100e-6):
+        s_pm = det.make_setup(em, ORBITS["9:2 NRHO"], f_ * det.window_control_weight(det.ACTIVE_POLICY, WINDOW_HOURS),
+                              Q_BASE, window_hours=WINDOW_HOURS, sigma_angle_rad=sig_)
+        inputs = [det.draw_trial(np.random.default_rng([SEED, 31, k]), s_pm, magnitude_m_s=1.0, direction=(az, 0.0))
+                  for k in range(PM_J_SEEDS) for az in AZ]
+        zs = []
+        for i0 in range(0, len(inputs), BATCH):
+            chunk = inputs[i0:i0 + BATCH]
+            rb = det.ocbe_batch(em, s_pm.scenario.t, np.array([c.y for c in chunk]), s_pm.observer_states,
+                                s_pm.scenario.model, s_pm.scenario.meas_cov, np.array([c.x0 for c in chunk]),
+                                chunk[0].P0, s_pm.control_weight, n_sub=s_pm.n_sub, tol=s_pm.tol)
+            zs.extend(rb.z_smooth * em.velocity_unit_km_s * 1e3)
+        zs = np.array(zs).reshape(PM_J_SEEDS, AZ.size).mean(axis=0)
+        pmj[f_, sig_] = (zs, (zs[1] + zs[3]) / (zs[0] + zs[2]))
+        print(f"f = {f_:4.1f}, sigma = {sig_ * 1e6:5.0f} urad: z at 0/90/180/270 deg = "
+              + " / ".join(f"{z:.3f}" for z in zs) + f" m/s; +-j contrast {pmj[f_, sig_][1]:.2f}")
+best_pmj = max(pmj.items(), key=lambda kv: kv[1][1])
 
 # %% [markdown]
 # ## 5 · Detection tests on independent data (Tables 7-8)
@@ -392,6 +466,40 @@ print(f"smoothed NEES mean {nees_h.mean():.0f} (6 if consistent); residual norms
       f"{np.mean(rh.residual_norms > np.sqrt(stats.chi2.ppf(0.99, 4))):.2f}")
 
 # %% [markdown]
+# **Does the control react before the residuals? (Fig. 22's claim, measured.)** Both tests below are online (they
+# use only data up to the current epoch) and both have a false-alarm rate of about 1 % per track:
+#
+# * *control test*: the running forward control integral $z_{fwd}(t_n) = \int_{t_0}^{t_n}\|\hat{\mathbf u}\|dt$
+#   (single-step smoothed control, Eq. 32) exceeds the 99 % quantile of the whole-track forward integral of the
+#   quiet H0 runs (a partial integral of a positive integrand never exceeds the whole, so this is conservative);
+# * *residual test*: the adaptive OCBE's rule of notebook 09b (the whitened innovation, $\chi^2_4$, above its 99 %
+#   limit at three consecutive epochs), declared at the third epoch.
+
+# %%
+zf_cum = np.concatenate([[0.0], np.cumsum(np.trapezoid(np.linalg.norm(rh.control_step, axis=-1), rh.t_sub, axis=-1))])
+zf_cum *= em.velocity_unit_km_s * 1e3  # m/s at each epoch
+zf_lim = float(np.quantile(ref.h0.z_step, 0.99))
+k_burn_h = int(np.searchsorted(s_q.scenario.t, s_q.t_maneuver, side="right"))
+over = np.flatnonzero(zf_cum > zf_lim)
+k_ctrl = int(over[0]) if over.size else None
+m_h, dof_h = ad.forward_metric(rh, s_q.scenario.model)
+k_first = ad.first_detection(m_h, ad.metric_limit(dof_h))
+k_res = None if k_first is None else k_first + ad.CONSECUTIVE_EPOCHS - 1
+cad_h = s_q.scenario.cadence_hours
+
+
+def after_burn(k):
+    return "never" if k is None else f"{(k - k_burn_h) * cad_h:+.0f} h"
+
+
+print(f"control test fires {after_burn(k_ctrl)} after the first epoch that sees the burn (threshold "
+      f"{zf_lim * 1e3:.1f} mm/s); residual test: first exceedance of the run that confirms it {after_burn(k_first)}, "
+      f"declared {after_burn(k_res)}")
+# the paper's claim is that the control deviates *before* the residuals do: compare with the residuals' first
+# exceedance (the 3-strike declaration adds two epochs of confirmation by construction)
+lead_ok = k_ctrl is not None and (k_first is None or k_ctrl < k_first)
+
+# %% [markdown]
 # ## Paper versus reproduction
 #
 # Statuses follow the guide's rule: *reproduced* only for an independent prediction within a tolerance fixed before
@@ -437,6 +545,14 @@ for (o, p), st in studies.items():
     table.add(f"Expected FP / MD, {o}, {p} (Tables 5-6)", "tables missing",
               f"{st.threshold.false_positive:.4f} / {st.threshold.missed_detection:.4f}", "not in paper",
               f"{st.threshold.crossings.size} PDF crossing(s)")
+for o in ORBITS:
+    worst_f = max(v["runs_f"] for k, v in nees_study.items() if k[0] == o)
+    worst_s = max(v["runs_s"] for k, v in nees_study.items() if k[0] == o)
+    table.add(f"Window-tuned OCBE consistent, {o} (NEES, forward / smoothed)", "consistent (Figs. 12-13, single runs)",
+              f"worst cell: {100 * worst_f:.0f} % / {100 * worst_s:.0f} % of runs inconsistent",
+              "reproduced" if max(worst_f, worst_s) <= 0.10 else
+              "differs: some policy/hypothesis cells have many inconsistent runs",
+              f"{N_NEES} runs per policy and hypothesis; criterion fixed in advance: at most 10 % inconsistent runs")
 n_cross = [st.threshold.crossings.size for st in studies.values()]
 table.add("H0 and H1 PDFs cross once", "yes (Figs. 15, 19)", f"crossings per case: {n_cross}",
           "reproduced" if all(c == 1 for c in n_cross) else "differs: KDE tails of the finite sample add crossings",
@@ -463,6 +579,10 @@ ctr_a, ctr_q = lin["9:2 NRHO", "active"][2], lin["9:2 NRHO", "quiet"][2]
 table.add("Largest z for burns at azimuth +-90 deg, active (Fig. 16)", "bimodal, peaks at +-j",
           f"z/|dv| at +-90 deg over 0/180 deg: {ctr_a:.2f}",
           "reproduced" if ctr_a > 1.1 else "differs: no clear +-j preference in our runs")
+table.add("Conditions for the +-j pattern (sweep over f and angle noise, 1 m/s in-plane burns)", "not discussed",
+          f"largest contrast {best_pmj[1][1]:.2f} at f = {best_pmj[0][0]:g}, {best_pmj[0][1] * 1e6:g} urad; "
+          f"range {min(v[1] for v in pmj.values()):.2f}-{max(v[1] for v in pmj.values()):.2f}", "beyond paper",
+          f"{PM_J_SEEDS} noise draw(s) per azimuth; a contrast near 1 means no +-j preference")
 table.add("Quiet policy: pattern less bimodal (Fig. 20)", "more uniform", f"ratio {ctr_q:.2f} (active {ctr_a:.2f})",
           "reproduced" if ctr_a > 1.1 and ctr_q < ctr_a else
           "differs: neither policy shows the +-j pattern clearly, so there is nothing to weaken")
@@ -475,6 +595,11 @@ table.add("Health metric: z for 0.5 m/s burn, quiet tuning", "0.4761 m/s", f"{z_
 table.add("Health metric: sigma level in the quiet H1 distribution", "about 30 sigma", f"{sig_h1:.0f} sigma",
           TUNED if 20 <= sig_h1 <= 45 else "differs: our quiet H1 spread differs from the paper's",
           "the quiet H1 spread scales with the window-weight factor f = 0.1 chosen in Section 2")
+table.add("Control metric reacts before a residual test (Fig. 22)", "yes (deviations before the residuals)",
+          f"control test {after_burn(k_ctrl)}; residuals above their limit {after_burn(k_first)} (3-strike "
+          f"declaration {after_burn(k_res)}) after the burn",
+          "reproduced" if lead_ok else "differs: the residuals exceed their limit no later than the control test",
+          "one run; both tests online; the control test has about 1 % false alarms per track")
 table.add("Health metric: residuals benign while the estimate diverges (Fig. 22)", "yes",
           f"NEES mean {nees_h.mean():.0f}; residual median {np.median(rh.residual_norms):.2f}",
           "reproduced" if nees_h.mean() > 20 and np.median(rh.residual_norms) < 3 else
