@@ -312,3 +312,114 @@ def test_burn_after_a_tracking_arc(pair):
         ssat.mmd_policy(em, xa, xt, t, v, P0, burn_index=12)
     with pytest.raises(ValueError, match="coast_indices"):
         ssat.compare_burn_policies(em, xa, xt, t, [3], v, P0, burn_index=b, n_grid=10, n_perp=4)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# independent checks added by the referee: equations as printed, and the covariance analysis from scratch
+# ---------------------------------------------------------------------------------------------------------------
+def test_eqs_15_to_18_as_printed(pair):
+    """Azimuth/elevation (Eqs. 15-17) and their Jacobian w.r.t. rho (Eq. 18) typed in from the paper."""
+    xa, xt = pair
+    val, Ha, Ht = AZIMUTH_ELEVATION.evaluate(xa, xt)
+    rx, ry, rz = xt[:3] - xa[:3]  # Eq. 22 below: rho = r_t - r_a
+    r = np.sqrt(rx**2 + ry**2 + rz**2)
+    rxy2 = rx**2 + ry**2
+    assert np.isclose(np.cos(val[0]), rx / np.sqrt(rxy2)) and np.isclose(np.sin(val[0]), ry / np.sqrt(rxy2))
+    assert np.isclose(val[1], np.arcsin(rz / r))
+    H18 = np.array([[-ry / rxy2, rx / rxy2, 0, 0, 0, 0],
+                    [-rx * rz / (r**2 * np.sqrt(rxy2)), -ry * rz / (r**2 * np.sqrt(rxy2)), np.sqrt(rxy2) / r**2, 0, 0, 0]])
+    assert np.allclose(Ht, H18, rtol=1e-12, atol=1e-12 * np.abs(H18).max())
+    assert np.allclose(Ha, -H18, rtol=1e-12, atol=1e-12 * np.abs(H18).max())
+
+
+def test_eqs_11_12_cr3bp_acceleration_as_printed():
+    """Eq. 11 with Eq. 12 (non-dimensional: G(m1+m2) = r12 = 1, so |omega| = 1) equals the package's equations of motion."""
+    rng = np.random.default_rng(11)
+    mu = em.mu
+    w = np.array([0.0, 0.0, 1.0])
+    for _ in range(5):
+        s = np.r_[rng.uniform(-1.2, 1.2, 3), rng.uniform(-0.5, 0.5, 3)]
+        r, v = s[:3], s[3:]
+        rho1 = r - np.array([-mu, 0, 0])  # from the Earth
+        rho2 = r - np.array([1 - mu, 0, 0])  # from the Moon
+        a = (-2 * np.cross(w, v) - np.cross(w, np.cross(w, r)) - (1 - mu) * rho1 / np.linalg.norm(rho1) ** 3
+             - mu * rho2 / np.linalg.norm(rho2) ** 3)
+        f = np.asarray(em.eom(s))
+        assert np.allclose(f[:3], v) and np.allclose(f[3:], a, rtol=1e-12, atol=1e-12)
+
+
+def test_covariance_analysis_against_finite_difference_batch(pair):
+    """J_rho and P_f from scratch: finite-difference measurement Jacobians of the propagated pair, Eq. 20 typed in.
+
+    Independent of the STMs, the whitened rows and the QR recursion of ``ssat_covariance``; a factor two in the noise
+    or in the projection, or a wrong STM across the impulse, fails it.
+    """
+    xa, xt = pair
+    t = np.arange(0, 6) * HR
+    tb, dv = 2.5 * HR, np.array([3e-4, -2e-4, 1e-4])
+    P0 = ssat.initial_covariance(em)
+    res = ssat.ssat_covariance(em, ssat.propagate_with_impulses(em, xa, t, [(tb, dv)]),
+                               ssat.propagate_with_impulses(em, xt, t), P0)
+
+    def states(X0):
+        """(m, 12) initial SSAT states -> (m, N, 12) states on the grid (agent burns dv at tb)."""
+        a1 = propagate(em, X0[:, :6], np.array([0.0, 1 * HR, 2 * HR, tb])).x
+        a2s = a1[:, -1].copy()
+        a2s[:, 3:6] += dv
+        a2 = propagate(em, a2s, np.array([tb, 3 * HR, 4 * HR, 5 * HR])).x
+        ag = np.concatenate([a1[:, :3], a2[:, 1:]], axis=1)
+        tg = propagate(em, X0[:, 6:], t).x
+        return np.concatenate([ag, tg], axis=-1)
+
+    x0 = np.r_[xa, xt]
+    h = 1e-7
+    X = states(np.vstack([x0 + h * np.eye(12), x0 - h * np.eye(12), x0[None]]))
+    nom = X[-1]
+
+    def angles(S):
+        return AZIMUTH_ELEVATION(S[..., :6], S[..., 6:])
+
+    y0 = angles(nom)
+    dy = AZIMUTH_ELEVATION.residual(angles(X[:12]), y0[None]) - AZIMUTH_ELEVATION.residual(angles(X[12:24]), y0[None])
+    Hk = np.moveaxis(dy / (2 * h), 0, -1)  # (N, 2, 12): d y_k / d x0
+    Phi_f = ((X[:12, -1] - X[12:24, -1]) / (2 * h)).T  # d x_f / d x0
+    rho_km = np.linalg.norm(nom[:, 6:9] - nom[:, :3], axis=-1) * em.length_unit_km
+    sig = np.sqrt((10e-6) ** 2 + (4e-3 / rho_km) ** 2)  # Eq. 20, typed in
+    Lam = np.linalg.inv(P0) + np.einsum("kai,kaj->ij", Hk / sig[:, None, None], Hk / sig[:, None, None])
+    Pf = Phi_f @ np.linalg.inv(Lam) @ Phi_f.T
+    u = (nom[-1, 6:9] - nom[-1, :3]) / np.linalg.norm(nom[-1, 6:9] - nom[-1, :3])
+    M = np.r_[-u, 0, 0, 0, u, 0, 0, 0]  # T^T M_rho, Eq. 22 in inertial coordinates
+    J = M @ Pf @ M
+    assert np.isclose(res.J_rho[0, -1], J, rtol=2e-4)
+    d = np.sqrt(np.diag(Pf))
+    assert np.allclose(res.P_final[0] / np.outer(d, d), Pf / np.outer(d, d), atol=2e-4)
+
+
+def test_compare_burn_policies_bookkeeping(pair):
+    """Every number of the policy comparison re-derived from the primitives (a factor or a swapped field fails)."""
+    xa, xt = pair
+    t = np.arange(0, 5) * HR
+    P0 = ssat.initial_covariance(em)
+    v = 1e-3 / em.velocity_unit_km_s
+    L = em.length_unit_km
+    r = ssat.compare_burn_policies(em, xa, xt, t, [2, 4], v, P0, n_grid=150, n_perp=12)
+    assert np.allclose(r.coast_hours, [2.0, 4.0])
+    tg = ssat.propagate_with_impulses(em, xt, t)
+    none = ssat.ssat_covariance(em, ssat.propagate_with_impulses(em, xa, t), tg, P0)
+    grid = ssat.range_sigma_over_directions(em, xa, None, t, v, ssat.fibonacci_sphere(150), P0, target=tg)
+    for i, k in enumerate((2, 4)):
+        assert np.isclose(r.none[i], np.sqrt(none.J_rho[0, k]) * L)
+        _, _, Jpm = ssat.mmd_policy(em, xa, xt, t[:k + 1], v, P0)
+        assert np.isclose(r.mmd[i], np.sqrt(Jpm.min()) * L) and np.isclose(r.mmd_other[i], np.sqrt(Jpm.max()) * L)
+        Jg = grid.J_rho[:, k]
+        assert np.isclose(r.grid_median[i], np.sqrt(np.median(Jg)) * L)
+        assert np.isclose(r.mmd_percentile[i], 100 * np.mean(Jg < Jpm.min()))
+        assert r.optimum[i] <= np.sqrt(Jg.min()) * L * (1 + 1e-12) and r.optimum[i] <= r.mmd[i]
+        assert r.optimum[i] <= r.perp_best[i] * (1 + 1e-12) <= r.perp_worst[i] * (1 + 1e-12)
+        check = ssat.range_sigma_over_directions(em, xa, None, t[:k + 1], v, r.optimum_direction[i][None], P0,
+                                                 target=ssat.ImpulsiveTrajectory(t[:k + 1], tg.x[:, :k + 1],
+                                                                                 tg.stm[:, :k + 1]))
+        assert np.isclose(check.final_range_sigma_km[0], r.optimum[i], rtol=1e-9)
+        los = (xt[:3] - xa[:3]) / np.linalg.norm(xt[:3] - xa[:3])
+        assert np.isclose(r.optimum_perp_angle_deg[i], np.degrees(np.arcsin(abs(r.optimum_direction[i] @ los))))
+    assert np.allclose(r.mmd_excess_percent, 100 * (r.mmd / r.optimum - 1))
