@@ -104,7 +104,8 @@ def _measurement_vector(model: CR3BPLPV, th1, th2, singular):
 
 
 def simulate_lpv_observer(model: CR3BPLPV, L, meas: Measurements, x_hat0, truth, *, sin3_threshold: float = 0.04,
-                          substeps: int | None = None) -> ObserverRun:
+                          substeps: int | None = None, exact_rho: bool = False,
+                          hold: str = "noise") -> ObserverRun:
     """Run the LPV observer (Eq. 3a) on noisy measurements.
 
     Parameters
@@ -122,6 +123,15 @@ def simulate_lpv_observer(model: CR3BPLPV, L, meas: Measurements, x_hat0, truth,
     substeps : int, optional
         RK4 steps per measurement interval; default enough that :math:`h\\,\\|LC\\| \\le 1` with the largest
         measurement matrix on the run (RK4 is stable for :math:`|h\\lambda| < 2.78`), at least 4.
+    hold : {"noise", "measurement"}
+        ``"noise"`` (default): the sensor is continuous and only its noise is held over each interval, i.e.
+        :math:`\\theta(t) = \\theta(x(t)) + n_k` with :math:`x(t)` the cubic Hermite interpolant of ``truth``;
+        this is the white-noise model of intensity :math:`\\sigma^2\\Delta t` the H2 conversion assumes.
+        ``"measurement"``: the whole measurement is held (a sampled sensor); a high-bandwidth observer then lags
+        the truth by about :math:`|\\dot\\theta|\\Delta t`, which acts as extra noise.
+    exact_rho : bool
+        Diagnostic: schedule on :math:`\\rho` of the true state (held like the measurements) instead of the
+        triangulated one, i.e. the situation the LMIs certify.
     """
     model = _checks.instance(model, "model", CR3BPLPV)
     meas = _checks.instance(meas, "meas", Measurements)
@@ -129,8 +139,14 @@ def simulate_lpv_observer(model: CR3BPLPV, L, meas: Measurements, x_hat0, truth,
     xh = _checks.as_array(x_hat0, "x_hat0", shape=(4,)).copy()
     truth = _checks.as_array(truth, "truth", shape=(meas.t.size, 4))
     thr = _checks.in_range(sin3_threshold, "sin3_threshold", 0.0, 1.0)
+    exact_rho = _checks.boolean(exact_rho, "exact_rho")
+    hold = _checks.choice(hold, "hold", ("noise", "measurement"))
     singular = np.abs(np.sin(meas.theta1 + meas.theta2)) < max(thr, 1e-9)
     y_all, rho_all = _measurement_vector(model, meas.theta1, meas.theta2, singular)
+    y_singular = singular
+    if exact_rho:
+        rho_all = model.rho(truth)
+        singular = np.zeros_like(singular)
     if substeps is None:
         rho_ok = rho_all[~singular] if np.any(~singular) else model.rho(truth)
         rate = np.linalg.norm(L, 2) * np.max(np.linalg.norm(model.C(rho_ok), 2, axis=(-2, -1))) + 10.0
@@ -157,16 +173,54 @@ def simulate_lpv_observer(model: CR3BPLPV, L, meas: Measurements, x_hat0, truth,
     m = meas.t.size
     out = np.empty((m, 4))
     out[0] = xh
+    if hold == "noise":
+        t1_true, t2_true = model.angles(truth)
+        n1 = np.angle(np.exp(1j * (meas.theta1 - t1_true)))
+        n2 = np.angle(np.exp(1j * (meas.theta2 - t2_true)))
+
+        def sensed(k, tau):
+            """Continuous sensor: angles of the (Hermite-interpolated) truth at tau plus the noise held over k."""
+            hk = meas.t[k + 1] - meas.t[k]
+            u = (tau - meas.t[k]) / hk
+            h00, h10, h01, h11 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u, -2 * u**3 + 3 * u**2, u**3 - u**2
+            pos = (h00 * truth[k, :2] + h10 * hk * truth[k, 2:] + h01 * truth[k + 1, :2]
+                   + h11 * hk * truth[k + 1, 2:])
+            a1, a2 = model.angles(pos)
+            th1, th2 = a1 + n1[k], a2 + n2[k]
+            sing = abs(np.sin(th1 + th2)) < max(thr, 1e-9)
+            if exact_rho:
+                rho = rho_of(pos)
+            elif sing:
+                rho = None
+            else:
+                rho = model.rho_from_angles(th1, th2)
+            yv = np.zeros(6)
+            yv[:4] = np.sin(th1), np.cos(th1), np.sin(th2), np.cos(th2)
+            if rho is not None and not exact_rho:
+                yv[4:] = 1.0 / rho[2] ** 2, 1.0 / rho[3] ** 2
+            return yv, rho
     for k in range(m - 1):
         h = (meas.t[k + 1] - meas.t[k]) / substeps
-        rho = None if singular[k] else rho_all[k]
-        y = y_all[k] if not singular[k] else np.nan_to_num(y_all[k])
-        for _ in range(substeps):
-            k1 = rhs(xh, y, rho)
-            k2 = rhs(xh + 0.5 * h * k1, y, rho)
-            k3 = rhs(xh + 0.5 * h * k2, y, rho)
-            k4 = rhs(xh + h * k3, y, rho)
-            xh = xh + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+        if hold == "measurement":
+            rho = None if singular[k] else rho_all[k]
+            y = y_all[k] if not y_singular[k] else np.nan_to_num(y_all[k])  # ranges undefined there (zero gain)
+            for _ in range(substeps):
+                k1 = rhs(xh, y, rho)
+                k2 = rhs(xh + 0.5 * h * k1, y, rho)
+                k3 = rhs(xh + 0.5 * h * k2, y, rho)
+                k4 = rhs(xh + h * k3, y, rho)
+                xh = xh + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+        else:
+            for j in range(substeps):
+                t0 = meas.t[k] + j * h
+                ya, ra = sensed(k, t0)
+                yb, rb = sensed(k, t0 + 0.5 * h)
+                yc, rc = sensed(k, t0 + h)
+                k1 = rhs(xh, ya, ra)
+                k2 = rhs(xh + 0.5 * h * k1, yb, rb)
+                k3 = rhs(xh + 0.5 * h * k2, yb, rb)
+                k4 = rhs(xh + h * k3, yc, rc)
+                xh = xh + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
         if not np.all(np.isfinite(xh)):
             raise RuntimeError(f"LPV observer diverged at t = {meas.t[k + 1]:.4f} TU (step {k + 1})")
         out[k + 1] = xh
