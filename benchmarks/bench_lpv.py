@@ -29,7 +29,7 @@ def main(max_k: int = 6, gamma: float = 0.0013) -> dict:
             try:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
-                    d = lmi.solve(gamma, solver=solver, **opts)
+                    d = lmi.solve(gamma, solver=solver, retry=False, **opts)
                 status, obj = d.status, d.objective
             except lpv.InfeasibleLMIError as exc:
                 status, obj = exc.status, float("nan")
