@@ -147,6 +147,10 @@ class SCvxSettings:
     hessian_error_ratio : float
         ... or when the information part of the last model error exceeded this fraction of the predicted
         decrease (> 0; an accepted step refreshes at the new point, a rejected one at the reference).
+    stall_iter : int
+        Raise :class:`SCvxError` ("stalled") when this many consecutive iterations bring no progress: no accepted
+        step lowering the cost by more than ``10 noise_tol (1 + |J|)``, no multiplier update and no halving of the
+        largest defect (0 disables; saves the remaining iterations of a run that grinds at the noise floor).
     curvature_floor : float
         Smallest concave curvature of the information model, relative to the largest Hessian eigenvalue
         magnitude (:func:`concave_part`; >= 0).
@@ -177,6 +181,7 @@ class SCvxSettings:
     hessian_step: float = 1e-5
     hessian_refresh: float = 5e-3
     hessian_error_ratio: float = 0.3
+    stall_iter: int = 60
     curvature_floor: float = 0.0
 
     def __post_init__(self):
@@ -185,8 +190,8 @@ class SCvxSettings:
         for f in fields(self):
             if f.name in ("method", "information_model"):
                 continue
-            if f.name == "max_iter":
-                _checks.integer(self.max_iter, "max_iter", minimum=1)
+            if f.name in ("max_iter", "stall_iter"):
+                _checks.integer(getattr(self, f.name), f.name, minimum=1 if f.name == "max_iter" else 0)
                 continue
             _checks.real(getattr(self, f.name), f.name)
         for name in ("rho0", "rho1", "rho2"):
@@ -542,6 +547,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
     x_hess = x_ref[info_node].copy() if info_node is not None else None
     eta = st.eta0
     threshold = st.multiplier_threshold0
+    last_progress, best_defect = 0, feasibility(ev)[0]
     history: list = []
     bar = _progress(range(st.max_iter), desc=f"SCvx alpha={alpha:g}", enabled=progress)
     try:
@@ -641,7 +647,13 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
                     w = min(w * st.penalty_growth, st.penalty_weight_max)
                     threshold *= st.multiplier_threshold_decay
                     rec["multiplier_update"] = True
+                if actual > 10.0 * st.noise_tol * scale or rec["multiplier_update"] or max_def_new < 0.5 * best_defect:
+                    last_progress = it
+                best_defect = min(best_defect, max_def_new)
                 J_ref, obj_ref = cost_of(x_ref, u_ref, ev)
+            if st.stall_iter and it - last_progress >= st.stall_iter:
+                raise SCvxError(f"stalled: no progress in {st.stall_iter} iterations (eta = {eta:.1e}, largest defect "
+                                f"{feasibility(ev)[0]:.2e})", history)
             if eta < st.eta_min:
                 raise SCvxError(f"trust region collapsed (eta < {st.eta_min:g}) at iteration {it} with largest "
                                 f"defect {feasibility(ev)[0]:.2e}", history)

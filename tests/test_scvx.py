@@ -190,6 +190,12 @@ def test_trust_region_collapse_raises_with_history_and_pickles():
     exc = err.value
     assert exc.history and not any(h["accepted"] for h in exc.history)
     assert exc.history[-1]["eta"] < 2 * st.eta_min
+    # the same run with a stall limit stops earlier, also with an error
+    with pytest.raises(scvx.SCvxError, match="stalled") as err2:
+        scvx.solve_scvx(em, t, propagate(em, dro.x0, t).x, np.zeros((t.size, 3)), np.full(t.size, A_MAX),
+                        info=lying_info, info_node=10, alpha=0.5,
+                        settings=scvx.SCvxSettings(eta0=1e-3, eta_min=1e-12, stall_iter=5))
+    assert len(err2.value.history) == 6
     back = pickle.loads(pickle.dumps(exc))
     assert isinstance(back, scvx.SCvxError) and back.reason == exc.reason and str(back) == str(exc)
     assert len(back.history) == len(exc.history) and back.history[-1]["rho"] == exc.history[-1]["rho"]
@@ -219,7 +225,7 @@ def test_concave_part_and_finite_difference_hessian():
     ("method", "exact", ValueError), ("information_model", "cubic", ValueError), ("penalty_growth", 0.5, ValueError),
     ("multiplier_threshold_decay", 0.0, ValueError), ("active_tol", 1.0, ValueError), ("noise_tol", -1.0, ValueError),
     ("hessian_refresh", float("nan"), ValueError), ("penalty_weight_max", 1.0, ValueError),
-    ("hessian_error_ratio", 0.0, ValueError), ("curvature_floor", -1.0, ValueError)])
+    ("hessian_error_ratio", 0.0, ValueError), ("curvature_floor", -1.0, ValueError), ("stall_iter", -1, ValueError)])
 def test_settings_validate_every_field(field, value, exc):
     with pytest.raises(exc, match=field):
         scvx.SCvxSettings(**{field: value})
