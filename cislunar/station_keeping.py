@@ -210,7 +210,8 @@ class StationKeepingSurface:
     range_sigma_at_arrival_km : ndarray (n_t, n_theta)
         :math:`\\sqrt{J_\\rho}` at the last measurement before or at the arrival, km.
     u_y : ndarray (n_t, 3)
-        MMD unit direction of the coast ``t_burn -> t_arrival[j]`` (sign as returned by the eigen-solver).
+        MMD unit direction of the coast ``t_burn -> t_arrival[j]`` (or ``-> t_final`` with ``mmd_horizon="final"``;
+        sign as returned by the eigen-solver).
     alignment : ndarray (n_t, n_theta)
         :math:`\\cos\\theta_u` of Eq. 25.
     candidates : ndarray (n_t, 2) of int
@@ -340,7 +341,8 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
                             cadence: float | None = None, t_track_start: float | None = None,
                             agent_theta: float = 0.0, agent_offset=None, P0=None,
                             sigma_min_rad: float = AMOS_SIGMA_MIN_RAD, resolution_km: float = AMOS_RESOLUTION_KM,
-                            batched: bool = True, progress: bool = True) -> StationKeepingSurface:
+                            mmd_horizon: str = "arrival", batched: bool = True,
+                            progress: bool = True) -> StationKeepingSurface:
     """All two-burn maneuvers from the agent's state at ``t_burn`` to the torus surface, with covariance analyses.
 
     Parameters
@@ -369,6 +371,9 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
         Covariance at ``t_track_start`` (default :func:`cislunar.ssat.initial_covariance`).
     sigma_min_rad, resolution_km : float
         Eq. 20 noise parameters.
+    mmd_horizon : {"arrival", "final"}
+        End :math:`\\tau_f` of the MMD coast (Eq. 24) for :math:`\\mathbf u_y`: each row's arrival time (default) or
+        ``t_final`` (where :math:`J_\\rho` is read); the paper does not say which.
     batched : bool
         One heyoka batch per arrival time (default) or a plain loop over maneuvers (for benchmarks).
     progress : bool
@@ -389,6 +394,8 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
         raise ValueError(f"t_arrival must be later than t_burn = {t_burn}; got first arrival {t_arr[0]}")
     if t_final < t_arr[-1]:
         raise ValueError(f"t_final must not precede the last arrival {t_arr[-1]}; got {t_final}")
+    if mmd_horizon not in ("arrival", "final"):
+        raise ValueError(f"mmd_horizon must be 'arrival' or 'final'; got {mmd_horizon!r}")
     dt = 3600.0 / system.time_unit_s if cadence is None else _checks.positive(cadence, "cadence")
     t_start = t_burn if t_track_start is None else float(_checks.as_array(t_track_start, "t_track_start", ndim=(0,)))
     if t_start > t_burn:
@@ -405,10 +412,13 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
     goal = _torus_states(torus, theta, t_arr)  # (n_theta, n_t, 6)
     target = target_trajectory(system, torus.orbit.x0, t)
     # unmaneuvered agent and target at the arrival times for MMD (Eq. 24)
-    nominal = propagate_with_impulses(system, xa_burn, np.r_[t_burn, t_arr])
+    t_mmd = t_arr if mmd_horizon == "arrival" else np.full(t_arr.shape, t_final)
+    t_nom = np.unique(np.r_[t_burn, t_mmd])
+    k_mmd = np.searchsorted(t_nom, t_mmd)
+    nominal = propagate_with_impulses(system, xa_burn, t_nom)
     tgt_burn = (target.x[0, 0] if t_start == t_burn
                 else propagate(system, target.x[0, 0], np.array([t_start, t_burn])).x[-1])
-    tgt_arr = propagate(system, tgt_burn, np.r_[t_burn, t_arr]).x[1:]
+    tgt_mmd = propagate(system, tgt_burn, t_nom).x
     nt, nth = t_arr.size, theta.size
     dv1 = np.empty((nt, nth, 3))
     dv2 = np.empty((nt, nth, 3))
@@ -421,8 +431,8 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
         agent_stm = np.empty((nt, nth, t.size, 6, 6))
     k_arr = np.searchsorted(t, t_arr, side="right") - 1
     for j in _progress(range(nt), total=nt, desc="station-keeping surface", enabled=progress):
-        _, Ha, _ = AZIMUTH_ELEVATION.evaluate(nominal.x[0, j + 1], tgt_arr[j])
-        u_y[j] = mmd_direction(mmd_matrix(nominal.stm[0, j + 1], Ha))
+        _, Ha, _ = AZIMUTH_ELEVATION.evaluate(nominal.x[0, k_mmd[j]], tgt_mmd[k_mmd[j]])
+        u_y[j] = mmd_direction(mmd_matrix(nominal.stm[0, k_mmd[j]], Ha))
         groups = [np.arange(nth)] if batched else [np.array([i]) for i in range(nth)]
         for g in groups:
             d1, d2, x1 = two_burn_transfer(system, xa_burn, t_burn, t_arr[j], goal[g, j])

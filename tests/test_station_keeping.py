@@ -204,3 +204,34 @@ def test_filter_trial_is_consistent(torus, surface):
     err = np.array([r.range_error_km[-1] for r in res])
     sig = np.mean([r.range_sigma_km[-1] for r in res])
     assert 0.5 * sig < np.sqrt(np.mean(err**2)) < 1.6 * sig
+
+
+def test_mmd_horizon_final(torus, surface):
+    """mmd_horizon="final": one u_y for every row, the MMD axis of the coast t_burn -> t_final; same maneuvers and costs."""
+    s = sk.station_keeping_surface(em, torus, surface.theta, surface.t_arrival, surface.t_burn, surface.t[-1],
+                                   mmd_horizon="final", progress=False)
+    assert np.allclose(s.dv1, surface.dv1) and np.allclose(s.range_sigma_km, surface.range_sigma_km)
+    t = np.array([s.t_burn, s.t[-1]])
+    tgt0 = propagate(em, torus.orbit.x0, np.array([0.0, s.t_burn])).x[-1]
+    nom = ssat.propagate_with_impulses(em, np.vstack([s.agent_x0, tgt0]), t)
+    _, Ha, _ = AZIMUTH_ELEVATION.evaluate(nom.x[0, -1], nom.x[1, -1])
+    e = ssat.mmd_direction(ssat.mmd_matrix(nom.stm[0, -1], Ha))
+    assert np.allclose(np.abs(s.u_y @ e), 1.0, atol=1e-10)
+    assert not np.allclose(np.abs(surface.u_y @ e), 1.0, atol=1e-3)  # the arrival horizon differs
+    with pytest.raises(ValueError, match="mmd_horizon"):
+        sk.station_keeping_surface(em, torus, surface.theta, surface.t_arrival, surface.t_burn, surface.t[-1],
+                                   mmd_horizon="tf", progress=False)
+
+
+def test_slice_statistics_by_hand(surface):
+    """Percentiles and fuel of the informed maneuver recomputed from the raw arrays (a factor or an off-by-one fails)."""
+    s = surface
+    V = em.velocity_unit_km_s * 1e3
+    fuel = (np.linalg.norm(s.dv1, axis=-1) + np.linalg.norm(s.dv2, axis=-1)) * V
+    assert np.allclose(s.fuel_m_s, fuel)
+    for j in range(s.t_arrival.size):
+        i = s.informed[j]
+        assert np.isclose(s.informed_percentile[j], 100 * np.sum(s.range_sigma_km[j] < s.range_sigma_km[j, i]) / s.theta.size)
+        assert np.isclose(s.informed_fuel_percentile[j], 100 * np.sum(fuel[j] > fuel[j, i]) / s.theta.size)
+    assert np.allclose(s.t_arrival_hours, [-6.0, 0.5, 7.0])
+    assert np.allclose(s.phase, s.theta / (2 * np.pi))
