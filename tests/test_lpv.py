@@ -318,3 +318,15 @@ def test_sensitivity_study_matches_direct_designs(scenario, designs):
     assert st.h2_kappa[0, 0, 1] >= st.h2_kappa[0, 0, 0] * (1 - 1e-6)
     dt = st.dt_for_h2(0.1)
     assert st.h2_per_sample_deg(dt[0, 0, 0])[0, 0, 0] == pytest.approx(0.1, rel=1e-9)
+
+
+def test_sensitivity_study_same_result_through_an_executor():
+    from concurrent.futures import ThreadPoolExecutor
+
+    kw = dict(orbits=[(2, 1, 0.3), (3, 1, 0.3)], structures="acceleration", levels=[1e-3], n_samples=300)
+    serial = lpv.sensitivity_study(**kw)
+    with ThreadPoolExecutor(2) as ex:
+        threaded = lpv.sensitivity_study(executor=ex, **kw)
+    assert np.array_equal(serial.h2_kappa, threaded.h2_kappa)
+    assert np.array_equal(serial.hinf_kappa, threaded.hinf_kappa)
+    assert np.array_equal(serial.r13_max, threaded.r13_max)
