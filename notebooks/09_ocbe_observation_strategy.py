@@ -463,11 +463,12 @@ else:
 # %% [markdown]
 # **Which stable NRHO, by evidence.** The paper says its stable NRHO gives "qualitatively similar but quantitatively
 # better" results than the 9:2. The two "better determined" rows of the closing table test exactly that for both
-# candidates, with a criterion fixed before looking (smaller final 3-sigma position at most cadences): in our runs
-# the inner-band member near the Moon is *worse* determined than the 9:2 (and is the only orbit whose angles-only
-# runs diverge at 12 h), while the outer-band member is better determined at every cadence. On this evidence the
-# paper's stable NRHO is more likely a member of the outer band; `orbits.stable_nrho` (used by notebooks 01 and 10)
-# still returns the inner one, so both are kept in the tables.
+# candidates, with a criterion fixed before looking (smaller final 3-sigma position at most cadences). When this
+# section was written (quick mode, 3 runs per cell) the inner-band member near the Moon failed it (worse determined
+# than the 9:2 at every cadence, and the only orbit whose angles-only runs diverged at 12 h) and the outer-band
+# member passed it at every cadence; check the two rows of this run. On that evidence the paper's stable NRHO is
+# more likely a member of the outer band; `orbits.stable_nrho` (used by notebooks 01 and 10) still returns the inner
+# one, so both are kept in the tables.
 
 # %% [markdown]
 # ## 6 · Paper versus reproduction
