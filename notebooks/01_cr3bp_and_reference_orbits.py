@@ -110,7 +110,7 @@ ax.set_xlabel("finite-difference step h [LU, LU/TU]")
 ax.set_ylabel("max relative error vs heyoka")
 ax.set_title("Variational equations vs finite differences, one 9:2 NRHO period")
 ax.legend()
-plotting.save_figure(fig, "01_stm_stt_vs_finite_differences", output_dir=out)
+_ = plotting.save_figure(fig, "01_stm_stt_vs_finite_differences", output_dir=out)
 best_stm, best_stt = min(stm_err), min(stt_err)
 print(f"best agreement: STM {best_stm:.1e}, STT {best_stt:.1e}")
 
@@ -176,7 +176,7 @@ ax2.plot([c.x0 for c in checks], [c.corrected.period_days for c in checks], "o",
 ax2.set_xlabel("x-axis crossing x0 [LU]")
 ax2.set_ylabel("period [days]")
 ax2.legend()
-plotting.save_figure(fig, "01_dro_family_wolf_jones", output_dir=out)
+_ = plotting.save_figure(fig, "01_dro_family_wolf_jones", output_dir=out)
 
 # %% [markdown]
 # ## 4 · The southern L2 halo family and the NRHOs
@@ -220,7 +220,7 @@ ax.set_xlabel("perilune radius [km]")
 ax.set_ylabel(r"stability index $\nu$")
 ax.set_title("Stability along the southern L2 halo family")
 ax.legend()
-plotting.save_figure(fig, "01_halo_stability_vs_perilune", output_dir=out)
+_ = plotting.save_figure(fig, "01_halo_stability_vs_perilune", output_dir=out)
 
 # %% [markdown]
 # The analogue of Greaves & Scheeres' Fig. 2: NRHO members about the Moon with the two reference orbits
@@ -239,7 +239,7 @@ for plane, ax in axes.items():
     plotting.plot_primaries(ax, em, plane, moon_centred=True, units="km", earth=False)
 axes["xy"].legend(loc="upper left")
 fig.suptitle("Southern L2 NRHO family (grey) with the 9:2 (blue) and stable (red) reference orbits")
-plotting.save_figure(fig, "01_nrho_family_fig2", output_dir=out)
+_ = plotting.save_figure(fig, "01_nrho_family_fig2", output_dir=out)
 
 # %% [markdown]
 # ## 5 · Observer sites (maneuver-detection paper, Fig. 3)
@@ -286,7 +286,7 @@ for plane, ax in axes.items():
         ax.plot(q[i], q[j], "^", color="C1", ms=6)
 axes["xy"].legend(loc="lower left")
 fig.suptitle("Observer sites (red) and the NRHOs (blue), Moon-centred; triangles: surface stations")
-plotting.save_figure(fig, "01_observer_sites_fig3", output_dir=out)
+_ = plotting.save_figure(fig, "01_observer_sites_fig3", output_dir=out)
 
 # %% [markdown]
 # ## 6 · Paper versus reproduction
