@@ -273,7 +273,8 @@ for ax, i in zip(axes, show):
     ax.plot(0, 0, "o", color="0.5", ms=5, label="Moon")
     ax.set(xlabel="x - x_Moon [1000 km]", ylabel="y [1000 km]", aspect="equal",
            title=rf"$\alpha_h$ = {ALPHAS[i]:g}: {best[i].impulse * MPS:.1f} m/s, I = {best[i].information:.1f} nats")
-    ax.legend(loc="upper right", fontsize=8)
+handles, labels = axes[0].get_legend_handles_labels()
+fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, -0.04))
 fig.suptitle("Fig. 1 analogue: observer trajectory, Moon-centred rotating frame")
 _ = plotting.save_figure(fig, "05_fig1_trajectories", output_dir=out)
 
