@@ -574,7 +574,12 @@ def mmd_matrix(agent_stm, H_agent) -> np.ndarray:
 
 
 def mmd_direction(Q) -> np.ndarray:
-    """Unit eigenvector of the largest eigenvalue of ``Q`` (..., 3, 3) (Eq. 23), sign fixed (largest |component| > 0)."""
+    """Unit eigenvector of the largest eigenvalue of ``Q`` (..., 3, 3) (Eq. 23), sign fixed (largest |component| > 0).
+
+    Eq. 23 as printed, :math:`\\mathbf u_y = \\pm\\upsilon\\max(\\mathrm{eig}(Q))`, names the largest eigenvalue (a
+    scalar); the policy is its eigenvector, the maximiser of the Rayleigh quotient :math:`\\mathbf u^TQ\\mathbf u`
+    on the unit sphere.
+    """
     Q = _checks.as_array(Q, "Q")
     if Q.shape[-2:] != (3, 3):
         raise ValueError(f"Q must have shape (..., 3, 3); got {Q.shape}")

@@ -22,7 +22,9 @@ Informed maneuver (Eq. 25)
 --------------------------
 For each arrival time the MMD direction :math:`\mathbf u_y` (Eqs. 23-24) of the coast :math:`t_b \to t_a` is
 computed on the unmaneuvered agent trajectory; the alignment
-:math:`\cos\theta_u = \mathbf u_y^T\Delta\mathbf v_1/\|\Delta\mathbf v_1\|` selects two candidates
+:math:`\cos\theta_u = \mathbf u_y^T\Delta\mathbf v_1/\|\Delta\mathbf v_1\|` (unit :math:`\mathbf u_y`; the
+printed Eq. 25 divides by :math:`\|\mathbf u_y^T\mathbf u_{sk}\|`, which would make every angle 0 or
+:math:`\pi`, so we read it as the angle between the vectors) selects two candidates
 (:math:`\theta_u` nearest 0 and nearest :math:`\pi`, since :math:`\pm\mathbf u_y` are both MMD solutions) and a
 covariance analysis of the two picks the informed maneuver :math:`\mathbf u^*`.
 
