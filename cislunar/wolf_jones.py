@@ -107,7 +107,8 @@ KEEP_OUT_SIGMAS = 3.0
 
 
 def keep_out_radius_km(sigma_pos_km: float = SIGMA_POS_KM, n_sigma: float = KEEP_OUT_SIGMAS) -> float:
-    """:math:`d_{min} = n_\\sigma\\sqrt2\\,\\sigma_p`: the target outside the prior n-sigma relative-position sphere, km."""
+    """:math:`d_{min} = n_\\sigma\\sqrt2\\,\\sigma_p` (km): the target outside the prior n-sigma relative-position
+    sphere."""
     s = _checks.positive(sigma_pos_km, "sigma_pos_km")
     k = _checks.positive(n_sigma, "n_sigma")
     return float(k * np.sqrt(2.0) * s)

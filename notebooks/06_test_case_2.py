@@ -125,7 +125,8 @@ dz = np.zeros(6)
 dz[5] = 1e-3 / em.velocity_unit_km_s  # 1 m/s in vz
 mi_up, mi_down = info(x_ws_ball + dz), info(x_ws_ball - dz)
 print(f"MI with vz = +1 m/s: {mi_up - I0:+.4f} nats, vz = -1 m/s: {mi_down - I0:+.4f} nats (relative to planar)")
-print(f"Hessian diagonal (z, vz): {H[2, 2]:.3e}, {H[5, 5]:.3e}; eigenvalues: {np.array2string(np.linalg.eigvalsh(H), precision=2)}")
+print(f"Hessian diagonal (z, vz): {H[2, 2]:.3e}, {H[5, 5]:.3e}; "
+      f"eigenvalues: {np.array2string(np.linalg.eigvalsh(H), precision=2)}")
 
 # %% [markdown]
 # ## 3 · Why a keep-out, and how large
@@ -135,7 +136,8 @@ print(f"Hessian diagonal (z, vz): {H[2, 2]:.3e}, {H[5, 5]:.3e}; eigenvalues: {np
 # observer's window-start state (Newton on the STM) so that it passes target 1 at a chosen distance at the middle
 # measurement of the window and evaluate the MI: nearly flat down to about a hundred metres, the reward then
 # grows without bound (like $\ln(1/\rho)$), so a maximiser that finds this region flies through the target (the
-# run without keep-out in section 11 does not converge). Even far from that singularity the reward is an artefact: the MI linearises the measurement about the *true* states, while the prior
+# run without keep-out in section 11 does not converge). Well before that singularity the reward stops being
+# trustworthy: the MI linearises the measurement about the *true* states, while the prior
 # uncertainty of the relative position is $\sigma_{rel} = \sqrt2\cdot 100$ km = 141 km per axis; the
 # line-of-sight direction that carries the range-rate information is uncertain by about $\sigma_{rel}/\rho$ rad. We
 # require the target to lie outside the prior 3-sigma relative-position sphere,
