@@ -191,8 +191,9 @@ table.add("SCvx converges with defects driven to zero (Eqs. 30, 42)", "yes (meth
           f"{len(res.history)} iterations, largest defect {res.max_defect:.0e}",
           "reproduced" if res.max_defect < 1e-9 else "differs: defects remain")
 table.add("converged FOH control flies the nonlinear dynamics to x_f", "implied",
-          f"miss {terminal_miss_km:.1e} km, {terminal_miss_mm_s:.1e} mm/s", "reproduced" if terminal_miss_km < 1e-3
-          else "differs: single-shooting miss too large")
+          f"miss {terminal_miss_km:.1e} km, {terminal_miss_mm_s:.1e} mm/s", "reproduced" if terminal_miss_km < 1.0
+          else "differs: single-shooting miss too large",
+          "tolerance 1 km (issue 7): node defects below 5e-10 LU (0.2 m) grow over 32 days of free flight")
 table.add("trust-region parameters (Table 1)", "user-defined, not given",
           f"rho = {settings.rho0}/{settings.rho1}/{settings.rho2}, beta = {settings.beta_shrink}/{settings.beta_grow}, "
           f"eta0 = {settings.eta0:g}, eta_max = {settings.eta_max:g}, w0 = {settings.penalty_weight0:g}",
