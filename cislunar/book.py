@@ -139,7 +139,7 @@ def read_entries(build: Path) -> list[NotebookEntry]:
     """
     from . import notebooks as runner
 
-    executed = {p.stem: p for p in sorted((build / "notebooks").glob("[0-9][0-9]_*.ipynb"))}
+    executed = {p.stem: p for p in sorted((build / "notebooks").glob("[0-9][0-9]*_*.ipynb"))}
     names = sorted(set(executed) | {p.stem for p in runner.discover()})
     entries = []
     for name in names:
@@ -348,7 +348,7 @@ def stage(build: Path) -> Path:
     BookError
         When ``<build>/notebooks`` holds no executed notebook.
     """
-    executed = sorted((build / "notebooks").glob("[0-9][0-9]_*.ipynb"))
+    executed = sorted((build / "notebooks").glob("[0-9][0-9]*_*.ipynb"))
     if not executed:
         raise BookError(f"no executed notebooks in {build / 'notebooks'}; run `make reproduce` (or "
                         "`python -m cislunar.notebooks`) first")

@@ -55,8 +55,8 @@ def notebooks_dir() -> Path:
 
 
 def discover(selection=None) -> list[Path]:
-    """Notebook sources ``notebooks/NN_*.py`` in order, optionally filtered by name prefixes (``"01"``, ``"02_mut"``)."""
-    found = sorted(p for p in notebooks_dir().glob("[0-9][0-9]_*.py"))
+    """Notebook sources ``notebooks/NN_*.py`` (or ``NNx_*.py``, e.g. ``09b``) in order, optionally filtered by name prefixes (``"01"``, ``"02_mut"``)."""
+    found = sorted(p for p in notebooks_dir().glob("[0-9][0-9]*_*.py"))
     if not selection:
         return found
     chosen = []

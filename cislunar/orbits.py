@@ -31,7 +31,7 @@ Times in TU, states in LU and LU/TU, rotating frame (see :mod:`cislunar.dynamics
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import numpy as np
@@ -604,6 +604,49 @@ def stable_nrho(system: CR3BP, *, step: float = 0.01) -> PeriodicOrbit:
         raise ConvergenceError("continuation from the 9:2 NRHO did not reach the stable region",
                                [_hyperbolic_margin(o) for o in fam], _pack(fam[-1].x0, fam[-1].period / 2, False))
     return refine_on_family(system, fam[-2], fam[-1], _hyperbolic_margin, label="stable NRHO (nu = 1)")
+
+
+def stable_nrho_outer(system: CR3BP, *, step: float = 0.01) -> PeriodicOrbit:
+    """The most stable member of the southern L2 halo family's outer stable band.
+
+    Continuing from the 9:2 NRHO away from the Moon (increasing half period), the family's hyperbolic pair turns
+    elliptic again at a perilune radius of about 13,400 km and stays so over a band of members ("roughly halfway to
+    the Moon" from L2).  This continues into that band, through it, and returns the member with the smallest
+    hyperbolic margin ``max |Broucke index| - 1`` (the most stable one; perilune about 16,200 km, period about
+    10.1 d in the Earth-Moon system).  :func:`stable_nrho` is the inner band's edge next to the Moon; which of the
+    two Greaves & Scheeres (2021) used is not stated (their Table 1 is missing), so notebooks 09, 09b and 10 carry
+    both.
+
+    Parameters
+    ----------
+    system : CR3BP
+    step : float
+        Continuation step in the half period, TU.
+
+    Returns
+    -------
+    PeriodicOrbit
+
+    Raises
+    ------
+    ConvergenceError
+        If the continuation does not reach the band or does not leave it within its step budget.
+    """
+    _checks.system(system)
+    step = abs(_checks.positive(step, "step"))
+    fam = continue_family(system, nrho_9_2(system), 120, step, parameter="half_period",
+                          stop=lambda o: _hyperbolic_margin(o) < 0)
+    if _hyperbolic_margin(fam[-1]) >= 0:
+        raise ConvergenceError("continuation from the 9:2 NRHO away from the Moon did not reach the outer stable "
+                               "band", [_hyperbolic_margin(o) for o in fam],
+                               _pack(fam[-1].x0, fam[-1].period / 2, False))
+    band = continue_family(system, fam[-1], 80, step, parameter="half_period",
+                           stop=lambda o: _hyperbolic_margin(o) > 0)
+    if _hyperbolic_margin(band[-1]) <= 0:
+        raise ConvergenceError("continuation did not cross the outer stable band within its step budget",
+                               [_hyperbolic_margin(o) for o in band], _pack(band[-1].x0, band[-1].period / 2, False))
+    best = min(band, key=_hyperbolic_margin)
+    return replace(best, label="stable NRHO (outer band)")
 
 
 def dro_family(system: CR3BP, x0_values, *, seed=None) -> list:

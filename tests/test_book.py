@@ -470,7 +470,7 @@ def built(quick_runs):
         out = build / "book"
         if not (out / "index.html").is_file():
             pytest.fail(f"CISLUNAR_BOOK_BUILD={existing}: no book at {out}; run `make book` first")
-        ok = sorted(p.stem for p in (build / "notebooks").glob("[0-9][0-9]_*.ipynb"))
+        ok = sorted(p.stem for p in (build / "notebooks").glob("[0-9][0-9]*_*.ipynb"))
         return build, out, ok, None
     results = quick_runs.all(SOURCES)
     build = quick_runs.build

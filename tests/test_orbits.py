@@ -145,3 +145,15 @@ def test_integrators_are_compiled_once_per_process():
     propagation.propagate_stm(em, [0.8, 0, 0, 0, 0.5, 0], 0.2)
     assert propagation._template.cache_info().misses == before.misses
     assert propagation._integrator(1, 1, propagation.DEFAULT_TOL) is first  # this thread's working copy is reused
+
+
+def test_stable_nrho_outer_band_member_is_stable_and_far_from_the_moon(nrho):
+    outer = orbits.stable_nrho_outer(em)
+    # linearly stable: every Broucke index inside [-1, 1] (all multipliers on the unit circle)
+    assert np.max(np.abs(outer.broucke_indices.real)) < 1.0
+    assert abs(outer.stability_index - 1.0) < 1e-6
+    assert outer.closure < 1e-10
+    # the outer band lies L2-ward of the 9:2 NRHO: larger perilune, longer period
+    assert 13000.0 < outer.perilune_radius_km < 20000.0
+    assert outer.period > nrho.period
+    assert outer.label == "stable NRHO (outer band)"
