@@ -279,7 +279,7 @@ def _index_markdown(entries: list[NotebookEntry], build: Path) -> str:
             if facts:
                 lines += [f"*Closing table:* {'; '.join(facts)}. See the [report](report.md).", ""]
         else:
-            lines += [f"*Not executed in this build* (`python -m cislunar.notebooks {e.name[:2]}`).", ""]
+            lines += [f"*Not executed in this build* (`python -m cislunar.notebooks {e.name}`).", ""]
     lines += ["```{toctree}", ":hidden:", ":caption: Notebooks", ""]
     lines += [f"notebooks/{e.name}" for e in entries if e.executed]
     lines += ["```", "", "```{toctree}", ":hidden:", ":caption: Results and references", "", "report", "papers",
