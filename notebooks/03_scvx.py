@@ -129,7 +129,7 @@ axes[1].set(xlabel="iteration", ylabel="largest defect after the step")
 axes[2].semilogy(its, [h["eta"] for h in res.history], "o-")
 axes[2].set(xlabel="iteration", ylabel=r"trust-region radius $\eta$")
 fig.suptitle("SCvx iterations, minimum-impulse DRO transfer (test case 1 boundary conditions)")
-plotting.save_figure(fig, "03_iterations", output_dir=out)
+_ = plotting.save_figure(fig, "03_iterations", output_dir=out)
 
 # %% [markdown]
 # ## 3 · Is the converged trajectory real?
@@ -156,7 +156,7 @@ plotting.plot_rotating(ax2, (x_single - propagate(em, dro.x0, t).x)[None], em, "
                        label="converged minus initial DRO")
 ax2.set_title("relative motion w.r.t. the initial DRO (rotating frame)")
 ax2.legend(loc="upper right")
-plotting.save_figure(fig, "03_converged_control", output_dir=out)
+_ = plotting.save_figure(fig, "03_converged_control", output_dir=out)
 
 # %% [markdown]
 # ## 4 · Independence from the initial guess

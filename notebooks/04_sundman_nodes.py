@@ -76,7 +76,7 @@ for ax, name in zip(axes, ARCS):
     ax.set_title(name)
 axes[0].legend()
 fig.suptitle(f"Sundman-spaced nodes ({N_NODES} per arc)")
-plotting.save_figure(fig, "04_node_spacing", output_dir=out)
+_ = plotting.save_figure(fig, "04_node_spacing", output_dir=out)
 spread = {(name, s): float(np.diff(nodes[name, s]).max() / np.diff(nodes[name, s]).min()) for name, s in nodes}
 for key, v in spread.items():
     print(f"{key[0]:30s} sigma = {key[1]:3.1f}: longest / shortest interval = {v:8.2f}")
@@ -95,7 +95,7 @@ for ax, name, plane in zip(axes, ARCS, ("xy", "yz")):
     ax.set_title(name)
     ax.legend(loc="lower left")
     ax.locator_params(axis="x", nbins=5)
-plotting.save_figure(fig, "04_nodes_on_orbits", output_dir=out)
+_ = plotting.save_figure(fig, "04_nodes_on_orbits", output_dir=out)
 
 # %% [markdown]
 # On the DRO $r_m$ varies only between about 70,000 and 120,000 km, so even $\sigma = 2$ changes the spacing by a
@@ -143,7 +143,7 @@ ax.set_xlabel(r"Sundman exponent $\sigma$")
 ax.set_ylabel("largest one-step linearisation error [km]")
 ax.set_title(f"FOH affine model vs nonlinear flow ({N_NODES} nodes, controls of size a_max)")
 ax.legend()
-plotting.save_figure(fig, "04_linearisation_error_vs_sigma", output_dir=out)
+_ = plotting.save_figure(fig, "04_linearisation_error_vs_sigma", output_dir=out)
 for key, v in lin_err.items():
     print(f"{key[0]:30s} sigma = {key[1]:3.1f}: {v:.3e} km")
 
@@ -172,7 +172,7 @@ ax.set_xlabel("time [days]")
 ax.set_ylabel(r"$u_{max,k}$ as printed [m/s]")
 ax.set_title("Eq. 41 minimum-norm node bounds on the NRHO arc")
 ax.legend()
-plotting.save_figure(fig, "04_umax_per_node", output_dir=out)
+_ = plotting.save_figure(fig, "04_umax_per_node", output_dir=out)
 t_demo = nodes[name, max(SIGMAS)]
 u_demo = D.max_control_per_node(t_demo, A_MAX)
 residual_40 = float(np.max(np.abs((u_demo[:-1] + u_demo[1:]) / (2 * np.diff(t_demo)) - A_MAX)) / A_MAX)
