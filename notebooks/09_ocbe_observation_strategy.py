@@ -60,25 +60,7 @@ executor = ProcessPoolExecutor(WORKERS) if WORKERS > 1 else None
 table = ComparisonTable("09 OCBE observation strategy (Greaves & Scheeres 2021 §Measurements, §State Estimation, "
                         "§Observation Strategy)")
 nrho, stable = orbits.nrho_9_2(em), orbits.stable_nrho(em)
-
-
-def outer_band_nrho(system):
-    """Most stable member of the southern L2 halo family's outer stable band (continuing from the 9:2 NRHO L2-ward).
-
-    ``orbits.stable_nrho`` takes the inner band's period-doubling edge (perilune about 95 km above the surface);
-    the family turns stable again at a perilune of about 13,400 km. Here: continue until the hyperbolic margin
-    (largest |Broucke index| - 1) turns negative, then through the band, and keep its most stable member.
-    """
-    def margin(o):
-        return float(np.max(np.abs(o.broucke_indices.real)) - 1.0)
-
-    fam = orbits.continue_family(system, orbits.nrho_9_2(system), 120, 0.01, parameter="half_period",
-                                 stop=lambda o: margin(o) < 0)
-    band = orbits.continue_family(system, fam[-1], 80, 0.01, parameter="half_period", stop=lambda o: margin(o) > 0)
-    return min(band, key=margin)
-
-
-outer = outer_band_nrho(em)
+outer = orbits.stable_nrho_outer(em)
 ORBITS = {"9:2 NRHO": nrho, "stable NRHO": stable, "stable NRHO (outer band)": outer}
 MAP_ORBITS = {"9:2 NRHO": nrho, "stable NRHO": stable}  # the regime map keeps to the paper's two
 for name, o in ORBITS.items():
@@ -90,7 +72,7 @@ for name, o in ORBITS.items():
 # where the L2 halo family turns stable next to the 9:2 NRHO, towards the Moon: its perilune is only about 95 km
 # above the surface and it sits exactly on the period-doubling boundary (stability index 1). The family has a
 # second stable band roughly halfway out (perilune about 13,400 km and beyond, notebook 01's stability figure); we
-# add its most stable member as a third orbit, so every comparison below that involves "the stable NRHO" can be
+# add its most stable member (`orbits.stable_nrho_outer`) as a third orbit, so every comparison below that involves "the stable NRHO" can be
 # read for both candidates.
 
 # %% [markdown]

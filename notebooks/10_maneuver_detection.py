@@ -67,21 +67,8 @@ rng = np.random.default_rng(SEED)
 executor = ProcessPoolExecutor(WORKERS, mp_context=mp.get_context("spawn")) if WORKERS > 1 else None
 TUNED = "consistent (tuned)"  # agreement that rests on a choice made while looking at the paper
 table = ComparisonTable("10 Maneuver detection (Greaves & Scheeres 2021, Eqs. 3-5, 33-35, Figs. 12-22, Tables 5-8)")
-
-
-def outer_band_nrho(system):
-    """Most stable member of the L2 halo family's outer stable band (as in notebook 09; requested for cislunar.orbits)."""
-    def margin(o):
-        return float(np.max(np.abs(o.broucke_indices.real)) - 1.0)
-
-    fam = orbits.continue_family(system, orbits.nrho_9_2(system), 120, 0.01, parameter="half_period",
-                                 stop=lambda o: margin(o) < 0)
-    band = orbits.continue_family(system, fam[-1], 80, 0.01, parameter="half_period", stop=lambda o: margin(o) > 0)
-    return min(band, key=margin)
-
-
 OUTER = "stable NRHO (outer band)"
-ORBITS = {"9:2 NRHO": orbits.nrho_9_2(em), "stable NRHO": orbits.stable_nrho(em), OUTER: outer_band_nrho(em)}
+ORBITS = {"9:2 NRHO": orbits.nrho_9_2(em), "stable NRHO": orbits.stable_nrho(em), OUTER: orbits.stable_nrho_outer(em)}
 STABLE = ("stable NRHO", OUTER)
 OUTER_SIZE = 0.2  # the outer-band candidate (notebook 09) runs a fifth of the training Monte Carlo, half the tests
 POLICIES = {"active": det.ACTIVE_POLICY, "quiet": det.QUIET_POLICY}
