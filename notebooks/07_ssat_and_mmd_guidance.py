@@ -100,6 +100,20 @@ print("T B_a (control in relative coordinates) =\n", ssat.control_matrix("relati
 # $\sigma_\theta = \sqrt{\sigma_{\theta,min}^2 + D^2/\rho^2}$, $\sigma_{\theta,min}$ = 10 micro-rad, $D$ = 4 m;
 # initial 3-sigma of 60 km and 60 cm/s per axis for both vehicles, uncorrelated; no process noise (the paper lists
 # none); the covariance is propagated along the true trajectories.
+#
+# **The covariance analysis and the cost (Eqs. 19-22).** Eq. 19, $\rho^2\sigma_\theta^2 = \rho^2\sigma_{\theta,min}^2 +
+# D^2$, adds in quadrature a pointing floor and the angle a 4 m resolution element subtends at range $\rho$; Eq. 20
+# solves it for $\sigma_\theta$, the same for both angles ($R_j = \sigma_\theta^2 I_2$). With no process noise, the
+# posterior covariance after the measurements up to $t_k$ is
+# $P_k = \Phi_k\big(P_0^{-1} + \sum_{j\le k}\Phi_j^TH_j^TR_j^{-1}H_j\Phi_j\big)^{-1}\Phi_k^T$, with the block-diagonal
+# STM $\Phi_j = \Phi(t_j, t_0)$ of both vehicles and $H_j = [-H_\theta\ \ H_\theta]$ (Eq. 18 with respect to the inertial
+# SSAT state); `ssat.ssat_covariance` evaluates it in square-root information form for a whole batch of agent
+# trajectories at once, and `ssat.ssat_covariance_ekf` by the textbook Joseph-form EKF recursion, as a check. The
+# cost is the range variance $J_\rho = M_\rho^T\tilde P_fM_\rho$ (Eq. 21) with $M_\rho = [\mathbf 0_6;
+# \hat{\boldsymbol\rho}_{\tau_f}; \mathbf 0_3]$ (Eq. 22) picking the range direction out of the relative partition
+# of $\tilde P = TPT^T$; in inertial coordinates the same number is $m^TPm$ with $m = T^TM_\rho =
+# [-\hat{\boldsymbol\rho}; \mathbf 0; \hat{\boldsymbol\rho}; \mathbf 0]$. $\sqrt{J_\rho}$ is the 1-sigma range
+# uncertainty; at $t_0$ a pair of angles says nothing about range, so it is $\sqrt2\times20$ km.
 
 # %%
 nrho = nrho_9_2(em)
@@ -135,8 +149,8 @@ for coords in ("inertial", "relative", "agent"):
 # %% [markdown]
 # **The equations as printed.** The dynamics (Eqs. 8-12) are the package's CR3BP in non-dimensional units, where
 # $G(m_1+m_2) = r_{12} = 1$, so Eq. 12 gives $\boldsymbol\omega_{D/N} = \hat{\mathbf e}_z$ and Eq. 11 reads
-# $\mathbf a = -2\boldsymbol\omega\times\mathbf v - \boldsymbol\omega\times(\boldsymbol\omega\times\mathbf r)
-# - (1-\mu)\boldsymbol\rho_{b1}/\rho_{b1}^3 - \mu\boldsymbol\rho_{b2}/\rho_{b2}^3$. The measurement (Eqs. 15-17)
+# $\mathbf a = -2\boldsymbol\omega\times\mathbf v - \boldsymbol\omega\times(\boldsymbol\omega\times\mathbf r) -
+# (1-\mu)\boldsymbol\rho_{b1}/\rho_{b1}^3 - \mu\boldsymbol\rho_{b2}/\rho_{b2}^3$. The measurement (Eqs. 15-17)
 # is azimuth $\theta_a = \tan^{-1}(\rho_y/\rho_x)$ (taken in the right quadrant, `arctan2`) and elevation
 # $\theta_e = \sin^{-1}(\rho_z/\rho)$ of $\boldsymbol\rho = \mathbf r_t - \mathbf r_a$, with the Jacobian
 # $H_\theta$ of Eq. 18 with respect to $\boldsymbol\rho$; with respect to the agent state it is $-H_\theta$. We type
@@ -164,13 +178,14 @@ print(f"Eq. 11 typed in vs package equations of motion: {err_eq11:.1e} relative;
 # %%
 fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
 hours = (t - t[0]) / HR
-for s, lab, c in ((tgt.x[0], "target (9:2 NRHO)", "k"), (agt.x[0], "agent", "tab:red")):
+for s, lab, c, ls in ((tgt.x[0], "target (9:2 NRHO)", "k", "-"),
+                      (agt.x[0], f"agent, same orbit {lag_h * 60:.0f} min behind", "tab:red", "--")):
     m = em.moon_centred(s) * L / 1e3
-    axes[0].plot(m[:, 1], m[:, 2], color=c, lw=1.5, label=lab)
+    axes[0].plot(m[:, 1], m[:, 2], color=c, lw=1.5, ls=ls, label=lab)
 axes[0].set_xlabel("y, Moon-centred (1000 km)")
 axes[0].set_ylabel("z (1000 km)")
 axes[0].set_title("three days about apolune")
-axes[0].legend(loc="lower left")
+axes[0].legend(loc="upper right", fontsize=8)
 axes[1].plot(hours, base.range_km[0], color="tab:blue")
 axes[1].set_xlabel("time since the burn epoch (h)")
 axes[1].set_ylabel("agent-target range (km)", color="tab:blue")
@@ -178,7 +193,12 @@ ax2 = axes[1].twinx()
 ax2.plot(hours, base.sigma_theta_rad[0] * 1e6, color="tab:orange")
 ax2.set_ylabel(r"$\sigma_\theta$ (micro-rad, Eq. 20)", color="tab:orange")
 axes[1].axvline(LEAD_DAYS * 24, color="0.6", ls=":", lw=1)
+axes[1].text(LEAD_DAYS * 24 + 1, 0.03, "apolune", transform=axes[1].get_xaxis_transform(), va="bottom", fontsize=8,
+             color="0.4")
 axes[2].semilogy(hours, base.range_sigma_km[0], color="k")
+axes[2].yaxis.set_major_formatter(plt.matplotlib.ticker.ScalarFormatter())
+axes[2].yaxis.set_minor_formatter(plt.matplotlib.ticker.NullFormatter())
+axes[2].set_yticks([12, 15, 20, 25, 30, 35])
 axes[2].set_xlabel("time since the burn epoch (h)")
 axes[2].set_ylabel(r"$\sqrt{J_\rho}$, 1-sigma range (km)")
 axes[2].set_title("no maneuver")

@@ -1,6 +1,7 @@
 """save_figure paths and determinism; report tables; the notebook runner's failure reporting."""
 
 import os
+import re
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -67,7 +68,7 @@ def test_runner_requires_one_parameters_cell(tmp_path):
 def test_every_notebook_source_follows_the_conventions():
     for src in notebooks.discover():
         text = src.read_text()
-        assert src.stem[:2].isdigit() and src.stem[2] == "_"
+        assert re.fullmatch(r"\d\d[a-z]?_[a-z0-9_]+", src.stem), f"{src.name}: NN_topic.py or NNx_topic.py"
         assert text.count('tags=["parameters"]') == 1, src
         for name in ("QUICK", "SEED", "OUTPUT_DIR"):
             assert f"\n{name} = " in text, (src, name)
