@@ -1,4 +1,5 @@
-"""SCvx on Wolf & Jones test case 1: where an iteration's time goes, re-solve vs rebuild, a full alpha_h sweep.
+"""SCvx on Wolf & Jones test cases 1 and 2: where an iteration's time goes, re-solve vs rebuild, a full alpha_h
+sweep per case.
 
 Scenario: :func:`cislunar.wolf_jones.test_case_1` (observer and one target on DROs, relative position 100 m, two
 periods, zero thrust in [3P/4, 3P/2]) on 40 Sundman nodes, the information model with fixed process noise.
@@ -11,6 +12,9 @@ periods, zero thrust in [3P/4, 3P/2]) on 40 Sundman nodes, the information model
 2. **Re-solve vs rebuild**: the subproblem built once with ``cvxpy.Parameter`` objects (DPP, canonicalised once)
    and re-solved with new values, against building and solving a fresh problem each time.
 3. **Sweep**: the alpha_h grid of notebook 05 (9 values) swept upward and downward, best kept.
+4. **Test case 2 sweep**: observer and three targets, range and range-rate, the minimum-range keep-out, 30 Sundman
+   nodes and the 8-value alpha_h grid of notebook 06, both directions serially (the notebook runs them in two
+   processes).
 
 ``python -m benchmarks scvx`` prints the numbers; ``main()`` returns them.  Ratios are within one run.
 """
@@ -27,6 +31,24 @@ from cislunar.dynamics import EARTH_MOON as em
 
 N_NODES = 40
 ALPHAS = [0.0, 1e-3, 2e-3, 3e-3, 5e-3, 7e-3, 1e-2, 1.5e-2, 2e-2]
+N_NODES_CASE_2 = 30
+ALPHAS_CASE_2 = [0.0, 5e-4, 1e-3, 2e-3, 5e-3, 7e-3, 1e-2, 2e-2]
+
+
+def sweep_case_2() -> dict:
+    """Test case 2: the notebook-06 alpha_h grid swept up and down (serial), with the keep-out."""
+    sc = wolf_jones.test_case_2()
+    t, k_ws, _ = sc.node_times(N_NODES_CASE_2, 1.0)
+    x0, u0 = sc.ballistic_guess(t)
+    solver = wolf_jones.ScenarioSolver(sc, t, k_ws, information=sc.information_model(), keep_out=True,
+                                       settings=scvx.SCvxSettings(max_iter=150))
+    t0 = time.perf_counter()
+    sweep = wolf_jones.sweep_both_ways(solver, ALPHAS_CASE_2, x0, u0)
+    seconds = time.perf_counter() - t0
+    n_it = int(sum(a["iterations"] for a in sweep.attempts))
+    return dict(case2_nodes=N_NODES_CASE_2, case2_alphas=len(ALPHAS_CASE_2), case2_runs=len(sweep.attempts),
+                case2_converged=int(sum(a["converged"] for a in sweep.attempts)), case2_iterations=n_it,
+                case2_sweep_s=seconds, case2_per_iteration_s=seconds / max(n_it, 1))
 
 
 def _best_time(fn, repeat=5):
@@ -157,6 +179,11 @@ def main() -> dict:
           f"({out['run_hessian_refreshes']} refreshes), solve {per_iter['t_solve']:.3f})")
     print(f"  alpha_h sweep up and down over {len(ALPHAS)} values: {out['sweep_converged']}/{out['sweep_runs']} "
           f"converged, {n_it} iterations, {sweep_s:.1f} s ({out['sweep_per_iteration_s']:.3f} s/iteration)")
+    c2 = sweep_case_2()
+    out.update(c2)
+    print(f"test case 2, {c2['case2_nodes']} nodes, keep-out: alpha_h sweep up and down over {c2['case2_alphas']} "
+          f"values: {c2['case2_converged']}/{c2['case2_runs']} converged, {c2['case2_iterations']} iterations, "
+          f"{c2['case2_sweep_s']:.1f} s ({c2['case2_per_iteration_s']:.3f} s/iteration)")
     return out
 
 
