@@ -127,19 +127,19 @@ print(f"Eq. 18 dense: {dense_toy:.12f} nats; chain rule: {total_toy:.12f} nats =
 # $[\hat\rho^T\ 0]$ and $[(\Delta\dot{\mathbf r}-\dot\rho\hat\rho)^T/\rho\ \ \hat\rho^T]$; the observer's Jacobian
 # is the negative (Eq. 21 puts both in $H_{\mathcal A}$). Optical angles (G&S 2021 Eqs. 7-8, AMOS Eqs. 15-18) use
 # the RMS model $\sigma_\theta = \sqrt{\sigma_{min}^2 + D^2/\rho^2}$ (AMOS Eq. 20, $\sigma_{min}$ = 10 µrad,
-# $D$ = 4 m): resolution dominates below $D/\sigma_{min}$ = 400 m, pointing above.
+# $D$ = 4 m = 0.004 km): resolution dominates below $D/\sigma_{min}$ = 0.004 km / 10 µrad = 400 km, pointing above.
 
 # %%
 rho_km = np.logspace(-2, 5, 200)
 sig = meas.angular_sigma(rho_km, meas.AMOS_SIGMA_MIN_RAD, meas.AMOS_RESOLUTION_KM)
 fig, ax = plt.subplots(figsize=(5.5, 3.5))
 ax.loglog(rho_km, sig * 1e6, label=r"$\sqrt{\sigma_{min}^2 + D^2/\rho^2}$ (AMOS Eq. 20)")
-ax.axvline(meas.AMOS_RESOLUTION_KM / meas.AMOS_SIGMA_MIN_RAD, color="0.5", ls=":", label=r"$\rho = D/\sigma_{min}$")
-ax.axvline(0.215, color="C3", ls="--", label="215 km: AMOS mean agent-target range")
+ax.axvline(meas.AMOS_RESOLUTION_KM / meas.AMOS_SIGMA_MIN_RAD, color="0.5", ls=":", label=r"$\rho = D/\sigma_{min}$ = 400 km")
+ax.axvline(215.0, color="C3", ls="--", label="215 km: AMOS mean agent-target range")
 ax.set(xlabel="range [km]", ylabel=r"$\sigma_\theta$ [µrad]", title="Angular noise model")
-ax.legend(fontsize=8)
-plotting.save_figure(fig, "02_angular_noise_model", output_dir=out)
-print(f"sigma_theta at 215 km: {meas.angular_sigma(215.0, 1e-5, 0.004) * 1e6:.3f} µrad")
+ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=1, frameon=False)  # below the axes
+_ = plotting.save_figure(fig, "02_angular_noise_model", output_dir=out)
+print(f"sigma_theta at 215 km: {meas.angular_sigma(215.0, meas.AMOS_SIGMA_MIN_RAD, meas.AMOS_RESOLUTION_KM) * 1e6:.3f} µrad")
 
 # %% [markdown]
 # ## 4 · Test case 2: the observation window and its CRLB
@@ -329,9 +329,14 @@ ax.loglog(TIMING_SIZES, [1e3 * r.dense_value for r in timings], "o-", label="den
 ax.loglog(TIMING_SIZES, [1e3 * r.structured_value for r in timings], "s-", label="chain rule")
 ax.loglog(TIMING_SIZES, [1e3 * r.dense_gradient for r in timings], "o--", label="dense Eq. 18 + Eqs. 47-50")
 ax.loglog(TIMING_SIZES, [1e3 * r.structured_gradient for r in timings], "s--", label="chain rule + gradient (square-root forward mode)")
-ax.set(xlabel="measurement times N", ylabel="time per evaluation [ms]", title="Evaluation cost")
-ax.legend(fontsize=8)
-plotting.save_figure(fig, "02_timing_dense_vs_structured", output_dir=out)
+ax.set(xlabel="measurement times N [-]", ylabel="time per evaluation [ms]", title="Evaluation cost")
+ax.set_xticks(TIMING_SIZES, [str(n) for n in TIMING_SIZES])  # plain labels at the sizes run, no minor labels
+ax.xaxis.set_minor_formatter(plt.NullFormatter())
+ax.yaxis.set_major_locator(plt.LogLocator(subs=(1.0, 2.0, 5.0)))
+ax.yaxis.set_major_formatter(plt.FormatStrFormatter("%g"))
+ax.yaxis.set_minor_formatter(plt.NullFormatter())
+ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=2, frameon=False)  # below the axes
+_ = plotting.save_figure(fig, "02_timing_dense_vs_structured", output_dir=out)
 for N, r in zip(TIMING_SIZES, timings):
     print(f"N = {N:3d}: MI {r.ratio_value:5.1f}x, MI + gradient {r.ratio_gradient:5.1f}x faster structured "
           f"(dense {1e3 * r.dense_gradient:.2f} ms, structured {1e3 * r.structured_gradient:.2f} ms)")
