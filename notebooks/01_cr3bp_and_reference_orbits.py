@@ -156,26 +156,52 @@ print(f"printed observer state: C = {em.jacobi(np.array([obs.x0, 0, 0, 0, obs.vy
 
 dro_x0 = np.linspace(0.95, 0.70, DRO_MEMBERS)
 dros = orbits.dro_family(em, dro_x0)
-fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 5))
+fig, (ax1, axz, ax2) = plt.subplots(1, 3, figsize=(15, 5.2), gridspec_kw=dict(width_ratios=[1.25, 0.8, 1]))
 for orb in dros[:: max(1, len(dros) // 12)]:
     _, xs = orb.sample(400)
-    plotting.plot_rotating(ax1, xs, em, "xy", units="km", moon_centred=True, color="0.6", lw=0.8)
+    plotting.plot_rotating(ax1, xs, em, "xy", units="km", moon_centred=True, color="0.75", lw=0.8)
+    plotting.plot_rotating(axz, xs, em, "xy", units="km", moon_centred=True, color="0.75", lw=0.8)
+# Table 2 and Table 4 print the same observer_t0 row: one curve, one colour, both labels.
+wj_groups = {}
 for c in checks:
-    _, xs = c.corrected.sample(400)
-    plotting.plot_rotating(ax1, xs, em, "xy", units="km", moon_centred=True, lw=1.2)
+    wj_groups.setdefault((c.x0, c.vy0), []).append(c)
+wj_groups = list(wj_groups.values())
+wj_colours = [plt.cm.tab10(i % 10) for i in (0, 1, 2, 4, 5, 6, 8, 9, 0, 1)[:len(wj_groups)]]  # no red (printed observer)
+for group, col in zip(wj_groups, wj_colours):
+    _, xs = group[0].corrected.sample(2000)
+    plotting.plot_rotating(ax1, xs, em, "xy", units="km", moon_centred=True, color=col, lw=1.2)
+    plotting.plot_rotating(axz, xs, em, "xy", units="km", moon_centred=True, color=col, lw=1.5,
+                           label=" = ".join(f"Table {c.table}: {c.label}" for c in group))
 _, bad = (lambda s: (None, propagation.propagate(em, s, np.linspace(0, obs.corrected.period, 400)).x))(
     np.array([obs.x0, 0, 0, 0, obs.vy0, 0]))
 plotting.plot_rotating(ax1, bad, em, "xy", units="km", moon_centred=True, color="C1", ls="--",
                        label="observer state as printed (not periodic)")
 plotting.plot_primaries(ax1, em, "xy", moon_centred=True, units="km", earth=False)
-ax1.set_title("DRO family (grey) and the Wolf & Jones orbits (Moon-centred)")
-ax1.locator_params(axis="x", nbins=5)
-ax1.legend(loc="lower left")
+ax1.set_title("DRO family (grey), Wolf & Jones orbits (colour)", fontsize=10)
+# Tick labels in thousands of km so that they cannot collide.
+for ax in (ax1, axz):
+    ax.xaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
+    ax.yaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
+    ax.set_xlabel("x (Moon-centred) [10³ km]")
+    ax.set_ylabel("y [10³ km]")
+ax1.locator_params(axis="both", nbins=5)
+ax1.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), frameon=False, fontsize=8)
+# Zoom on the -x crossing, where the Wolf & Jones orbits (x0 within ~0.01 LU of each other) separate.
+x_wj = np.array([(c.x0 - em.secondary_position[0]) * em.length_unit_km for c in checks])
+axz.set_xlim(x_wj.min() - 1500.0, x_wj.max() + 1500.0)
+axz.set_ylim(-15000.0, 15000.0)
+axz.set_aspect("auto")
+axz.locator_params(axis="x", nbins=4)
+axz.set_title("zoom: x-axis crossing of the W&J DROs", fontsize=10)
+axz.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=1, frameon=False, fontsize=8)
 ax2.plot([o.x0[0] for o in dros], [o.period_days for o in dros], "-", color="0.5", label="DRO family")
-ax2.plot([c.x0 for c in checks], [c.corrected.period_days for c in checks], "o", label="Tables 2 and 4 (corrected)")
-ax2.set_xlabel("x-axis crossing x0 [LU]")
+for group, col in zip(wj_groups, wj_colours):
+    ax2.plot(group[0].x0, group[0].corrected.period_days, "o", color=col, ms=5)
+ax2.plot([], [], "o", color="0.3", label="Tables 2, 4 (corrected; colours as zoom)")
+ax2.set_xlabel("x-axis crossing x0 (barycentric) [LU]")
 ax2.set_ylabel("period [days]")
-ax2.legend()
+ax2.legend(loc="lower left")  # the family line runs from upper left to lower right: this corner is empty
+fig.tight_layout()
 _ = plotting.save_figure(fig, "01_dro_family_wolf_jones", output_dir=out)
 
 # %% [markdown]
@@ -284,8 +310,17 @@ for plane, ax in axes.items():
     for s in stations:
         q = (s.position(em) - em.secondary_position) * em.length_unit_km
         ax.plot(q[i], q[j], "^", color="C1", ms=6)
-axes["xy"].legend(loc="lower left")
+names = {"xy": ("x", "y"), "xz": ("x", "z"), "yz": ("y", "z")}
+for plane, ax in axes.items():  # tick labels in thousands of km, at most five per axis: no collisions
+    ax.locator_params(axis="both", nbins=5)
+    ax.xaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
+    ax.yaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
+    ax.set_xlabel(f"{names[plane][0]} (Moon-centred) [10³ km]")
+    ax.set_ylabel(f"{names[plane][1]} (Moon-centred) [10³ km]")
+handles, labels = axes["xy"].get_legend_handles_labels()
+fig.legend(handles, labels, loc="lower center", ncol=len(labels), frameon=False)  # below the panels
 fig.suptitle("Observer sites (red) and the NRHOs (blue), Moon-centred; triangles: surface stations")
+fig.tight_layout(rect=(0, 0.07, 1, 1))
 _ = plotting.save_figure(fig, "01_observer_sites_fig3", output_dir=out)
 
 # %% [markdown]
