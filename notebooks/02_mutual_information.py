@@ -297,9 +297,9 @@ for name, res in study.items():
     ax2.loglog(b_km, res["tgt"], "s--", label=f"target, {name}")
 ax1.set(xlabel="mean baseline [km]", ylabel=r"$\mathcal{I} - \mathcal{I}_{shortest}$ [nats]", title="MI gain vs baseline")
 ax2.set(xlabel="mean baseline [km]", ylabel="terminal position RMS [km]", title="CRLB vs baseline")
-ax1.legend(fontsize=8)
-ax2.legend(fontsize=7)
-plotting.save_figure(fig, "02_baseline_study", output_dir=out)
+ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)  # legends below the axes
+ax2.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, frameon=False)
+_ = plotting.save_figure(fig, "02_baseline_study", output_dir=out)
 for name, res in study.items():
     print(name, "\n  baseline [km]:", np.round(em.lu_to_km(res["baseline"])), "\n  MI [nats]:", np.round(res["mi"], 2),
           "\n  observer RMS [km]:", np.round(res["obs"], 3))
