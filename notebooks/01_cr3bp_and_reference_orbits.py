@@ -263,8 +263,16 @@ for o, colour, lab in ((nrho, "C0", "9:2 NRHO"), (stable, "C1", "stable NRHO")):
     plotting.plot_three_planes(axes, xs, em, moon_centred=True, units="km", color=colour, lw=1.6, label=lab)
 for plane, ax in axes.items():
     plotting.plot_primaries(ax, em, plane, moon_centred=True, units="km", earth=False)
-axes["xy"].legend(loc="upper left")
+for plane, ax in axes.items():  # tick labels in thousands of km, at most five per axis: no collisions
+    ax.locator_params(axis="both", nbins=5)
+    ax.xaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
+    ax.yaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
+    ax.set_xlabel(f"{plane[0]} (Moon-centred) [10³ km]")
+    ax.set_ylabel(f"{plane[1]} (Moon-centred) [10³ km]")
+handles, labels = axes["xy"].get_legend_handles_labels()
+fig.legend(handles, labels, loc="lower center", ncol=len(labels), frameon=False)  # below the panels, off the data
 fig.suptitle("Southern L2 NRHO family (grey) with the 9:2 (blue) and stable (red) reference orbits")
+fig.tight_layout(rect=(0, 0.07, 1, 1))
 _ = plotting.save_figure(fig, "01_nrho_family_fig2", output_dir=out)
 
 # %% [markdown]
