@@ -238,6 +238,23 @@ def seed_entropy(value, name: str = "seed"):
     return value
 
 
+def one_or_many(value, name: str, single, what: str) -> tuple:
+    """A non-empty tuple from one item of type ``single`` or an iterable of them.
+
+    ``what`` names the expected items in the messages (e.g. ``"str"``, ``"SurfaceStation"``).  The items themselves
+    are not checked beyond that (callers check each with :func:`choice`, :func:`instance`, ...).
+    """
+    if isinstance(value, single):
+        return (value,)
+    try:
+        items = tuple(value)
+    except TypeError:
+        raise ArgumentTypeError(f"{name} must be a {what} or a sequence of {what}; got {_type_name(value)}") from None
+    if not items:
+        raise ValueError(f"{name} must hold at least one {what}")
+    return items
+
+
 def square(value, name: str, *, n: int | None = None, batch: bool = False) -> np.ndarray:
     """A finite square matrix (or a stack ``(..., n, n)`` when ``batch``)."""
     A = as_array(value, name, ndim=None if batch else (2,))

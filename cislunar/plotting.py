@@ -18,7 +18,7 @@ from . import _checks, paths
 from .dynamics import CR3BP
 
 __all__ = ["use_style", "style_path", "save_figure", "plot_primaries", "plot_rotating", "three_plane_axes",
-           "plot_three_planes"]
+           "plot_three_planes", "thousands_km_axes"]
 
 _PLANES = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
 
@@ -145,6 +145,25 @@ def plot_rotating(ax, states, system: CR3BP | None = None, plane: str = "xy", *,
     ax.set_ylabel(f"{'xyz'[j]} [{unit}]")
     ax.set_aspect("equal", adjustable="datalim")
     return lines
+
+
+def thousands_km_axes(ax, plane: str, frame: str = "Moon-centred", nbins: int = 5) -> None:
+    """Label an axes drawn in km on ``plane`` in units of 10^3 km, with at most ``nbins`` ticks per axis.
+
+    Large km values (tens of thousands) collide as tick labels; printing them in thousands keeps them short.
+    Axis labels name the coordinate, the ``frame`` and the unit, e.g. ``"x (Moon-centred) [10³ km]"``.
+    """
+    _check_axes(ax, "locator_params")
+    _checks.choice(plane, "plane", tuple(_PLANES))
+    nbins = _checks.integer(nbins, "nbins", minimum=2)
+    import matplotlib.pyplot as plt
+
+    ax.locator_params(axis="both", nbins=nbins)
+    ax.xaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
+    ax.yaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
+    suffix = f" ({frame})" if frame else ""
+    ax.set_xlabel(f"{plane[0]}{suffix} [10³ km]")
+    ax.set_ylabel(f"{plane[1]}{suffix} [10³ km]")
 
 
 def three_plane_axes(figsize=(12, 4)):

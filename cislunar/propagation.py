@@ -592,15 +592,7 @@ def find_events(system: CR3BP, x0, t_end: float, events=("y_crossing",), *, t0: 
     t_end = _checks.real(t_end, "t_end")
     if t_end == t0:
         raise ValueError(f"t_end must differ from t0 = {t0}; got {t_end}")
-    if isinstance(events, str):
-        events = (events,)
-    try:
-        kinds = tuple(events)
-    except TypeError:
-        raise _checks.ArgumentTypeError(f"events must be a str or a sequence of str; got "
-                                        f"{type(events).__name__}") from None
-    if not kinds:
-        raise ValueError(f"events must name at least one of {_EVENT_KINDS}")
+    kinds = _checks.one_or_many(events, "events", str, "str")
     for k in kinds:
         _checks.choice(k, "events", _EVENT_KINDS)
     tol = _check_tol(tol)

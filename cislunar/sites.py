@@ -161,15 +161,7 @@ def surface_coverage(system: CR3BP, target_positions, stations=DEFAULT_STATIONS,
     t = _checks.as_array(target_positions, "target_positions", ndim=(2,))
     _position_stack(t, "target_positions")
     _checks.in_range(min_elevation_deg, "min_elevation_deg", -90.0, 90.0)
-    if isinstance(stations, SurfaceStation):
-        stations = (stations,)
-    try:
-        stations = tuple(stations)
-    except TypeError:
-        raise _checks.ArgumentTypeError(f"stations must be a sequence of SurfaceStation; got "
-                                        f"{type(stations).__name__}") from None
-    if not stations:
-        raise ValueError("stations must hold at least one SurfaceStation")
+    stations = _checks.one_or_many(stations, "stations", SurfaceStation, "SurfaceStation")
     for st in stations:
         _checks.instance(st, "stations", SurfaceStation, "a sequence of cislunar.sites.SurfaceStation")
     return np.array([station_elevation(system, s.position(system), t) > np.deg2rad(min_elevation_deg)

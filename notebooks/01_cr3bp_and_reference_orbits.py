@@ -264,11 +264,7 @@ for o, colour, lab in ((nrho, "C0", "9:2 NRHO"), (stable, "C1", "stable NRHO")):
 for plane, ax in axes.items():
     plotting.plot_primaries(ax, em, plane, moon_centred=True, units="km", earth=False)
 for plane, ax in axes.items():  # tick labels in thousands of km, at most five per axis: no collisions
-    ax.locator_params(axis="both", nbins=5)
-    ax.xaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
-    ax.yaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
-    ax.set_xlabel(f"{plane[0]} (Moon-centred) [10³ km]")
-    ax.set_ylabel(f"{plane[1]} (Moon-centred) [10³ km]")
+    plotting.thousands_km_axes(ax, plane)
 handles, labels = axes["xy"].get_legend_handles_labels()
 fig.legend(handles, labels, loc="lower center", ncol=len(labels), frameon=False)  # below the panels, off the data
 fig.suptitle("Southern L2 NRHO family (grey) with the 9:2 (blue) and stable (red) reference orbits")
@@ -318,13 +314,8 @@ for plane, ax in axes.items():
     for s in stations:
         q = (s.position(em) - em.secondary_position) * em.length_unit_km
         ax.plot(q[i], q[j], "^", color="C1", ms=6)
-names = {"xy": ("x", "y"), "xz": ("x", "z"), "yz": ("y", "z")}
 for plane, ax in axes.items():  # tick labels in thousands of km, at most five per axis: no collisions
-    ax.locator_params(axis="both", nbins=5)
-    ax.xaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
-    ax.yaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
-    ax.set_xlabel(f"{names[plane][0]} (Moon-centred) [10³ km]")
-    ax.set_ylabel(f"{names[plane][1]} (Moon-centred) [10³ km]")
+    plotting.thousands_km_axes(ax, plane)
 handles, labels = axes["xy"].get_legend_handles_labels()
 fig.legend(handles, labels, loc="lower center", ncol=len(labels), frameon=False)  # below the panels
 fig.suptitle("Observer sites (red) and the NRHOs (blue), Moon-centred; triangles: surface stations")

@@ -85,3 +85,17 @@ def test_status_words_follow_the_guide():
     for bad_status in ("agrees", "consistent"):
         with pytest.raises(ValueError, match="status"):
             ComparisonTable("t").add("x", 1, 2, bad_status)
+
+
+def test_thousands_km_axes_labels_and_ticks():
+    fig, ax = plt.subplots()
+    ax.plot([0.0, 40000.0], [-20000.0, 60000.0])
+    plotting.thousands_km_axes(ax, "yz", frame="Moon-centred")
+    assert ax.get_xlabel() == "y (Moon-centred) [10³ km]" and ax.get_ylabel() == "z (Moon-centred) [10³ km]"
+    for axis in (ax.xaxis, ax.yaxis):  # printed in thousands of km
+        assert axis.get_major_formatter()(40000.0, 0) == "40"
+        assert axis.get_major_formatter()(-2500.0, 0) == "-2.5"
+    assert len(ax.get_xticks()) <= 7 and len(ax.get_yticks()) <= 7  # at most nbins + 1 intervals
+    with pytest.raises(ValueError, match="plane"):
+        plotting.thousands_km_axes(ax, "xq")
+    plt.close(fig)

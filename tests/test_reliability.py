@@ -493,6 +493,9 @@ def _specs():
     s.append(S("plot_three_planes", plotting.plot_three_planes, dict(axes=lazy(lambda: plotting.three_plane_axes()[1]),
                                                                      states=np.zeros((3, 6))),
                dict(axes="instance")))
+    s.append(S("thousands_km_axes", plotting.thousands_km_axes, dict(ax=lazy(_ax_kw), plane="xy", frame="Moon-centred",
+                                                                     nbins=5),
+               dict(ax="instance", plane="choice", nbins="int2")))
     return s
 
 
