@@ -106,7 +106,17 @@ def symmetrize(P, name: str = "P") -> np.ndarray:
     return 0.5 * (P + np.swapaxes(P, -1, -2))
 
 
+def _name(name) -> str:
+    """The ``name`` argument of the SPD helpers (a string used in their messages)."""
+    return _checks.instance(name, "name", str, "a str (the argument name used in messages)")
+
+
+def _rtol(rtol) -> float:
+    return _checks.positive(rtol, "rtol", allow_zero=True)
+
+
 def _square(P, name):
+    _name(name)
     P = _checks.as_array(P, name)
     if P.ndim < 2 or P.shape[-1] != P.shape[-2]:
         raise ValueError(f"{name} must be a square matrix (..., n, n); got shape {P.shape}")
@@ -130,6 +140,7 @@ def cholesky_spd(P, name: str = "P", *, rtol: float = 1e-8) -> np.ndarray:
         Not square, NaN, asymmetric beyond ``rtol`` or not positive definite (names ``name``).
     """
     P = _square(P, name)
+    rtol = _rtol(rtol)
     scale = np.max(np.abs(P)) if P.size else 0.0
     if scale == 0.0:
         raise ValueError(f"{name} must be positive definite; got a zero matrix")
@@ -162,6 +173,7 @@ def check_psd(Q, name: str = "Q", *, rtol: float = 1e-8) -> np.ndarray:
         Not square, NaN, asymmetric beyond ``rtol`` or with a negative eigenvalue (names ``name``).
     """
     Q = _square(Q, name)
+    rtol = _rtol(rtol)
     scale = float(np.max(np.abs(Q))) if Q.size else 0.0
     if scale == 0.0:
         return symmetrize(Q, name)
@@ -187,21 +199,23 @@ def block_diag(blocks) -> np.ndarray:
     With an array input the leading axes are kept: ``(..., k, n, n) -> (..., k n, k n)``.
     """
     if isinstance(blocks, np.ndarray) and blocks.ndim >= 3:
+        blocks = _checks.square(blocks, "blocks", batch=True)
         k, n = blocks.shape[-3], blocks.shape[-1]
         out = np.zeros(blocks.shape[:-3] + (k * n, k * n))
         for i in range(k):
             out[..., i * n:(i + 1) * n, i * n:(i + 1) * n] = blocks[..., i, :, :]
         return out
-    return scipy.linalg.block_diag(*[np.atleast_2d(np.asarray(b, dtype=float)) for b in blocks])
+    items = _checks.one_or_many(blocks, "blocks", np.ndarray, "square matrix")
+    mats = [_checks.square(np.atleast_2d(_checks.as_array(b, f"blocks[{i}]")), f"blocks[{i}]")
+            for i, b in enumerate(items)]
+    return scipy.linalg.block_diag(*mats)
 
 
 # --------------------------------------------------------------------------------------------------------------
 # augmented state and initial covariances
 # --------------------------------------------------------------------------------------------------------------
 def _check_system(system):
-    if not isinstance(system, CR3BP):
-        raise ValueError(f"system must be a cislunar.dynamics.CR3BP; got {type(system).__name__}")
-    return system
+    return _checks.system(system, "system")
 
 
 def state_covariance(sigma_pos_km: float, sigma_vel_km_s: float, system: CR3BP) -> np.ndarray:
@@ -341,8 +355,7 @@ def process_noise(system: CR3BP, x, t, q: float, *, n_nodes: int = 12) -> np.nda
     if x.shape[-2] != t.size:
         raise ValueError(f"x must hold one state per time of t ({t.size}); got shape {x.shape}")
     q = _checks.positive(q, "q", allow_zero=True)
-    if int(n_nodes) < 2:
-        raise ValueError(f"n_nodes must be at least 2; got {n_nodes}")
+    n_nodes = _checks.integer(n_nodes, "n_nodes", minimum=2)
     single = x.ndim == 2
     xs = x[None] if single else x
     n, m = xs.shape[0], xs.shape[1]
@@ -364,6 +377,8 @@ def process_noise_lyapunov(system: CR3BP, x0, dt: float, q: float, *, rtol: floa
     x0 = _checks.as_state(x0, "x0", batch=False)
     dt = _checks.positive(dt, "dt")
     q = _checks.positive(q, "q", allow_zero=True)
+    rtol = _checks.in_range(rtol, "rtol", 1e-16, 1e-2)
+    atol = _checks.in_range(atol, "atol", 1e-20, 1e-2)
     W = np.zeros((6, 6))
     W[3:, 3:] = q * np.eye(3)
 
@@ -546,10 +561,10 @@ def _check_linear_system(P0, F, Q, H, R, *, chol_R: bool = False):
 
 def position_sigma_km(P, index: int, system: CR3BP) -> np.ndarray:
     """RMS position error :math:`\\sqrt{\\mathrm{tr} P_{rr}}` (km) of object ``index`` (0 = observer) in augmented covariances ``(..., n, n)``."""
-    P = _square(P, "P")
+    P = _checks.spd(P, "P", batch=True)
     _check_system(system)
-    i = int(index)
-    if i < 0 or 6 * (i + 1) > P.shape[-1]:
+    i = _checks.integer(index, "index", minimum=0)
+    if 6 * (i + 1) > P.shape[-1]:
         raise ValueError(f"index must select an object in 0..{P.shape[-1] // 6 - 1}; got {index}")
     blk = P[..., 6 * i:6 * i + 3, 6 * i:6 * i + 3]
     return np.sqrt(np.trace(blk, axis1=-2, axis2=-1)) * system.length_unit_km
@@ -675,9 +690,9 @@ def propagate_arcs(system: CR3BP, x0, t, *, q: float | None = None, order: int =
     if x0.ndim != 2:
         raise ValueError(f"x0 must have shape (K, 6) or (6,); got {x0.shape}")
     t = _checks.time_grid(t, "t", increasing=True)
-    if order not in (1, 2):
-        raise ValueError(f"order must be 1 or 2; got {order!r}")
+    order = _checks.integer(order, "order", minimum=1, maximum=2)
     qq = None if q is None else _checks.positive(q, "q", allow_zero=True)
+    n_nodes = _checks.integer(n_nodes, "n_nodes", minimum=2)
     K, N = x0.shape[0], t.size
     X = propagate(system, x0, t).x
     X = X if X.ndim == 3 else X[None]
@@ -710,15 +725,19 @@ def assemble_augmented(model: MeasurementModel, noise, P0, observer: ObjectArcs,
     index : int
         Which observer arc to use.
     """
-    if not isinstance(model, MeasurementModel):
-        raise ValueError(f"model must be a cislunar.measurements.MeasurementModel; got {type(model).__name__}")
+    _checks.instance(model, "model", MeasurementModel)
+    _checks.instance(observer, "observer", ObjectArcs)
+    _checks.instance(targets, "targets", ObjectArcs)
     if observer.t.shape != targets.t.shape or not np.array_equal(observer.t, targets.t):
         raise ValueError("observer and targets arcs must share the same time grid")
     t = observer.t
     NT, N, m = targets.x.shape[0], t.size, model.dim
     n = 6 * (NT + 1)
     P0 = check_spd(_checks.as_array(P0, "P0", shape=(n, n)), "P0")
-    i = int(index)
+    i = _checks.integer(index, "index", minimum=0, maximum=observer.x.shape[0] - 1)
+    if Q is not None:
+        Q = _as_sequence(Q, "Q", N - 1, (n, n))
+        check_psd(Q, "Q")
     obs = observer.x[i]
     tgts = targets.x
     Fo = observer.F[i]
@@ -728,7 +747,7 @@ def assemble_augmented(model: MeasurementModel, noise, P0, observer: ObjectArcs,
             raise ValueError("give Q, or arcs propagated with a process-noise PSD q")
         Qa = block_diag(np.moveaxis(np.concatenate([observer.Q[i][None], targets.Q], axis=0), 0, 1))
     else:
-        Qa = _as_sequence(Q, "Q", N - 1, (n, n))
+        Qa = Q
     stm = np.empty((N, 6, 6))
     stm[0] = np.eye(6)
     for k in range(1, N):
@@ -805,8 +824,7 @@ def linearize_augmented(system: CR3BP, observer_x0, targets_x0, t, model: Measur
     :func:`propagate_arcs` and :func:`assemble_augmented`.
     """
     _check_system(system)
-    if not isinstance(model, MeasurementModel):
-        raise ValueError(f"model must be a cislunar.measurements.MeasurementModel; got {type(model).__name__}")
+    _checks.instance(model, "model", MeasurementModel)
     xs0 = _checks.as_state(observer_x0, "observer_x0", batch=False)
     xt0 = _checks.as_array(targets_x0, "targets_x0", last=6)
     if xt0.ndim == 1:
@@ -814,12 +832,19 @@ def linearize_augmented(system: CR3BP, observer_x0, targets_x0, t, model: Measur
     if xt0.ndim != 2 or xt0.shape[0] < 1:
         raise ValueError(f"targets_x0 must have shape (N_T, 6); got {xt0.shape}")
     t = _checks.time_grid(t, "t", increasing=True)
-    if (q is None) == (Q is None):
-        raise ValueError("give exactly one of q (process-noise PSD) and Q (discrete process noise)")
     n = 6 * (xt0.shape[0] + 1)
     P0 = check_spd(_checks.as_array(P0, "P0", shape=(n, n)), "P0")
+    if q is not None:
+        q = _checks.positive(q, "q", allow_zero=True)
     if Q is not None:
         Q = _as_sequence(Q, "Q", t.size - 1, (n, n))
+        check_psd(Q, "Q")
+    if (q is None) == (Q is None):
+        raise ValueError("give exactly one of q (process-noise PSD) and Q (discrete process noise)")
+    derivatives = _checks.boolean(derivatives, "derivatives")
+    n_nodes = _checks.integer(n_nodes, "n_nodes", minimum=2)
+    if not callable(noise):
+        check_spd(_checks.as_array(noise, "noise", shape=(model.dim, model.dim)), "noise")
     obs = propagate_arcs(system, xs0, t, q=q, order=2 if derivatives else 1, n_nodes=n_nodes)
     tgt = propagate_arcs(system, xt0, t, q=q, order=1, n_nodes=n_nodes)
     return assemble_augmented(model, noise, P0, obs, tgt, Q=Q)

@@ -108,11 +108,10 @@ def sundman_nodes(system: CR3BP, x0, t_final: float, n_nodes: int, sigma: float,
     RuntimeError
         The ballistic reference hits the surface of the Moon or the Earth before ``t_final`` (terminal event).
     """
+    _checks.system(system, "system")
     x0 = _checks.as_state(x0, "x0", batch=False)
     tf = _checks.positive(t_final, "t_final")
-    n = int(n_nodes)
-    if n < 2:
-        raise ValueError(f"n_nodes must be at least 2; got {n_nodes}")
+    n = _checks.integer(n_nodes, "n_nodes", minimum=2)
     sigma = _checks.in_range(sigma, "sigma", -3.0, 3.0)
     tol = _check_tol(tol)
     ta = thread_local_copy(("sundman", tol), lambda: _sundman_template(tol))
@@ -271,6 +270,7 @@ def foh_discretize(system: CR3BP, t_nodes, x_nodes, u_nodes, *, tol: float = DEF
     RuntimeError
         An interval's propagation hits the surface of the Moon or the Earth (terminal event) or fails.
     """
+    _checks.system(system, "system")
     t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
     n = t.size
     x = _checks.as_array(x_nodes, "x_nodes", shape=(n, 6))
@@ -314,11 +314,13 @@ def propagate_foh(system: CR3BP, x0, t_nodes, u_nodes, *, tol: float = DEFAULT_T
     RuntimeError
         The trajectory hits the surface of the Moon or the Earth (terminal event), or the integration fails.
     """
+    _checks.system(system, "system")
     t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
     u = _checks.as_array(u_nodes, "u_nodes", shape=(t.size, 3))
     x = np.empty((t.size, 6))
     x[0] = _checks.as_state(x0, "x0", batch=False)
+    tol = _check_tol(tol)
     _check_outside(system, x[0], "x0")
     for k in range(t.size - 1):
-        x[k + 1], _ = _foh_interval(system, x[k], u[k], u[k + 1], t[k], t[k + 1], _check_tol(tol))
+        x[k + 1], _ = _foh_interval(system, x[k], u[k], u[k + 1], t[k], t[k + 1], tol)
     return x

@@ -136,9 +136,12 @@ def stacked_derivative(F, H, dF, dH) -> np.ndarray:
     :math:`\\partial\\Phi(t_j,t_k) = \\partial F_{j-1}\\Phi(t_{j-1},t_k) + F_{j-1}\\partial\\Phi(t_{j-1},t_k)` --
     Eq. 50 extended to every block of Eq. 20.
     """
-    F = np.asarray(F, dtype=float)
-    H = np.asarray(H, dtype=float)
+    H = _checks.as_array(H, "H", ndim=(3,), min_size=1)
     N, M, n = H.shape
+    F = _checks.as_array(F, "F", ndim=(3,))
+    if F.shape != (N - 1, n, n):
+        raise ValueError(f"F must have shape {(N - 1, n, n)} to match H {H.shape}; got {F.shape}")
+    dF, dH = _check_derivatives(F, H, dF, dH)
     p = dH.shape[-1]
     dF_p = np.moveaxis(dF, -1, 1)  # (N-1, p, n, n)
     dH_p = np.moveaxis(dH, -1, 1)  # (N, p, M, n)
@@ -205,9 +208,13 @@ def _check_derivatives(F, H, dF, dH):
     if dH.shape[:3] != H.shape:
         raise ValueError(f"dH must have shape {H.shape} + (p,); got {dH.shape}")
     p = dH.shape[-1]
+    if p < 1:
+        raise ValueError(f"dH must hold at least one parameter (last axis p >= 1); got shape {dH.shape}")
     dF = _checks.as_array(dF, "dF", ndim=(4,))
-    if dF.shape != F.shape + (p,):
-        raise ValueError(f"dF must have shape {F.shape + (p,)}; got {dF.shape}")
+    if dF.shape[:3] != F.shape:
+        raise ValueError(f"dF must have shape {F.shape} + (p,); got {dF.shape}")
+    if dF.shape[-1] != p:
+        raise ValueError(f"dF and dH must hold the same number of parameters p; got dF {dF.shape}, dH {dH.shape}")
     return dF, dH
 
 
@@ -304,6 +311,7 @@ def mutual_information(P0, F, Q, H, R, *, return_terms: bool = False):
     float, or (float, ndarray)
     """
     P0, F, Q, H, R, LR = _check_linear_system(P0, F, Q, H, R, chol_R=True)
+    return_terms = _checks.boolean(return_terms, "return_terms")
     Hw = np.linalg.solve(LR, H)
     terms = _sqrt_forward(P0, F, Q, Hw)
     total = float(np.sum(terms))
@@ -448,11 +456,10 @@ def mutual_information_gradient(P0, F, Q, H, R, dF, dH, *, method: str = "sqrt")
         Mutual information (the square-root value of :func:`mutual_information` in both methods), nats.
     grad : ndarray (p,)
     """
+    _checks.choice(method, "method", ("sqrt", "adjoint"))
     if method == "sqrt":
         return _gradient_sqrt(P0, F, Q, H, R, dF, dH)
-    if method == "adjoint":
-        return _gradient_adjoint(P0, F, Q, H, R, dF, dH)
-    raise ValueError(f"method must be 'sqrt' or 'adjoint'; got {method!r}")
+    return _gradient_adjoint(P0, F, Q, H, R, dF, dH)
 
 
 def window_information(lin: AugmentedLinearization, *, method: str = "structured", gradient: bool = False):
@@ -470,11 +477,9 @@ def window_information(lin: AugmentedLinearization, *, method: str = "structured
     float, or (float, ndarray (6,))
         Nats; gradient in nats per LU (position) and per LU/TU (velocity).
     """
-    if not isinstance(lin, AugmentedLinearization):
-        raise ValueError(f"lin must be an AugmentedLinearization; got {type(lin).__name__}")
-    if method not in ("structured", "dense"):
-        raise ValueError(f"method must be 'structured' or 'dense'; got {method!r}")
-    if gradient:
+    _checks.instance(lin, "lin", AugmentedLinearization)
+    _checks.choice(method, "method", ("structured", "dense"))
+    if _checks.boolean(gradient, "gradient"):
         if lin.dF is None:
             raise ValueError("lin has no derivatives: build it with linearize_augmented(..., derivatives=True)")
         f = mutual_information_gradient if method == "structured" else mutual_information_gradient_dense
@@ -531,11 +536,8 @@ def monte_carlo_mutual_information(P0, F, Q, H, R, n_samples: int, rng: np.rando
         Sample standard deviation of the log ratio divided by sqrt(n_samples).
     """
     P0, F, Q, H, R = _check_linear_system(P0, F, Q, H, R)
-    if not isinstance(rng, np.random.Generator):
-        raise ValueError(f"rng must be a numpy.random.Generator; got {type(rng).__name__}")
-    ns = int(n_samples)
-    if ns < 2:
-        raise ValueError(f"n_samples must be at least 2; got {n_samples}")
+    rng = _checks.rng(rng, "rng")
+    ns = _checks.integer(n_samples, "n_samples", minimum=2)
     N, M, n = H.shape
 
     def chol_psd(A):
@@ -618,9 +620,7 @@ def time_evaluations(P0, F, Q, H, R, dF, dH, *, repeat: int = 3, min_time: float
     Each round times every evaluation once (repeating it until ``min_time`` seconds have passed and taking the
     mean); the best round is kept for each, so the ratios are robust to load changing during the measurement.
     """
-    rep = int(repeat)
-    if rep < 1:
-        raise ValueError(f"repeat must be >= 1; got {repeat}")
+    rep = _checks.integer(repeat, "repeat", minimum=1)
     mt = _checks.positive(min_time, "min_time")
     args = (P0, F, Q, H, R)
     times = _interleaved_best([

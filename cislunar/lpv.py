@@ -149,6 +149,14 @@ class CR3BPLPV:
         out[..., [0, 1, 3, 4]] = s
         return out
 
+    @staticmethod
+    def _planar_input(state, name: str = "state") -> np.ndarray:
+        """Planar states (..., 4) or positions (..., 2), finite, at least one."""
+        s = _checks.as_array(state, name, ndim=(1, 2, 3), min_size=1)
+        if s.shape[-1] not in (2, 4):
+            raise ValueError(f"{name} must have last axis 2 (position) or 4 (planar state); got shape {s.shape}")
+        return s
+
     def _distances(self, s):
         mu = self.mu
         r13 = np.hypot(s[..., 0] + mu, s[..., 1])
@@ -161,9 +169,7 @@ class CR3BPLPV:
 
         ``[1/r13^3 (LU^-3), 1/r23^3 (LU^-3), 1/r13 (LU^-1), 1/r23 (LU^-1), x (LU), y (LU)]``.
         """
-        s = _checks.as_array(state, "state", ndim=(1, 2, 3))
-        if s.shape[-1] not in (2, 4):
-            raise ValueError(f"state must have last axis 2 (position) or 4 (planar state); got shape {s.shape}")
+        s = self._planar_input(state)
         r13, r23 = self._distances(s)
         if np.any(r13 == 0) or np.any(r23 == 0):
             raise ValueError("state coincides with a primary (r13 or r23 is zero)")
@@ -174,7 +180,7 @@ class CR3BPLPV:
 
         :math:`\theta_1 = \operatorname{atan2}(y, x+\mu)`, :math:`\theta_2 = \operatorname{atan2}(y, 1-\mu-x)`.
         """
-        s = _checks.as_array(state, "state", ndim=(1, 2, 3))
+        s = self._planar_input(state)
         mu = self.mu
         return np.arctan2(s[..., 1], s[..., 0] + mu), np.arctan2(s[..., 1], 1.0 - mu - s[..., 0])
 
@@ -210,7 +216,7 @@ class CR3BPLPV:
 
     def measure(self, state) -> np.ndarray:
         """Nonlinear sensor model (..., 6): ``[sin th1, cos th1, sin th2, cos th2, r13^2, r23^2]`` from geometry."""
-        s = _checks.as_array(state, "state", ndim=(1, 2, 3))
+        s = self._planar_input(state)
         t1, t2 = self.angles(s)
         r13, r23 = self._distances(s)
         return np.stack([np.sin(t1), np.cos(t1), np.sin(t2), np.cos(t2), r13**2, r23**2], axis=-1)
@@ -309,12 +315,18 @@ class ParameterBox:
     source: str = ""
 
     def __post_init__(self):
-        lo = _checks.as_array(self.lower, "lower", ndim=(1,))
-        hi = _checks.as_array(self.upper, "upper", shape=lo.shape)
+        lo = _checks.as_array(self.lower, "lower", ndim=(1,), min_size=1)
+        hi = _checks.as_array(self.upper, "upper", ndim=(1,))
+        if hi.shape != lo.shape:
+            raise ValueError(f"lower and upper must have the same shape; got lower {lo.shape}, upper {hi.shape}")
         if np.any(hi < lo):
             raise ValueError(f"upper must be >= lower componentwise; got lower={lo}, upper={hi}")
+        if not isinstance(self.names, (tuple, list)) or not all(isinstance(n, str) for n in self.names):
+            raise _checks.ArgumentTypeError(f"names must be a tuple of str (one per parameter); got "
+                                            f"{type(self.names).__name__}")
         if len(self.names) != lo.size:
-            raise ValueError(f"names must have {lo.size} entries; got {len(self.names)}")
+            raise ValueError(f"names must have one entry per parameter of lower ({lo.size}); got {len(self.names)}")
+        _checks.instance(self.source, "source", str)
         object.__setattr__(self, "lower", lo)
         object.__setattr__(self, "upper", hi)
 
@@ -325,9 +337,11 @@ class ParameterBox:
         if r.shape[0] < 1:
             raise ValueError("rho must hold at least one sample")
         margin = _checks.positive(margin, "margin", allow_zero=True)
+        _checks.instance(source, "source", str)
         lo, hi = r.min(axis=0), r.max(axis=0)
         w = (hi - lo) * margin
-        return cls(lo - w, hi + w, source=source)
+        names = RHO_NAMES if r.shape[1] == len(RHO_NAMES) else tuple(f"rho_{i + 1}" for i in range(r.shape[1]))
+        return cls(lo - w, hi + w, names=names, source=source)
 
     @property
     def dim(self) -> int:
@@ -350,7 +364,12 @@ class ParameterBox:
         """
         if free is None:
             free = [i for i in range(self.dim) if self.upper[i] > self.lower[i]]
-        free = [int(i) for i in free]
+        try:
+            items = list(free)
+        except TypeError:
+            raise _checks.ArgumentTypeError(f"free must be a sequence of parameter indices; got "
+                                            f"{type(free).__name__}") from None
+        free = [_checks.integer(i, "free") for i in items]
         if any(i < 0 or i >= self.dim for i in free) or len(set(free)) != len(free):
             raise ValueError(f"free must hold distinct indices in [0, {self.dim}); got {free}")
         out = np.tile(self.centre, (2 ** len(free), 1))
@@ -368,6 +387,7 @@ class ParameterBox:
     def contains(self, rho, *, rtol: float = 1e-12) -> np.ndarray:
         """Whether points (..., dim) lie in the box (with a relative tolerance)."""
         r = _checks.as_array(rho, "rho", last=self.dim)
+        rtol = _checks.positive(rtol, "rtol", allow_zero=True)
         tol = rtol * np.maximum(np.abs(self.lower), np.abs(self.upper))
         return np.all((r >= self.lower - tol) & (r <= self.upper + tol), axis=-1)
 
@@ -640,7 +660,7 @@ class ObserverDesign:
     def gain(self, *, drop_unused: bool = True) -> np.ndarray:
         """Observer gain (4, 6); with ``drop_unused`` the columns of removed sensors are set to zero."""
         L = self.L.copy()
-        if drop_unused:
+        if _checks.boolean(drop_unused, "drop_unused"):
             L[:, ~self.used] = 0.0
         return L
 
@@ -1233,8 +1253,10 @@ def paper_scenario(system: CR3BP = EARTH_MOON, *, p: int = 2, q: int = 1, perige
     each range (0 by default: the samples are dense enough that the extrema are resolved to ~1e-5).
     """
     model = CR3BPLPV(_checks.system(system, "system"))
+    n_samples = _checks.integer(n_samples, "n_samples", minimum=2)
+    margin = _checks.positive(margin, "margin", allow_zero=True)
     orbit = resonant_orbit(system, p, q, perigee_radius)
-    t, x = orbit.sample(_checks.integer(n_samples, "n_samples", minimum=2))
+    t, x = orbit.sample(n_samples)
     s = model.planar(x)
     rho = model.rho(s)
     box = ParameterBox.from_samples(rho, margin=margin,
@@ -1274,6 +1296,8 @@ def guaranteed_error_rms(design: ObserverDesign, noise_rms_deg: float, dt: float
     """
     design = _checks.instance(design, "design", ObserverDesign)
     sig = np.radians(_checks.positive(noise_rms_deg, "noise_rms_deg", allow_zero=True))
+    if dt is not None:
+        dt = _checks.positive(dt, "dt")
     used = design.used[:2]
     if not used.any():
         raise ValueError("design must use a theta1 sensor (sin th1 or cos th1)")
@@ -1281,7 +1305,7 @@ def guaranteed_error_rms(design: ObserverDesign, noise_rms_deg: float, dt: float
     if design.norm == "h2":
         if dt is None:
             raise ValueError("dt (the sampling interval, TU) is required for an H2 design")
-        return design.gamma * kmax * sig * np.sqrt(_checks.positive(dt, "dt"))
+        return design.gamma * kmax * sig * np.sqrt(dt)
     return design.gamma * kmax * sig
 
 
@@ -1439,17 +1463,17 @@ def sensitivity_study(gamma: float = 0.0013, *, orbits=RESONANT_CANDIDATES, stru
         raise _checks.ArgumentTypeError("orbits must be a sequence of (p, q, perigee_radius) tuples") from exc
     if not orbits:
         raise ValueError("orbits must hold at least one (p, q, perigee_radius)")
-    if isinstance(structures, str):
-        structures = (structures,)
-    structures = tuple(_checks.choice(s, "structures", DISTURBANCE_STRUCTURES) for s in structures)
-    if not structures:
-        raise ValueError("structures must name at least one disturbance structure")
+    structures = tuple(_checks.choice(s, "structures", DISTURBANCE_STRUCTURES)
+                       for s in _checks.one_or_many(structures, "structures", str, "disturbance structure name"))
     lv = _checks.as_array(levels, "levels", ndim=(1,), min_size=1)
     if np.any(lv < 0):
         raise ValueError(f"levels must be >= 0; got {lv}")
     R = _checks.positive(pole_radius, "pole_radius")
     n_samples = _checks.integer(n_samples, "n_samples", minimum=10)
     progress = _checks.boolean(progress, "progress")
+    if executor is not None and not callable(getattr(executor, "map", None)):
+        raise _checks.ArgumentTypeError(f"executor must be a concurrent.futures-style executor with a map method "
+                                        f"(or None); got {type(executor).__name__}")
     tasks = [(system, o, structures, tuple(lv), gamma, R, n_samples) for o in orbits]
     t0 = time.perf_counter()
     mapper = map if executor is None else executor.map

@@ -55,6 +55,15 @@ class Measurements:
     theta2: np.ndarray
     sigma: float
 
+    def __post_init__(self):
+        t = _checks.time_grid(self.t, "t", increasing=True)
+        th1 = _checks.as_array(self.theta1, "theta1", shape=t.shape)
+        th2 = _checks.as_array(self.theta2, "theta2", shape=t.shape)
+        object.__setattr__(self, "t", t)
+        object.__setattr__(self, "theta1", th1)
+        object.__setattr__(self, "theta2", th2)
+        object.__setattr__(self, "sigma", _checks.positive(self.sigma, "sigma", allow_zero=True))
+
 
 @dataclass(frozen=True)
 class ObserverRun:

@@ -9,12 +9,13 @@ the printed state, the period, the Jacobi constant and how far the corrected ``v
 from __future__ import annotations
 
 import csv
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from . import paths
+from . import _checks, paths
 from .dynamics import CR3BP
 from .orbits import PeriodicOrbit, correct_symmetric, half_period_guess
 from .propagation import propagate
@@ -30,6 +31,12 @@ class TableRow:
     label: str
     x0: float
     vy0: float
+
+    def __post_init__(self):
+        _checks.integer(self.table, "table", minimum=1)
+        _checks.instance(self.label, "label", str)
+        _checks.real(self.x0, "x0")
+        _checks.real(self.vy0, "vy0")
 
     @property
     def state(self) -> np.ndarray:
@@ -66,6 +73,8 @@ class RowCheck:
 
 def load_wolf_jones_table(path: str | Path | None = None) -> list[TableRow]:
     """Read ``data/wolf_jones_dros.csv`` (comment lines start with ``#``)."""
+    if path is not None:
+        _checks.instance(path, "path", (str, os.PathLike), "a str or os.PathLike (a file path)")
     path = Path(path) if path is not None else paths.repo_root() / "data" / "wolf_jones_dros.csv"
     with open(path, newline="") as fh:
         lines = [ln for ln in fh if not ln.startswith("#")]
@@ -78,6 +87,8 @@ def verify_table_row(system: CR3BP, row: TableRow) -> RowCheck:
     The correction is seeded with the half period of the nearest DRO of the family rather than the printed
     state's own first x-axis return, so a wrong printed ``vy0`` cannot seed a different orbit.
     """
+    _checks.system(system, "system")
+    _checks.instance(row, "row", TableRow)
     state = row.state
     try:
         orb = correct_symmetric(system, state, half_period_guess(system, state), fix="x0", label=row.label)

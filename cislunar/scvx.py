@@ -65,7 +65,7 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from . import _checks
-from .discretization import foh_discretize
+from .discretization import _check_outside, foh_discretize
 from .dynamics import CR3BP
 from .progress import progress as _progress
 
@@ -270,6 +270,8 @@ class SCvxResult:
 
 def impulse(t, u) -> float:
     """Trapezoid total impulse of node accelerations ``u`` (N, 3) on node times ``t`` (N,), LU/TU."""
+    t = _checks.time_grid(t, "t", increasing=True)
+    u = _checks.as_array(u, "u", shape=(t.size, 3))
     nrm = np.linalg.norm(u, axis=1)
     return float(np.sum(np.diff(t) * (nrm[:-1] + nrm[1:]) / 2.0))
 
@@ -303,20 +305,25 @@ def finite_difference_hessian(gradient, x, step: float = 1e-5, *, g0=None) -> np
     Central differences (2n gradient calls, error O(h^2)), or forward differences from the gradient ``g0`` at
     ``x`` when it is given (n calls, error O(h)).  The step of component ``i`` is ``step (1 + |x_i|)``.
     """
-    x = _checks.as_array(x, "x", ndim=(1,))
+    _checks.callable_(gradient, "gradient")
+    x = _checks.as_array(x, "x", ndim=(1,), min_size=1)
     step = _checks.positive(step, "step")
     n = x.size
     if g0 is not None:
         g0 = _checks.as_array(g0, "g0", shape=(n,))
+
+    def grad(z):
+        return _checks.as_array(gradient(z), "gradient(x)", shape=(n,), finite=False)
+
     H = np.empty((n, n))
     for i in range(n):
         h = step * (1.0 + abs(x[i]))
         e = np.zeros(n)
         e[i] = h
         if g0 is None:
-            H[:, i] = (np.asarray(gradient(x + e)) - np.asarray(gradient(x - e))) / (2.0 * h)
+            H[:, i] = (grad(x + e) - grad(x - e)) / (2.0 * h)
         else:
-            H[:, i] = (np.asarray(gradient(x + e)) - g0) / h
+            H[:, i] = (grad(x + e) - g0) / h
     return 0.5 * (H + H.T)
 
 
@@ -444,6 +451,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
     t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
     n = t.size
     x_ref = _checks.as_array(x_guess, "x_guess", shape=(n, 6)).copy()
+    _check_outside(system, x_ref, "x_guess")
     u_ref = _checks.as_array(u_guess, "u_guess", shape=(n, 3)).copy()
     umax = _checks.as_array(u_max, "u_max", shape=(n,))
     if np.any(umax < 0):
@@ -685,6 +693,7 @@ class SweepResult:
 
     def column(self, name: str) -> np.ndarray:
         """``impulse``, ``information``, ``cost``, ``iterations`` or ``max_defect`` of the best per alpha (NaN if none)."""
+        _checks.choice(name, "name", ("impulse", "information", "cost", "iterations", "max_defect", "alpha"))
         return np.array([np.nan if b is None else float(getattr(b, name)) for b in self.best])
 
 
@@ -714,8 +723,12 @@ def homotopy_sweep(solve, alphas, x_guess, u_guess, *, directions=("up", "down")
     a = _checks.as_array(alphas, "alphas", ndim=(1,), min_size=1)
     if np.any(np.diff(a) <= 0) or a[0] < 0 or a[-1] > 1:
         raise ValueError("alphas must be strictly increasing within [0, 1]")
+    xg = _checks.as_array(x_guess, "x_guess", ndim=(2,), last=6, min_size=1)
+    _checks.as_array(u_guess, "u_guess", shape=(xg.shape[0], 3))
+    directions = _checks.one_or_many(directions, "directions", str, "str")
     for d in directions:
         _checks.choice(d, "directions", ("up", "down"))
+    progress = _checks.boolean(progress, "progress")
     best, source, attempts = [None] * a.size, [""] * a.size, []
     runs = []
     if "up" in directions:
