@@ -124,12 +124,44 @@ class UnderResolvedWarning(UserWarning):
     """A torus solved on its grid is not invariant between grid points: too few circle points N."""
 
 
+#: Smallest RMS ring size (LU, about 4 micrometres) of a circle that is a torus and not the base periodic orbit.
+_MIN_SIZE_LU = 1e-11
+
+
+# ----------------------------------------------------------------------------------------------------------
+# argument checks (private helpers on top of cislunar._checks)
+# ----------------------------------------------------------------------------------------------------------
+def _heyoka_tol(tol, name: str = "tol") -> float:
+    """An integrator tolerance, checked under the caller's name (heyoka accepts [1e-16, 1e-3])."""
+    return _checks.in_range(tol, name, 1e-16, 1e-3)
+
+
+def _orbit(orbit, name: str = "orbit") -> PeriodicOrbit:
+    return _checks.instance(orbit, name, PeriodicOrbit, "a cislunar.orbits.PeriodicOrbit (e.g. orbits.nrho_9_2)")
+
+
+def _torus(torus, name: str = "torus") -> "InvariantTorus":
+    return _checks.instance(torus, name, InvariantTorus, "a cislunar.torus.InvariantTorus")
+
+
+def _check_circle_outside_primaries(system: CR3BP, circle: np.ndarray, name: str = "circle") -> None:
+    """A ring point on or inside the Earth or the Moon is not a torus of the CR3BP (ValueError naming ``name``)."""
+    r1, r2 = system.distances(circle)
+    for body, r, radius in (("Moon", r2, system.secondary_radius), ("Earth", r1, system.primary_radius)):
+        inside = np.flatnonzero(r <= radius)
+        if inside.size:
+            k = int(inside[0])
+            raise ValueError(f"{name} point {k} lies inside the {body} ({r[k] * system.length_unit_km:.6g} km from "
+                             f"its centre, radius {radius * system.length_unit_km:.6g} km): not a torus of the "
+                             "CR3BP")
+
+
 # ----------------------------------------------------------------------------------------------------------
 # Fourier interpolation on the circle
 # ----------------------------------------------------------------------------------------------------------
 def _check_n(n, name: str = "N") -> int:
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
-        raise TypeError(f"{name} must be an odd integer >= 5; got {n!r}")
+    if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)):
+        raise _checks.ArgumentTypeError(f"{name} must be an odd integer >= 5; got {type(n).__name__} {n!r:.60}")
     n = int(n)
     if n < 5 or n % 2 == 0:
         raise ValueError(f"{name} must be an odd integer >= 5 (odd: no ambiguous Nyquist mode); got {n}")
@@ -155,6 +187,7 @@ def fourier_weights(theta, n: int, derivative: bool = False) -> np.ndarray:
     """
     n = _check_n(n, "n")
     theta = _checks.as_array(theta, "theta", ndim=(0, 1)).reshape(-1)
+    derivative = _checks.boolean(derivative, "derivative")
     grid = 2.0 * np.pi * np.arange(n) / n
     d = theta[:, None] - grid[None, :]
     k = np.arange(1, (n - 1) // 2 + 1)
@@ -200,16 +233,24 @@ class InvariantTorus:
     label: str = ""
 
     def __post_init__(self):
-        if not isinstance(self.orbit, PeriodicOrbit):
-            raise TypeError(f"orbit must be a cislunar.orbits.PeriodicOrbit; got {type(self.orbit).__name__}")
+        _orbit(self.orbit, "orbit")
         circle = _checks.as_array(self.circle, "circle", ndim=(2,), last=6)
         _check_n(circle.shape[0], "circle.shape[0] (N)")
+        _check_circle_outside_primaries(self.orbit.system, circle, "circle")
+        if _rms_about_mean(circle[:, :3]) < _MIN_SIZE_LU:
+            raise ValueError(f"circle is degenerate: its {circle.shape[0]} points coincide (RMS ring size "
+                             f"{_rms_about_mean(circle[:, :3]):.2e} LU); a zero-size torus is the base periodic orbit")
         object.__setattr__(self, "circle", circle)
         object.__setattr__(self, "period", _checks.positive(self.period, "period"))
         rho = _checks.as_array(self.rho, "rho", ndim=(0,))
         object.__setattr__(self, "rho", float(np.mod(rho, 2.0 * np.pi)))
-        if self.phase_component not in (0, 1, 2):
-            raise ValueError(f"phase_component must be 0, 1 or 2; got {self.phase_component!r}")
+        res = _checks.as_array(self.residuals, "residuals", ndim=(1,), finite=False)
+        if np.any(np.isnan(res)) or np.any(res < 0):
+            raise ValueError("residuals must be a sequence of non-negative residual norms")
+        object.__setattr__(self, "residuals", tuple(float(r) for r in res))
+        object.__setattr__(self, "phase_component", _checks.integer(self.phase_component, "phase_component",
+                                                                    minimum=0, maximum=2))
+        _checks.instance(self.label, "label", str)
 
     # ---------------------------------------------------------------------------------------- basic numbers
     @property
@@ -315,6 +356,7 @@ class InvariantTorus:
         """
         theta0 = _checks.as_array(theta0, "theta0", ndim=(0, 1)).reshape(-1)
         t = _checks.as_array(t, "t", ndim=(0, 1)).reshape(-1)
+        tol = _heyoka_tol(tol)
         if theta0.size == 0 or t.size == 0:
             raise ValueError("theta0 and t must hold at least one value each")
         T = self.period
@@ -337,12 +379,10 @@ class InvariantTorus:
 
     def ring(self, t: float = 0.0, n_theta: int | None = None) -> np.ndarray:
         """The invariant ring at time ``t`` (TU) at ``n_theta`` equally spaced initial angles, ``(n_theta, 6)``."""
-        n_theta = self.N if n_theta is None else int(n_theta)
-        if n_theta < 1:
-            raise ValueError(f"n_theta must be a positive integer; got {n_theta}")
-        _checks.as_array(t, "t", ndim=(0,))
+        n_theta = self.N if n_theta is None else _checks.integer(n_theta, "n_theta", minimum=1)
+        t = _checks.real(t, "t")
         th = 2.0 * np.pi * np.arange(n_theta) / n_theta
-        return self.states(th, [float(t)])[:, 0]
+        return self.states(th, [t])[:, 0]
 
     def invariance_error(self, theta=None, *, tol: float = DEFAULT_TOL) -> float:
         """Max-norm (over angles) of :math:`\\|\\varphi_T(u(\\theta)) - u(\\theta+\\rho)\\|_2` (6-D, non-dimensional).
@@ -352,6 +392,9 @@ class InvariantTorus:
         """
         theta = (self.thetas + np.pi / self.N) if theta is None else _checks.as_array(theta, "theta", ndim=(0, 1))
         theta = np.atleast_1d(theta)
+        if theta.size == 0:
+            raise ValueError("theta must hold at least one angle")
+        tol = _heyoka_tol(tol)
         x = propagate(self.system, self.circle_at(theta), self.period, tol=tol).x
         x = x.reshape(theta.size, 2, 6)[:, -1]
         return float(np.max(np.linalg.norm(x - self.circle_at(theta + self.rho), axis=1)))
@@ -378,6 +421,10 @@ class InvariantTorus:
         from scipy.optimize import minimize_scalar
 
         x = np.atleast_2d(_checks.as_state(x, "x"))
+        if x.shape[0] == 0:
+            raise ValueError("x must hold at least one state")
+        t = _checks.real(t, "t")
+        n_search = _checks.integer(n_search, "n_search", minimum=8)
         ring = self.ring(t) if t != 0.0 else self.circle
         th = 2.0 * np.pi * np.arange(n_search) / n_search
         dense = fourier_weights(th, self.N) @ ring
@@ -389,7 +436,11 @@ class InvariantTorus:
                 return float(np.linalg.norm(fourier_weights([a], self.N) @ ring - xi))
 
             h = 2.0 * np.pi / n_search
-            res = minimize_scalar(f, bracket=(th[j] - h, th[j], th[j] + h), tol=1e-12)
+            try:
+                res = minimize_scalar(f, bracket=(th[j] - h, th[j], th[j] + h), tol=1e-12)
+            except ValueError:  # flat neighbourhood (equal distances): the grid point is the answer
+                out[i] = f(th[j])
+                continue
             out[i] = min(res.fun, f(th[j]))
         return out
 
@@ -408,6 +459,7 @@ class InvariantTorus:
         ndarray, shape (6N,), complex
         """
         n = self.N
+        tol = _heyoka_tol(tol)
         stm = propagate_stm(self.system, self.circle, self.period, tol=tol).stm.reshape(n, 2, 6, 6)[:, -1]
         W = fourier_weights(self.thetas - self.rho, n)
         A = np.einsum("jl,lab->jalb", W, stm).reshape(6 * n, 6 * n)
@@ -434,11 +486,10 @@ class InvariantTorus:
         (theta0, t) : tuple of float
             Initial ring angle (rad) and time (TU) of the closest approach.
         """
-        if body not in ("Moon", "Earth"):
-            raise ValueError(f"body must be 'Moon' or 'Earth'; got {body!r}")
-        n_theta, n_t = int(n_theta), int(n_t)
-        if n_theta < 4 or n_t < 11:
-            raise ValueError(f"n_theta must be >= 4 and n_t >= 11; got {n_theta}, {n_t}")
+        _checks.choice(body, "body", ("Moon", "Earth"))
+        n_theta = _checks.integer(n_theta, "n_theta", minimum=4)
+        n_t = _checks.integer(n_t, "n_t", minimum=11)
+        tol = _heyoka_tol(tol)
         centre = self.system.secondary_position if body == "Moon" else self.system.primary_position
         km = self.system.length_unit_km
         th = 2.0 * np.pi * np.arange(n_theta) / n_theta
@@ -481,8 +532,14 @@ def centre_eigenpair(orbit: PeriodicOrbit, *, unit_tol: float = 1e-6, trivial_to
     ValueError
         If the orbit has no centre eigenvalue pair (no family of tori about it).
     """
-    if not isinstance(orbit, PeriodicOrbit):
-        raise TypeError(f"orbit must be a cislunar.orbits.PeriodicOrbit; got {type(orbit).__name__}")
+    _orbit(orbit)
+    unit_tol = _checks.positive(unit_tol, "unit_tol")
+    trivial_tol = _checks.positive(trivial_tol, "trivial_tol")
+    if unit_tol >= 1.0:
+        raise ValueError(f"unit_tol must be below 1 (a distance from the unit circle); got {unit_tol!r}")
+    if trivial_tol >= 2.0:
+        raise ValueError(f"trivial_tol must be below 2 (every unit-circle eigenvalue is within 2 of 1); got "
+                         f"{trivial_tol!r}")
     lam, vec = np.linalg.eig(orbit.monodromy)
     ok = (np.abs(np.abs(lam) - 1.0) < unit_tol) & (np.abs(lam - 1.0) > trivial_tol) & (lam.imag > 0)
     if not np.any(ok):
@@ -507,6 +564,7 @@ def torus_seed(orbit: PeriodicOrbit, N: int = 25, size_km: float = 1.0) -> Invar
     size_km : float
         RMS position radius of the ring, km, > 0.
     """
+    _orbit(orbit)
     N = _check_n(N)
     size_km = _checks.positive(size_km, "size_km")
     lam, v = centre_eigenpair(orbit)
@@ -514,6 +572,9 @@ def torus_seed(orbit: PeriodicOrbit, N: int = 25, size_km: float = 1.0) -> Invar
     c = int(np.argmax(np.abs(v[:3])))
     v = v * np.conj(v[c]) / np.abs(v[c])
     eps = size_km / orbit.system.length_unit_km
+    if eps < 100 * _MIN_SIZE_LU:
+        raise ValueError(f"size_km must be at least {100 * _MIN_SIZE_LU * orbit.system.length_unit_km:.1e} km (a "
+                         f"smaller ring is numerically the base periodic orbit); got {size_km!r}")
     th = 2.0 * np.pi * np.arange(N) / N
     circle = orbit.x0[None, :] + eps * np.real(v[None, :] * np.exp(1j * th)[:, None])
     return InvariantTorus(orbit=orbit, circle=circle, period=orbit.period, rho=float(np.angle(lam)),
@@ -680,12 +741,14 @@ def solve_torus(guess: InvariantTorus, *, fix: dict, free_period: bool = False, 
     ValueError, TypeError
         Bad arguments (named).
     """
-    if not isinstance(guess, InvariantTorus):
-        raise TypeError(f"guess must be an InvariantTorus; got {type(guess).__name__}")
-    fixes = _parse_fix(fix, bool(free_period), guess.system)
+    _torus(guess, "guess")
+    free_period = _checks.boolean(free_period, "free_period")
+    fixes = _parse_fix(fix, free_period, guess.system)
     tol = _checks.in_range(tol, "tol", 1e-15, 1e-3)
-    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
-        raise ValueError(f"max_iter must be a positive integer; got {max_iter!r}")
+    max_iter = _checks.integer(max_iter, "max_iter", minimum=1)
+    int_tol = _heyoka_tol(int_tol, "int_tol")
+    _checks.instance(label, "label", str)
+    check_midpoints = _checks.boolean(check_midpoints, "check_midpoints")
     prob = _Problem(guess.orbit, guess.N, fixes, bool(free_period), guess.phase_component, int_tol, guess.period)
     X = prob.pack(guess.circle, guess.rho, guess.period)
     history: list[float] = []
@@ -698,6 +761,11 @@ def solve_torus(guess: InvariantTorus, *, fix: dict, free_period: bool = False, 
                 break
             if err < tol:
                 U, rho, T = prob.unpack(X)
+                size = _rms_about_mean(U[:, :3])
+                if size < _MIN_SIZE_LU:
+                    raise TorusConvergenceError(
+                        f"torus solve converged to a degenerate circle (RMS ring size {size:.2e} LU): the base "
+                        f"periodic orbit, not a torus (fix={dict(fix)}, N={guess.N})", history, X, "degenerate")
                 torus = InvariantTorus(orbit=guess.orbit, circle=U.copy(), period=float(T), rho=float(rho),
                                        residuals=tuple(history), phase_component=guess.phase_component,
                                        label=label or guess.label)
@@ -756,10 +824,12 @@ def torus_from_orbit(orbit: PeriodicOrbit, N: int = 25, size_km: float = 10.0, *
     **solve_kw
         Passed to :func:`solve_torus` (``tol``, ``max_iter``, ``int_tol``).
     """
+    _orbit(orbit)
     N = _check_n(N)
     size_km = _checks.positive(size_km, "size_km")
     start_km = min(_checks.positive(start_km, "start_km"), size_km)
     step_km = _checks.positive(step_km, "step_km")
+    progress = _checks.boolean(progress, "progress")
     torus = solve_torus(torus_seed(orbit, N, start_km), fix={"size_km": start_km}, label=f"torus size_km={start_km:g}",
                         **solve_kw)
     if size_km == start_km:
@@ -821,14 +891,20 @@ def continue_tori(torus: InvariantTorus, values, *, parameter: str = "size_km", 
     TorusConvergenceError
         A step fails even after ``max_halvings`` halvings.
     """
-    if not isinstance(torus, InvariantTorus):
-        raise TypeError(f"torus must be an InvariantTorus; got {type(torus).__name__}")
-    if parameter not in ("size_km", "size", "jacobi", "rho"):
-        raise ValueError(f"parameter must be one of 'size_km', 'size', 'jacobi', 'rho'; got {parameter!r}")
+    _torus(torus)
+    _checks.choice(parameter, "parameter", ("size_km", "size", "jacobi", "rho"))
+    progress = _checks.boolean(progress, "progress")
+    max_halvings = _checks.integer(max_halvings, "max_halvings", minimum=0)
+    free_period = _checks.boolean(free_period, "free_period")
     hold = {} if hold is None else hold
-    if not isinstance(hold, dict) or parameter in hold:
+    if not isinstance(hold, dict):
+        raise _checks.ArgumentTypeError(f"hold must be a dict of constraints (or None); got {type(hold).__name__}")
+    if parameter in hold:
         raise ValueError(f"hold must be a dict of constraints other than {parameter!r}; got {hold!r}")
-    values = _checks.as_array(values, "values", ndim=(0, 1)).reshape(-1)
+    if len(hold) != int(free_period):
+        raise ValueError(f"hold must fix {int(free_period)} constraint(s) with free_period={free_period}; got "
+                         f"{sorted(hold)}")
+    values = _checks.as_array(values, "values", ndim=(0, 1), min_size=1).reshape(-1)
     if parameter in ("size_km", "size") and np.any(values <= 0):
         raise ValueError("values must be positive sizes")
     out = []
@@ -942,15 +1018,11 @@ def mean_range(torus: InvariantTorus, *, n_theta: int = 48, n_t: int = 1201, per
     -------
     RangeStats
     """
-    if not isinstance(torus, InvariantTorus):
-        raise TypeError(f"torus must be an InvariantTorus; got {type(torus).__name__}")
-    n_theta, n_t, periods = int(n_theta), int(n_t), int(periods)
-    if n_theta < 4:
-        raise ValueError(f"n_theta must be at least 4; got {n_theta}")
-    if n_t < 11:
-        raise ValueError(f"n_t must be at least 11; got {n_t}")
-    if periods < 1:
-        raise ValueError(f"periods must be a positive integer; got {periods}")
+    _torus(torus)
+    n_theta = _checks.integer(n_theta, "n_theta", minimum=4)
+    n_t = _checks.integer(n_t, "n_t", minimum=11)
+    periods = _checks.integer(periods, "periods", minimum=1)
+    tol = _heyoka_tol(tol)
     T = torus.period
     th = 2.0 * np.pi * np.arange(n_theta) / n_theta
     t = np.linspace(0.0, periods * T, periods * (n_t - 1) + 1)
@@ -1038,11 +1110,15 @@ def qpo_for_mean_range(orbit: PeriodicOrbit, target_km: float = 215.0, N: int = 
     TorusConvergenceError
         If the secant iteration does not reach ``rtol``.
     """
+    _orbit(orbit)
     target_km = _checks.positive(target_km, "target_km")
-    if statistic not in ("mean_km", "ring_mean_km", "rms_km"):
-        raise ValueError(f"statistic must be 'mean_km', 'ring_mean_km' or 'rms_km'; got {statistic!r}")
+    _checks.choice(statistic, "statistic", ("mean_km", "ring_mean_km", "rms_km"))
     rtol = _checks.in_range(rtol, "rtol", 1e-12, 0.1)
     N = _check_n(N)
+    n_theta = _checks.integer(n_theta, "n_theta", minimum=4)
+    n_t = _checks.integer(n_t, "n_t", minimum=11)
+    progress = _checks.boolean(progress, "progress")
+    max_iter = _checks.integer(max_iter, "max_iter", minimum=1)
     small = torus_from_orbit(orbit, N, min(5.0, target_km / 10.0), **solve_kw)
     stats = mean_range(small, n_theta=n_theta, n_t=n_t)
     sizes, means = [small.size_km], [getattr(stats, statistic)]
