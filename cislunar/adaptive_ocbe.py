@@ -92,7 +92,8 @@ from .propagation import DEFAULT_TOL, _check_tol
 
 __all__ = ["DETECTION_PROBABILITY", "CONSECUTIVE_EPOCHS", "metric_law", "metric_limit", "MetricTerms",
            "RESET_RULES", "metric_terms", "forward_metric", "smoothed_metric", "first_detection", "Detection", "reset_factor",
-           "AdaptiveOCBEResult", "adaptive_ocbe", "adaptive_ocbe_batch", "ResetError"]
+           "AdaptiveOCBEResult", "adaptive_ocbe", "adaptive_ocbe_batch", "ResetError", "PASSES", "PanelSeries",
+           "panel_series", "figure_errors", "figure_control_metric"]
 
 #: Probability of the metric's detection limit (the paper's 99 %).
 DETECTION_PROBABILITY = 0.99
@@ -218,6 +219,47 @@ def _dof(model, available, N: int, K: int) -> np.ndarray:
     return np.asarray(available, bool).reshape(N, K).sum(axis=1) * model.dim
 
 
+def _availability(available, N: int, K: int) -> np.ndarray:
+    """``available`` as an (N, K) bool array (all True when None), refused by name when malformed."""
+    if available is None:
+        return np.ones((N, K), bool)
+    if isinstance(available, (str, bytes)) or available is None:
+        raise _checks.ArgumentTypeError(f"available must be an array of bool; got {type(available).__name__}")
+    try:
+        a = np.asarray(available)
+    except ValueError:
+        raise _checks.ArgumentTypeError("available must be an array of bool (a regular, non-ragged array)") from None
+    if a.dtype != bool:
+        raise _checks.ArgumentTypeError(f"available must be an array of bool; got dtype {a.dtype}")
+    if a.shape not in ((N, K),) + (((N,),) if K == 1 else ()):
+        raise ValueError(f"available must have shape ({N}, {K}); got {a.shape}")
+    return a.reshape(N, K)
+
+
+def _measurement_inputs(N: int, y, observer_states, model, meas_cov, available):
+    """Checked measurement arrays of a run: y (N, K, m), observers (N, K, 6), R (N, m, m), availability (N, K)."""
+    model = ocbe.check_model(model)
+    obs = _checks.as_array(observer_states, "observer_states", ndim=(2, 3), last=6)
+    obs = obs[:, None, :] if obs.ndim == 2 else obs
+    if obs.shape[0] != N:
+        raise ValueError(f"observer_states must have {N} epochs; got shape {obs.shape}")
+    K = obs.shape[1]
+    yy = _checks.as_array(y, "y", ndim=(2, 3), finite=False)
+    yy = yy[:, None, :] if yy.ndim == 2 else yy
+    if yy.shape != (N, K, model.dim):
+        raise ValueError(f"y must have shape ({N}, {model.dim}) or ({N}, {K}, {model.dim}); got {yy.shape}")
+    avail = _availability(available, N, K)
+    if not np.all(np.isfinite(yy[avail])):
+        raise ValueError("y contains NaN or infinite values where measurements are available")
+    R = _checks.as_array(meas_cov, "meas_cov", ndim=(2, 3))
+    R = np.broadcast_to(R, (N, model.dim, model.dim)) if R.shape == (model.dim, model.dim) else R
+    if R.shape != (N, model.dim, model.dim):
+        raise ValueError(f"meas_cov must have shape ({model.dim}, {model.dim}) or ({N}, {model.dim}, {model.dim}); "
+                         f"got {R.shape}")
+    _checks.spd(R, "meas_cov", batch=True)
+    return yy, obs, R, avail
+
+
 def forward_metric(result, model, available=None):
     """Forward OCBE metric per epoch and its degrees of freedom.
 
@@ -237,10 +279,20 @@ def forward_metric(result, model, available=None):
     dof : ndarray of int, shape (N,)
     """
     model = ocbe.check_model(model)
-    r = np.asarray(result.residual_norms, float)
+    if not hasattr(result, "residual_norms"):
+        raise _checks.ArgumentTypeError("result must be a cislunar.ocbe.OCBEResult or a "
+                                        f"cislunar.detection.BatchOCBEResult; got {type(result).__name__}")
+    r = _checks.as_array(result.residual_norms, "result.residual_norms", ndim=(1, 2))
     N = r.shape[-1]
-    K = 1 if available is None else int(np.asarray(available).size // N)
-    dof = _dof(model, available, N, K)
+    if available is None:
+        dof = _dof(model, None, N, 1)
+    else:
+        try:
+            size = int(np.size(available))
+        except ValueError:  # ragged: refused by name below
+            size = 0
+        K = max(size // N, 1)
+        dof = _dof(model, _availability(available, N, K), N, K)
     return np.where(dof > 0, r**2, np.nan), dof
 
 
@@ -262,23 +314,18 @@ def smoothed_metric(result, y, observer_states, model, meas_cov, control_weight,
         Epoch 0 carries the a-priori term and its measurement term; the control integral uses Simpson's rule on
         the run's sub-grid.  See the module docstring for its (epoch-averaged) mean.
     """
+    _checks.instance(result, "result", ocbe.OCBEResult, "a cislunar.ocbe.OCBEResult")
     if result.x_smooth is None:
         raise ValueError("result must come from a run with smooth=True")
     model = ocbe.check_model(model)
     N = result.t.size
-    obs = np.asarray(observer_states, float)
-    obs = obs[:, None, :] if obs.ndim == 2 else obs
-    yy = np.asarray(y, float)
-    yy = yy[:, None, :] if yy.ndim == 2 else yy
-    K = obs.shape[1]
-    avail = np.ones((N, K), bool) if available is None else np.asarray(available, bool).reshape(N, K)
-    R = np.asarray(meas_cov, float)
-    W = srif.sri_from_covariance(np.zeros(model.dim), R, name="meas_cov")[0]
+    yy, obs, R, avail = _measurement_inputs(N, y, observer_states, model, meas_cov, available)
     qs = ocbe.control_weights(control_weight, N - 1)
     out = np.zeros(N)
     for k in range(N):
         vis = np.flatnonzero(avail[k])
         if vis.size:
+            W = srif.sri_from_covariance(np.zeros(model.dim), R[k], name="meas_cov")[0]
             r = model.residual(yy[k, vis], model(obs[k, vis], result.x_smooth[k]))
             out[k] = float(np.sum((r @ W.T) ** 2))
         else:
@@ -385,10 +432,16 @@ def reset_factor(system: CR3BP, t, k: int, x_filt_prev, P_filt_prev, y_k, observ
     k = _checks.integer(k, "k", minimum=1, maximum=t.size - 1)
     q = _checks.positive(control_weight, "control_weight")
     P = _checks.spd(P_filt_prev, "P_filt_prev", n=6)
+    x_prev = _checks.as_state(x_filt_prev, "x_filt_prev", batch=False)
+    model = ocbe.check_model(model)
     obs = _checks.as_array(observers_k, "observers_k", ndim=(1, 2), last=6).reshape(-1, 6)
-    yk = _checks.as_array(y_k, "y_k", ndim=(1, 2)).reshape(obs.shape[0], -1)
+    yk = _checks.as_array(y_k, "y_k", ndim=(1, 2), last=model.dim)
+    if yk.size != obs.shape[0] * model.dim:
+        raise ValueError(f"y_k must hold {obs.shape[0]} measurement(s) of length {model.dim}; got shape {yk.shape}")
+    yk = yk.reshape(obs.shape[0], model.dim)
+    meas_cov = _checks.spd(meas_cov, "meas_cov", n=model.dim)
     grid = np.linspace(t[k - 1], t[k], _checks.integer(n_sub, "n_sub", minimum=2))
-    tr = ocbe.ocbe_transition(system, x_filt_prev, grid, q, tol=_check_tol(tol))
+    tr = ocbe.ocbe_transition(system, x_prev, grid, q, tol=_check_tol(tol))
     Phi = tr.phi[-1, :6, :6]
     Q = ocbe.ocbe_process_noise(tr.phi[-1])
     val, _, Ht = model.evaluate(obs, tr.x[-1])
@@ -503,20 +556,15 @@ def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0,
     consecutive = _checks.integer(consecutive, "consecutive", minimum=1)
     max_resets = _checks.integer(max_resets, "max_resets", minimum=0)
     _checks.choice(reset, "reset", RESET_RULES)
+    _checks.in_range(probability, "probability", 0.0, 1.0, closed=False)
+    yy, obs3, R, avail = _measurement_inputs(N, y, observer_states, model, meas_cov, available)
 
     def run():
         return ocbe.ocbe_filter_smoother(system, t, y, observer_states, model, meas_cov, x0, P0, q,
                                          available=available, n_sub=n_sub, smooth=smooth, tol=tol)
 
     res = run()  # validates every remaining argument by name
-    obs = np.asarray(observer_states, float)
-    obs3 = obs[:, None, :] if obs.ndim == 2 else obs
-    yy = np.asarray(y, float)
-    y3 = yy[:, None, :] if yy.ndim == 2 else yy
-    K = obs3.shape[1]
-    avail = np.ones((N, K), bool) if available is None else np.asarray(available, bool).reshape(N, K)
-    R = np.asarray(meas_cov, float)
-    R = np.broadcast_to(R, (N, model.dim, model.dim)) if R.shape == (model.dim, model.dim) else R
+    y3 = yy
     metric, dof = forward_metric(res, model, avail)
     limit = metric_limit(dof, probability)
     first = metric.copy()
@@ -576,6 +624,9 @@ def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x
     q = ocbe.control_weights(control_weight, N - 1, batch=B).copy()
     obs = _checks.as_array(observer_states, "observer_states", shape=(N, 6))
     consecutive = _checks.integer(consecutive, "consecutive", minimum=1)
+    max_resets = _checks.integer(max_resets, "max_resets", minimum=0)
+    _checks.choice(reset, "reset", RESET_RULES)
+    _checks.in_range(probability, "probability", 0.0, 1.0, closed=False)
 
     def run():
         return detection.ocbe_batch(system, t, yy, obs, model, meas_cov, x0, P0, q, n_sub=n_sub, tol=tol)
@@ -605,3 +656,221 @@ def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x
             dets[b].append(Detection(k, k + consecutive - 1, float(t[k]), factor, m0, float(metric[b, k])))
             start[b] = k + 1
     return res, q, metric, [tuple(d) for d in dets]
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The paper's figure panels (Figs. 6-13): state errors with 3-sigma bounds, control norm, normalised metric
+# ---------------------------------------------------------------------------------------------------------------
+#: The two passes every panel figure shows, left to right.
+PASSES = ("forward", "smoothed")
+_VELOCITY_UNITS = {"m/s": 1e3, "mm/s": 1e6}
+
+
+@dataclass(frozen=True)
+class PanelSeries:
+    """What the paper's Figs. 6-13 plot for one OCBE run, in display units.
+
+    Index 0 of every leading axis of length 2 is the forward filter (with the single-step smoothed control of
+    Eq. 32), index 1 the full smoother (:data:`PASSES`).
+
+    Attributes
+    ----------
+    t_days : ndarray, shape (N,)
+        Epochs, days from the start of the track.
+    t_sub_days : ndarray, shape (N-1, n_sub)
+        Sub-grid of each interval on which the control is evaluated, days.
+    position_error_km, position_3sigma_km : ndarray, shape (2, N)
+        Norm of the position error against the truth and :math:`3\\sqrt{\\mathrm{tr}\\,P_{rr}}`, km.
+    velocity_error_m_s, velocity_3sigma_m_s : ndarray, shape (2, N)
+        The same for the velocity, m/s.
+    control_norm_m_s2 : ndarray, shape (2, N-1, n_sub)
+        :math:`\\|\\hat{\\mathbf u}\\|` of the forward (single-step) and smoothed control, m/s^2.
+    metric : ndarray, shape (2, N)
+        Forward OCBE metric (:func:`forward_metric`) and smoothed metric (:func:`smoothed_metric`).
+    limit : ndarray, shape (N,)
+        99 % detection limit of the forward metric (:func:`metric_limit`).
+    dof : ndarray of int, shape (N,)
+        Degrees of freedom (= mean) of the forward metric.
+    nees : ndarray, shape (2, N)
+        Normalised estimation error squared of both passes (:math:`\\chi^2_6` when consistent).
+    """
+
+    t_days: np.ndarray
+    t_sub_days: np.ndarray
+    position_error_km: np.ndarray
+    position_3sigma_km: np.ndarray
+    velocity_error_m_s: np.ndarray
+    velocity_3sigma_m_s: np.ndarray
+    control_norm_m_s2: np.ndarray
+    metric: np.ndarray
+    limit: np.ndarray
+    dof: np.ndarray
+    nees: np.ndarray
+
+    @property
+    def normalized_metric(self) -> np.ndarray:
+        """Both metrics divided by the forward limit (the paper's "normalized OCBE metric"), shape (2, N)."""
+        return self.metric / self.limit
+
+    @property
+    def mean_line(self) -> np.ndarray:
+        """The metric's mean over its limit per epoch (the paper's red line), shape (N,)."""
+        return self.dof / self.limit
+
+
+def panel_series(system: CR3BP, result, truth, control_weight, y, observer_states, model, meas_cov, *,
+                 available=None) -> PanelSeries:
+    """The panels of the paper's Figs. 6-13 for one run of :func:`cislunar.ocbe.ocbe_filter_smoother`.
+
+    Parameters
+    ----------
+    system : CR3BP
+        Units (states LU, LU/TU; times TU).
+    result : cislunar.ocbe.OCBEResult
+        A run with ``smooth=True``.
+    truth : array_like, shape (N, 6)
+        True states at the epochs, LU and LU/TU (rotating frame).
+    control_weight : float or array_like, shape (N-1,)
+        Per-interval control weight :math:`q_n` used in the run, LU^2/TU^3.
+    y, observer_states, model, meas_cov, available
+        As passed to the run.
+
+    Returns
+    -------
+    PanelSeries
+    """
+    _checks.system(system)
+    _checks.instance(result, "result", ocbe.OCBEResult, "a cislunar.ocbe.OCBEResult")
+    if result.x_smooth is None:
+        raise ValueError("result must come from a run with smooth=True")
+    N = result.t.size
+    _measurement_inputs(N, y, observer_states, model, meas_cov, available)
+    truth = _checks.as_array(truth, "truth", shape=(N, 6))
+    model = ocbe.check_model(model)
+    q = ocbe.control_weights(control_weight, N - 1)
+    from . import tracking
+
+    L, V = system.length_unit_km, system.velocity_unit_km_s * 1e3
+    pos_e, pos_s, vel_e, vel_s, nees = [], [], [], [], []
+    for x, P in ((result.x_filt, result.P_filt), (result.x_smooth, result.P_smooth)):
+        e = x - truth
+        pos_e.append(np.linalg.norm(e[:, :3], axis=1) * L)
+        vel_e.append(np.linalg.norm(e[:, 3:], axis=1) * V)
+        pos_s.append(3 * np.sqrt(np.trace(P[:, :3, :3], axis1=1, axis2=2)) * L)
+        vel_s.append(3 * np.sqrt(np.trace(P[:, 3:, 3:], axis1=1, axis2=2)) * V)
+        nees.append(tracking.nees(x, P, truth))
+    acc = system.length_unit_km * 1e3 / system.time_unit_s**2
+    control = np.stack([np.linalg.norm(result.control_step, axis=-1), np.linalg.norm(result.control_smooth, axis=-1)])
+    m_f, dof = forward_metric(result, model, available)
+    m_s = smoothed_metric(result, y, observer_states, model, meas_cov, q, available=available)
+    day = system.time_unit_s / 86400.0
+    return PanelSeries(result.t * day, result.t_sub * day, np.array(pos_e), np.array(pos_s), np.array(vel_e),
+                       np.array(vel_s), control * acc, np.stack([m_f, m_s]), metric_limit(dof), dof, np.array(nees))
+
+
+def _mark(ax, burn_days, detection_days):
+    if burn_days is not None:
+        ax.axvline(burn_days, color="0.5", ls=":", lw=1, label="burn")
+    for d in detection_days:
+        ax.axvline(d, color="C2", ls="--", lw=1, label="detection")
+
+
+def _legend_below(fig, ax):
+    handles, labels = ax.get_legend_handles_labels()
+    uniq = dict(zip(labels, handles))
+    fig.legend(uniq.values(), uniq.keys(), loc="lower center", ncol=len(uniq), bbox_to_anchor=(0.5, 0.0))
+    fig.tight_layout(rect=(0, 0.06, 1, 1))
+
+
+def figure_errors(panels: PanelSeries, title: str, *, burn_days=None, detection_days=(), velocity_unit="m/s"):
+    """Figs. 6, 8, 10, 12 layout: position (top) and velocity (bottom) error norms with their 3-sigma bounds,
+    forward filter (left) and smoother (right), on log axes.
+
+    Parameters
+    ----------
+    panels : PanelSeries
+    title : str
+        Prefix of the panel titles.
+    burn_days : float, optional
+        Time of the burn, days (dotted line).
+    detection_days : sequence of float
+        Times of adaptive detections, days (dashed lines).
+    velocity_unit : {"m/s", "mm/s"}
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.figure import Figure
+
+    _checks.instance(panels, "panels", PanelSeries)
+    _checks.instance(title, "title", str)
+    vu = _checks.choice(velocity_unit, "velocity_unit", tuple(_VELOCITY_UNITS))
+    burn = None if burn_days is None else _checks.real(burn_days, "burn_days")
+    dets = _checks.as_array(detection_days, "detection_days", ndim=(0, 1)).reshape(-1)
+    fig = Figure(figsize=(12, 6.5))
+    ax = fig.subplots(2, 2, sharex=True)
+    scale_v = _VELOCITY_UNITS[vu] / 1e3
+    for j, name in enumerate(PASSES):
+        rows = ((panels.position_error_km[j], panels.position_3sigma_km[j], "position error [km]"),
+                (panels.velocity_error_m_s[j] * scale_v, panels.velocity_3sigma_m_s[j] * scale_v,
+                 f"velocity error [{vu}]"))
+        for i, (err, sig, lab) in enumerate(rows):
+            ax[i, j].semilogy(panels.t_days, err, "C0", label="true error")
+            ax[i, j].semilogy(panels.t_days, sig, "C3", label=r"3$\sigma$")
+            _mark(ax[i, j], burn, dets)
+            ax[i, j].set_ylabel(lab)
+        ax[0, j].set_title(f"{title}: {name}")
+        ax[1, j].set_xlabel("time from periapsis [d]")
+    _legend_below(fig, ax[0, 0])
+    return fig
+
+
+def figure_control_metric(panels: PanelSeries, title: str, *, burn_days=None, detection_days=(),
+                          first_pass_metric=None, first_pass_until=None):
+    """Figs. 7, 9, 11, 13 layout: control norm (top) and normalised OCBE metric (bottom), forward (left) and
+    smoothed (right); the metric with its mean (red) and the 99 % limit (dashed), as in the paper.
+
+    Parameters
+    ----------
+    panels : PanelSeries
+    title : str
+    burn_days : float, optional
+    detection_days : sequence of float
+    first_pass_metric : array_like, shape (N,), optional
+        Forward metric of the adaptive filter's first pass (shown as crosses up to ``first_pass_until``).
+    first_pass_until : int, optional
+        Last epoch (inclusive) of ``first_pass_metric`` to show (the epoch at which the first reset was declared).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.figure import Figure
+
+    _checks.instance(panels, "panels", PanelSeries)
+    _checks.instance(title, "title", str)
+    burn = None if burn_days is None else _checks.real(burn_days, "burn_days")
+    dets = _checks.as_array(detection_days, "detection_days", ndim=(0, 1)).reshape(-1)
+    N = panels.t_days.size
+    fp = None if first_pass_metric is None else _checks.as_array(first_pass_metric, "first_pass_metric",
+                                                                 shape=(N,), finite=False)
+    until = N - 1 if first_pass_until is None else _checks.integer(first_pass_until, "first_pass_until",
+                                                                    minimum=0, maximum=N - 1)
+    fig = Figure(figsize=(12, 6.5))
+    ax = fig.subplots(2, 2, sharex=True)
+    norm = panels.normalized_metric
+    for j, name in enumerate(PASSES):
+        ax[0, j].semilogy(panels.t_sub_days.ravel(), panels.control_norm_m_s2[j].ravel(), "C0", lw=0.8)
+        ax[0, j].set(ylabel=r"control norm $\|\hat{\mathbf{u}}\|$ [m/s$^2$]", title=f"{title}: {name}")
+        if j == 0 and fp is not None:
+            ax[1, j].semilogy(panels.t_days[:until + 1], fp[:until + 1] / panels.limit[:until + 1], "x",
+                              color="0.4", ms=5, label="before the reset")
+        ax[1, j].semilogy(panels.t_days, norm[j], "C0.-", ms=3, lw=0.8, label="metric / limit")
+        ax[1, j].plot(panels.t_days, panels.mean_line, "C3", lw=1.2, label="mean / limit")
+        ax[1, j].axhline(1.0, color="k", ls="--", lw=0.8, label="99 % limit")
+        ax[1, j].set(ylabel="normalised OCBE metric [-]", xlabel="time from periapsis [d]")
+        for i in range(2):
+            _mark(ax[i, j], burn, dets)
+    _legend_below(fig, ax[1, 0])
+    return fig
