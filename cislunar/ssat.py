@@ -118,9 +118,38 @@ def agent_transform_matrix(n: int = 6) -> np.ndarray:
 
 
 def _check_n(n):
-    if not isinstance(n, (int, np.integer)) or n < 1:
-        raise ValueError(f"n must be a positive integer (sub-state dimension); got {n!r}")
-    return int(n)
+    return _checks.integer(n, "n (sub-state dimension)", minimum=1)
+
+
+_COORDINATES = ("inertial", "relative", "agent")
+
+
+def _noise(sigma_min_rad, resolution_km):
+    """Eq. 20 noise parameters, checked by name; both zero would make every measurement exact (infinite weight)."""
+    smin = _checks.positive(sigma_min_rad, "sigma_min_rad", allow_zero=True)
+    dres = _checks.positive(resolution_km, "resolution_km", allow_zero=True)
+    if smin == 0.0 and dres == 0.0:
+        raise ValueError("sigma_min_rad and resolution_km are both zero: the angular noise of Eq. 20 would vanish "
+                         "(exact measurements); give at least one a positive value")
+    return smin, dres
+
+
+def _initial_cov(P0, name: str = "P0") -> np.ndarray:
+    """A 12x12 SPD covariance of the inertial SSAT state (its symmetric part, as the filters use it)."""
+    return check_spd(_checks.spd(P0, name, n=12), name)
+
+
+def _trajectory(value, name: str) -> "ImpulsiveTrajectory":
+    return _checks.instance(value, name, ImpulsiveTrajectory,
+                            "a cislunar.ssat.ImpulsiveTrajectory (from propagate_with_impulses)")
+
+
+def _grid_indices(value, name: str) -> np.ndarray:
+    """A non-empty 1-D sequence of integer grid indices (integral floats accepted; 2.5 or NaN refused)."""
+    a = _checks.as_array(value, name, ndim=(1,), min_size=1)
+    if not np.all(a == np.round(a)):
+        raise ValueError(f"{name} must hold integer grid indices; got {value!r:.80}")
+    return a.astype(int)
 
 
 def _pair(x, name):
@@ -164,7 +193,7 @@ def _cov(P, name):
     P = _checks.as_array(P, name)
     if P.ndim < 2 or P.shape[-1] != P.shape[-2] or P.shape[-1] % 2 or P.shape[-1] == 0:
         raise ValueError(f"{name} must be square with an even size (..., 2n, 2n); got shape {P.shape}")
-    return P
+    return _checks.psd(P, name, batch=True)
 
 
 def relative_covariance(P) -> np.ndarray:
@@ -195,6 +224,7 @@ def control_matrix(coordinates: str = "inertial") -> np.ndarray:
     ----------
     coordinates : {"inertial", "relative", "agent"}
     """
+    _checks.choice(coordinates, "coordinates", _COORDINATES)
     B = np.zeros((12, 3))
     B[3:6, :] = np.eye(3)
     if coordinates == "inertial":
@@ -208,8 +238,8 @@ def control_matrix(coordinates: str = "inertial") -> np.ndarray:
 
 def apply_impulse(x, u) -> np.ndarray:
     """Eq. 13: :math:`\\mathbf x^+ = \\mathbf x^- + B_a\\mathbf u` for SSAT states ``x`` (..., 12) and impulses ``u`` (..., 3) (LU/TU)."""
-    x = _checks.as_array(x, "x", last=12)
-    u = _checks.as_array(u, "u", last=3)
+    x = _checks.as_array(x, "x", last=12, min_size=1)
+    u = _checks.as_array(u, "u", last=3, min_size=1)
     try:
         shape = np.broadcast_shapes(x.shape[:-1], u.shape[:-1])
     except ValueError as exc:
@@ -226,7 +256,8 @@ def range_projection(x, coordinates: str = "inertial") -> np.ndarray:
     :math:`M_\\rho = [0_6; \\hat{\\boldsymbol\\rho}; 0_3]` (for :math:`\\tilde P`; also valid for the agent-based
     state), ``"inertial"`` gives :math:`T^TM_\\rho = [-\\hat{\\boldsymbol\\rho}; 0_3; \\hat{\\boldsymbol\\rho}; 0_3]`.
     """
-    x = _checks.as_array(x, "x", last=12)
+    x = _checks.as_array(x, "x", last=12, min_size=1)
+    _checks.choice(coordinates, "coordinates", _COORDINATES)
     rho = x[..., 6:9] - x[..., 0:3]
     norm = np.linalg.norm(rho, axis=-1, keepdims=True)
     if np.any(norm <= 0):
@@ -245,9 +276,7 @@ def range_projection(x, coordinates: str = "inertial") -> np.ndarray:
 
 def range_variance(P, x, coordinates: str = "inertial") -> np.ndarray:
     """:math:`J_\\rho = M^TPM` (Eq. 21), LU^2, for covariances ``P`` (..., 12, 12) in the given coordinates at state ``x``."""
-    P = _checks.as_array(P, "P")
-    if P.shape[-2:] != (12, 12):
-        raise ValueError(f"P must have shape (..., 12, 12); got {P.shape}")
+    P = _checks.psd(P, "P", n=12, batch=True)
     M = range_projection(x, coordinates)
     return np.einsum("...i,...ij,...j->...", M, P, M)
 
@@ -262,6 +291,7 @@ def initial_covariance(system: CR3BP, sigma3_pos_km: float = AMOS_SIGMA3_POS_KM,
     sigma3_pos_km, sigma3_vel_km_s : float
         3-sigma per axis (AMOS 2023 Sec. 5: 60 km and 60 cm/s = 6e-4 km/s).
     """
+    _checks.system(system)
     sp = _checks.positive(sigma3_pos_km, "sigma3_pos_km") / 3.0
     sv = _checks.positive(sigma3_vel_km_s, "sigma3_vel_km_s") / 3.0
     P = state_covariance(sp, sv, system)
@@ -293,6 +323,18 @@ class ImpulsiveTrajectory:
     x: np.ndarray
     stm: np.ndarray
 
+    def __post_init__(self):
+        t = _checks.time_grid(self.t, "t", increasing=True)
+        x = _checks.as_array(self.x, "x", ndim=(3,), last=6)
+        if x.shape[0] < 1 or x.shape[1] != t.size:
+            raise ValueError(f"x must have shape (n, N, 6) with n >= 1 and N = t.size = {t.size}; got {x.shape}")
+        stm = _checks.as_array(self.stm, "stm", ndim=(4,))
+        if stm.shape != x.shape[:2] + (6, 6):
+            raise ValueError(f"stm must have shape (n, N, 6, 6) = {x.shape[:2] + (6, 6)} to match x; got {stm.shape}")
+        object.__setattr__(self, "t", t)
+        object.__setattr__(self, "x", x)
+        object.__setattr__(self, "stm", stm)
+
 
 def propagate_with_impulses(system: CR3BP, x0, t, impulses=(), *, threads: int | None = None) -> ImpulsiveTrajectory:
     """Propagate states with impulsive velocity changes, returning states and STMs on a grid (batched).
@@ -317,19 +359,30 @@ def propagate_with_impulses(system: CR3BP, x0, t, impulses=(), *, threads: int |
     """
     from .propagation import propagate_stm
 
-    if not isinstance(system, CR3BP):
-        raise ValueError(f"system must be a cislunar.dynamics.CR3BP; got {type(system).__name__}")
+    _checks.system(system)
     x0 = _checks.as_state(x0, "x0")
     xs = np.atleast_2d(x0).copy()
     n = xs.shape[0]
+    if n == 0:
+        raise ValueError("x0 must hold at least one state")
     t = _checks.time_grid(t, "t", increasing=True)
+    if isinstance(impulses, (str, bytes, dict)):
+        raise _checks.ArgumentTypeError(f"impulses must be a sequence of (time, dv) pairs; got "
+                                        f"{type(impulses).__name__}")
+    try:
+        items = list(impulses)
+    except TypeError:
+        raise _checks.ArgumentTypeError(f"impulses must be a sequence of (time, dv) pairs; got "
+                                        f"{type(impulses).__name__}") from None
     imp = []
-    for i, item in enumerate(impulses):
+    for i, item in enumerate(items):
+        if isinstance(item, (str, bytes)):
+            raise _checks.ArgumentTypeError(f"impulses[{i}] must be a (time, dv) pair; got {type(item).__name__}")
         try:
             tau, dv = item
         except (TypeError, ValueError) as exc:
             raise ValueError(f"impulses[{i}] must be a (time, dv) pair") from exc
-        tau = float(tau)
+        tau = _checks.real(tau, f"impulses[{i}] time")
         if not (t[0] <= tau <= t[-1]):
             raise ValueError(f"impulses[{i}] time {tau} must lie within the grid [{t[0]}, {t[-1]}] TU")
         dv = _checks.as_array(dv, f"impulses[{i}] dv", last=3)
@@ -430,10 +483,8 @@ def _measurement_rows(system, xa, xt, sigma_min_rad, resolution_km):
 
 
 def _check_pair_trajectories(agent, target, n_agent_name="agent", n_target_name="target"):
-    if not isinstance(agent, ImpulsiveTrajectory):
-        raise ValueError(f"{n_agent_name} must be an ImpulsiveTrajectory; got {type(agent).__name__}")
-    if not isinstance(target, ImpulsiveTrajectory):
-        raise ValueError(f"{n_target_name} must be an ImpulsiveTrajectory; got {type(target).__name__}")
+    _trajectory(agent, n_agent_name)
+    _trajectory(target, n_target_name)
     if target.x.shape[0] != 1 and target.x.shape[0] != agent.x.shape[0]:
         raise ValueError(f"{n_target_name} must hold one trajectory or as many as {n_agent_name} "
                          f"({agent.x.shape[0]}); got {target.x.shape[0]}")
@@ -471,12 +522,10 @@ def ssat_covariance(system: CR3BP, agent: ImpulsiveTrajectory, target: Impulsive
     :math:`J_\\rho(t_k) = \\|R_k^{-T}\\Phi(t_k,t_0)^Tm_k\\|^2` with :math:`m_k` from :func:`range_projection`.
     Equal to the Joseph-form EKF recursion of :func:`ssat_covariance_ekf` (tested).
     """
-    if not isinstance(system, CR3BP):
-        raise ValueError(f"system must be a cislunar.dynamics.CR3BP; got {type(system).__name__}")
+    _checks.system(system)
     _check_pair_trajectories(agent, target)
-    P0 = check_spd(_checks.as_array(P0, "P0", shape=(12, 12)), "P0")
-    smin = _checks.positive(sigma_min_rad, "sigma_min_rad", allow_zero=True)
-    dres = _checks.positive(resolution_km, "resolution_km", allow_zero=True)
+    P0 = _initial_cov(P0)
+    smin, dres = _noise(sigma_min_rad, resolution_km)
     n, N = agent.x.shape[0], agent.t.size
     xt = np.broadcast_to(target.x, (n, N, 6))
     st = np.broadcast_to(target.stm, (n, N, 6, 6))
@@ -524,12 +573,14 @@ def ssat_covariance_ekf(system: CR3BP, agent: ImpulsiveTrajectory, target: Impul
     """
     from .covariance import covariance_analysis
 
+    _checks.system(system)
     _check_pair_trajectories(agent, target)
     if agent.x.shape[0] != 1:
         raise ValueError(f"agent must hold a single trajectory for the reference recursion; got {agent.x.shape[0]}")
-    C = {"inertial": np.eye(12), "relative": transform_matrix(6), "agent": agent_transform_matrix(6)}.get(coordinates)
-    if C is None:
-        raise ValueError(f"coordinates must be 'inertial', 'relative' or 'agent'; got {coordinates!r}")
+    _checks.choice(coordinates, "coordinates", _COORDINATES)
+    P0 = _initial_cov(P0)
+    sigma_min_rad, resolution_km = _noise(sigma_min_rad, resolution_km)
+    C = {"inertial": np.eye(12), "relative": transform_matrix(6), "agent": agent_transform_matrix(6)}[coordinates]
     Ci = np.linalg.inv(C)
     xa, xt = agent.x[0], target.x[0]
     sa, st = agent.stm[0], target.stm[0]
@@ -541,7 +592,7 @@ def ssat_covariance_ekf(system: CR3BP, agent: ImpulsiveTrajectory, target: Impul
     F = C @ np.swapaxes(F, -1, -2) @ Ci  # Phi_{k+1} Phi_k^{-1}
     H, _, _ = _measurement_rows(system, xa, xt, sigma_min_rad, resolution_km)
     H = H @ Ci
-    P0c = C @ check_spd(_checks.as_array(P0, "P0", shape=(12, 12)), "P0") @ C.T
+    P0c = C @ P0 @ C.T
     hist = covariance_analysis(P0c, F, np.zeros((12, 12)), H, np.eye(2))
     X = np.concatenate([xa, xt], axis=-1)
     J = range_variance(hist.posterior, X, coordinates)
@@ -563,8 +614,8 @@ def mmd_matrix(agent_stm, H_agent) -> np.ndarray:
         \\boldsymbol\\delta`).  Only the agent block of the 12-state :math:`H\\Phi B_a` is non-zero, because
         :math:`B_a` acts on the agent and :math:`\\Phi` is block diagonal.
     """
-    S = _checks.as_array(agent_stm, "agent_stm", last=6)
-    H = _checks.as_array(H_agent, "H_agent", last=6)
+    S = _checks.as_array(agent_stm, "agent_stm", last=6, min_size=1)
+    H = _checks.as_array(H_agent, "H_agent", last=6, min_size=1)
     if S.shape[-2:] != (6, 6):
         raise ValueError(f"agent_stm must have shape (..., 6, 6); got {S.shape}")
     if H.ndim < 2:
@@ -580,9 +631,10 @@ def mmd_direction(Q) -> np.ndarray:
     scalar); the policy is its eigenvector, the maximiser of the Rayleigh quotient :math:`\\mathbf u^TQ\\mathbf u`
     on the unit sphere.
     """
-    Q = _checks.as_array(Q, "Q")
+    Q = _checks.as_array(Q, "Q", min_size=1)
     if Q.shape[-2:] != (3, 3):
         raise ValueError(f"Q must have shape (..., 3, 3); got {Q.shape}")
+    Q = _checks.psd(Q, "Q", n=3, batch=True)
     w, V = np.linalg.eigh(0.5 * (Q + np.swapaxes(Q, -1, -2)))
     v = V[..., :, -1]
     idx = np.argmax(np.abs(v), axis=-1)
@@ -625,11 +677,14 @@ def mmd_policy(system: CR3BP, agent_x0, target_x0, t, dv_magnitude: float, P0, *
     J_pm : ndarray (2,)
         Final :math:`J_\\rho` of ``+e`` and ``-e`` (LU^2).
     """
+    _checks.system(system)
     v = _checks.positive(dv_magnitude, "dv_magnitude")
     t = _checks.time_grid(t, "t", increasing=True)
     xa0 = _checks.as_state(agent_x0, "agent_x0", batch=False)
     xt0 = _checks.as_state(target_x0, "target_x0", batch=False)
     b = _burn_index(burn_index, t)
+    _initial_cov(P0)
+    _noise(sigma_min_rad, resolution_km)
     nominal = propagate_with_impulses(system, np.vstack([xa0, xt0]), t)
     _, Ha, _ = AZIMUTH_ELEVATION.evaluate(nominal.x[0, -1], nominal.x[1, -1])
     phi_fb = nominal.stm[0, -1] @ np.linalg.inv(nominal.stm[0, b])  # Phi(tau_f, tau_0)
@@ -647,8 +702,7 @@ def mmd_policy(system: CR3BP, agent_x0, target_x0, t, dv_magnitude: float, P0, *
 # --------------------------------------------------------------------------------------------------------------
 def fibonacci_sphere(n: int) -> np.ndarray:
     """``n`` nearly uniform unit vectors (Fibonacci lattice), shape (n, 3); spacing about :math:`\\sqrt{4\\pi/n}` rad."""
-    if not isinstance(n, (int, np.integer)) or n < 2:
-        raise ValueError(f"n must be an integer >= 2; got {n!r}")
+    n = _checks.integer(n, "n", minimum=2)
     i = np.arange(n) + 0.5
     z = 1.0 - 2.0 * i / n
     phi = np.pi * (1.0 + 5**0.5) * i
@@ -662,8 +716,7 @@ def perpendicular_directions(line_of_sight, n: int) -> np.ndarray:
     nrm = np.linalg.norm(los)
     if nrm == 0:
         raise ValueError("line_of_sight must be non-zero")
-    if not isinstance(n, (int, np.integer)) or n < 1:
-        raise ValueError(f"n must be a positive integer; got {n!r}")
+    n = _checks.integer(n, "n", minimum=1)
     u = los / nrm
     a = np.eye(3)[np.argmin(np.abs(u))]
     e1 = np.cross(u, a)
@@ -684,18 +737,25 @@ def range_sigma_over_directions(system: CR3BP, agent_x0, target_x0, t, dv_magnit
     the grid), so one call covers every coast time of the grid.  ``directions`` (m, 3) need not be unit vectors
     only if the caller wants other magnitudes; they are normalised here.
     """
+    _checks.system(system)
     v = _checks.positive(dv_magnitude, "dv_magnitude", allow_zero=True)
-    D = _checks.as_array(directions, "directions", ndim=(2,), last=3)
+    D = _checks.as_array(directions, "directions", ndim=(2,), last=3, min_size=1)
     nrm = np.linalg.norm(D, axis=-1, keepdims=True)
     if np.any(nrm == 0):
         raise ValueError("directions must be non-zero vectors")
     D = D / nrm
     t = _checks.time_grid(t, "t", increasing=True)
     xa0 = _checks.as_state(agent_x0, "agent_x0", batch=False)
+    b = _burn_index(burn_index, t)
+    _initial_cov(P0)
+    _noise(sigma_min_rad, resolution_km)
     if target is None:
         xt0 = _checks.as_state(target_x0, "target_x0", batch=False)
         target = propagate_with_impulses(system, xt0, t)
-    b = _burn_index(burn_index, t)
+    else:
+        _trajectory(target, "target")
+        if target.t.shape != t.shape or not np.allclose(target.t, t, rtol=0, atol=1e-12):
+            raise ValueError("target must be given on the grid t")
     ag = propagate_with_impulses(system, np.broadcast_to(xa0, D.shape[:1] + (6,)), t, [(t[b], v * D)],
                                  threads=threads)
     return ssat_covariance(system, ag, target, P0, sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
@@ -703,12 +763,14 @@ def range_sigma_over_directions(system: CR3BP, agent_x0, target_x0, t, dv_magnit
 
 def minimize_range_sigma(system: CR3BP, agent_x0, target_x0, t, dv_magnitude: float, P0, *, n_grid: int = 2000,
                          refine: bool = True, burn_index: int = 0, target: ImpulsiveTrajectory | None = None,
-                         grid_result: SSATCovariance | None = None):
+                         grid_result: SSATCovariance | None = None, sigma_min_rad: float = AMOS_SIGMA_MIN_RAD,
+                         resolution_km: float = AMOS_RESOLUTION_KM):
     """True minimiser of the final :math:`J_\\rho` over burn directions of fixed magnitude.
 
     A Fibonacci grid of ``n_grid`` directions is evaluated (or ``grid_result`` from
     :func:`range_sigma_over_directions` on that grid is reused), then the best grid direction is refined with
-    Nelder-Mead on the two spherical angles.
+    Nelder-Mead on the two spherical angles.  ``sigma_min_rad`` and ``resolution_km`` (Eq. 20) must be those of
+    ``grid_result`` when it is given.
 
     Returns
     -------
@@ -719,13 +781,25 @@ def minimize_range_sigma(system: CR3BP, agent_x0, target_x0, t, dv_magnitude: fl
     """
     from scipy.optimize import minimize
 
+    _checks.system(system)
     t = _checks.time_grid(t, "t", increasing=True)
+    _checks.as_state(agent_x0, "agent_x0", batch=False)
+    _checks.positive(dv_magnitude, "dv_magnitude")
+    _initial_cov(P0)
+    n_grid = _checks.integer(n_grid, "n_grid", minimum=2)
+    refine = _checks.boolean(refine, "refine")
+    _burn_index(burn_index, t)
+    if grid_result is not None:
+        _checks.instance(grid_result, "grid_result", SSATCovariance,
+                         "a cislunar.ssat.SSATCovariance (from range_sigma_over_directions) or None")
+    _noise(sigma_min_rad, resolution_km)
     if target is None:
         target = propagate_with_impulses(system, _checks.as_state(target_x0, "target_x0", batch=False), t)
-    D = fibonacci_sphere(int(n_grid))
+    D = fibonacci_sphere(n_grid)
     if grid_result is None:
         grid_result = range_sigma_over_directions(system, agent_x0, None, t, dv_magnitude, D, P0, target=target,
-                                                  burn_index=burn_index)
+                                                  burn_index=burn_index, sigma_min_rad=sigma_min_rad,
+                                                  resolution_km=resolution_km)
     Jg = grid_result.J_rho[:, -1]
     if Jg.size != D.shape[0]:
         raise ValueError(f"grid_result must hold {D.shape[0]} directions (n_grid); got {Jg.size}")
@@ -742,7 +816,8 @@ def minimize_range_sigma(system: CR3BP, agent_x0, target_x0, t, dv_magnitude: fl
 
     def cost(p):
         r = range_sigma_over_directions(system, agent_x0, None, t, dv_magnitude, to_vec(p)[None], P0, target=target,
-                                        burn_index=burn_index)
+                                        burn_index=burn_index, sigma_min_rad=sigma_min_rad,
+                                        resolution_km=resolution_km)
         return r.J_rho[0, -1] / Jbest
 
     step = np.sqrt(4 * np.pi / D.shape[0])
@@ -831,27 +906,33 @@ def compare_burn_policies(system: CR3BP, agent_x0, target_x0, t, coast_indices, 
     refine : bool
         Refine the grid optimum with Nelder-Mead (:func:`minimize_range_sigma`).
     """
+    _checks.system(system)
     t = _checks.time_grid(t, "t", increasing=True)
-    ks = np.asarray(coast_indices, dtype=int)
+    ks = _grid_indices(coast_indices, "coast_indices")
     b = _burn_index(burn_index, t)
-    if ks.ndim != 1 or ks.size == 0 or np.any(ks <= b) or np.any(ks >= t.size):
+    if np.any(ks <= b) or np.any(ks >= t.size):
         raise ValueError(f"coast_indices must be grid indices in {b + 1}..{t.size - 1} (after the burn); "
                          f"got {coast_indices!r}")
     xa0 = _checks.as_state(agent_x0, "agent_x0", batch=False)
     xt0 = _checks.as_state(target_x0, "target_x0", batch=False)
     v = _checks.positive(dv_magnitude, "dv_magnitude")
+    _initial_cov(P0)
+    n_grid = _checks.integer(n_grid, "n_grid", minimum=2)
+    n_perp = _checks.integer(n_perp, "n_perp", minimum=1)
+    refine = _checks.boolean(refine, "refine")
+    _noise(sigma_min_rad, resolution_km)
     kmax = int(ks.max())
     tt = t[:kmax + 1]
     L = system.length_unit_km
     target = propagate_with_impulses(system, xt0, tt)
     nominal = propagate_with_impulses(system, xa0, tt)
     none = ssat_covariance(system, nominal, target, P0, sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
-    D = fibonacci_sphere(int(n_grid))
+    D = fibonacci_sphere(n_grid)
     grid = range_sigma_over_directions(system, xa0, None, tt, v, D, P0, target=target, burn_index=b,
                                        sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
     los = target.x[0, b, :3] - nominal.x[0, b, :3]  # line of sight at the burn
     los = los / np.linalg.norm(los)
-    perp = range_sigma_over_directions(system, xa0, None, tt, v, perpendicular_directions(los, int(n_perp)), P0,
+    perp = range_sigma_over_directions(system, xa0, None, tt, v, perpendicular_directions(los, n_perp), P0,
                                        target=target, burn_index=b, sigma_min_rad=sigma_min_rad,
                                        resolution_km=resolution_km)
     out = {k: [] for k in ("none", "mmd", "mmd_other", "optimum", "grid_median", "grid_max", "perp_best",
@@ -865,8 +946,9 @@ def compare_burn_policies(system: CR3BP, agent_x0, target_x0, t, coast_indices, 
         sub = SSATCovariance(tk, grid.J_rho[:, :k + 1], grid.P_final, grid.range_km[:, :k + 1],
                              grid.sigma_theta_rad[:, :k + 1], L)
         tgt_k = ImpulsiveTrajectory(tk, target.x[:, :k + 1], target.stm[:, :k + 1])
-        d_opt, J_opt = minimize_range_sigma(system, xa0, None, tk, v, P0, n_grid=int(n_grid), refine=refine,
-                                            burn_index=b, target=tgt_k, grid_result=sub)
+        d_opt, J_opt = minimize_range_sigma(system, xa0, None, tk, v, P0, n_grid=n_grid, refine=refine,
+                                            burn_index=b, target=tgt_k, grid_result=sub,
+                                            sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
         J_mmd = float(Jpm.min())
         e = u / v
         out["none"].append(np.sqrt(none.J_rho[0, k]) * L)

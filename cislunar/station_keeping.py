@@ -44,9 +44,9 @@ import numpy as np
 from . import _checks
 from .dynamics import CR3BP
 from .measurements import AMOS_RESOLUTION_KM, AMOS_SIGMA_MIN_RAD, AZIMUTH_ELEVATION, angular_sigma
-from .propagation import propagate, propagate_stm
-from .ssat import (ImpulsiveTrajectory, initial_covariance, mmd_direction, mmd_matrix, propagate_with_impulses,
-                   range_projection, ssat_covariance)
+from .propagation import ImpactError, PropagationError, propagate, propagate_stm
+from .ssat import (ImpulsiveTrajectory, _initial_cov, _noise, initial_covariance, mmd_direction, mmd_matrix,
+                   propagate_with_impulses, range_projection, ssat_covariance)
 
 __all__ = [
     "TransferConvergenceError",
@@ -74,24 +74,27 @@ class TransferConvergenceError(RuntimeError):
         Largest position miss (LU) over the batch at each iteration.
     failed : list of int
         Batch indices that did not converge.
+    reason : str
+        ``"max_iter"`` (no convergence), ``"impact"`` (an iterate's arc reaches a primary), ``"propagation"`` (the
+        integrator stopped), ``"singular"`` (the position-velocity block of the STM is singular) or
+        ``"non_finite"``.
     """
 
-    def __init__(self, message: str, residuals, failed):
+    def __init__(self, message: str, residuals, failed, reason: str = "max_iter"):
         self.message = message
         self.residuals = [float(r) for r in residuals]
         self.failed = [int(i) for i in failed]
+        self.reason = str(reason)
         hist = ", ".join(f"{r:.3e}" for r in self.residuals)
         super().__init__(f"{message}; residual history (max position miss, LU): [{hist}]; failed indices "
                          f"{self.failed[:10]}{'...' if len(self.failed) > 10 else ''}")
 
     def __reduce__(self):
-        return (type(self), (self.message, self.residuals, self.failed))
+        return (type(self), (self.message, self.residuals, self.failed, self.reason))
 
 
 def _system(system):
-    if not isinstance(system, CR3BP):
-        raise ValueError(f"system must be a cislunar.dynamics.CR3BP; got {type(system).__name__}")
-    return system
+    return _checks.system(system)
 
 
 def position_transfer(system: CR3BP, x0, t0: float, t1: float, r_target, *, tol: float = 1e-12,
@@ -127,26 +130,42 @@ def position_transfer(system: CR3BP, x0, t0: float, t1: float, r_target, *, tol:
     Raises
     ------
     TransferConvergenceError
-        Some transfers did not reach ``tol`` (residual history and failed indices attached).
+        Some transfers did not reach ``tol`` (residual history and failed indices attached), an iterate's arc
+        reaches the Earth or the Moon (``reason="impact"``: a transfer never passes through a primary), the
+        integrator stops, or the Newton matrix is singular.
+    ValueError, TypeError
+        Bad arguments (named).
     """
     _system(system)
-    t0 = float(t0)
-    t1 = float(t1)
-    if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
+    t0 = _checks.real(t0, "t0")
+    t1 = _checks.real(t1, "t1")
+    if not t1 > t0:
         raise ValueError(f"t1 must be finite and later than t0; got t0 = {t0}, t1 = {t1}")
     tol = _checks.positive(tol, "tol")
-    r_target = _checks.as_array(r_target, "r_target", ndim=(1, 2), last=3)
+    max_iter = _checks.integer(max_iter, "max_iter", minimum=1)
+    r_target = _checks.as_array(r_target, "r_target", ndim=(1, 2), last=3, min_size=1)
     rt = np.atleast_2d(r_target)
-    xs = _checks.as_state(x0, "x0")
-    xs = np.broadcast_to(np.atleast_2d(xs), (rt.shape[0], 6)).copy()
+    xs = np.atleast_2d(_checks.as_state(x0, "x0"))
+    if xs.shape[0] not in (1, rt.shape[0]):
+        raise ValueError(f"x0 and r_target must hold one state or as many as each other; got x0 {xs.shape} and "
+                         f"r_target {rt.shape}")
+    xs = np.broadcast_to(xs, (rt.shape[0], 6)).copy()
     n = rt.shape[0]
     dv = np.zeros((n, 3))
     hist = []
     grid = np.array([t0, t1])
-    for _ in range(int(max_iter)):
+    what = f"position transfer over {t1 - t0:.4g} TU"
+    for _ in range(max_iter):
         x = xs.copy()
         x[:, 3:6] += dv
-        tr = propagate_stm(system, x, grid)
+        try:
+            tr = propagate_stm(system, x, grid)
+        except (ImpactError, PropagationError) as exc:
+            member = getattr(exc, "member", None)
+            failed = range(n) if member is None else [member]
+            reason = "impact" if isinstance(exc, ImpactError) else "propagation"
+            raise TransferConvergenceError(f"{what}: an iterate cannot be flown ({exc})", hist, failed,
+                                           reason) from None
         xf = (tr.x if tr.x.ndim == 3 else tr.x[None])[:, -1]
         stm = (tr.stm if tr.stm.ndim == 4 else tr.stm[None])[:, -1]
         miss = xf[:, :3] - rt
@@ -154,7 +173,14 @@ def position_transfer(system: CR3BP, x0, t0: float, t1: float, r_target, *, tol:
         hist.append(float(err.max()))
         if err.max() <= tol:
             return dv, xf, hist
-        dv = dv - np.linalg.solve(stm[:, :3, 3:6], miss[..., None])[..., 0]
+        try:
+            dv = dv - np.linalg.solve(stm[:, :3, 3:6], miss[..., None])[..., 0]
+        except np.linalg.LinAlgError as exc:
+            raise TransferConvergenceError(f"{what}: singular position-velocity block of the STM ({exc})", hist,
+                                           np.flatnonzero(err > tol), "singular") from None
+        if not np.all(np.isfinite(dv)):
+            raise TransferConvergenceError(f"{what}: non-finite Newton step", hist,
+                                           np.flatnonzero(~np.all(np.isfinite(dv), axis=1)), "non_finite")
     raise TransferConvergenceError(f"position transfer over {t1 - t0:.4g} TU did not converge to {tol:g} LU "
                                    f"in {max_iter} iterations", hist, np.flatnonzero(err > tol))
 
@@ -169,7 +195,8 @@ def two_burn_transfer(system: CR3BP, x0, t0: float, t1: float, x_target, *, tol:
     x1 : ndarray (n, 6)
         Post-second-burn arrival states (equal to ``x_target`` in velocity exactly, in position to ``tol``).
     """
-    xt = _checks.as_array(x_target, "x_target", ndim=(1, 2), last=6)
+    _system(system)
+    xt = _checks.as_array(x_target, "x_target", ndim=(1, 2), last=6, min_size=1)
     xt = np.atleast_2d(xt)
     dv1, x1, _ = position_transfer(system, x0, t0, t1, xt[:, :3], tol=tol, max_iter=max_iter)
     dv2 = xt[:, 3:6] - x1[:, 3:6]
@@ -292,9 +319,15 @@ class StationKeepingSurface:
         return 100.0 * np.mean(self.fuel_m_s > self.informed_fuel_m_s[:, None], axis=1)
 
 
+def _check_torus(torus):
+    if not callable(getattr(torus, "states", None)) or not hasattr(torus, "orbit"):
+        raise _checks.ArgumentTypeError("torus must provide states(theta0, t) and an orbit attribute (e.g. "
+                                        f"cislunar.torus.InvariantTorus); got {type(torus).__name__}")
+    return torus
+
+
 def _torus_states(torus, theta, t):
-    if not hasattr(torus, "states") or not hasattr(torus, "orbit"):
-        raise ValueError("torus must provide states(theta0, t) and an orbit attribute (e.g. cislunar.torus.InvariantTorus)")
+    _check_torus(torus)
     out = np.asarray(torus.states(theta, t), dtype=float)
     if out.shape != (np.size(theta), np.size(t), 6):
         raise ValueError(f"torus.states returned shape {out.shape}; expected {(np.size(theta), np.size(t), 6)}")
@@ -324,8 +357,16 @@ def informed_choice(dv1, u_y, cost):
         The candidate with the smaller ``cost``.
     """
     dv1 = _checks.as_array(dv1, "dv1", ndim=(3,), last=3)
-    u_y = _checks.as_array(u_y, "u_y", shape=(dv1.shape[0], 3))
-    cost = _checks.as_array(cost, "cost", shape=dv1.shape[:2])
+    if dv1.shape[0] == 0 or dv1.shape[1] == 0:
+        raise ValueError(f"dv1 must hold at least one burn per row and one row; got shape {dv1.shape}")
+    u_y = _checks.as_array(u_y, "u_y", ndim=(2,), last=3)
+    cost = _checks.as_array(cost, "cost", ndim=(2,))
+    if u_y.shape[0] != dv1.shape[0]:
+        raise ValueError(f"u_y must have one direction per row of dv1: shape ({dv1.shape[0]}, 3) for dv1 "
+                         f"{dv1.shape}; got {u_y.shape}")
+    if cost.shape != dv1.shape[:2]:
+        raise ValueError(f"cost must have the shape (n_t, n_theta) = {dv1.shape[:2]} of dv1 {dv1.shape}; got "
+                         f"{cost.shape}")
     un = np.linalg.norm(u_y, axis=-1)
     if np.any(un == 0):
         raise ValueError("u_y must hold non-zero directions")
@@ -384,32 +425,40 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
     from .progress import progress as _progress
 
     _system(system)
+    _check_torus(torus)
     theta = _checks.as_array(theta, "theta", ndim=(1,))
     if theta.size < 1:
         raise ValueError("theta must hold at least one ring angle")
     t_arr = _checks.as_array(t_arrival, "t_arrival", ndim=(1,))
     if t_arr.size < 1 or np.any(np.diff(t_arr) <= 0):
         raise ValueError("t_arrival must be a non-empty, strictly increasing array of times (TU)")
-    t_burn = float(_checks.as_array(t_burn, "t_burn", ndim=(0,)))
-    t_final = float(_checks.as_array(t_final, "t_final", ndim=(0,)))
+    t_burn = _checks.real(t_burn, "t_burn")
+    t_final = _checks.real(t_final, "t_final")
     if not t_arr[0] > t_burn:
         raise ValueError(f"t_arrival must be later than t_burn = {t_burn}; got first arrival {t_arr[0]}")
     if t_final < t_arr[-1]:
         raise ValueError(f"t_final must not precede the last arrival {t_arr[-1]}; got {t_final}")
-    if mmd_horizon not in ("arrival", "final"):
-        raise ValueError(f"mmd_horizon must be 'arrival' or 'final'; got {mmd_horizon!r}")
+    _checks.choice(mmd_horizon, "mmd_horizon", ("arrival", "final"))
     dt = 3600.0 / system.time_unit_s if cadence is None else _checks.positive(cadence, "cadence")
-    t_start = t_burn if t_track_start is None else float(_checks.as_array(t_track_start, "t_track_start", ndim=(0,)))
+    t_start = t_burn if t_track_start is None else _checks.real(t_track_start, "t_track_start")
     if t_start > t_burn:
         raise ValueError(f"t_track_start must not be after t_burn = {t_burn}; got {t_start}")
+    agent_theta = _checks.real(agent_theta, "agent_theta")
+    if agent_offset is not None:
+        agent_offset = _checks.as_array(agent_offset, "agent_offset", shape=(6,))
+    if P0 is not None:
+        _initial_cov(P0)
+    _noise(sigma_min_rad, resolution_km)
+    batched = _checks.boolean(batched, "batched")
+    progress = _checks.boolean(progress, "progress")
     n_meas = int(np.floor((t_final - t_start) / dt + 1e-9)) + 1
     t = t_start + dt * np.arange(n_meas)
     if t[-1] < t_final - 1e-12:
         t = np.r_[t, t_final]
     P0 = initial_covariance(system) if P0 is None else P0
-    xa0 = _torus_states(torus, np.array([float(agent_theta)]), np.array([t_start]))[0, 0]
+    xa0 = _torus_states(torus, np.array([agent_theta]), np.array([t_start]))[0, 0]
     if agent_offset is not None:
-        xa0 = xa0 + _checks.as_array(agent_offset, "agent_offset", shape=(6,))
+        xa0 = xa0 + agent_offset
     xa_burn = xa0 if t_start == t_burn else propagate(system, xa0, np.array([t_start, t_burn])).x[-1]
     goal = _torus_states(torus, theta, t_arr)  # (n_theta, n_t, 6)
     target = target_trajectory(system, torus.orbit.x0, t)
@@ -466,7 +515,7 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
 # --------------------------------------------------------------------------------------------------------------
 def execution_sigma(dv, sigma_abs: float, sigma_rel: float) -> np.ndarray:
     """1-sigma per-axis execution error of a burn: :math:`\\sqrt{\\sigma_{abs}^2 + (\\sigma_{rel}\\|\\Delta v\\|)^2}` (units of ``dv``)."""
-    dv = _checks.as_array(dv, "dv", last=3)
+    dv = _checks.as_array(dv, "dv", last=3, min_size=1)
     a = _checks.positive(sigma_abs, "sigma_abs", allow_zero=True)
     r = _checks.positive(sigma_rel, "sigma_rel", allow_zero=True)
     return np.sqrt(a**2 + (r * np.linalg.norm(dv, axis=-1)) ** 2)
@@ -505,6 +554,33 @@ class FilterScenario:
     resolution_km: float = AMOS_RESOLUTION_KM
     label: str = ""
 
+    def __post_init__(self):
+        _system(self.system)
+        t = _checks.time_grid(self.t, "t", increasing=True)
+        agent_x0 = _checks.as_state(self.agent_x0, "agent_x0", batch=False)
+        target_x0 = _checks.as_state(self.target_x0, "target_x0", batch=False)
+        burns = self.burns
+        if isinstance(burns, (str, bytes, dict)) or not isinstance(burns, (tuple, list)):
+            raise _checks.ArgumentTypeError(f"burns must be a sequence of (time, dv) pairs; got "
+                                            f"{type(burns).__name__}")
+        checked = []
+        for k, item in enumerate(burns):
+            if not isinstance(item, (tuple, list)) or len(item) != 2:
+                raise ValueError(f"burns[{k}] must be a (time, dv) pair; got {item!r:.60}")
+            tb = _checks.real(item[0], f"burns[{k}] time")
+            if not t[0] <= tb <= t[-1]:
+                raise ValueError(f"burns[{k}] time {tb} must lie within the grid t [{t[0]}, {t[-1]}] TU")
+            checked.append((tb, _checks.as_array(item[1], f"burns[{k}] dv", shape=(3,))))
+        P0 = _checks.spd(self.P0, "P0", n=12)
+        a = _checks.positive(self.exec_sigma_abs, "exec_sigma_abs", allow_zero=True)
+        r = _checks.positive(self.exec_sigma_rel, "exec_sigma_rel", allow_zero=True)
+        smin, dres = _noise(self.sigma_min_rad, self.resolution_km)
+        _checks.instance(self.label, "label", str)
+        for name, value in (("t", t), ("agent_x0", agent_x0), ("target_x0", target_x0), ("burns", tuple(checked)),
+                            ("P0", P0), ("exec_sigma_abs", a), ("exec_sigma_rel", r), ("sigma_min_rad", smin),
+                            ("resolution_km", dres)):
+            object.__setattr__(self, name, value)
+
 
 def filter_scenario(surface: StationKeepingSurface, j: int, i: int, target_x0, system: CR3BP, *,
                     exec_sigma_abs_m_s: float = 1e-3, exec_sigma_rel: float = 0.01, P0=None,
@@ -514,8 +590,14 @@ def filter_scenario(surface: StationKeepingSurface, j: int, i: int, target_x0, s
     ``target_x0`` is the target state at ``surface.t[0]`` (start of tracking); execution errors: ``exec_sigma_abs_m_s`` (m/s) and
     ``exec_sigma_rel`` (fraction of the burn) per axis.
     """
+    _checks.instance(surface, "surface", StationKeepingSurface,
+                     "a cislunar.station_keeping.StationKeepingSurface (from station_keeping_surface)")
     _system(system)
-    j, i = int(j), int(i)
+    j = _checks.integer(j, "j", minimum=0)
+    i = _checks.integer(i, "i", minimum=0)
+    if P0 is not None:
+        P0 = _checks.spd(P0, "P0", n=12)
+    _checks.instance(label, "label", str)
     if not (0 <= j < surface.t_arrival.size and 0 <= i < surface.theta.size):
         raise ValueError(f"(j, i) must index the surface {surface.range_sigma_km.shape}; got ({j}, {i})")
     a = _checks.positive(exec_sigma_abs_m_s, "exec_sigma_abs_m_s", allow_zero=True) / (system.velocity_unit_km_s * 1e3)
@@ -587,8 +669,9 @@ def filter_trial(rng: np.random.Generator, scenario: FilterScenario, *, n_iter: 
     burn the *planned* :math:`\\Delta\\mathbf v` is added to the estimate and the execution covariance to
     :math:`P` (the filter knows the error model); azimuth/elevation updates every grid time (Joseph form).
     """
-    if not isinstance(scenario, FilterScenario):
-        raise ValueError(f"scenario must be a FilterScenario; got {type(scenario).__name__}")
+    _checks.rng(rng)
+    _checks.instance(scenario, "scenario", FilterScenario, "a cislunar.station_keeping.FilterScenario")
+    n_iter = _checks.integer(n_iter, "n_iter", minimum=1)
     sc = scenario
     sys_ = sc.system
     t = sc.t
@@ -644,7 +727,17 @@ def random_choice_trial(rng: np.random.Generator, scenarios) -> FilterTrialResul
 
     Models an *uninformed* station-keeping choice: the target phase is picked without regard to information.
     """
-    scenarios = tuple(scenarios)
+    _checks.rng(rng)
+    if isinstance(scenarios, (str, bytes, dict)):
+        raise _checks.ArgumentTypeError(f"scenarios must be a sequence of FilterScenario; got "
+                                        f"{type(scenarios).__name__}")
+    try:
+        scenarios = tuple(scenarios)
+    except TypeError:
+        raise _checks.ArgumentTypeError(f"scenarios must be a sequence of FilterScenario; got "
+                                        f"{type(scenarios).__name__}") from None
     if not scenarios:
         raise ValueError("scenarios must hold at least one FilterScenario")
+    for k, sc in enumerate(scenarios):
+        _checks.instance(sc, f"scenarios[{k}]", FilterScenario, "a cislunar.station_keeping.FilterScenario")
     return filter_trial(rng, scenarios[int(rng.integers(len(scenarios)))])
