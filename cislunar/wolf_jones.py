@@ -18,7 +18,9 @@ What is here
 * :func:`evaluate_crlb`: the CRLB (EKF covariance recursion along the true trajectories, process noise recomputed
   along them) with per-axis and RMS position errors, for Figs. 4, 5, 9 and 10.
 * :class:`ScenarioSolver` (one SCvx solve per alpha_h, picklable), :func:`sweep_both_ways` (upward and downward
-  warm-started homotopy chains, optionally in two processes, best cost kept per alpha_h), :func:`fly` and
+  warm-started homotopy chains, optionally in two processes, best cost kept per alpha_h),
+  :func:`solve_for_impulse` (the plan of most information at a prescribed total impulse: a root-find on alpha_h
+  along the weighted-sum Pareto front), :func:`fly` and
   :func:`terminal_miss_km` (single-shooting re-flight of a first-order-hold control).
 
 Process-noise units (Tables 3 and 5)
@@ -57,6 +59,7 @@ from . import covariance as cov
 from . import information as info
 from . import measurements as meas
 from .dynamics import CR3BP, EARTH_MOON
+from .scvx import impulse  # noqa: F401 - re-exported: the trapezoid impulse of Eq. 42 has one home (scvx)
 
 __all__ = [
     "PROCESS_NOISE_PSD_ND",
@@ -79,6 +82,9 @@ __all__ = [
     "node_times_with_window",
     "ScenarioSolver",
     "sweep_both_ways",
+    "ImpulseBudgetError",
+    "ImpulseSolve",
+    "solve_for_impulse",
     "fly",
     "terminal_miss_km",
 ]
@@ -114,14 +120,6 @@ def keep_out_radius_km(sigma_pos_km: float = SIGMA_POS_KM, n_sigma: float = KEEP
     return float(k * np.sqrt(2.0) * s)
 
 
-def impulse(t, u) -> float:
-    """Trapezoid total impulse :math:`\\sum_k\\Delta t_k(\\|u_k\\|+\\|u_{k+1}\\|)/2` (Eq. 42), LU/TU."""
-    t = _checks.time_grid(t, "t", increasing=True)
-    u = _checks.as_array(u, "u", shape=(t.size, 3))
-    nrm = np.linalg.norm(u, axis=1)
-    return float(np.sum(np.diff(t) * (nrm[:-1] + nrm[1:]) / 2.0))
-
-
 def node_times_with_window(t_nodes, window) -> tuple[np.ndarray, int, int]:
     """Move the interior nodes nearest to the window ends onto them.
 
@@ -139,7 +137,7 @@ def node_times_with_window(t_nodes, window) -> tuple[np.ndarray, int, int]:
     k_start, k_end : int
     """
     t = _checks.time_grid(t_nodes, "t_nodes", increasing=True).copy()
-    ws, we = float(window[0]), float(window[1])
+    ws, we = _checks.as_array(window, "window", shape=(2,))
     if not t[0] < ws < we < t[-1]:
         raise ValueError(f"window must satisfy t0 < start < end < tf; got {window} for [{t[0]}, {t[-1]}]")
     if t.size < 4:
@@ -249,7 +247,9 @@ class Scenario:
         """Target states at times ``t`` (TU, from 0), shape (N_T, len(t), 6)."""
         from .propagation import propagate
 
-        t = np.atleast_1d(_checks.as_array(t, "t"))
+        t = np.atleast_1d(_checks.as_array(t, "t", ndim=(0, 1)))
+        if t.size == 0 or t[0] < 0 or np.any(np.diff(t) <= 0):
+            raise ValueError("t must hold one or more non-negative, strictly increasing times (TU)")
         grid = np.r_[0.0, t] if t[0] > 0 else t
         x = propagate(self.system, self.targets_x0, grid).x
         return x[:, 1:] if t[0] > 0 else x
@@ -262,7 +262,9 @@ class Scenario:
         """
         from .discretization import sundman_nodes
 
-        t, _ = sundman_nodes(self.system, self.observer_x0, self.duration, int(n_nodes), sigma)
+        n = _checks.integer(n_nodes, "n_nodes", minimum=4)
+        s = _checks.real(sigma, "sigma")
+        t, _ = sundman_nodes(self.system, self.observer_x0, self.duration, n, s)
         return node_times_with_window(t, self.window)
 
     def control_bounds(self, t_nodes) -> np.ndarray:
@@ -294,7 +296,7 @@ class Scenario:
         from .discretization import propagate_foh
 
         t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
-        s = float(np.sign(z_sign)) or 1.0
+        s = float(np.sign(_checks.real(z_sign, "z_sign"))) or 1.0
         f = _checks.in_range(fraction, "fraction", 0.0, 1.0)
         u = np.zeros((t.size, 3))
         u[t < self.window[0] - 1e-12, 2] = s * f * self.a_max
@@ -311,12 +313,15 @@ class Scenario:
 
         if x_reference is None:
             x_reference = propagate(self.system, self.observer_x0, [0.0, self.window[0]]).x[-1]
+        x_reference = _checks.as_state(x_reference, "x_reference", batch=False)
+        q = self.q if q is None else _checks.positive(q, "q", allow_zero=True)
         targets = self.targets_at([self.window[0]])[:, 0]
         return WindowInformation(self.system, self.measurement_times, targets, self.model, self.noise,
-                                 self.prior_covariance, q=self.q if q is None else q, x_reference=x_reference)
+                                 self.prior_covariance, q=q, x_reference=x_reference)
 
     def keep_out(self, node: int, d_min_km: float | None = None) -> "MinimumRange":
         """:class:`MinimumRange` for the window starting at node ``node`` (default radius: :attr:`keep_out_km`)."""
+        node = _checks.integer(node, "node", minimum=0)
         d = self.keep_out_km if d_min_km is None else _checks.positive(d_min_km, "d_min_km")
         targets = self.targets_at([self.window[0]])[:, 0]
         return MinimumRange(self.system, self.measurement_times, targets, self.system.km_to_lu(d), node)
@@ -348,6 +353,9 @@ def test_case_1(system: CR3BP = EARTH_MOON, *, q: float = PROCESS_NOISE_PSD_ND,
 
     ``q`` is the acceleration PSD in LU^2/TU^3 (default: the adopted reading of Table 3).
     """
+    _checks.system(system, "system")
+    q = _checks.positive(q, "q", allow_zero=True)
+    a_max_km_s2 = _checks.positive(a_max_km_s2, "a_max_km_s2", allow_zero=True)
     noise = meas.relative_position_noise(meas.WOLF_JONES_RELPOS_SIGMA_KM, system)
     return _build(1, system, q, a_max_km_s2, 2, ["target1_t0"], 2, (0.75, 1.5), meas.RELATIVE_POSITION, noise)
 
@@ -361,6 +369,9 @@ def test_case_2(system: CR3BP = EARTH_MOON, *, q: float = PROCESS_NOISE_PSD_ND,
 
     Table 4's row labels are lost except the last; they are read as in Table 2 (``data/wolf_jones_dros.csv``).
     """
+    _checks.system(system, "system")
+    q = _checks.positive(q, "q", allow_zero=True)
+    a_max_km_s2 = _checks.positive(a_max_km_s2, "a_max_km_s2", allow_zero=True)
     noise = meas.range_range_rate_noise(meas.WOLF_JONES_RANGE_SIGMA_KM, meas.WOLF_JONES_RANGE_RATE_SIGMA_KM_S,
                                         system)
     return _build(2, system, q, a_max_km_s2, 4, ["target1_t0", "target2_t0", "target3_t0"], 3, (1.0, 2.0),
@@ -419,7 +430,7 @@ class WindowInformation:
         xt = _checks.as_array(targets_x0, "targets_x0", last=6)
         self.targets_x0 = xt[None] if xt.ndim == 1 else xt
         self.model = model
-        self.noise = _checks.as_array(noise, "noise", shape=(model.dim, model.dim))
+        self.noise = cov.check_spd(_checks.as_array(noise, "noise", shape=(model.dim, model.dim)), "noise")
         n = 6 * (self.targets_x0.shape[0] + 1)
         self.P0 = cov.check_spd(_checks.as_array(P0, "P0", shape=(n, n)), "P0")
         self.q = _checks.positive(q, "q", allow_zero=True)
@@ -437,7 +448,7 @@ class WindowInformation:
     def linearization(self, x, derivatives: bool = False) -> cov.AugmentedLinearization:
         """The augmented linearisation (fixed Q) for observer state ``x`` (6,) at the window start."""
         x = _checks.as_state(x, "x", batch=False)
-        key = (x.tobytes(), bool(derivatives))
+        key = (x.tobytes(), _checks.boolean(derivatives, "derivatives"))
         if key in self._cache:
             return self._cache[key]
         arcs = cov.propagate_arcs(self.system, x, self.t, order=2 if derivatives else 1)
@@ -449,8 +460,7 @@ class WindowInformation:
 
     def __call__(self, x, order: int = 0):
         """``order=0``: MI (nats); ``order=1``: (MI, gradient (6,)) in nats per LU and per LU/TU."""
-        if order not in (0, 1):
-            raise ValueError(f"order must be 0 or 1; got {order!r}")
+        order = _checks.integer(order, "order", minimum=0, maximum=1)
         if order == 0:
             return info.mutual_information(*self.linearization(x).arrays)
         lin = self.linearization(x, derivatives=True)
@@ -522,7 +532,7 @@ class MinimumRange:
         xt = _checks.as_array(targets_x0, "targets_x0", last=6)
         xt = xt[None] if xt.ndim == 1 else xt
         self.d_min = _checks.positive(d_min, "d_min")
-        self.node = int(node)
+        self.node = _checks.integer(node, "node", minimum=0)
         tr = propagate(system, xt, self.t).x
         self.target_positions = (tr if tr.ndim == 3 else tr[None])[:, :, :3]  # (N_T, N, 3)
         self.size = int(self.target_positions.shape[0] * self.t.size)
@@ -626,11 +636,16 @@ class ScenarioSolver:
             raise ValueError(f"scenario must be a Scenario; got {type(scenario).__name__}")
         self.scenario = scenario
         self.t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
-        self.k_window = int(k_window)
-        if not 0 < self.k_window < self.t.size - 1 or not np.isclose(self.t[self.k_window], scenario.window[0]):
+        self.k_window = _checks.integer(k_window, "k_window", minimum=1, maximum=self.t.size - 2)
+        if not np.isclose(self.t[self.k_window], scenario.window[0]):
             raise ValueError(f"k_window must index the window-start node; got {k_window}")
-        self.information = scenario.information_model() if information is None else information
-        self.constraints = (scenario.keep_out(self.k_window),) if keep_out else ()
+        self.information = (scenario.information_model() if information is None
+                            else _checks.callable_(information, "information"))
+        self.constraints = (scenario.keep_out(self.k_window),) if _checks.boolean(keep_out, "keep_out") else ()
+        if settings is not None:
+            from .scvx import SCvxSettings
+
+            _checks.instance(settings, "settings", SCvxSettings)
         self.settings = settings
         self.u_max = scenario.control_bounds(self.t)
 
@@ -685,9 +700,12 @@ def sweep_both_ways(solver: ScenarioSolver, alphas, x_guess, u_guess, *, executo
     """
     from .scvx import SweepResult
 
+    _checks.callable_(solver, "solver")
     a = _checks.as_array(alphas, "alphas", ndim=(1,))
     if a.size < 1 or np.any(np.diff(a) <= 0) or a[0] < 0 or a[-1] > 1:
         raise ValueError("alphas must be strictly increasing within [0, 1]")
+    x_guess = _checks.as_array(x_guess, "x_guess", ndim=(2,), last=6)
+    u_guess = _checks.as_array(u_guess, "u_guess", shape=(x_guess.shape[0], 3))
     if executor is None:
         chains = [_chain(solver, a, x_guess, u_guess, d) for d in ("up", "down")]
     else:
@@ -708,6 +726,133 @@ def sweep_both_ways(solver: ScenarioSolver, alphas, x_guess, u_guess, *, executo
     return SweepResult(a, best, source, chains[0][1] + chains[1][1])
 
 
+class ImpulseBudgetError(RuntimeError):
+    """:func:`solve_for_impulse` did not reach the budget (the front jumps across it, or a solve failed).
+
+    Attributes
+    ----------
+    reason : str
+    budget : float
+        Requested total impulse, LU/TU.
+    solves : list of (float, float)
+        ``(alpha_h, impulse)`` of every converged solve, in order.
+    """
+
+    def __init__(self, reason: str, budget: float = float("nan"), solves=()):
+        self.reason = str(reason)
+        self.budget = float(budget)
+        self.solves = [tuple(map(float, s)) for s in solves]
+        super().__init__(f"{self.reason} (budget {self.budget:.6g} LU/TU; solves (alpha_h, impulse): "
+                         f"{[(round(a, 8), round(i, 8)) for a, i in self.solves]})")
+
+    def __reduce__(self):
+        return (type(self), (self.reason, self.budget, self.solves))
+
+
+@dataclass(frozen=True)
+class ImpulseSolve:
+    """A plan solved at a prescribed total impulse (:func:`solve_for_impulse`).
+
+    Attributes
+    ----------
+    alpha : float
+        Homotopy weight :math:`\\alpha_h` whose optimum spends the budget.
+    result : cislunar.scvx.SCvxResult
+        That optimum (``result.impulse`` within ``rtol`` of the budget).
+    budget : float
+        Requested total impulse, LU/TU.
+    solves : list of (float, float)
+        ``(alpha_h, impulse)`` of every solve made by the search.
+    """
+
+    alpha: float
+    result: object
+    budget: float
+    solves: list
+
+
+def solve_for_impulse(solver, budget: float, lower, upper, *, rtol: float = 0.02, max_solves: int = 8):
+    """The maximum-information plan that spends a prescribed total impulse.
+
+    SCvx has no impulse constraint, but the weighted-sum objective of Eq. 42 traces the Pareto front: the optimum
+    of :math:`\\alpha_h` spends the least impulse for its information and gathers the most information for its
+    impulse, and the impulse grows with :math:`\\alpha_h`.  Solving for the :math:`\\alpha_h` whose optimum spends
+    ``budget`` therefore imposes the budget with the solver as it is.  The search is a bracketed secant (Illinois
+    regula falsi) on :math:`\\alpha_h`, each solve warm-started from the bracketing solution nearer in impulse.
+
+    Parameters
+    ----------
+    solver : callable
+        ``solver(alpha, x_guess, u_guess) -> SCvxResult`` (e.g. :class:`ScenarioSolver`).
+    budget : float
+        Total impulse to spend (trapezoid of Eq. 42), LU/TU.
+    lower, upper : (float, SCvxResult)
+        Two converged solutions ``(alpha_h, result)`` bracketing the budget (``lower`` spends less, ``upper``
+        more), e.g. neighbours on a homotopy sweep.
+    rtol : float
+        Accept when ``|impulse - budget| <= rtol * budget`` (fixed before solving; default 2 %).
+    max_solves : int
+        Largest number of solves.
+
+    Returns
+    -------
+    ImpulseSolve
+
+    Raises
+    ------
+    ImpulseBudgetError
+        The budget was not reached within ``max_solves`` (e.g. the front jumps across it between local optima)
+        or a solve failed; carries every ``(alpha_h, impulse)`` tried.
+    ValueError, TypeError
+        Bad arguments, or a bracket that does not contain the budget.
+    """
+    from .scvx import SCvxError
+
+    _checks.callable_(solver, "solver")
+    b = _checks.positive(budget, "budget")
+    tol = _checks.in_range(rtol, "rtol", 0.0, 1.0, closed=False)
+    n_max = _checks.integer(max_solves, "max_solves", minimum=1)
+    ends = []
+    for name, end in (("lower", lower), ("upper", upper)):
+        if not isinstance(end, (tuple, list)) or len(end) != 2 or not hasattr(end[1], "impulse"):
+            raise _checks.ArgumentTypeError(f"{name} must be a pair (alpha_h, SCvxResult); got "
+                                            f"{type(end).__name__}")
+        ends.append([_checks.in_range(end[0], f"{name}[0] (alpha_h)", 0.0, 1.0), end[1]])
+    (a_lo, r_lo), (a_hi, r_hi) = ends
+    if not (a_lo < a_hi and r_lo.impulse <= b <= r_hi.impulse):
+        raise ValueError(f"lower and upper must bracket the budget: alpha_h {a_lo:g} < {a_hi:g} and impulse "
+                         f"{r_lo.impulse:.6g} <= budget {b:.6g} <= {r_hi.impulse:.6g} (LU/TU)")
+    for a, r in ((a_lo, r_lo), (a_hi, r_hi)):
+        if abs(r.impulse - b) <= tol * b:
+            return ImpulseSolve(alpha=a, result=r, budget=b, solves=[(a, r.impulse)])
+    f_lo, f_hi = r_lo.impulse - b, r_hi.impulse - b
+    solves = []
+    side = 0
+    for _ in range(n_max):
+        a = a_lo - f_lo * (a_hi - a_lo) / (f_hi - f_lo)
+        a = min(max(a, a_lo + 1e-3 * (a_hi - a_lo)), a_hi - 1e-3 * (a_hi - a_lo))
+        warm = r_lo if abs(f_lo) <= abs(f_hi) else r_hi
+        try:
+            res = solver(a, warm.x, warm.u)
+        except SCvxError as exc:
+            raise ImpulseBudgetError(f"the solve at alpha_h = {a:.6g} failed: {exc.reason}", b, solves) from exc
+        solves.append((a, res.impulse))
+        f = res.impulse - b
+        if abs(f) <= tol * b:
+            return ImpulseSolve(alpha=float(a), result=res, budget=b, solves=solves)
+        if f < 0:
+            a_lo, r_lo, f_lo = a, res, f
+            if side == -1:
+                f_hi /= 2.0  # Illinois: halve the stale end's weight
+            side = -1
+        else:
+            a_hi, r_hi, f_hi = a, res, f
+            if side == +1:
+                f_lo /= 2.0
+            side = +1
+    raise ImpulseBudgetError(f"budget not reached within {n_max} solves (the front may jump across it)", b, solves)
+
+
 def fly(scenario: Scenario, t_nodes, u_nodes, *, refine: int = 8) -> tuple[np.ndarray, np.ndarray]:
     """Single-shooting re-flight from :attr:`Scenario.observer_x0` with the first-order-hold control.
 
@@ -719,9 +864,9 @@ def fly(scenario: Scenario, t_nodes, u_nodes, *, refine: int = 8) -> tuple[np.nd
 
     t = _checks.time_grid(t_nodes, "t_nodes", increasing=True)
     u = _checks.as_array(u_nodes, "u_nodes", shape=(t.size, 3))
-    r = int(refine)
-    if r < 1:
-        raise ValueError(f"refine must be >= 1; got {refine}")
+    if not isinstance(scenario, Scenario):
+        raise ValueError(f"scenario must be a Scenario; got {type(scenario).__name__}")
+    r = _checks.integer(refine, "refine", minimum=1)
     tf = np.concatenate([np.linspace(t[k], t[k + 1], r + 1)[:-1] for k in range(t.size - 1)] + [t[-1:]])
     uf = np.stack([np.interp(tf, t, u[:, i]) for i in range(3)], axis=1)
     return tf, propagate_foh(scenario.system, scenario.observer_x0, tf, uf)
