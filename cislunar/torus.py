@@ -613,8 +613,12 @@ def _parse_fix(fix, free_period: bool, system: CR3BP) -> list[tuple[str, float]]
             v = _checks.positive(value, f"fix[{kind!r}]")
         else:
             v = float(_checks.as_array(value, f"fix[{kind!r}]", ndim=(0,)))
+        key = kind
         if kind == "size_km":
             kind, v = "size", v / system.length_unit_km
+        if kind == "size" and v < 100 * _MIN_SIZE_LU:
+            raise ValueError(f"fix[{key!r}] asks for a ring of {v:.2e} LU: below {100 * _MIN_SIZE_LU:.0e} LU a ring is "
+                             "numerically the base periodic orbit, not a torus")
         out.append((kind, v))
     return out
 
