@@ -12,7 +12,9 @@ from cislunar.propagation import propagate
 
 A_MAX = 1e-6 / em.acceleration_unit_km_s2  # 1e-6 km/s^2 (Wolf & Jones Table 3)
 N_NODES = 24  # coarse, but the same problem as notebook 05
-ALPHAS = (0.0, 2e-3, 5e-3, 2e-2)
+# Up to 1e-2 (notebook 05 goes further): the cold start at the top then converges in ~28 iterations instead of ~80
+# at 2e-2, and the front still spans a factor > 100 in impulse and > 20 nats in information.
+ALPHAS = (0.0, 1e-3, 3e-3, 1e-2)
 
 
 @pytest.fixture(scope="module")
@@ -84,10 +86,10 @@ def test_cold_start_at_the_largest_alpha_reaches_the_swept_optimum(case1, sweep1
     assert last["accepted"] and not last["tr_active"]
 
 
-def test_exact_penalty_variant_converges_without_information():
+def test_exact_penalty_variant_converges_without_information(free_transfer):
     dro, xf, t = _transfer()
     kw = dict(x_final=xf)
-    r_al = scvx.solve_scvx(em, t, propagate(em, dro.x0, t).x, np.zeros((t.size, 3)), np.full(t.size, A_MAX), **kw)
+    r_al = free_transfer
     r_pen = scvx.solve_scvx(em, t, propagate(em, dro.x0, t).x, np.zeros((t.size, 3)), np.full(t.size, A_MAX),
                             settings=scvx.SCvxSettings(method="penalty"), **kw)
     assert r_al.max_defect < 1e-9 and r_pen.max_defect < 1e-9
@@ -103,10 +105,17 @@ def _transfer():
     return Orbit, sc.observer_xf, np.linspace(0.0, 2 * sc.period, 30)
 
 
-def test_minimum_impulse_transfer_is_feasible_and_guess_independent():
+@pytest.fixture(scope="module")
+def free_transfer():
+    """The minimum-impulse transfer (no information, no keep-out), solved once for the tests that start from it."""
     dro, xf, t = _transfer()
-    res = scvx.solve_scvx(em, t, propagate(em, dro.x0, t).x, np.zeros((t.size, 3)), np.full(t.size, A_MAX),
-                          x_final=xf)
+    return scvx.solve_scvx(em, t, propagate(em, dro.x0, t).x, np.zeros((t.size, 3)), np.full(t.size, A_MAX),
+                           x_final=xf)
+
+
+def test_minimum_impulse_transfer_is_feasible_and_guess_independent(free_transfer):
+    dro, xf, t = _transfer()
+    res = free_transfer
     assert res.max_defect < 1e-9
     assert np.all(np.linalg.norm(res.u, axis=1) <= A_MAX * (1 + 1e-7))
     xs = D.propagate_foh(em, dro.x0, t, res.u)
@@ -159,11 +168,11 @@ class _Sphere:
         return np.array([self.d - rng_]), C
 
 
-def test_nonconvex_keep_out_constraint_is_met():
+def test_nonconvex_keep_out_constraint_is_met(free_transfer):
     dro, xf, t = _transfer()
     x_ball = propagate(em, dro.x0, t).x
     node = 12
-    free = scvx.solve_scvx(em, t, x_ball, np.zeros((t.size, 3)), np.full(t.size, A_MAX), x_final=xf)
+    free = free_transfer
     d = em.km_to_lu(2000.0)
     centre = free.x[node, :3] + 0.3 * d * np.array([0.0, 1.0, 0.0])  # the free optimum sits inside the sphere
     res = scvx.solve_scvx(em, t, x_ball, np.zeros((t.size, 3)), np.full(t.size, A_MAX), x_final=xf,
