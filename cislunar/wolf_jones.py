@@ -665,9 +665,9 @@ def _chain(solver, alphas, x_guess, u_guess, direction):
     order = range(len(alphas)) if direction == "up" else range(len(alphas) - 1, -1, -1)
     results = [None] * len(alphas)
     attempts = []
-    guess = (x_guess, u_guess)
+    guess, is_cold = (x_guess, u_guess), True
     for i in order:
-        starts = [("warm", guess)] if guess[0] is x_guess else [("warm", guess), ("cold", (x_guess, u_guess))]
+        starts = [("cold", guess)] if is_cold else [("warm", guess), ("cold", (x_guess, u_guess))]
         for kind, g in starts:
             try:
                 res = solver(float(alphas[i]), g[0], g[1])
@@ -678,7 +678,7 @@ def _chain(solver, alphas, x_guess, u_guess, direction):
             attempts.append(dict(alpha=float(alphas[i]), direction=direction, start=kind, converged=True,
                                  cost=res.cost, iterations=res.iterations, error=""))
             results[i] = res
-            guess = (res.x, res.u)
+            guess, is_cold = (res.x, res.u), False
             break
     return results, attempts
 

@@ -231,11 +231,16 @@ def test_fly_reproduces_first_order_hold(case1):
 
 @pytest.fixture(scope="module")
 def case2_sweep(case2):
-    t, ks, ke = case2.node_times(20)
+    """One warm-started homotopy chain alpha_h = 0 -> 1e-3 on case 2 (two SCvx solves shared by the module; the
+    up/down merge of sweep_both_ways is tested with a stand-in solver below)."""
+    t, ks, ke = case2.node_times(16)
     solver = W.ScenarioSolver(case2, t, ks, keep_out=True)
     x, u = case2.ballistic_guess(t)
-    best = W.sweep_both_ways(solver, [0.0, 1e-3], x, u)
-    return t, ks, ke, solver, best
+    r0 = solver(0.0, x, u)
+    r1 = solver(1e-3, r0.x, r0.u)
+    from cislunar.scvx import SweepResult
+
+    return t, ks, ke, solver, SweepResult(np.array([0.0, 1e-3]), [r0, r1], ["up", "up"], [])
 
 
 def test_case2_solutions_are_feasible_and_monotone(case2, case2_sweep):
@@ -259,3 +264,86 @@ def test_case2_solutions_are_feasible_and_monotone(case2, case2_sweep):
     # the information trajectory is far better determined than the minimum-impulse one
     rms = [W.evaluate_crlb(case2, r.x[ks]).terminal_rms_km[0] for r in best.best]
     assert rms[1] < 0.5 * rms[0]
+
+
+# ------------------------------------------------------------------------------------------------ sweeps, budgets
+class _Res:
+    def __init__(self, alpha, cost, x, u, impulse=0.0):
+        self.alpha, self.cost, self.x, self.u, self.impulse, self.iterations = alpha, cost, x, u, impulse, 1
+
+
+class _ToySolver:
+    """Picklable stand-in with two basins: a warm start from a large control (u > 0.5) lands in a basin 0.01
+    worse; the upward chain's warm start at alpha = 0.2 fails (forcing the cold retry) and its warm start at
+    alpha >= 0.5 is 0.02 worse than the downward chain's cold start there."""
+
+    def __call__(self, alpha, x, u):
+        from cislunar.scvx import SCvxError
+
+        warm = bool(np.any(u))
+        basin = float(u[0, 0]) if warm else 0.0
+        if warm and basin <= 0.5 and alpha == 0.2:
+            raise SCvxError("toy failure", [{"iteration": 0}])
+        cost = -alpha + (0.01 if basin > 0.5 else 0.0) + (0.02 if warm and basin <= 0.5 and alpha >= 0.5 else 0.0)
+        return _Res(alpha, cost, x, np.full_like(u, 1.0 if alpha >= 0.5 or basin > 0.5 else 0.1))
+
+
+def test_sweep_both_ways_merges_retries_and_is_executor_independent():
+    from concurrent.futures import ThreadPoolExecutor
+
+    x, u = np.zeros((4, 6)), np.zeros((4, 3))
+    alphas = [0.0, 0.2, 0.6]
+    serial = W.sweep_both_ways(_ToySolver(), alphas, x, u)
+    with ThreadPoolExecutor(2) as ex:
+        threaded = W.sweep_both_ways(_ToySolver(), alphas, x, u, executor=ex)
+    for sw in (serial, threaded):
+        assert sw.source == ["up", "up", "down"]  # the lower cost of the two chains per alpha
+        np.testing.assert_allclose([r.cost for r in sw.best], [0.0, -0.2, -0.6])
+        assert [(a["alpha"], a["direction"], a["start"], a["converged"]) for a in sw.attempts] == [
+            (0.0, "up", "cold", True), (0.2, "up", "warm", False), (0.2, "up", "cold", True),
+            (0.6, "up", "warm", True), (0.6, "down", "cold", True), (0.2, "down", "warm", True),
+            (0.0, "down", "warm", True)]
+        np.testing.assert_allclose([a["cost"] for a in sw.attempts],
+                                   [0.0, np.nan, -0.2, -0.58, -0.6, -0.19, 0.01], equal_nan=True)
+    with pytest.raises(ValueError, match="alphas"):
+        W.sweep_both_ways(_ToySolver(), [0.2, 0.1], x, u)
+    with pytest.raises(ValueError, match="executor"):
+        W.sweep_both_ways(_ToySolver(), alphas, x, u, executor=object())
+
+
+class _FrontSolver:
+    """impulse(alpha) along a toy front; counts solves; a jump makes a budget unreachable."""
+
+    def __init__(self, f):
+        self.f, self.calls = f, []
+
+    def __call__(self, alpha, x, u):
+        self.calls.append(alpha)
+        return _Res(alpha, -alpha, x, u, impulse=self.f(alpha))
+
+
+def test_solve_for_impulse_hits_the_budget_and_reports_a_jump():
+    import pickle
+
+    x, u = np.zeros((3, 6)), np.zeros((3, 3))
+    f = lambda a: 0.4 + 3e3 * a**2 + 50.0 * a  # noqa: E731 - convex, monotone impulse(alpha)
+    sol = _FrontSolver(f)
+    lo, hi = (0.0, sol(0.0, x, u)), (0.02, sol(0.02, x, u))
+    out = W.solve_for_impulse(sol, 1.5, lo, hi, rtol=1e-6, max_solves=30)
+    assert abs(out.result.impulse - 1.5) <= 1.5e-6
+    a_true = (-50.0 + np.sqrt(50.0**2 + 4 * 3e3 * 1.1)) / (2 * 3e3)
+    assert out.alpha == pytest.approx(a_true, rel=1e-5)
+    assert len(out.solves) <= 12  # Illinois: superlinear, not bisection-slow
+    assert [s[0] for s in out.solves] == sol.calls[2:]
+    # a budget on a bracket end is returned without a solve
+    assert W.solve_for_impulse(sol, f(0.02), lo, hi).alpha == 0.02
+    # the budget outside the bracket is refused by name
+    with pytest.raises(ValueError, match="bracket"):
+        W.solve_for_impulse(sol, 100.0, lo, hi)
+    # a front that jumps across the budget: no alpha_h spends it; the error carries every try and pickles
+    jump = _FrontSolver(lambda a: 0.4 if a < 0.01 else 20.0)
+    with pytest.raises(W.ImpulseBudgetError) as err:
+        W.solve_for_impulse(jump, 5.0, (0.0, jump(0.0, x, u)), (0.02, jump(0.02, x, u)), max_solves=6)
+    assert len(err.value.solves) == 6 and err.value.budget == 5.0
+    back = pickle.loads(pickle.dumps(err.value))
+    assert back.solves == err.value.solves and back.reason == err.value.reason
