@@ -430,12 +430,29 @@ def detection_trial_batch(rng: np.random.Generator, setup: DetectionSetup, polic
     _check_setup(setup)
     _check_policy(policy, optional=True)
     B = _checks.integer(batch_size, "batch_size", minimum=1)
-    inputs = [draw_trial(child, setup, policy) for child in rng.spawn(B)]
+    return _detection_batches([rng], setup, policy, B)[0]
+
+
+def _detection_batches(rngs, setup, policy, batch_size) -> list:
+    """Several :func:`detection_trial_batch` batches (one per generator) in one lockstep :func:`ocbe_batch` call.
+
+    Batch ``k`` draws its sub-trials with the children of ``rngs[k]`` exactly as :func:`detection_trial_batch`;
+    every trial of the batched OCBE is computed on its own (stacked per-trial algebra, one integrator lane per
+    trial), so the results equal those of separate calls.  Returns one list of :class:`TrialResult` per generator.
+    """
+    B = batch_size
+    inputs = [draw_trial(child, setup, policy) for rng in rngs for child in rng.spawn(B)]
     sc = setup.scenario
     res = ocbe_batch(setup.system, sc.t, np.array([i.y for i in inputs]), setup.observer_states, sc.model, sc.meas_cov,
                      np.array([i.x0 for i in inputs]), np.array([i.P0 for i in inputs]), setup.control_weight,
                      n_sub=setup.n_sub, tol=setup.tol)
-    return [_result(setup, inp, zs, zf) for inp, zs, zf in zip(inputs, res.z_smooth, res.z_step)]
+    flat = [_result(setup, inp, zs, zf) for inp, zs, zf in zip(inputs, res.z_smooth, res.z_step)]
+    return [flat[k * B:(k + 1) * B] for k in range(len(rngs))]
+
+
+#: Trials per lockstep call of the batched OCBE in :func:`run_detection_monte_carlo` (several batches together;
+#: the numpy algebra's per-call overhead is shared by more trials, ``benchmarks/bench_detection.py``).
+LOCKSTEP_TRIALS = 64
 
 
 @dataclass(frozen=True)
@@ -472,10 +489,12 @@ def run_detection_monte_carlo(setup: DetectionSetup, policy: StationKeepingPolic
                               desc: str | None = None) -> MonteCarloSample:
     """Monte Carlo of the control integral through :func:`cislunar.montecarlo.run_monte_carlo`.
 
-    Trials run ``batch_size`` at a time in lockstep (:func:`detection_trial_batch`): task ``i`` of
-    ``run_monte_carlo`` is batch ``i``, seeded by child ``i`` of ``SeedSequence(seed)``; the sub-trials of a batch
-    are its children.  Results therefore depend on ``seed`` and ``batch_size`` only, not on the executor.  The
-    last batch is trimmed to ``n_trials``.  ``batch_size=1`` with :func:`detection_trial` semantics is available
+    Trials run in batches of ``batch_size`` (:func:`detection_trial_batch`): batch ``i`` is trial ``i`` of
+    ``run_monte_carlo``, seeded by child ``i`` of ``SeedSequence(seed)``; the sub-trials of a batch are its
+    children.  Results therefore depend on ``seed`` and ``batch_size`` only, not on the executor.  The last batch
+    is trimmed to ``n_trials``.  Consecutive batches (about :data:`LOCKSTEP_TRIALS` trials, at least four tasks
+    per run) go through the batched OCBE together as one vectorized task; this changes the speed only, every
+    trial being computed on its own.  ``batch_size=1`` with :func:`detection_trial` semantics is available
     by passing ``batch_size=0``, which runs the single-trial OCBE per trial.
 
     Parameters
@@ -512,8 +531,9 @@ def run_detection_monte_carlo(setup: DetectionSetup, policy: StationKeepingPolic
     else:
         n_batches = -(-n // B)
         try:
-            chunks = run_monte_carlo(detection_trial_batch, n_batches, seed, args=(setup, policy, B),
-                                     executor=executor, chunk_size=1, progress=progress, desc=label)
+            group = max(1, min(LOCKSTEP_TRIALS // B, -(-n_batches // 4)))
+            chunks = run_monte_carlo(_detection_batches, n_batches, seed, args=(setup, policy, B), executor=executor,
+                                     chunk_size=group, progress=progress, desc=label, vectorized=True)
         except MonteCarloError as exc:  # name the trials of the failing batch; keep completed trials by index
             k = exc.trial_index
             f = exc.failure
@@ -592,7 +612,7 @@ class BatchOCBEResult:
 
 
 def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *, n_sub: int = 9,
-               tol: float = DEFAULT_TOL) -> BatchOCBEResult:
+               tol: float = DEFAULT_TOL, engine: str = "fast") -> BatchOCBEResult:
     """The extended SRI OCBE filter and full smoother of :func:`cislunar.ocbe.ocbe_filter_smoother` for B trials.
 
     Same algorithm, step for step (Eqs. 17, 21-32 and the backward SRI smoother with costates
@@ -621,6 +641,14 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
         Control evaluation points per interval (>= 2).
     tol : float
         Integrator tolerance.
+    engine : {"fast", "reference"}
+        ``"fast"`` (default): the transition blocks from :func:`cislunar.ocbe.block_integrator` (the same
+        variational equations without the identically zero block, about four times cheaper to integrate) and the
+        square-root-information algebra with fewer temporaries.  ``"reference"``: the first batched
+        implementation, integrating the full 12x12 variational system of
+        :func:`cislunar.ocbe.variational_system`; kept to check the fast engine against
+        (``tests/test_detection.py``: equal to about 1e-12 relative) and to benchmark it
+        (``benchmarks/bench_detection.py``).
     """
     _checks.system(system)
     model = ocbe.check_model(model)
@@ -640,7 +668,14 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
     qs = ocbe.control_weights(control_weight, N - 1, batch=B)
     n_sub = _checks.integer(n_sub, "n_sub", minimum=2)
     tol = _check_tol(tol)
-    hy = _heyoka()
+    engine = _checks.choice(engine, "engine", ("fast", "reference"))
+    run = _ocbe_batch_fast if engine == "fast" else _ocbe_batch_reference
+    return run(system, t, y, obs, model, R, x, P0, qs, n_sub, tol)
+
+
+def _ocbe_batch_reference(system, t, y, obs, model, R, x, P0, qs, n_sub, tol) -> BatchOCBEResult:
+    """The first batched OCBE (full 12x12 variational system); arguments checked by :func:`ocbe_batch`."""
+    B, N = y.shape[0], t.size
     template, index = _batch_template(tol, B)
     tb = copy.deepcopy(template)
     W = _sri_of_cov(R)
@@ -722,6 +757,118 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
         P_s[:, n] = _cov_of_sri(Rs)
     w = (x_s[:, 1:] - x_pred[:, 1:]) - (phis[:, :, :6, :6] @ (x_s[:, :-1] - x_filt[:, :-1])[..., None])[..., 0]
     p_s = np.linalg.solve(phis[:, :, :6, 6:], w[..., None])[..., 0]
+    control_s = -qs[:, :, None, None] * np.einsum("bnkij,bnj->bnki", phi_pp_sub, p_s)[..., 3:6]
+    P_filt = _cov_of_sri(S_filt)
+    return BatchOCBEResult(x_pred, x_filt, P_filt, x_s, P_s, t_sub, control_step, control_s,
+                           _control_integral(t_sub, control_step), _control_integral(t_sub, control_s), resid)
+
+
+#: Trials per heyoka batch integrator in the fast engine (larger lockstep batches are integrated in groups of
+#: this size: the Taylor integrator's cost per trial grows again beyond a few SIMD widths).
+_LANES = 16
+
+
+def _ocbe_batch_fast(system, t, y, obs, model, R, x, P0, qs, n_sub, tol) -> BatchOCBEResult:
+    """:func:`ocbe_batch` on the block integrator (:func:`cislunar.ocbe.block_integrator`); arguments checked.
+
+    The algebra is that of :func:`_ocbe_batch_reference` step for step; what changes is where the transition
+    comes from (the three non-zero 6x6 blocks instead of the full 12x12 matrix) and bookkeeping: the sub-grids,
+    the integrator's initial state and the measurement-update matrix are allocated once, quantities shared by all
+    trials (whitened measurement noise, epochs) are computed once.
+    """
+    B, N = y.shape[0], t.size
+    lay = ocbe.BLOCK_LAYOUT
+    s_xx, s_xp, s_pp = lay["phi_xx"], lay["phi_xp"], lay["phi_pp"]
+    lanes = [(a, min(a + _LANES, B)) for a in range(0, B, _LANES)]
+    integrators = [ocbe.block_integrator(b - a, tol) for a, b in lanes]
+    W = _sri_of_cov(R)
+    m = W.shape[0]
+    t_sub = np.array([np.linspace(t[n], t[n + 1], n_sub) for n in range(N - 1)])  # as the reference, per interval
+    start = np.zeros((s_pp.stop, B))
+    out = np.empty((n_sub, s_pp.stop, B))
+    start[s_xx] = start[s_pp] = np.eye(6).ravel()[:, None]
+    A_meas = np.zeros((B, 6 + m, 7))  # [S 0; W H  W dy]
+
+    def update(S, x_ref, k):
+        val, _, Ht = model.evaluate(obs[k], x_ref)
+        dy = model.residual(y[:, k], val)
+        A_meas[:, :6, :6] = S
+        A_meas[:, 6:, :6] = W @ Ht
+        A_meas[:, 6:, 6] = (W @ dy[..., None])[..., 0]
+        U = _triangularize(A_meas)
+        S_new, b = U[:, :6, :6], U[:, :6, 6]
+        return S_new, x_ref + _solve_upper(S_new, b), np.abs(U[:, 6, 6])
+
+    S = _sri_of_cov(P0)
+    x_pred = np.empty((B, N, 6))
+    x_filt = np.empty((B, N, 6))
+    S_filt = np.empty((B, N, 6, 6))
+    resid = np.empty((B, N))
+    phi_xx = np.empty((B, N - 1, 6, 6))
+    phi_xp = np.empty((B, N - 1, 6, 6))
+    terms = np.empty((B, N - 1, 6, 13))  # [Rw | Rwx | zw] of each time update
+    phi_pp_sub = np.empty((B, N - 1, n_sub, 6, 6))
+    p_step = np.empty((B, N - 1, 6))
+    A_time = np.zeros((B, 12, 13))
+    x_pred[:, 0] = x
+    S, x, resid[:, 0] = update(S, x, 0)
+    x_filt[:, 0], S_filt[:, 0] = x, S
+    mu = system.mu
+    for n in range(N - 1):
+        grid = t_sub[n]
+        start[:6] = x.T
+        ok = True
+        for (a, b), tb in zip(lanes, integrators):  # SIMD-sized groups of trials (one lane each)
+            tb.set_time(np.full(b - a, grid[0]))
+            tb.state[:] = start[:, a:b]
+            tb.pars[0] = mu
+            tb.pars[1] = qs[a:b, n]
+            out[:, :, a:b] = tb.propagate_grid(np.repeat(grid[:, None], b - a, axis=1))[-1]  # (n_sub, 114, lanes)
+            ok = ok and bool(np.all(np.abs(tb.time - grid[-1]) <= 1e-12))
+        if not ok or not np.all(np.isfinite(out)):
+            raise ocbe.FilterDivergenceError(n, float(grid[0]), "heyoka batch propagation failed (non-finite "
+                                             "state)")
+        # no impact events in the batch integrator (see ocbe.ocbe_transition): check every sub-grid state
+        r1, r2 = system.distances(np.moveaxis(out[:, :3], -1, 1))
+        if np.any(r2 <= system.secondary_radius) or np.any(r1 <= system.primary_radius):
+            member = int(np.flatnonzero(np.any((r2 <= system.secondary_radius) | (r1 <= system.primary_radius),
+                                               axis=0))[0])
+            raise ocbe.FilterDivergenceError(n, float(grid[0]), f"the reference of trial {member} of the batch "
+                                             "entered a primary")
+        end = out[-1].T  # (B, 114)
+        Phi_xx = phi_xx[:, n] = end[:, s_xx].reshape(B, 6, 6)
+        phi_xp[:, n] = end[:, s_xp].reshape(B, 6, 6)
+        phi_pp_sub[:, n] = np.moveaxis(out[:, s_pp], -1, 0).reshape(B, n_sub, 6, 6)
+        Q = ocbe._process_noise(Phi_xx, phi_xp[:, n])
+        # Eq. 23: time update with Gamma = I, b_x = 0
+        Rt = np.swapaxes(np.linalg.solve(np.swapaxes(Phi_xx, -1, -2), np.swapaxes(S, -1, -2)), -1, -2)
+        A_time[:, :6, :6] = _sri_of_cov(Q)
+        A_time[:, 6:, :6] = -Rt
+        A_time[:, 6:, 6:12] = Rt
+        U = _triangularize(A_time)
+        S_bar, term = U[:, 6:12, 6:12], U[:, :6, :]
+        x_prior = end[:, :6]
+        x_pred[:, n + 1] = x_prior
+        S_new, x_new, resid[:, n + 1] = update(S_bar, x_prior, n + 1)  # Eqs. 24-28
+        # single-step smoother (Eqs. 29-30) and costate (Eq. 31)
+        S1, b1 = _smoother_step(S_new, (S_new @ (x_new - x_prior)[..., None])[..., 0], Phi_xx, term)
+        p_step[:, n] = -((np.swapaxes(S, -1, -2) @ S) @ _solve_upper(S1, b1)[..., None])[..., 0]
+        terms[:, n] = term
+        S, x = S_new, x_new
+        x_filt[:, n + 1], S_filt[:, n + 1] = x, S
+    control_step = -qs[:, :, None, None] * np.einsum("bnkij,bnj->bnki", phi_pp_sub, p_step)[..., 3:6]
+    # full SRI smoother (backward)
+    x_s = np.empty((B, N, 6))
+    P_s = np.empty((B, N, 6, 6))
+    Rs, bs = S_filt[:, -1], np.zeros((B, 6))
+    x_s[:, -1], P_s[:, -1] = x_filt[:, -1], _cov_of_sri(Rs)
+    for n in range(N - 2, -1, -1):
+        z_next = bs + (Rs @ (x_filt[:, n + 1] - x_pred[:, n + 1])[..., None])[..., 0]
+        Rs, bs = _smoother_step(Rs, z_next, phi_xx[:, n], terms[:, n])
+        x_s[:, n] = x_filt[:, n] + _solve_upper(Rs, bs)
+        P_s[:, n] = _cov_of_sri(Rs)
+    w = (x_s[:, 1:] - x_pred[:, 1:]) - (phi_xx @ (x_s[:, :-1] - x_filt[:, :-1])[..., None])[..., 0]
+    p_s = np.linalg.solve(phi_xp, w[..., None])[..., 0]
     control_s = -qs[:, :, None, None] * np.einsum("bnkij,bnj->bnki", phi_pp_sub, p_s)[..., 3:6]
     P_filt = _cov_of_sri(S_filt)
     return BatchOCBEResult(x_pred, x_filt, P_filt, x_s, P_s, t_sub, control_step, control_s,

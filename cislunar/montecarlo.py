@@ -22,6 +22,7 @@ killing the pool.  All of these objects pickle, so they cross process pools inta
 from __future__ import annotations
 
 import concurrent.futures as _cf
+import functools
 import itertools
 import pickle
 import threading
@@ -165,11 +166,33 @@ def _stop(token) -> None:
         _STOPPED.add(token)
 
 
-def _run_chunk(trial, seed, indices, args, kwargs, token=None, collect=False):
-    """Run trials ``indices``; returns ``[(index, ok, result_or_failure), ...]`` (never raises for a trial error)."""
+def _run_chunk(trial, seed, indices, args, kwargs, token=None, collect=False, vectorized=False):
+    """Run trials ``indices``; returns ``[(index, ok, result_or_failure), ...]`` (never raises for a trial error).
+
+    ``vectorized``: one call ``trial([rng_i for i in indices], ...)`` returning one result per generator; if it
+    raises, the trials are rerun one at a time (``trial([rng_i])``, fresh generators) to name the failing one.
+    """
     root = np.random.SeedSequence(seed) if not isinstance(seed, np.random.SeedSequence) else seed
     base = tuple(root.spawn_key)
     offset = root.n_children_spawned
+    if vectorized:
+        if token is not None and token in _STOPPED:
+            return []
+        try:
+            rngs = [np.random.default_rng(np.random.SeedSequence(root.entropy, spawn_key=base + (offset + i,),
+                                                                 pool_size=root.pool_size)) for i in indices]
+            res = list(trial(rngs, *args, **kwargs))
+            if len(res) != len(rngs):
+                raise ValueError(f"a vectorized trial must return one result per generator: got {len(res)} for "
+                                 f"{len(rngs)}")
+            return [(i, True, r) for i, r in zip(indices, res)]
+        except Exception as exc:  # noqa: BLE001 - rerun one by one to name the trial and keep the others
+            if len(indices) > 1:
+                return _run_chunk(functools.partial(_first_of_vectorized, trial), seed, indices, args, kwargs, token,
+                                  collect)
+            ss = np.random.SeedSequence(root.entropy, spawn_key=base + (offset + indices[0],), pool_size=root.pool_size)
+            seed_txt = f"SeedSequence(entropy={ss.entropy}, spawn_key={tuple(ss.spawn_key)})"
+            return [(indices[0], False, TrialFailure(indices[0], seed_txt, _picklable(exc), traceback.format_exc()))]
     out = []
     for i in indices:
         if token is not None and token in _STOPPED:
@@ -183,6 +206,14 @@ def _run_chunk(trial, seed, indices, args, kwargs, token=None, collect=False):
             if not collect:
                 break
     return out
+
+
+def _first_of_vectorized(trial, rng, *args, **kwargs):
+    """A vectorized trial called with one generator, returning its single result."""
+    res = list(trial([rng], *args, **kwargs))
+    if len(res) != 1:
+        raise ValueError(f"a vectorized trial must return one result per generator: got {len(res)} for 1")
+    return res[0]
 
 
 def _run_tasks(fn, items, token=None, collect=False):
@@ -279,7 +310,8 @@ def _drive(submit_chunks, n_total, desc, progress, collect, serial_run):
 
 
 def run_monte_carlo(trial, n_trials: int, seed, *, args=(), kwargs=None, executor=None, chunk_size: int | None = None,
-                    progress: bool = True, desc: str = "Monte Carlo", on_error: str = "raise") -> list:
+                    progress: bool = True, desc: str = "Monte Carlo", on_error: str = "raise",
+                    vectorized: bool = False) -> list:
     """Run ``trial(rng, *args, **kwargs)`` for ``n_trials`` independent generators.
 
     Parameters
@@ -296,7 +328,8 @@ def run_monte_carlo(trial, n_trials: int, seed, *, args=(), kwargs=None, executo
     executor : object with ``submit``, optional
         ``None`` runs serially in this process.
     chunk_size : int, optional
-        Trials per submitted task (default: about four tasks per worker, at most 64 trials).
+        Trials per submitted task (default: about four tasks per worker, at most 64 trials); serially, trials per
+        progress step (default: about a hundredth of the run, at most 64).
     progress : bool
         Progress bar over completed trials (:func:`cislunar.progress.progress`).
     desc : str
@@ -305,6 +338,12 @@ def run_monte_carlo(trial, n_trials: int, seed, *, args=(), kwargs=None, executo
         ``"raise"``: stop at the first failing trial with :class:`MonteCarloError` (queued work is cancelled; the
         completed results are on the exception).  ``"collect"``: run every trial; failed entries of the returned
         list are :class:`TrialFailure` records.
+    vectorized : bool
+        ``True``: ``trial(rngs, *args, **kwargs)`` receives the generators of a whole chunk (a list in trial order,
+        trial ``i`` still getting child ``i``) and returns one result per generator, e.g. to run the trials of a
+        chunk in lockstep.  Results are those of the per-trial calls as long as the trial treats each generator
+        on its own.  If the call raises, the chunk's trials are rerun one at a time (``trial([rng])`` with a
+        fresh generator of each seed) so the failure names its trial and the others are kept.
 
     Returns
     -------
@@ -330,16 +369,18 @@ def run_monte_carlo(trial, n_trials: int, seed, *, args=(), kwargs=None, executo
     if not isinstance(desc, str):
         raise _checks.ArgumentTypeError(f"desc must be a str; got {type(desc).__name__}")
     _checks.choice(on_error, "on_error", ("raise", "collect"))
+    vectorized = _checks.boolean(vectorized, "vectorized")
     collect = on_error == "collect"
     args = tuple(args)
     if executor is None:
         if chunk_size is not None:
-            _checks.integer(chunk_size, "chunk_size", minimum=1)
+            chunk_size = _checks.integer(chunk_size, "chunk_size", minimum=1)
 
         def serial():  # chunks of up to 64 trials keep the bookkeeping off the per-trial cost
-            step = max(1, min(64, n_trials // 100))
+            step = chunk_size or max(1, min(64, n_trials // 100))
             for i in range(0, n_trials, step):
-                yield _run_chunk(trial, root, range(i, min(i + step, n_trials)), args, kwargs, None, collect)
+                yield _run_chunk(trial, root, range(i, min(i + step, n_trials)), args, kwargs, None, collect,
+                                 vectorized)
 
         return _drive(None, n_trials, desc, progress, collect, serial)
     _check_executor(executor)
@@ -350,7 +391,8 @@ def run_monte_carlo(trial, n_trials: int, seed, *, args=(), kwargs=None, executo
     chunks = [range(i, min(i + chunk_size, n_trials)) for i in range(0, n_trials, chunk_size)]
 
     def submit(token):
-        futures = [executor.submit(_run_chunk, trial, root, c, args, kwargs, token, collect) for c in chunks]
+        futures = [executor.submit(_run_chunk, trial, root, c, args, kwargs, token, collect, vectorized)
+                   for c in chunks]
         return futures, [len(c) for c in chunks]
 
     return _drive(submit, n_trials, desc, progress, collect, None)

@@ -193,3 +193,52 @@ def test_monte_carlo_reproducible_and_executor_agnostic(short_setup):
         det.run_detection_monte_carlo(s, None, 0, 1)
     with pytest.raises(ValueError, match="batch_size"):
         det.run_detection_monte_carlo(s, None, 2, 1, batch_size=-1)
+
+
+def test_fast_engine_equals_the_reference_batched_ocbe(short_setup):
+    """The default engine (block integrator) equals the first batched OCBE (full 12x12 system) on several trials."""
+    s = short_setup
+    sc = s.scenario
+    inputs = [det.draw_trial(k, s, det.ACTIVE_POLICY if j % 2 else None)
+              for j, k in enumerate(np.random.default_rng(8).spawn(4))]
+    args = (em, sc.t, np.array([i.y for i in inputs]), s.observer_states, sc.model, sc.meas_cov,
+            np.array([i.x0 for i in inputs]), np.array([i.P0 for i in inputs]), s.control_weight)
+    fast = det.ocbe_batch(*args, n_sub=s.n_sub)
+    ref = det.ocbe_batch(*args, n_sub=s.n_sub, engine="reference")
+    rel = lambda a, b: np.max(np.abs(a - b)) / np.max(np.abs(b))  # noqa: E731
+    # states, covariances, residuals: ~1e-14 here; the controls (costates solved through the ill-conditioned
+    # Phi_xp) amplify round-off to ~1e-10 for noise-only trials, as between the reference engine and the
+    # single-trial filter (1.4e-10 on the same trial), hence their looser bound
+    for b in range(len(inputs)):
+        for name in ("x_pred", "x_filt", "P_filt", "x_smooth", "P_smooth", "residual_norms"):
+            assert rel(getattr(fast, name)[b], getattr(ref, name)[b]) < 1e-10, (b, name)
+        for name in ("control_step", "control_smooth"):
+            assert rel(getattr(fast, name)[b], getattr(ref, name)[b]) < 1e-9, (b, name)
+    assert np.max(np.abs(fast.z_smooth / ref.z_smooth - 1)) < 1e-10
+    assert np.max(np.abs(fast.z_step / ref.z_step - 1)) < 1e-9
+    assert np.array_equal(fast.t_sub, ref.t_sub)
+    # every trial is computed on its own: a trial's result does not depend on the others in the batch
+    alone = det.ocbe_batch(em, sc.t, args[2][1:2], s.observer_states, sc.model, sc.meas_cov, args[6][1:2],
+                           args[7][1], s.control_weight, n_sub=s.n_sub)
+    assert abs(alone.z_smooth[0] / fast.z_smooth[1] - 1) < 1e-12
+    with pytest.raises(ValueError, match="engine"):
+        det.ocbe_batch(*args, engine="slow")
+
+
+def test_lockstep_groups_equal_separate_batches_and_any_executor(short_setup):
+    """run_detection_monte_carlo runs several batches per lockstep call; results equal one call per batch."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from cislunar.montecarlo import trial_rng
+
+    s = short_setup
+    n, B = 13, 2  # 7 batches (the last trimmed): lockstep groups of 2 batches
+    mc = det.run_detection_monte_carlo(s, det.QUIET_POLICY, n, 21, batch_size=B, progress=False)
+    one = [r for k in range(-(-n // B)) for r in det.detection_trial_batch(trial_rng(21, k), s, det.QUIET_POLICY, B)]
+    one = det.MonteCarloSample.from_results(one[:n])
+    assert np.array_equal(mc.magnitude, one.magnitude) and np.array_equal(mc.azimuth, one.azimuth)
+    assert np.max(np.abs(mc.z / one.z - 1)) < 1e-12 and np.max(np.abs(mc.z_step / one.z_step - 1)) < 1e-12
+    with ProcessPoolExecutor(2) as ex:
+        procs = det.run_detection_monte_carlo(s, det.QUIET_POLICY, n, 21, batch_size=B, executor=ex, progress=False)
+    for name in ("z", "z_step", "magnitude", "azimuth", "elevation"):
+        assert np.array_equal(getattr(mc, name), getattr(procs, name), equal_nan=True), name

@@ -169,3 +169,36 @@ def test_several_observers_equal_sequential_updates_and_gaps_are_time_updates(oc
     avail[4] = False
     gap = ocbe.ocbe_filter_smoother(em, t, y, obs, model, Rm, x0, P0, q, available=avail, smooth=False)
     assert np.array_equal(gap.x_filt[4], gap.x_pred[4]) and np.allclose(gap.P_filt[4], gap.P_pred[4], rtol=1e-12)
+
+
+def test_block_integrator_equals_the_full_variational_system(two_hours_near_perilune):
+    """The 114-state block integrator (Phi_px = 0 and the p-terms dropped) equals the 156-state one to round-off.
+
+    Two references (the fixture's and a perturbed one, with different control weights) run in one batch; each is
+    compared with :func:`cislunar.ocbe.ocbe_transition` on the same grid, block by block.  A sign error in the
+    -q B B^T coupling or in -A^T would show in phi_xp / phi_pp at order one.
+    """
+    x0, grid, _ = two_hours_near_perilune
+    lay = ocbe.BLOCK_LAYOUT
+    starts = np.array([x0, x0 + np.r_[1e-5, -2e-5, 1e-5, 3e-5, 0.0, -1e-5]])
+    qs = np.array([Q_WEIGHT, 40 * Q_WEIGHT])
+    tb = ocbe.block_integrator(2)
+    init = np.zeros((lay["phi_pp"].stop, 2))
+    init[lay["x"]] = starts.T
+    init[lay["phi_xx"]] = init[lay["phi_pp"]] = np.eye(6).ravel()[:, None]
+    tb.set_time(np.full(2, grid[0]))
+    tb.state[:] = init
+    tb.pars[0] = em.mu
+    tb.pars[1] = qs
+    out = tb.propagate_grid(np.repeat(grid[:, None], 2, axis=1))[-1]  # (grid, 114, 2)
+    for b in range(2):
+        full = ocbe.ocbe_transition(em, starts[b], grid, qs[b])
+        assert np.max(np.abs(out[:, lay["x"], b] - full.x)) < 1e-14
+        for name, ref in (("phi_xx", full.phi_xx), ("phi_xp", full.phi_xp), ("phi_pp", full.phi_pp)):
+            blk = out[:, lay[name], b].reshape(-1, 6, 6)
+            assert np.max(np.abs(blk - ref)) < 1e-12 * np.max(np.abs(ref)), name
+        assert np.max(np.abs(full.phi_px)) == 0.0  # the block that is dropped
+    with pytest.raises(ValueError, match="batch_size"):
+        ocbe.block_integrator(0)
+    with pytest.raises(ValueError, match="tol"):
+        ocbe.block_integrator(2, tol=1.0)

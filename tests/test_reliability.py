@@ -385,6 +385,8 @@ def _specs():
                                                                  p=np.ones(6)),
                dict(control_weight="pos", phi_pp="arr", p="arr")))
     s.append(S("variational_system", ocbe.variational_system, dict(tol=1e-13), dict(tol="range:1e-16:1e-3")))
+    s.append(S("block_integrator", ocbe.block_integrator, dict(batch_size=2, tol=1e-13),
+               dict(batch_size="int1", tol="range:1e-16:1e-3")))
 
     def _ocbe_kwargs():
         sc = scenario()
@@ -459,16 +461,18 @@ def _specs():
                dict(system=em, t=np.array([0.0, 0.05, 0.1]), y=np.zeros((2, 3, 4)),
                     observer_states=np.tile(OBS, (3, 1)), model=measurements.ANGLES_AND_RATES,
                     meas_cov=np.eye(4) * 1e-8, x0=np.tile(TGT, (2, 1)), P0=SPD6, control_weight=1e-8, n_sub=2,
-                    tol=1e-13),
+                    tol=1e-13, engine="fast"),
                dict(system="system", t="grid", y="arr", observer_states="arr", model="instance", meas_cov="spd",
-                    x0="arr", P0="spd", control_weight="weights", n_sub="int2", tol="range:1e-16:1e-3"),
+                    x0="arr", P0="spd", control_weight="weights", n_sub="int2", tol="range:1e-16:1e-3",
+                    engine="choice"),
                baseline=False))
     # montecarlo
     s.append(S("run_monte_carlo", montecarlo.run_monte_carlo,
                dict(trial=_unit_trial, n_trials=3, seed=0, args=(), kwargs=None, executor=None, chunk_size=None,
-                    progress=False, on_error="raise"),
+                    progress=False, on_error="raise", vectorized=False),
                dict(trial="callable", n_trials="int1", seed="seed", args="instance", kwargs="instance_opt",
-                    executor="instance_opt", chunk_size="int1_opt", progress="bool", on_error="choice")))
+                    executor="instance_opt", chunk_size="int1_opt", progress="bool", on_error="choice",
+                    vectorized="bool")))
     s.append(S("map_tasks", montecarlo.map_tasks, dict(fn=abs, tasks=[1, -2], progress=False, chunk_size=1,
                                                        on_error="raise"),
                dict(fn="callable", tasks="iterable", progress="bool", chunk_size="int1", on_error="choice")))
