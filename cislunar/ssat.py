@@ -462,6 +462,25 @@ class SSATCovariance:
     sigma_theta_rad: np.ndarray
     length_unit_km: float
 
+    def __post_init__(self):
+        t = _checks.time_grid(self.t, "t", increasing=True)
+        J = _checks.as_array(self.J_rho, "J_rho", ndim=(2,))
+        n = J.shape[0]
+        if n < 1 or J.shape[1] != t.size:
+            raise ValueError(f"J_rho must have shape (n, N) with n >= 1 and N = t.size = {t.size}; got {J.shape}")
+        if np.any(J < 0):
+            raise ValueError("J_rho must be non-negative (a variance)")
+        P = _checks.as_array(self.P_final, "P_final", shape=(n, 12, 12))
+        fields = {"t": t, "J_rho": J, "P_final": P}
+        for name in ("range_km", "sigma_theta_rad"):
+            a = _checks.as_array(getattr(self, name), name, shape=(n, t.size))
+            if np.any(a <= 0):
+                raise ValueError(f"{name} must be positive")
+            fields[name] = a
+        fields["length_unit_km"] = _checks.positive(self.length_unit_km, "length_unit_km")
+        for name, value in fields.items():
+            object.__setattr__(self, name, value)
+
     @property
     def range_sigma_km(self) -> np.ndarray:
         """:math:`\\sqrt{J_\\rho}`, the 1-sigma range uncertainty, km, shape (n, N)."""

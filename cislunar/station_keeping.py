@@ -269,6 +269,38 @@ class StationKeepingSurface:
     velocity_unit_km_s: float
     time_unit_s: float
 
+    def __post_init__(self):
+        theta = _checks.as_array(self.theta, "theta", ndim=(1,), min_size=1)
+        t_arr = _checks.as_array(self.t_arrival, "t_arrival", ndim=(1,), min_size=1)
+        if np.any(np.diff(t_arr) <= 0):
+            raise ValueError("t_arrival must be strictly increasing")
+        nt, nth = t_arr.size, theta.size
+        f = {"theta": theta, "t_arrival": t_arr, "t_burn": _checks.real(self.t_burn, "t_burn"),
+             "t": _checks.time_grid(self.t, "t", increasing=True),
+             "agent_x0": _checks.as_state(self.agent_x0, "agent_x0", batch=False)}
+        def sized(name, shape, what):
+            a = _checks.as_array(getattr(self, name), name, ndim=(len(shape),))
+            if a.shape != shape:
+                raise ValueError(f"{name} must have shape {what} = {shape} (n_t = t_arrival.size, n_theta = "
+                                 f"theta.size); got {a.shape}")
+            return a
+
+        for name, shape, what in (("dv1", (nt, nth, 3), "(n_t, n_theta, 3)"), ("dv2", (nt, nth, 3), "(n_t, n_theta, 3)"),
+                                  ("range_sigma_km", (nt, nth), "(n_t, n_theta)"),
+                                  ("range_sigma_at_arrival_km", (nt, nth), "(n_t, n_theta)"),
+                                  ("u_y", (nt, 3), "(n_t, 3)"), ("alignment", (nt, nth), "(n_t, n_theta)"),
+                                  ("transfer_miss", (nt, nth), "(n_t, n_theta)")):
+            f[name] = sized(name, shape, what)
+        for name, shape, what in (("candidates", (nt, 2), "(n_t, 2)"), ("informed", (nt,), "(n_t,)")):
+            a = sized(name, shape, what)
+            if np.any(a != np.round(a)) or np.any(a < 0) or np.any(a >= nth):
+                raise ValueError(f"{name} must hold ring-angle indices in 0..{nth - 1}")
+            f[name] = a.astype(int)
+        f["velocity_unit_km_s"] = _checks.positive(self.velocity_unit_km_s, "velocity_unit_km_s")
+        f["time_unit_s"] = _checks.positive(self.time_unit_s, "time_unit_s")
+        for name, value in f.items():
+            object.__setattr__(self, name, value)
+
     @property
     def dv1_m_s(self) -> np.ndarray:
         """First-burn magnitude, m/s, (n_t, n_theta)."""

@@ -5,13 +5,16 @@ method and input dataclass, with the kind of every argument (kinds of ``test_rel
 objects that cost a propagation (the 9:2 NRHO, one small converged torus, an agent/target pair, a small
 station-keeping surface and a filter scenario) are built once, lazily, and shared.
 
-Result containers that the package builds and the user only reads (``RangeStats``, ``SSATCovariance``,
-``PolicyComparison``, ``StationKeepingSurface``, ``FilterTrialResult``) have no argument-taking method and are not
-swept; the exception classes are covered by the pickling test of ``test_reliability.py``.
+Result containers that are also inputs (``SSATCovariance`` to ``minimize_range_sigma``, ``StationKeepingSurface`` to
+``filter_scenario``) validate their fields and are swept; the pure outputs (``RangeStats``, ``PolicyComparison``,
+``FilterTrialResult``, which holds NaN by design for epochs a diverged filter never reached) have no
+argument-taking method and are not; the exception classes are covered by the pickling test of
+``test_reliability.py``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 
 import numpy as np
@@ -79,6 +82,15 @@ def _scenario():
     return sk.filter_scenario(_surface(), 0, 1, _target_at_track_start(), em)
 
 
+@functools.lru_cache(maxsize=None)
+def _cov():
+    return ssat.ssat_covariance(em, _agent(), _target(), ssat.initial_covariance(em))
+
+
+_SSAT_COV_FIELDS = [f.name for f in dataclasses.fields(ssat.SSATCovariance)]
+_SURFACE_FIELDS = [f.name for f in dataclasses.fields(sk.StationKeepingSurface)]
+
+
 def _rng():
     return np.random.default_rng(0)
 
@@ -89,7 +101,7 @@ SPD3 = np.diag([1.0, 2.0, 3.0])
 
 def specs(S, lazy):
     s = []
-    orbit, torus, pair = lazy(_orbit), lazy(_torus), lazy(_pair)
+    orbit, torus = lazy(_orbit), lazy(_torus)
     xa0, xt0 = lazy(lambda: _pair()[0]), lazy(lambda: _pair()[1])
     rng = lazy(_rng)
 
@@ -177,6 +189,10 @@ def specs(S, lazy):
     s.append(S("ssat_covariance", ssat.ssat_covariance, cov_kw, cov_kinds))
     s.append(S("ssat_covariance_ekf", ssat.ssat_covariance_ekf, dict(cov_kw, coordinates="agent"),
                dict(cov_kinds, coordinates="choice")))
+    s.append(S("SSATCovariance", ssat.SSATCovariance,
+               {k: lazy(functools.partial(lambda k: getattr(_cov(), k), k)) for k in _SSAT_COV_FIELDS},
+               dict(t="grid", J_rho="arr", P_final="arr", range_km="arr", sigma_theta_rad="arr",
+                    length_unit_km="pos")))
     s.append(S("mmd_matrix", ssat.mmd_matrix, dict(agent_stm=lazy(lambda: _agent().stm[0, -1]),
                                                    H_agent=np.arange(12.0).reshape(2, 6)),
                dict(agent_stm="arr", H_agent="arr")))
@@ -226,6 +242,10 @@ def specs(S, lazy):
                     cadence="pos_opt", t_track_start="real_opt", agent_theta="real", agent_offset="arr_opt",
                     P0="spd_opt", sigma_min_rad="nonneg", resolution_km="nonneg", mmd_horizon="choice",
                     batched="bool", progress="bool")))
+    s.append(S("StationKeepingSurface", sk.StationKeepingSurface,
+               {k: lazy(functools.partial(lambda k: getattr(_surface(), k), k)) for k in _SURFACE_FIELDS},
+               dict({k: "arr" for k in _SURFACE_FIELDS}, t_burn="real", t="grid", agent_x0="state",
+                    velocity_unit_km_s="pos", time_unit_s="pos")))
     s.append(S("informed_choice", sk.informed_choice,
                dict(dv1=np.array([[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]]), u_y=np.array([[1.0, 0.2, 0.0]]),
                     cost=np.array([[1.0, 2.0]])),
