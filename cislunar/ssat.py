@@ -501,6 +501,16 @@ def _measurement_rows(system, xa, xt, sigma_min_rad, resolution_km):
     return H, rho_km, sig
 
 
+def _check_separated(xa, xt, t):
+    """Angles (and the range direction) are undefined where agent and target coincide."""
+    bad = np.argwhere(np.all(xa[..., :3] == xt[..., :3], axis=-1))
+    if bad.size:
+        k = int(bad[0, -1])
+        which = f" (agent trajectory {int(bad[0, 0])})" if bad.shape[1] > 1 else ""
+        raise ValueError(f"agent and target coincide at t[{k}] = {t[k]:.6g} TU{which}: the line of sight and the "
+                         "angles are undefined")
+
+
 def _check_pair_trajectories(agent, target, n_agent_name="agent", n_target_name="target"):
     _trajectory(agent, n_agent_name)
     _trajectory(target, n_target_name)
@@ -548,6 +558,7 @@ def ssat_covariance(system: CR3BP, agent: ImpulsiveTrajectory, target: Impulsive
     n, N = agent.x.shape[0], agent.t.size
     xt = np.broadcast_to(target.x, (n, N, 6))
     st = np.broadcast_to(target.stm, (n, N, 6, 6))
+    _check_separated(agent.x, xt, agent.t)
     H, rho_km, sig = _measurement_rows(system, agent.x, xt, smin, dres)  # (n, N, 2, 12)
     # A_k = H_k blockdiag(Phi_a, Phi_t)
     A = np.concatenate([H[..., :6] @ agent.stm, H[..., 6:] @ st], axis=-1)
@@ -602,6 +613,7 @@ def ssat_covariance_ekf(system: CR3BP, agent: ImpulsiveTrajectory, target: Impul
     C = {"inertial": np.eye(12), "relative": transform_matrix(6), "agent": agent_transform_matrix(6)}[coordinates]
     Ci = np.linalg.inv(C)
     xa, xt = agent.x[0], target.x[0]
+    _check_separated(xa, xt, agent.t)
     sa, st = agent.stm[0], target.stm[0]
     N = agent.t.size
     Phi = np.zeros((N, 12, 12))

@@ -198,6 +198,9 @@ def two_burn_transfer(system: CR3BP, x0, t0: float, t1: float, x_target, *, tol:
     _system(system)
     xt = _checks.as_array(x_target, "x_target", ndim=(1, 2), last=6, min_size=1)
     xt = np.atleast_2d(xt)
+    n0 = np.atleast_2d(_checks.as_state(x0, "x0")).shape[0]
+    if n0 not in (1, xt.shape[0]):
+        raise ValueError(f"x0 and x_target must hold one state or as many as each other; got {n0} and {xt.shape[0]}")
     dv1, x1, _ = position_transfer(system, x0, t0, t1, xt[:, :3], tol=tol, max_iter=max_iter)
     dv2 = xt[:, 3:6] - x1[:, 3:6]
     x1 = x1.copy()

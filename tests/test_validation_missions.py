@@ -121,6 +121,17 @@ def test_an_angular_noise_model_without_noise_is_refused():
     fn(em, ag, tg, P0, sigma_min_rad=0.0, resolution_km=4e-3)  # one of them is enough
 
 
+def test_coincident_agent_and_target_are_refused():
+    t = np.array([0.0, 1.0, 2.0]) * HR
+    tg = ssat.propagate_with_impulses(em, _pair()[1], t)
+    for fn in (ssat.ssat_covariance, ssat.ssat_covariance_ekf):
+        with pytest.raises(ValueError, match=r"agent and target coincide at t\[0\]"):
+            fn(em, tg, tg, ssat.initial_covariance(em))
+    x0 = np.tile(_orbit().x0, (3, 1))
+    with pytest.raises(ValueError, match="x0 and x_target"):
+        sk.two_burn_transfer(em, x0, 0.0, 0.1, np.tile(_orbit().x0, (2, 1)))
+
+
 def test_minimize_range_sigma_refines_with_the_callers_noise_model():
     """The refined optimum's J is that of its direction under the caller's Eq. 20 noise (not the default's)."""
     xa0, xt0 = _pair()
