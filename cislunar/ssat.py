@@ -356,6 +356,13 @@ def propagate_with_impulses(system: CR3BP, x0, t, impulses=(), *, threads: int |
     -------
     ImpulsiveTrajectory
         With a leading batch axis even for a single ``x0``.
+
+    Raises
+    ------
+    cislunar.propagation.ImpactError
+        A trajectory starts inside or reaches the Earth or the Moon (it is never integrated through a primary).
+    ValueError, TypeError
+        Bad arguments (named).
     """
     from .propagation import propagate_stm
 

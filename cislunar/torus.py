@@ -353,6 +353,11 @@ class InvariantTorus:
         -------
         ndarray, shape (n, m, 6)
             LU and LU/TU, rotating frame.
+
+        Raises
+        ------
+        cislunar.propagation.ImpactError
+            A torus trajectory reaches the Earth or the Moon (impact detection is on for every propagation here).
         """
         theta0 = _checks.as_array(theta0, "theta0", ndim=(0, 1)).reshape(-1)
         t = _checks.as_array(t, "t", ndim=(0, 1)).reshape(-1)
