@@ -717,6 +717,20 @@ class PanelSeries:
         """The metric's mean over its limit per epoch (the paper's red line), shape (N,)."""
         return self.dof / self.limit
 
+    def spike_contrast(self, t_days, half_width_days: float = 4 / 24) -> np.ndarray:
+        """How much the control norm stands out near ``t_days``: the largest norm within ``half_width_days`` of
+        it over the median norm farther away, for the forward and the smoothed control (shape (2,)).
+
+        A contrast near 1 means no spike; the paper's Figs. 11 and 13 show a smoothed spike at the burn.
+        """
+        t0 = _checks.real(t_days, "t_days")
+        hw = _checks.positive(half_width_days, "half_width_days")
+        near = np.abs(self.t_sub_days - t0) <= hw
+        if not near.any() or near.all():
+            raise ValueError(f"t_days +- half_width_days must cover some but not all of the track; got {t0} +- {hw}")
+        u = self.control_norm_m_s2
+        return np.array([u[j][near].max() / np.median(u[j][~near]) for j in range(2)])
+
 
 def panel_series(system: CR3BP, result, truth, control_weight, y, observer_states, model, meas_cov, *,
                  available=None) -> PanelSeries:
@@ -817,7 +831,7 @@ def figure_errors(panels: PanelSeries, title: str, *, burn_days=None, detection_
                  f"velocity error [{vu}]"))
         for i, (err, sig, lab) in enumerate(rows):
             ax[i, j].semilogy(panels.t_days, err, "C0", label="true error")
-            ax[i, j].semilogy(panels.t_days, sig, "C3", label=r"3$\sigma$")
+            ax[i, j].semilogy(panels.t_days, sig, "C1", label=r"3$\sigma$")
             _mark(ax[i, j], burn, dets)
             ax[i, j].set_ylabel(lab)
         ax[0, j].set_title(f"{title}: {name}")
@@ -829,7 +843,7 @@ def figure_errors(panels: PanelSeries, title: str, *, burn_days=None, detection_
 def figure_control_metric(panels: PanelSeries, title: str, *, burn_days=None, detection_days=(),
                           first_pass_metric=None, first_pass_until=None):
     """Figs. 7, 9, 11, 13 layout: control norm (top) and normalised OCBE metric (bottom), forward (left) and
-    smoothed (right); the metric with its mean (red) and the 99 % limit (dashed), as in the paper.
+    smoothed (right); the metric (blue) with its mean (red) and the 99 % limit (dashed), as in the paper.
 
     Parameters
     ----------
@@ -867,7 +881,7 @@ def figure_control_metric(panels: PanelSeries, title: str, *, burn_days=None, de
             ax[1, j].semilogy(panels.t_days[:until + 1], fp[:until + 1] / panels.limit[:until + 1], "x",
                               color="0.4", ms=5, label="before the reset")
         ax[1, j].semilogy(panels.t_days, norm[j], "C0.-", ms=3, lw=0.8, label="metric / limit")
-        ax[1, j].plot(panels.t_days, panels.mean_line, "C3", lw=1.2, label="mean / limit")
+        ax[1, j].plot(panels.t_days, panels.mean_line, "C1", lw=1.2, label="mean / limit")
         ax[1, j].axhline(1.0, color="k", ls="--", lw=0.8, label="99 % limit")
         ax[1, j].set(ylabel="normalised OCBE metric [-]", xlabel="time from periapsis [d]")
         for i in range(2):

@@ -107,7 +107,7 @@ ax.loglog(steps, stm_err[-1] * (steps / steps[-1]) ** 2, "k:", lw=1, label=r"$\p
 ax.loglog(steps, stm_err[0] * steps[0] / steps, "k--", lw=1, label=r"$\propto 1/h$ (round-off)")
 ax.set_ylim(min(stm_err) / 10, 10 * max(stt_err))
 ax.set_xlabel("finite-difference step h [LU, LU/TU]")
-ax.set_ylabel("max relative error vs heyoka")
+ax.set_ylabel("max relative error vs heyoka [-]")
 ax.set_title("Variational equations vs finite differences, one 9:2 NRHO period")
 ax.legend()
 _ = plotting.save_figure(fig, "01_stm_stt_vs_finite_differences", output_dir=out)
@@ -220,22 +220,45 @@ _ = plotting.save_figure(fig, "01_dro_family_wolf_jones", output_dir=out)
 # through bifurcations). The 9:2 NRHO's hyperbolic pair has index $\approx -1.32$; continuing Moonward, that
 # index rises through $-1$ (a period-doubling boundary) and the orbits become linearly stable. The **stable NRHO**
 # is the member on that boundary, located by root finding on the half period, so its stability index is 1.
+#
+# **A second stable band.** Continuing the other way, away from the Moon, the hyperbolic pair turns elliptic again
+# over a band of members roughly halfway between the Moon and L2 (perilune radius about 13,000-17,000 km): the
+# flat stretch at $\nu = 1$ in the stability figure below. Greaves & Scheeres call their second orbit simply "a
+# stable NRHO" and their Table 1 is missing, so either band could be theirs. `orbits.stable_nrho_outer` returns the
+# band's most stable member (smallest margin $\max|{\rm Re}\,\nu_B| - 1$ of the Broucke indices), and we list the
+# family members that fall in the band.
 
 # %%
 stable = orbits.stable_nrho(em)
+outer = orbits.stable_nrho_outer(em)
 family = orbits.l2_southern_halo_family(em, step=HALO_STEP)
 rp = np.array([o.perilune_radius_km for o in family])
 nu = np.array([o.stability_index for o in family])
-for name, o in (("9:2 NRHO", nrho), ("stable NRHO", stable)):
+margin = np.array([np.max(np.abs(o.broucke_indices.real)) - 1.0 for o in family])  # < 0: linearly stable
+outer_band = [o for o, m in zip(family, margin) if m < 0 and o.perilune_radius_km > nrho.perilune_radius_km]
+band_rp = (min(o.perilune_radius_km for o in outer_band), max(o.perilune_radius_km for o in outer_band))
+for name, o in (("9:2 NRHO", nrho), ("stable NRHO", stable), ("outer band", outer)):
     print(f"{name:12s} x0 = [{o.x0[0]:.10f}, 0, {o.x0[2]:+.10f}, 0, {o.x0[4]:+.10f}, 0]  T = {o.period_days:.6f} d"
           f"  rp = {o.perilune_radius_km:8.1f} km  ra = {o.apolune_radius_km:8.1f} km  nu = {o.stability_index:.6f}"
           f"  C = {o.jacobi:.8f}  closure = {o.closure:.1e}")
 print(f"{len(family)} family members; worst closure {max(o.closure for o in family):.1e}")
+print(f"outer stable band: {len(outer_band)} family members with perilune {band_rp[0]:.0f}-{band_rp[1]:.0f} km, "
+      f"periods {min(o.period_days for o in outer_band):.2f}-{max(o.period_days for o in outer_band):.2f} d; "
+      f"most stable member: perilune {outer.perilune_radius_km:.0f} km, period {outer.period_days:.3f} d, "
+      f"Broucke margin {np.max(np.abs(outer.broucke_indices.real)) - 1:+.3f}")
+print(f"{'perilune [km]':>14} {'apolune [km]':>13} {'period [d]':>11} {'Broucke indices (Re)':>24}")
+for o in outer_band[:: max(1, len(outer_band) // 8)]:
+    print(f"{o.perilune_radius_km:14.0f} {o.apolune_radius_km:13.0f} {o.period_days:11.3f} "
+          f"{'  '.join(f'{b:+.3f}' for b in np.sort(o.broucke_indices.real))}")
 
 fig, ax = plt.subplots()
 ax.semilogy(rp, nu, "-", color="0.3", label="southern L2 halo family")
 ax.semilogy(nrho.perilune_radius_km, nrho.stability_index, "o", color="C0", ms=8, label="9:2 NRHO")
-ax.semilogy(stable.perilune_radius_km, stable.stability_index, "o", color="C1", ms=8, label="stable NRHO (nu = 1)")
+ax.semilogy(stable.perilune_radius_km, stable.stability_index, "o", color="C1", ms=8,
+            label="stable NRHO, inner band edge (nu = 1)")
+ax.axvspan(*band_rp, color="C2", alpha=0.15, label="outer stable band (family members)")
+ax.semilogy(outer.perilune_radius_km, outer.stability_index, "D", color="C2", ms=7,
+            label="stable NRHO, outer band (most stable)")
 ax.axvline(em.secondary_radius_km, color="0.6", ls=":", lw=1)
 ax.text(em.secondary_radius_km * 1.05, 2, "lunar radius", color="0.4", rotation=90)
 ax.set_xscale("log")
@@ -243,14 +266,20 @@ ax.set_xticks([2000, 3000, 5000, 10000, 20000, 50000])
 ax.xaxis.set_major_formatter(plt.matplotlib.ticker.ScalarFormatter())
 ax.xaxis.set_minor_formatter(plt.matplotlib.ticker.NullFormatter())
 ax.set_xlabel("perilune radius [km]")
-ax.set_ylabel(r"stability index $\nu$")
+ax.set_ylabel(r"stability index $\nu$ [-]")
 ax.set_title("Stability along the southern L2 halo family")
-ax.legend()
+ax.legend(loc="upper center", fontsize=8)
 _ = plotting.save_figure(fig, "01_halo_stability_vs_perilune", output_dir=out)
 
 # %% [markdown]
-# The analogue of Greaves & Scheeres' Fig. 2: NRHO members about the Moon with the two reference orbits
-# highlighted (Moon-centred axes, as in the paper).
+# The outer band is the flat stretch at $\nu = 1$ (shaded; its edges are resolved to the family's continuation
+# step, so the quick run's band is narrower than the full run's); its most stable member (green diamond) has a
+# perilune about five times higher than the 9:2 NRHO's and a period of about ten days. Inside the band
+# the stability index is exactly 1 and does not distinguish members; the Broucke indices printed above do
+# (all within $[-1, 1]$, the member chosen is the one farthest from both edges).
+#
+# The analogue of Greaves & Scheeres' Fig. 2: NRHO members about the Moon with the 9:2 NRHO and both stable
+# candidates highlighted (Moon-centred axes, as in the paper).
 
 # %%
 fig, axes = plotting.three_plane_axes(figsize=(13, 4.5))
@@ -258,7 +287,8 @@ nrho_like = [o for o in family if o.perilune_radius_km < 20000]
 for o in nrho_like[:: max(1, len(nrho_like) // 10)]:
     _, xs = o.sample(600)
     plotting.plot_three_planes(axes, xs, em, moon_centred=True, units="km", color="0.7", lw=0.7)
-for o, colour, lab in ((nrho, "C0", "9:2 NRHO"), (stable, "C1", "stable NRHO")):
+for o, colour, lab in ((nrho, "C0", "9:2 NRHO"), (stable, "C1", "stable NRHO (inner band)"),
+                       (outer, "C2", "stable NRHO (outer band)")):
     _, xs = o.sample(1500)
     plotting.plot_three_planes(axes, xs, em, moon_centred=True, units="km", color=colour, lw=1.6, label=lab)
 for plane, ax in axes.items():
@@ -267,7 +297,7 @@ for plane, ax in axes.items():  # tick labels in thousands of km, at most five p
     plotting.thousands_km_axes(ax, plane)
 handles, labels = axes["xy"].get_legend_handles_labels()
 fig.legend(handles, labels, loc="lower center", ncol=len(labels), frameon=False)  # below the panels, off the data
-fig.suptitle("Southern L2 NRHO family (grey) with the 9:2 (blue) and stable (red) reference orbits")
+fig.suptitle("Southern L2 NRHO family (grey) with the 9:2 (blue) and the two stable candidates (red, green)")
 fig.tight_layout(rect=(0, 0.07, 1, 1))
 _ = plotting.save_figure(fig, "01_nrho_family_fig2", output_dir=out)
 
@@ -348,6 +378,13 @@ table.add("stable NRHO stability index", 1.0, stable.stability_index,
 table.add("stable NRHO perilune radius [km] / period [d]", "Table 1 missing",
           f"{stable.perilune_radius_km:.1f} / {stable.period_days:.4f}", "not in paper",
           "Table 1 absent; any member of the stable band has index 1, we take its boundary")
+table.add("outer stable band of the L2 halo family: perilune radius [km]", "not discussed",
+          f"{band_rp[0]:.0f}-{band_rp[1]:.0f} ({len(outer_band)} family members)", "beyond paper",
+          f"members with every Broucke index in [-1, 1]; family step {HALO_STEP} (band edges to that resolution)")
+table.add("stable NRHO, outer band: perilune [km] / period [d] / stability index", "Table 1 missing",
+          f"{outer.perilune_radius_km:.0f} / {outer.period_days:.3f} / {outer.stability_index:.6f}", "not in paper",
+          "most stable member of the outer band (orbits.stable_nrho_outer); notebooks 09, 09b and 10 carry both "
+          "candidates")
 for c in checks:
     ok = c.periodic_as_printed
     table.add(f"W&J Table {c.table} {c.label}: closure of printed state", "periodic DRO", f"{c.raw_closure:.1e}",
