@@ -117,7 +117,7 @@ def _rtol(rtol) -> float:
 
 def _square(P, name):
     _name(name)
-    P = _checks.as_array(P, name)
+    P = _checks.as_array(P, name, min_size=1)
     if P.ndim < 2 or P.shape[-1] != P.shape[-2]:
         raise ValueError(f"{name} must be a square matrix (..., n, n); got shape {P.shape}")
     return P
@@ -371,14 +371,19 @@ def process_noise_lyapunov(system: CR3BP, x0, dt: float, q: float, *, rtol: floa
     """Reference :math:`Q` over one interval by integrating :math:`\\dot Q = A(t)Q + QA(t)^T + qGG^T` with scipy.
 
     ``x0`` (6,) is the reference state at the start, ``dt`` (TU) the interval, ``q`` the PSD in LU^2/TU^3.
-    Independent of heyoka: DOP853 on the state and the full 6x6 Q (42 equations).
+    Independent of heyoka: DOP853 on the state and the full 6x6 Q (42 equations).  A start inside a primary or a
+    reference trajectory that reaches the surface of the Moon or the Earth raises
+    :class:`cislunar.propagation.ImpactError` (terminal ``solve_ivp`` events on the squared distances).
     """
+    from .propagation import ImpactError, check_outside_primaries
+
     _check_system(system)
     x0 = _checks.as_state(x0, "x0", batch=False)
     dt = _checks.positive(dt, "dt")
     q = _checks.positive(q, "q", allow_zero=True)
     rtol = _checks.in_range(rtol, "rtol", 1e-16, 1e-2)
     atol = _checks.in_range(atol, "atol", 1e-20, 1e-2)
+    check_outside_primaries(system, x0, "x0")
     W = np.zeros((6, 6))
     W[3:, 3:] = q * np.eye(3)
 
@@ -388,7 +393,20 @@ def process_noise_lyapunov(system: CR3BP, x0, dt: float, q: float, *, rtol: floa
         A = system.jacobian(xs)
         return np.concatenate([system.eom(xs), (A @ Q + Q @ A.T + W).ravel()])
 
-    sol = solve_ivp(rhs, (0.0, dt), np.r_[x0, np.zeros(36)], method="DOP853", rtol=rtol, atol=atol)
+    def hit_moon(_t, y):
+        return (y[0] - 1.0 + system.mu) ** 2 + y[1] ** 2 + y[2] ** 2 - system.secondary_radius ** 2
+
+    def hit_earth(_t, y):
+        return (y[0] + system.mu) ** 2 + y[1] ** 2 + y[2] ** 2 - system.primary_radius ** 2
+
+    for ev in (hit_moon, hit_earth):
+        ev.terminal, ev.direction = True, -1.0
+    sol = solve_ivp(rhs, (0.0, dt), np.r_[x0, np.zeros(36)], method="DOP853", rtol=rtol, atol=atol,
+                    events=[hit_moon, hit_earth])
+    if sol.status == 1:
+        for body, te, ye in zip(("Moon", "Earth"), sol.t_events, sol.y_events):
+            if len(te):
+                raise ImpactError(body, float(te[0]), None, ye[0][:6])
     if not sol.success:  # pragma: no cover
         raise RuntimeError(f"solve_ivp failed: {sol.message}")
     return symmetrize(sol.y[6:, -1].reshape(6, 6))
@@ -474,12 +492,12 @@ class CovarianceHistory:
     innovation: np.ndarray
 
 
-def _as_sequence(arr, name, count, shape):
+def _as_sequence(arr, name, count, shape, context: str = ""):
     a = _checks.as_array(arr, name)
     if a.shape == shape:
         return np.broadcast_to(a, (count,) + shape)
     if a.shape != (count,) + shape:
-        raise ValueError(f"{name} must have shape {(count,) + shape} or {shape}; got {a.shape}")
+        raise ValueError(f"{name} must have shape {(count,) + shape} or {shape}{context}; got {a.shape}")
     return a
 
 
@@ -532,13 +550,14 @@ def _check_linear_system(P0, F, Q, H, R, *, chol_R: bool = False):
     if H.shape[-1] != n:
         raise ValueError(f"H must have shape (N, M, {n}) to match P0; got {H.shape}")
     N, M = H.shape[0], H.shape[1]
-    if N < 1:
-        raise ValueError("H must hold at least one measurement time")
+    if N < 1 or M < 1:
+        raise ValueError(f"H must hold at least one measurement time and component (N, M >= 1); got {H.shape}")
+    ctx = f" (N - 1 intervals from H {H.shape}, n from P0 {P0.shape})"
     F = _checks.as_array(F, "F")
     if N == 1 and F.size == 0:
         F = np.zeros((0, n, n))
-    F = _as_sequence(F, "F", N - 1, (n, n))
-    Q = _as_sequence(Q, "Q", N - 1, (n, n)) if np.size(Q) else np.zeros((0, n, n))
+    F = _as_sequence(F, "F", N - 1, (n, n), ctx)
+    Q = _as_sequence(Q, "Q", N - 1, (n, n), ctx) if np.size(Q) else np.zeros((0, n, n))
     if N > 1:
         Qs = symmetrize(Q)
         if np.max(np.abs(Q - Qs)) > 1e-8 * max(np.max(np.abs(Q)), 1e-300):
@@ -553,7 +572,7 @@ def _check_linear_system(P0, F, Q, H, R, *, chol_R: bool = False):
         except np.linalg.LinAlgError as exc:
             raise ValueError("Q must be positive semi-definite") from exc
         Q = Qs
-    R = _as_sequence(R, "R", N, (M, M))
+    R = _as_sequence(R, "R", N, (M, M), f" (N, M from H {H.shape})")
     LR = cholesky_spd(R, "R")
     R = symmetrize(R)
     return (P0, F, Q, H, R, LR) if chol_R else (P0, F, Q, H, R)

@@ -136,7 +136,7 @@ class CR3BPLPV:
     @staticmethod
     def planar(state6) -> np.ndarray:
         """``[x, y, z, vx, vy, vz]`` (..., 6) -> planar ``[x, y, vx, vy]`` (..., 4); rejects non-planar states."""
-        s = _checks.as_array(state6, "state6", last=6)
+        s = _checks.as_array(state6, "state6", last=6, min_size=1)
         if np.any(np.abs(s[..., [2, 5]]) > 1e-12):
             raise ValueError("state6 must be planar (z = vz = 0)")
         return s[..., [0, 1, 3, 4]]
@@ -144,7 +144,7 @@ class CR3BPLPV:
     @staticmethod
     def spatial(state4) -> np.ndarray:
         """Planar ``[x, y, vx, vy]`` (..., 4) -> ``[x, y, 0, vx, vy, 0]`` (..., 6)."""
-        s = _checks.as_array(state4, "state4", last=4)
+        s = _checks.as_array(state4, "state4", last=4, min_size=1)
         out = np.zeros(s.shape[:-1] + (6,))
         out[..., [0, 1, 3, 4]] = s
         return out
@@ -210,7 +210,7 @@ class CR3BPLPV:
     # ------------------------------------------------------- vector fields
     def f(self, state) -> np.ndarray:
         """Nonlinear planar CR3BP vector field (..., 4), from :meth:`CR3BP.eom` (LU/TU, LU/TU^2)."""
-        s = _checks.as_array(state, "state", last=4)
+        s = _checks.as_array(state, "state", last=4, min_size=1)
         d = self.system.eom(self.spatial(s))
         return d[..., [0, 1, 3, 4]]
 
@@ -254,7 +254,7 @@ class CR3BPLPV:
         return {"A": A, "b": b, "C": C, "d": d}
 
     def _affine(self, key, rho):
-        r = _checks.as_array(rho, "rho", last=6)
+        r = _checks.as_array(rho, "rho", last=6, min_size=1)
         coef = self.affine_coefficients()[key]
         return coef[0] + np.tensordot(r, coef[1:], axes=(-1, 0))
 
@@ -276,20 +276,20 @@ class CR3BPLPV:
 
     def d_as_printed_eq23(self, rho) -> np.ndarray:
         """The paper's Eq. 23 :math:`d(\\rho)` as printed, kept only to show (in tests) that it is inconsistent."""
-        r = _checks.as_array(rho, "rho", last=6)
+        r = _checks.as_array(rho, "rho", last=6, min_size=1)
         mu = self.mu
         z = np.zeros(r.shape[:-1])
         return np.stack([z, r[..., 2], z, -r[..., 3], r[..., 4] + 2 * mu, r[..., 4] + 2 * mu - 2], axis=-1)
 
     def lpv_rhs(self, state, rho=None) -> np.ndarray:
         """:math:`A(\\rho)x + b(\\rho)` (..., 4) with :math:`\\rho` from ``state`` unless given."""
-        s = _checks.as_array(state, "state", last=4)
+        s = _checks.as_array(state, "state", last=4, min_size=1)
         r = self.rho(s) if rho is None else rho
         return np.einsum("...ij,...j->...i", self.A(r), s) + self.b(r)
 
     def lpv_measure(self, state, rho=None) -> np.ndarray:
         """:math:`C(\\rho)x + d(\\rho)` (..., 6) with :math:`\\rho` from ``state`` unless given."""
-        s = _checks.as_array(state, "state", last=4)
+        s = _checks.as_array(state, "state", last=4, min_size=1)
         r = self.rho(s) if rho is None else rho
         return np.einsum("...ij,...j->...i", self.C(r), s) + self.d(r)
 
@@ -774,7 +774,8 @@ class PrecisionLMI:
             raise ValueError(f"A_vertices must have shape (n_v >= 1, nx, nx); got {A_v.shape}")
         C_all = _checks.as_array(C_vertices, "C_vertices", ndim=(3,))
         if C_all.shape[0] != A_v.shape[0] or C_all.shape[2] != nx:
-            raise ValueError(f"C_vertices must have shape ({A_v.shape[0]}, ny, {nx}); got {C_all.shape}")
+            raise ValueError(f"C_vertices must have shape ({A_v.shape[0]}, ny, {nx}) to match A_vertices "
+                             f"{A_v.shape}; got {C_all.shape}")
         ny = C_all.shape[1]
         norm = _checks.choice(norm, "norm", _NORMS)
         objective = _checks.choice(objective, "objective", tuple(_OBJECTIVES))
@@ -786,9 +787,13 @@ class PrecisionLMI:
         Bd = _checks.as_array(Bd, "disturbance Bd", ndim=(2,))
         nd = Bd.shape[1]
         if Bd.shape[0] != nx:
-            raise ValueError(f"disturbance Bd must have {nx} rows; got shape {Bd.shape}")
+            raise ValueError(f"disturbance Bd must have {nx} rows (nx of A_vertices {A_v.shape}); got shape "
+                             f"{Bd.shape}")
         Sd = _checks.as_array(Sd, "disturbance Sd", shape=(nd, nd))
-        Dd = _checks.as_array(Dd, "disturbance Dd", shape=(ny, nd))
+        Dd = _checks.as_array(Dd, "disturbance Dd", ndim=(2,))
+        if Dd.shape != (ny, nd):
+            raise ValueError(f"disturbance Dd must have shape ({ny}, {nd}) (ny from C_vertices {C_all.shape}, nd from "
+                             f"Bd {Bd.shape}); got {Dd.shape}")
         Cz = np.eye(min(2, nx), nx) if Cz is None else _checks.as_array(Cz, "Cz", ndim=(2,), last=nx)
         if sensors is None:
             sensors = list(range(ny))

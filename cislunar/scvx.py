@@ -293,6 +293,8 @@ def concave_part(H, floor: float = 0.0) -> np.ndarray:
         ``L = V diag(sqrt(max(-lambda, floor max|lambda|)))`` from ``H = V diag(lambda) V^T``.
     """
     H = _checks.square(H, "H")
+    if H.size == 0:
+        raise ValueError("H must be a non-empty square matrix; got shape (0, 0)")
     floor = _checks.positive(floor, "floor", allow_zero=True)
     lam, V = np.linalg.eigh(0.5 * (H + H.T))
     lo = floor * float(np.max(np.abs(lam))) if lam.size else 0.0

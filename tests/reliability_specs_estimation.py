@@ -20,7 +20,9 @@ MODULES = [covariance, information, discretization, scvx, reference, lpv, observ
 # Output containers (CovarianceHistory, AugmentedLinearization, ObjectArcs, FOHModel, SCvxResult, SCvxError,
 # SweepResult, TimingResult, RowCheck, ObserverDesign, Verification, ResonantOrbit, Scenario, SensitivityStudy,
 # ObserverRun, InfeasibleLMIError) are built by the package and are not input boundaries; their public methods that
-# take arguments are swept below.  Every module-level public function has a spec.
+# take arguments are swept below.  Every module-level public function has a spec.  Arguments that accept any
+# square matrix (symmetrize, concave_part) or any planar state/position stack (CR3BPLPV.rho, angles, measure) are
+# swept with "arr_finite" (their shape refusals are tested in tests/test_validation_estimation.py).
 EXEMPT: dict = {}
 
 X_DRO = np.array([0.8, 0.0, 0.0, 0.0, 0.52, 0.0])
@@ -146,7 +148,7 @@ def specs(Spec, lazy):
 
     # ------------------------------------------------------------------------------------------- covariance
     C = covariance
-    s.append(S("symmetrize", C.symmetrize, dict(P=SPD3, name="P"), dict(P="arr", name="instance_str")))
+    s.append(S("symmetrize", C.symmetrize, dict(P=SPD3, name="P"), dict(P="arr_finite", name="instance_str")))
     for name in ("check_spd", "cholesky_spd"):
         s.append(S(name, getattr(C, name), dict(P=SPD3, name="P", rtol=1e-8),
                    dict(P="spd", name="instance_str", rtol="nonneg")))
@@ -253,7 +255,7 @@ def specs(Spec, lazy):
                dict(system="system", t_nodes="grid", x_guess="arr", u_guess="arr", u_max="arr",
                     x_final="state_opt", info="callable_opt", info_node="int0_opt", constraints="instance_opt",
                     alpha="range:0:1", settings="instance_opt", solver="choice", progress="bool")))
-    s.append(S("concave_part", scvx.concave_part, dict(H=-SPD3, floor=0.0), dict(H="arr", floor="nonneg")))
+    s.append(S("concave_part", scvx.concave_part, dict(H=-SPD3, floor=0.0), dict(H="arr_finite", floor="nonneg")))
     s.append(S("finite_difference_hessian", scvx.finite_difference_hessian,
                dict(gradient=lambda x: 2.0 * np.asarray(x), x=np.array([0.1, 0.2]), step=1e-5, g0=None),
                dict(gradient="callable", x="vec", step="pos", g0="arr_opt")))
@@ -277,8 +279,11 @@ def specs(Spec, lazy):
     s.append(S("CR3BPLPV", lpv.CR3BPLPV, dict(system=em), dict(system="system")))
     s.append(S("CR3BPLPV.planar", MODEL.planar, dict(state6=X_DRO), dict(state6="state")))
     s.append(S("CR3BPLPV.spatial", MODEL.spatial, dict(state4=S_PLANAR[0]), dict(state4="arr")))
-    for meth in ("rho", "angles", "f", "measure"):
-        s.append(S(f"CR3BPLPV.{meth}", getattr(MODEL, meth), dict(state=S_PLANAR[0]), dict(state="arr")))
+    # rho, angles and measure take planar states (..., 4) or positions (..., 2): any such shape is valid, so the
+    # shape cases are in tests/test_validation_estimation.py
+    for meth in ("rho", "angles", "measure"):
+        s.append(S(f"CR3BPLPV.{meth}", getattr(MODEL, meth), dict(state=S_PLANAR[0]), dict(state="arr_finite")))
+    s.append(S("CR3BPLPV.f", MODEL.f, dict(state=S_PLANAR[0]), dict(state="arr")))
     s.append(S("CR3BPLPV.rho_from_angles", MODEL.rho_from_angles, dict(theta1=0.3, theta2=0.5),
                dict(theta1="arr_finite", theta2="arr_finite")))
     for meth in ("A", "b", "C", "d", "d_as_printed_eq23"):
