@@ -288,7 +288,8 @@ class StationKeepingSurface:
                                  f"theta.size); got {a.shape}")
             return a
 
-        for name, shape, what in (("dv1", (nt, nth, 3), "(n_t, n_theta, 3)"), ("dv2", (nt, nth, 3), "(n_t, n_theta, 3)"),
+        for name, shape, what in (("dv1", (nt, nth, 3), "(n_t, n_theta, 3)"),
+                                  ("dv2", (nt, nth, 3), "(n_t, n_theta, 3)"),
                                   ("range_sigma_km", (nt, nth), "(n_t, n_theta)"),
                                   ("range_sigma_at_arrival_km", (nt, nth), "(n_t, n_theta)"),
                                   ("u_y", (nt, 3), "(n_t, 3)"), ("alignment", (nt, nth), "(n_t, n_theta)"),

@@ -83,7 +83,8 @@ def test_free_period_continuation_needs_one_held_constraint():
 
 def test_integer_arguments_are_not_truncated():
     torus = _torus()
-    for call, name in ((lambda: torus.ring(0.0, 2.9), "n_theta"), (lambda: tm.mean_range(torus, periods=1.5), "periods"),
+    for call, name in ((lambda: torus.ring(0.0, 2.9), "n_theta"),
+                       (lambda: tm.mean_range(torus, periods=1.5), "periods"),
                        (lambda: tm.mean_range(torus, n_t=20.5), "n_t"),
                        (lambda: torus.closest_approach(n_theta=True), "n_theta")):
         with pytest.raises((TypeError, ValueError), match=name):
