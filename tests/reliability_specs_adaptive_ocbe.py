@@ -109,7 +109,7 @@ def specs(Spec, lazy):
                                           k["meas_cov"])
 
     s.append(S("PanelSeries.spike_contrast", lazy(lambda: _panels().spike_contrast),
-               dict(t_days=0.5, half_width_days=0.3), dict(t_days="real", half_width_days="pos")))
+               dict(t_days=1.0, half_width_days=0.3), dict(t_days="real", half_width_days="pos")))
     s.append(S("figure_errors", adaptive_ocbe.figure_errors,
                dict(panels=lazy(_panels), title="t", burn_days=0.5, detection_days=[1.0], velocity_unit="mm/s"),
                dict(panels="instance", title="instance_str", burn_days="real_opt", detection_days="arr_finite",
