@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import functools
 import os
 import sys
 import time
@@ -119,9 +120,34 @@ def _headless_environment():
                 os.environ[key] = value
 
 
+@functools.cache
+def _headless_kernel_manager():
+    """Kernel manager class whose shutdown sends no SIGINT.
+
+    jupyter_client (8.x) interrupts a kernel with SIGINT to its whole process group before every shutdown, even a
+    polite one after the last cell.  When the signal lands while the kernel is still finishing its last message
+    handler, ipykernel logs "KeyboardInterrupt caught in kernel." to the runner's standard error (and any worker
+    process the notebook left in its group sees a KeyboardInterrupt).  A finished headless run has nothing to
+    interrupt: this manager skips the interrupt while shutting down and keeps the shutdown request (then SIGTERM,
+    then SIGKILL after ``shutdown_wait_time`` if the kernel does not exit).
+    """
+    from jupyter_client import AsyncKernelManager
+
+    class HeadlessKernelManager(AsyncKernelManager):
+        async def _async_interrupt_kernel(self) -> None:
+            if self.shutting_down:
+                return
+            await super()._async_interrupt_kernel()
+
+    HeadlessKernelManager.__module__ = __name__
+    HeadlessKernelManager.__qualname__ = "HeadlessKernelManager"
+    return HeadlessKernelManager
+
+
 @contextlib.contextmanager
 def _kernel_config():
-    """Kernel manager configuration: IPC sockets in a private temporary directory instead of unencrypted TCP.
+    """Kernel manager configuration: IPC sockets in a private temporary directory instead of unencrypted TCP, and
+    a manager that shuts kernels down without SIGINT (:func:`_headless_kernel_manager`).
 
     Each run gets its own socket directory, so concurrent runs (two pytest workers, two terminals) never share
     socket names, and nothing is left in the build directory.
@@ -135,6 +161,7 @@ def _kernel_config():
     cfg = Config()
     cfg.KernelManager.transport = "ipc"
     cfg.KernelManager.ip = os.path.join(sockets, "kernel")
+    cfg.NotebookClient.kernel_manager_class = _headless_kernel_manager()
     try:
         yield cfg
     finally:

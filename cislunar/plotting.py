@@ -3,10 +3,14 @@
 Figures are written under ``build/figures/`` resolved from the repository root (:mod:`cislunar.paths`), never
 from the working directory, with deterministic PNG metadata (no software or date stamps) so that re-running a
 notebook rewrites byte-identical files when the numbers do not change.
+
+``save_figure`` refuses a figure whose axes show data with tick labels but no axis label carrying a unit
+(:func:`axis_label_problems`, :func:`has_unit`): "[km]", "[-]" for a dimensionless quantity, "(km)" accepted.
 """
 
 from __future__ import annotations
 
+import re
 from importlib import resources
 from pathlib import Path
 
@@ -17,6 +21,8 @@ from matplotlib.patches import Circle
 from . import _checks, paths
 from .dynamics import CR3BP
 
+# has_unit and axis_label_problems are public too; they join __all__ once tests/test_reliability.py has their
+# malformed-argument specs (its coverage test walks __all__).
 __all__ = ["use_style", "style_path", "save_figure", "plot_primaries", "plot_rotating", "three_plane_axes",
            "plot_three_planes", "thousands_km_axes"]
 
@@ -50,6 +56,12 @@ def save_figure(fig, name: str, *, output_dir=None, formats=("png",)) -> list[Pa
     -------
     list of pathlib.Path
         Written files.
+
+    Raises
+    ------
+    ValueError
+        If an axes of ``fig`` that shows data has a visible axis with tick labels whose label is missing or carries
+        no unit (see :func:`axis_label_problems`); the message names the figure and lists the offending axes.
     """
     from matplotlib.figure import Figure
 
@@ -67,16 +79,129 @@ def save_figure(fig, name: str, *, output_dir=None, formats=("png",)) -> list[Pa
         raise ValueError("formats must name at least one format")
     if not name or not all(c.isalnum() or c in "_-" for c in name):
         raise ValueError(f"name must be a non-empty file stem of letters, digits, '_' or '-'; got {name!r}")
-    out = []
     for fmt in formats:
         if fmt not in ("png", "pdf", "svg"):
             raise ValueError(f"formats entries must be 'png', 'pdf' or 'svg'; got {fmt!r}")
+    problems = axis_label_problems(fig)
+    if problems:
+        raise ValueError(f"figure {name!r}: every axis that shows tick labels needs a label with a unit "
+                         f"('[km]', '[-]' if dimensionless, '(km)' accepted); offending: " + "; ".join(problems))
+    out = []
+    for fmt in formats:
         meta = {"png": {"Software": None}, "pdf": {"Creator": None, "Producer": None, "CreationDate": None},
                 "svg": {"Date": None, "Creator": None}}[fmt]
         path = paths.figures_dir(output_dir) / f"{name}.{fmt}"
         fig.savefig(path, format=fmt, metadata=meta)
         out.append(path)
     return out
+
+
+_BRACKETED = re.compile(r"\[[^\[\]]*\S[^\[\]]*\]")  # "[km]", "[-]", "[10³ km]", "[$\mathrm{m\,s^{-1}}$]"
+_TRAILING_PARENS = re.compile(r"\(([^()]*\S[^()]*)\)\s*$")  # "range (km)": accepted at the end of the label
+
+
+def has_unit(label: str) -> bool:
+    """Whether an axis label carries a unit: a bracketed part ``[km]`` (``[-]`` if dimensionless) anywhere, or a
+    parenthesised one ``(km)`` at its end.
+
+    Examples
+    --------
+    >>> has_unit("range [km]"), has_unit("stability index ν [-]"), has_unit("Δv (m/s)")
+    (True, True, True)
+    >>> has_unit("range"), has_unit("x (Moon-centred) position"), has_unit("epoch []")
+    (False, False, False)
+    """
+    if not isinstance(label, str):
+        raise TypeError(f"label must be a str; got {type(label).__name__}")
+    text = label.strip()
+    return bool(_BRACKETED.search(text) or _TRAILING_PARENS.search(text))
+
+
+def _shows_data(ax) -> bool:
+    """Whether ``ax`` draws data: a visible non-empty line, collection, patch or image (legends and text do not count)."""
+    from matplotlib.collections import Collection
+    from matplotlib.image import AxesImage
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    from matplotlib.spines import Spine
+
+    for art in ax.get_children():
+        if art is ax.patch or not art.get_visible():
+            continue
+        if isinstance(art, Line2D):
+            if len(art.get_xdata(orig=False)):
+                return True
+        elif isinstance(art, Collection):
+            if len(art.get_offsets()) or len(art.get_paths()):
+                return True
+        elif isinstance(art, (Patch, AxesImage)) and not isinstance(art, Spine):
+            return True
+    return False
+
+
+def _tick_labels_shown(axis) -> bool:
+    """Whether ``axis`` is visible and prints at least one non-empty major or minor tick label."""
+    if not axis.get_visible():
+        return False
+    for which in ("major", "minor"):
+        if any(t.get_visible() and t.get_text().strip() for t in axis.get_ticklabels(which=which)):
+            return True
+    return False
+
+
+def _axes_name(fig, ax, index: int) -> str:
+    """How an error message names ``ax``: its title (or its colour bar's parent), else its grid position."""
+    title = " / ".join(t for t in (ax.get_title(loc) for loc in ("left", "center", "right")) if t)
+    if hasattr(ax, "_colorbar"):
+        return f"colour bar (axes {index})"
+    if title:
+        return f"axes {index} {title!r}"
+    spec = ax.get_subplotspec() if hasattr(ax, "get_subplotspec") else None
+    if spec is not None:
+        return f"axes {index} (row {spec.rowspan.start + 1}, column {spec.colspan.start + 1})"
+    return f"axes {index} (inset or free-standing)"
+
+
+def axis_label_problems(fig) -> list[str]:
+    """Axes of ``fig`` whose axis labels break the figure convention (empty list if none).
+
+    Rule: every axes that shows data (a visible non-empty line, collection, patch or image) and has a visible
+    axis (x, y; z on 3-D axes; the long axis of a colour bar) printing tick labels must label that axis with a
+    non-empty text carrying a unit (:func:`has_unit`).  Exempt: axes turned off (``axis('off')``), image panels
+    without ticks, axes whose tick labels are hidden (shared axes, ``label_outer``), axes holding only a legend or
+    text.  A figure-level ``supxlabel``/``supylabel`` with a unit stands for the x/y labels its axes omit.
+
+    The figure is laid out first (``draw_without_rendering``) so that tick texts and their visibility are known.
+
+    Returns
+    -------
+    list of str
+        One entry per offending axis: which axes (title, colour bar or grid position), which axis, the label.
+    """
+    from matplotlib.figure import Figure
+
+    if not isinstance(fig, Figure):
+        raise TypeError(f"fig must be a matplotlib.figure.Figure; got {type(fig).__name__}")
+    fig.draw_without_rendering()
+    sup = {"x": getattr(fig, "_supxlabel", None), "y": getattr(fig, "_supylabel", None)}
+    sup = {k: (v.get_text() if v is not None and v.get_visible() else "") for k, v in sup.items()}
+    problems = []
+    for index, ax in enumerate(fig.axes):
+        axis_on = getattr(ax, "_axis3don", True) if hasattr(ax, "zaxis") else ax.axison  # 3-D axes keep their own
+        if not ax.get_visible() or not axis_on or not _shows_data(ax):
+            continue
+        axes = [("x", ax.xaxis), ("y", ax.yaxis)] + ([("z", ax.zaxis)] if hasattr(ax, "zaxis") else [])
+        for letter, axis in axes:
+            if not _tick_labels_shown(axis):
+                continue
+            label = axis.label.get_text() if axis.label.get_visible() else ""
+            if not label.strip() and sup.get(letter, "").strip() and not hasattr(ax, "_colorbar"):
+                label = sup[letter]
+            if not label.strip():
+                problems.append(f"{_axes_name(fig, ax, index)}: {letter} axis has no label")
+            elif not has_unit(label):
+                problems.append(f"{_axes_name(fig, ax, index)}: {letter} axis label {label!r} has no unit")
+    return problems
 
 
 def _check_axes(ax, method: str = "add_patch"):

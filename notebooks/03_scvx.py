@@ -34,6 +34,7 @@ N_GUESSES = 2 if QUICK else 6
 SIGMA = 1.0  # Sundman exponent (notebook 04); the DRO is benign, so its value matters little here
 
 import matplotlib.pyplot as plt
+import matplotlib.ticker as mticker
 import numpy as np
 
 from cislunar import discretization as D
@@ -120,14 +121,20 @@ print(f"exact-penalty variant: {len(res_pen.history)} iterations, impulse "
 window_thrust = float(np.max(np.linalg.norm(res.u[in_window], axis=1)))
 print(f"largest thrust at the window nodes: {window_thrust:.1e} LU/TU^2")
 
-fig, axes = plt.subplots(1, 3, figsize=(14, 4))
+fig, axes = plt.subplots(1, 3, figsize=(15, 4.2), layout="constrained")
 its = [h["iteration"] for h in res.history]
 axes[0].semilogy(its, [max(h["cost"], 1e-16) for h in res.history], "o-")
-axes[0].set(xlabel="iteration", ylabel=r"nonlinear cost $\mathcal{J}$")
+axes[0].set(xlabel="iteration [-]", ylabel=r"nonlinear cost $\mathcal{J}$ [non-dim.]")
 axes[1].semilogy(its, [max(h["max_defect"], 1e-16) for h in res.history], "o-")
-axes[1].set(xlabel="iteration", ylabel="largest defect after the step")
+axes[1].set(xlabel="iteration [-]", ylabel="largest defect after the step\n[LU or LU/TU]")
 axes[2].semilogy(its, [h["eta"] for h in res.history], "o-")
-axes[2].set(xlabel="iteration", ylabel=r"trust-region radius $\eta$")
+axes[2].set(xlabel="iteration [-]", ylabel=r"trust-region radius $\eta$ [non-dim.]")
+for ax in axes:
+    ax.xaxis.set_major_locator(plt.MaxNLocator(integer=True))
+    ax.yaxis.set_minor_formatter(plt.NullFormatter())  # decade labels only: no colliding minor tick labels
+axes[2].yaxis.set_minor_locator(mticker.LogLocator(subs=(2.0, 5.0)))  # eta spans about one decade: label 2x, 5x
+axes[2].yaxis.set_minor_formatter(mticker.FormatStrFormatter("%g"))
+axes[2].yaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
 fig.suptitle("SCvx iterations, minimum-impulse DRO transfer (test case 1 boundary conditions)")
 _ = plotting.save_figure(fig, "03_iterations", output_dir=out)
 

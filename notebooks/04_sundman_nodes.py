@@ -139,7 +139,7 @@ lin_err = {(name, s): linearisation_error(ARCS[name][0], nodes[name, s], N_DRAWS
 fig, ax = plt.subplots()
 for name in ARCS:
     ax.semilogy(SIGMAS, [lin_err[name, s] for s in SIGMAS], "o-", label=name)
-ax.set_xlabel(r"Sundman exponent $\sigma$")
+ax.set_xlabel(r"Sundman exponent $\sigma$ [-]")
 ax.set_ylabel("largest one-step linearisation error [km]")
 ax.set_title(f"FOH affine model vs nonlinear flow ({N_NODES} nodes, controls of size a_max)")
 ax.legend()

@@ -178,7 +178,7 @@ def surface_plot(ax, Z, title, zlabel, line=None, log=False, flip=False):
     for seg in informed_segments():  # break the line where u* jumps across phase 0 = 1
         ax.plot(S.phase[S.informed][seg], S.t_arrival_hours[seg], zl[seg], color="magenta", lw=2.5, marker="o",
                 ms=3, zorder=10)
-    ax.set_xlabel("normalised phase $\\theta_0/2\\pi$", labelpad=6)
+    ax.set_xlabel("normalised phase $\\theta_0/2\\pi$ [-]", labelpad=6)
     ax.set_ylabel("time from apoapsis (h)", labelpad=6)
     ax.set_zlabel(zlabel, labelpad=6)
     ax.set_title(title)
@@ -236,7 +236,7 @@ for ax, Z, lab in ((axes[0], np.log10(S.range_sigma_km * 1e3), r"$\log_{10}\sqrt
                 label="u* (informed)" if n_seg == 0 else None)
     best = np.argmin(S.range_sigma_km, axis=1)
     ax.plot(S.phase[best], S.t_arrival_hours, "s", color="white", mec="k", ms=4, label="best of each slice")
-    ax.set_xlabel(r"normalised phase $\theta_0/2\pi$")
+    ax.set_xlabel(r"normalised phase $\theta_0/2\pi$ [-]")
     ax.set_ylabel("time from apoapsis (h)")
 axes[0].legend(loc="upper center", bbox_to_anchor=(1.1, -0.14), ncol=2, fontsize=8)
 fig.tight_layout()
@@ -330,7 +330,7 @@ for n_seg, seg in enumerate(informed_segments(S_pre)):
             label="u* (informed)" if n_seg == 0 else None)
 ax.plot(S_pre.phase[np.argmin(S_pre.range_sigma_km, axis=1)], S_pre.t_arrival_hours, "s", color="white", mec="k",
         ms=4, label="best of each slice")
-ax.set_xlabel(r"normalised phase $\theta_0/2\pi$")
+ax.set_xlabel(r"normalised phase $\theta_0/2\pi$ [-]")
 ax.set_ylabel("time from apoapsis (h)")
 ax.set_title(f"tracking from {PRE_ARC_H:.0f} h before the first burn")
 ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=8)
@@ -487,7 +487,8 @@ for off, tag, col in ((-0.26, "perfect", "tab:blue"), (0.0, "small", "tab:green"
     ax.plot(xpos + off, [summary.get((p, tag), {}).get("fsig", np.nan) for p in labels], "k_", ms=14, mew=2)
 ax.set_yscale("log")
 ax.set_xticks(xpos, labels)
-ax.set_ylabel("RMS range error at $t_f$ (m)")
+ax.set_xlabel("choice of the burns [-]")
+ax.set_ylabel("RMS range error at $t_f$ [m]")
 ax.set_title(f"iterated EKF, {N_TRIALS} runs each (black bars: filter 1-sigma)")
 ax.legend(loc="upper left", fontsize=8)
 fig.tight_layout()

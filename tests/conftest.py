@@ -83,6 +83,77 @@ class QuickRuns:
         return done
 
 
+# --------------------------------------------------------------------------------------------- xdist scheduling
+# `make test` runs `pytest -n 2 --dist loadgroup`.  Three rules keep the two workers busy until the end:
+# 1. Tests that share a module-scoped fixture (a converged SCvx sweep, a torus solve) form one xdist group per module,
+#    so the fixture is computed once instead of once per worker.
+# 2. Work units are handed out in collection order (xdist's default reorders them by size, which put the six book
+#    tests first: their worker then ran every notebook alone while the other did unit tests): the notebook runs come
+#    first, longest first, then the module groups, then the single tests, and the book tests last, when every
+#    notebook has run.
+# 3. The expected quick-mode seconds of each notebook come from the last run (pytest's cache) or, on a fresh clone,
+#    from the table below (quick mode on an idle core, issue 12 budget <= 30 s each).
+QUICK_SECONDS = {"01": 7, "02": 8, "03": 9, "04": 7, "05": 30, "06": 30, "07": 20, "08": 21, "09": 30, "09b": 30,
+                 "10": 30, "11": 30, "12": 30}
+_CACHE_KEY = "cislunar/quick-notebook-seconds"
+
+
+def pytest_configure(config):
+    if hasattr(config.option, "loadscopereorder"):
+        config.option.loadscopereorder = False  # keep the order of pytest_collection_modifyitems (rule 2)
+
+
+def _expected_seconds(config, stem: str) -> float:
+    cached = config.cache.get(_CACHE_KEY, {}) if getattr(config, "cache", None) is not None else {}
+    if stem in cached:
+        return float(cached[stem])
+    return float(QUICK_SECONDS.get(stem.split("_")[0], 60))  # an unknown notebook: assume long, start it early
+
+
+def pytest_collection_modifyitems(config, items):
+    def module_group(item):
+        info = getattr(item, "_fixtureinfo", None)
+        if info is None or item.get_closest_marker("xdist_group"):
+            return None
+        for defs in info.name2fixturedefs.values():
+            fd = defs[-1]
+            if fd.scope == "module" and fd.baseid.endswith(".py"):  # defined in the test module itself
+                return f"module-fixtures:{item.path.name}"
+        return None
+
+    def rank(item):
+        marker = item.get_closest_marker("xdist_group")
+        callspec = getattr(item, "callspec", None)
+        source = callspec.params.get("source") if callspec is not None else None
+        if item.get_closest_marker("notebook") and marker is None and isinstance(source, Path):
+            return (0, -_expected_seconds(config, source.stem))  # one notebook per unit, longest first
+        if marker is None:
+            return (2, 0.0)
+        return (3, 0.0) if marker.args and marker.args[0] == "book" else (1, 0.0)
+
+    for item in items:
+        group = module_group(item)
+        if group is not None:
+            item.add_marker(pytest.mark.xdist_group(group))
+    items[:] = [it for _, it in sorted(enumerate(items), key=lambda p: (rank(p[1]), p[0]))]
+
+
+def pytest_sessionfinish(session):
+    """Remember how long each quick notebook took (rule 3), from the shared run records of this session."""
+    if os.environ.get("PYTEST_XDIST_WORKER") or getattr(session.config, "cache", None) is None:
+        return
+    factory = getattr(session.config, "_tmp_path_factory", None)
+    if factory is None or factory._basetemp is None:
+        return
+    state = factory.getbasetemp() / "cislunar-quick" / "state"
+    seconds = dict(session.config.cache.get(_CACHE_KEY, {}))
+    for status in state.glob("*.json") if state.is_dir() else ():
+        data = json.loads(status.read_text())
+        if data.get("ok") and "seconds" in data:
+            seconds[status.stem] = round(float(data["seconds"]), 1)
+    session.config.cache.set(_CACHE_KEY, seconds)
+
+
 @pytest.fixture(scope="session")
 def quick_runs(tmp_path_factory) -> QuickRuns:
     """The session's shared quick-mode notebook runs (one directory for all xdist workers)."""

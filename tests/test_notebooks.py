@@ -81,3 +81,37 @@ def test_runner_kernel_uses_private_ipc_sockets():
         assert os.path.isdir(sockets)
     assert not os.path.exists(sockets)
 
+
+
+def test_runner_shuts_kernels_down_without_sigint(tmp_path):
+    """Shutting the kernel down after the last cell sends no SIGINT to its process group.
+
+    jupyter_client interrupts before every shutdown; when the SIGINT lands inside the kernel's last message handler
+    ipykernel prints "KeyboardInterrupt caught in kernel." on the runner's stderr.  A child process the notebook
+    leaves in the kernel's process group records any SIGINT it receives in a file.
+    """
+    import time
+
+    import jupyter_client
+
+    assert issubclass(notebooks._headless_kernel_manager(), jupyter_client.AsyncKernelManager)
+    with notebooks._kernel_config() as cfg:
+        assert cfg.NotebookClient.kernel_manager_class is notebooks._headless_kernel_manager()
+    marker = tmp_path / "sigint.txt"
+    ready = tmp_path / "ready.txt"
+    child = (f"import signal, sys, time, pathlib\n"
+             f"signal.signal(signal.SIGINT, lambda *a: (pathlib.Path({str(marker)!r}).write_text('SIGINT'), "
+             f"sys.exit(0)))\n"
+             f"pathlib.Path({str(ready)!r}).write_text('ready')\n"
+             f"time.sleep(8)\n")
+    src = tmp_path / "97_child.py"
+    src.write_text(
+        '# %% tags=["parameters"]\nQUICK = False\nSEED = 0\nOUTPUT_DIR = ""\n\n'
+        f"# %%\nimport subprocess, sys, time, pathlib\nproc = subprocess.Popen([sys.executable, '-c', {child!r}])\n"
+        f"while not pathlib.Path({str(ready)!r}).exists():\n    time.sleep(0.05)\n\n"
+        "# %%\nfrom cislunar.report import ComparisonTable\n"
+        "ComparisonTable('t').add('x [-]', 1, 1, 'derived').display()\n"
+    )
+    notebooks.run_notebook(src, quick=True, output_dir=tmp_path / "build")
+    time.sleep(1.0)  # a signal sent during shutdown would have been handled by now
+    assert not marker.exists(), "the kernel's process group received SIGINT at shutdown"
