@@ -29,11 +29,14 @@ OUTPUT_DIR = ""
 
 # %%
 # Sizes derived from QUICK: fewer nodes and a coarser alpha_h grid in quick mode; the same experiments.
-N_NODES = 20 if QUICK else 40  # Sundman-spaced nodes over the two periods (the paper does not give its N)
+N_NODES = 18 if QUICK else 40  # Sundman-spaced nodes over the two periods (the paper does not give its N)
+N_NODES_ALT = 24 if QUICK else 28  # second grid of the mesh check (section 5)
 SIGMA = 1.0  # Sundman exponent (notebook 04)
-ALPHAS = ([0.0, 2e-3, 5e-3, 1e-2, 2e-2] if QUICK else
+ALPHAS = ([0.0, 5e-3, 1e-2] if QUICK else  # quick: the right panels of Figs. 1 and 3 show the grid's top
           [0.0, 1e-3, 2e-3, 3e-3, 5e-3, 7e-3, 1e-2, 1.5e-2, 2e-2])
-PENALTY_ITER = 25 if QUICK else 80  # iterations granted to the paper's exact-penalty SCvx in section 4
+PENALTY_ITER = 10 if QUICK else 80  # iterations granted to the paper's exact-penalty SCvx in section 4
+BUDGETS_EXTRA_MPS = [5.0] if QUICK else [1.0, 5.0, 20.0]  # impulse budgets above the baseline's (section 8)
+BUDGET_RTOL = 0.02  # a budget counts as met within 2 % (fixed before solving)
 
 import time
 
@@ -44,7 +47,7 @@ from scipy.stats import spearmanr
 
 from cislunar import covariance as cov
 from cislunar import discretization as D
-from cislunar import plotting, scvx, wolf_jones
+from cislunar import orbits, plotting, scvx, wolf_jones
 from cislunar.dynamics import EARTH_MOON as em
 from cislunar.propagation import ImpactError, propagate
 from cislunar.report import ComparisonTable
@@ -62,7 +65,8 @@ MPS = KM_S * 1e3
 # Observer and target fly neighbouring planar DROs. The observer starts on the DRO of Table 2's $x_{\mathcal S}(t_0)$,
 # flies two periods $P_{ref}$ and must end at the printed $x_{\mathcal S}(t_f)$ (a state on a third DRO). Inside the
 # observation window $[3P_{ref}/4, 3P_{ref}/2]$ it coasts ($a_{max} = 0$) and measures the target's relative position
-# once per day with 100 m noise per axis. Priors: 100 km and 1 cm/s per axis for both spacecraft (Table 3).
+# once per day with 100 m noise per axis. Priors: 100 km and $10^{-2}$ km/s = 10 m/s per axis for both spacecraft
+# (Table 3); a 10 m/s velocity error alone moves a position by 864 km in a day, the transient of Fig. 4.
 #
 # **The printed observer state is not a DRO.** Its $\dot y_0 = 0.528996986$ does not close (notebook 01): held at
 # the printed $x_0$, the periodic DRO has $\dot y_0 = 0.5559319$, a transcription slip in two digits is the likely
@@ -70,6 +74,11 @@ MPS = KM_S * 1e3
 # the two periods are over**; reaching $x_{\mathcal S}(t_f)$ from it with the window constraint costs tens of m/s
 # (computed below: essentially the 27.6 m/s velocity slip), where the corrected state needs well under 1 m/s
 # (section 5). We use the corrected state.
+#
+# **Which digit slipped, $x_0$ or $\dot y_0$?** Both readings give a DRO: hold $x_0$ and correct $\dot y_0$, or hold
+# the printed $\dot y_0$ and correct $x_0$. The paper's own day counts decide: its text puts test case 1's window
+# at "12 and 23 days" ($[3P/4, 3P/2]$) and test case 2's at "roughly 17 and 32 days" ($[P, 2P]$). Below, the
+# windows that each reading implies, judged with a tolerance of 1 day fixed before comparing.
 #
 # **Process noise.** Table 3 prints $Q = 10^{-11}$ "km/s³". Notebook 06 (and `cislunar.wolf_jones`) tries the
 # plausible readings against the paper's statement that the CRLB stays bounded over the window and adopts the
@@ -101,6 +110,20 @@ printed_transfer = scvx.solve_scvx(em, t_tmp, x_tmp, np.zeros((t_tmp.size, 3)), 
                                    x_final=sc.observer_xf)
 print(f"minimum-impulse transfer (alpha_h = 0) from the printed state to x_S(t_f): "
       f"{printed_transfer.impulse * MPS:.2f} m/s")
+# the two readings of the slip and the windows they imply (paper: 12-23 d for case 1, roughly 17-32 d for case 2)
+vy0_held = orbits.correct_symmetric(em, sc.observer_x0_printed + [0.02, 0, 0, 0, 0, 0], fix="vy0")
+readings = {"x0 held (vy0 corrected)": (sc.observer_x0, P),
+            "vy0 held (x0 corrected)": (vy0_held.x0, vy0_held.period)}
+paper_days = {"case 1": (12.0, 23.0), "case 2": (17.0, 32.0)}
+reading_miss = {}
+for name, (x0_r, P_r) in readings.items():
+    pd = em.tu_to_days(P_r)
+    w1, w2 = (0.75 * pd, 1.5 * pd), (pd, 2.0 * pd)
+    reading_miss[name] = max(abs(w1[0] - 12.0), abs(w2[0] - 17.0), abs(w2[1] - 32.0))
+    print(f"{name:<26}: x0 = {x0_r[0]:.7f}, vy0 = {x0_r[4]:.7f}, P = {pd:.2f} d -> case 1 window "
+          f"{w1[0]:.2f}-{w1[1]:.2f} d, case 2 window {w2[0]:.2f}-{w2[1]:.2f} d")
+print("largest miss of the paper's 12 (case 1), 17 and 32 days (case 2):",
+      {k: round(v, 2) for k, v in reading_miss.items()}, "(its '23 days' is missed by both readings)")
 
 # %% [markdown]
 # ## 2 · Nodes, thrust bounds and the information model
@@ -122,6 +145,8 @@ t, k_ws, k_we = sc.node_times(N_NODES, SIGMA)
 u_max = sc.control_bounds(t)
 x_ball, u_ball = sc.ballistic_guess(t)
 info = sc.information_model()
+if QUICK:  # quick mode: forward-difference Hessian (6 gradients instead of 12; it only shapes the trust-region model)
+    info.hessian_scheme = "forward"
 in_window = u_max == 0
 print(f"{N_NODES} nodes; window nodes {k_ws}..{k_we} (t = {em.tu_to_days(t[k_ws]):.3f}, {em.tu_to_days(t[k_we]):.3f} d);"
       f" node spacing {em.tu_to_days(np.diff(t)).min():.2f}-{em.tu_to_days(np.diff(t)).max():.2f} d")
@@ -207,24 +232,29 @@ its = [h["iteration"] for h in ha]
 axes[0].semilogy(its, [max(abs(h["predicted"]), 1e-16) for h in ha], "o-", ms=3, label="augmented Lagrangian")
 axes[0].semilogy([h["iteration"] for h in pen_history], [max(abs(h["predicted"]), 1e-16) for h in pen_history],
                  ".-", ms=3, color="C3", label="exact penalty")
-axes[0].set(xlabel="iteration", ylabel="|predicted decrease|")
+axes[0].set(xlabel="iteration [-]", ylabel="|predicted decrease| [-]")
 axes[0].legend(fontsize=8, loc="upper right")
 axes[1].semilogy(its, [h["eta"] for h in ha], "o-", ms=3)
 axes[1].semilogy([h["iteration"] for h in pen_history], [h["eta"] for h in pen_history], ".-", ms=3, color="C3")
-axes[1].set(xlabel="iteration", ylabel=r"trust-region radius $\eta$")
+axes[1].set(xlabel="iteration [-]", ylabel=r"trust-region radius $\eta$ [-]")
 axes[2].semilogy(its, [max(h["max_defect"], 1e-16) for h in ha], "o-", ms=3)
 axes[2].semilogy([h["iteration"] for h in pen_history], [max(h["max_defect"], 1e-16) for h in pen_history], ".-",
                  ms=3, color="C3")
-axes[2].set(xlabel="iteration", ylabel="largest defect [LU, LU/TU]")
+axes[2].set(xlabel="iteration [-]", ylabel="largest defect [LU, LU/TU]")
 fig.suptitle(r"SCvx on test case 1, $\alpha_h = 5\times10^{-3}$, from the ballistic DRO")
 _ = plotting.save_figure(fig, "05_convergence", output_dir=out)
 
 # %% [markdown]
-# ## 5 · Does every plan fly? (beyond the paper)
+# ## 5 · Does every plan fly, and does it depend on the node grid? (beyond the paper)
 #
 # Each converged trajectory is re-flown by single shooting: its first-order-hold control alone, from $x_{\mathcal
 # S}(t_0)$, through the nonlinear CR3BP. The terminal miss measures how real the plan is; the defects and bounds are
 # checked as in the tests.
+#
+# **Mesh check.** The thrust bound never binds (largest $|u|/a_{max}$ below 1 in the table), so the optimal thrust
+# is a few single-node spikes: the plans are nearly impulsive and the node grid, which the paper does not give,
+# could move their impulse. We solve $\alpha_h = 5\times10^{-3}$ again on a second Sundman grid (warm-started from
+# the first solution interpolated onto it) and compare impulse, information and terminal RMS.
 
 # %%
 miss_km, miss_mm_s, max_ratio, window_thrust = [], [], [], []
@@ -242,6 +272,17 @@ for a, r, mk, mv, mr in zip(ALPHAS, best, miss_km, miss_mm_s, max_ratio):
           f"{mv:9.1e} {mr:11.4f}")
 print(f"largest thrust inside the window: {max(window_thrust):.1e} LU/TU^2")
 
+t_alt, k_alt, _ = sc.node_times(N_NODES_ALT, SIGMA)
+x_alt = np.stack([np.interp(t_alt, t, best[i5].x[:, j]) for j in range(6)], axis=1)
+u_alt = np.stack([np.interp(t_alt, t, best[i5].u[:, j]) for j in range(3)], axis=1)
+mesh_solver = wolf_jones.ScenarioSolver(sc, t_alt, k_alt, information=info, settings=settings)
+mesh = mesh_solver(5e-3, x_alt, u_alt)
+mesh_rms = [wolf_jones.evaluate_crlb(sc, r.x[k]).terminal_rms_km[0] for r, k in ((best[i5], k_ws), (mesh, k_alt))]
+mesh_dimp = abs(mesh.impulse - best[i5].impulse) / best[i5].impulse
+print(f"alpha_h = 5e-3 on {N_NODES} nodes: {best[i5].impulse * MPS:.2f} m/s, I = {best[i5].information:.3f} nats, "
+      f"observer RMS {mesh_rms[0]:.2f} km; on {N_NODES_ALT} nodes: {mesh.impulse * MPS:.2f} m/s, "
+      f"I = {mesh.information:.3f} nats, RMS {mesh_rms[1]:.2f} km (impulse change {100 * mesh_dimp:.1f} %)")
+
 
 # %% [markdown]
 # ## 6 · Figures 1-3: trajectories and thrust
@@ -258,8 +299,8 @@ def dense_flight(res, n=600):
 
 t_dense = np.linspace(0.0, sc.duration, 600)
 ref_dro = propagate(em, sc.observer_x0, t_dense).x
-show = [ALPHAS.index(5e-3), ALPHAS.index(2e-2)]
-fig, axes = plt.subplots(1, 2, figsize=(12, 5.2))
+show = [ALPHAS.index(5e-3), len(ALPHAS) - 1]  # the paper's 5e-3 and 2e-2 (quick mode: the grid's largest)
+fig, axes = plt.subplots(1, 2, figsize=(10, 5.6))
 for ax, i in zip(axes, show):
     td, xd, ud = dense_flight(best[i])
     pos = (xd[:, :2] - [1 - em.mu, 0]) * em.length_unit_km / 1e3
@@ -274,34 +315,40 @@ for ax, i in zip(axes, show):
     ax.set(xlabel="x - x_Moon [1000 km]", ylabel="y [1000 km]", aspect="equal",
            title=rf"$\alpha_h$ = {ALPHAS[i]:g}: {best[i].impulse * MPS:.1f} m/s, I = {best[i].information:.1f} nats")
 handles, labels = axes[0].get_legend_handles_labels()
-fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, -0.04))
+fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, 0.0))
 fig.suptitle("Fig. 1 analogue: observer trajectory, Moon-centred rotating frame")
+fig.tight_layout(rect=(0, 0.06, 1, 1))
 _ = plotting.save_figure(fig, "05_fig1_trajectories", output_dir=out)
 
 fig, ax = plt.subplots(figsize=(6.5, 5.5))
 cmap = plt.get_cmap("viridis")
+departure_km = []  # largest distance from the reference DRO over the scenario, per alpha_h
 for j, (a, r) in enumerate(zip(ALPHAS, best)):
     td, xd, _ = dense_flight(r, 400)
     rel = (xd[:, :3] - propagate(em, sc.observer_x0, td).x[:, :3]) * em.length_unit_km / 1e3
+    departure_km.append(float(np.max(np.linalg.norm(rel, axis=1))) * 1e3)
     ax.plot(rel[:, 0], rel[:, 1], color=cmap(j / max(1, len(ALPHAS) - 1)), lw=1.2, label=rf"$\alpha_h$={a:g}")
 ax.plot(0, 0, "o", color="C2", ms=6, label="start")
 ax.set(xlabel=r"$\Delta x$ [1000 km]", ylabel=r"$\Delta y$ [1000 km]", aspect="equal",
        title="Fig. 2 analogue: position relative to the reference DRO")
 ax.legend(fontsize=7, ncol=2, loc="center left", bbox_to_anchor=(1.02, 0.5))
 _ = plotting.save_figure(fig, "05_fig2_relative_motion", output_dir=out)
+departure_monotone = bool(np.all(np.diff(departure_km) >= 0))
+print("largest departure from the reference DRO [km]:", ", ".join(f"{a:g}: {d:.0f}" for a, d in
+                                                                   zip(ALPHAS, departure_km)))
 
 fig, axes = plt.subplots(1, 2, figsize=(13, 4), sharey=True)
 for ax, i in zip(axes, show):
     td, _, ud = dense_flight(best[i])
     days = em.tu_to_days(td)
-    scale = em.acceleration_unit_km_s2 * 1e9  # um/s^2
+    scale = em.acceleration_unit_km_s2 * 1e6  # mm/s^2
     ax.axvspan(em.tu_to_days(sc.window[0]), em.tu_to_days(sc.window[1]), color="0.9", label="observation window")
     ax.plot(days, ud[:, 0] * scale, label="$a_x$")
     ax.plot(days, ud[:, 1] * scale, label="$a_y$")
     ax.plot(days, np.linalg.norm(ud, axis=1) * scale, "k", lw=1.0, label="|a|")
     ax.axhline(sc.a_max * scale, color="0.4", ls=":", lw=0.8)
     ax.set(xlabel="time [days]", title=rf"$\alpha_h$ = {ALPHAS[i]:g}")
-axes[0].set_ylabel("thrust acceleration [µm/s²]")
+axes[0].set_ylabel("thrust acceleration [mm/s²]")
 handles, labels = axes[0].get_legend_handles_labels()
 fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, -0.06))
 fig.suptitle("Fig. 3 analogue: thrust acceleration (dotted: a_max)")
@@ -316,6 +363,10 @@ _ = plotting.save_figure(fig, "05_fig3_thrust", output_dir=out)
 # last measurement of the window. The paper's x-axis "average impulse" is not defined; any per-node or per-day
 # average is the total divided by a constant, which does not change the shape of the curve. Finally the plans of
 # $\alpha_h = 0$ and the largest $\alpha_h$ are judged again with the literal unit fix of Table 3's process noise.
+#
+# Observer and target panels look alike, and should: a relative-position measurement fixes
+# $x_{\mathcal T} - x_{\mathcal S}$ to 100 m, so the absolute errors of the two spacecraft move together and their
+# RMS values agree to a fraction of a kilometre; what the dynamics must supply is the common absolute part.
 
 # %%
 crlb = [wolf_jones.evaluate_crlb(sc, r.x[k_ws]) for r in best]
@@ -361,14 +412,20 @@ bounded = bool(np.all(np.array([c.rms_km[:, -1] <= c.rms_km[:, 1] for c in crlb]
 transient = bool(np.all(np.array([c.rms_km[:, 1] > c.rms_km[:, 0] for c in crlb])))
 
 # %% [markdown]
-# ## 8 · Beyond the paper: does the mutual information rank the plans like the CRLB?
+# ## 8 · Beyond the paper: MI against the CRLB, and the baseline at equal impulse
 #
 # "The mutual information correlates well with the expected performance of a sequential estimator": over the grid,
-# the Spearman rank correlation between $\mathcal I$ and the terminal RMS (perfect agreement: -1). And the paper's
-# baseline claim: against the minimum-impulse plan ($\alpha_h = 0$), how much do the information plans buy, and what
-# does the Pareto curve say about equal impulse? Every point of the curve is the most information obtainable for
-# its impulse (a weighted-sum scalarisation), so at the baseline's impulse the baseline itself is the best plan;
-# what matters is the price of each improvement, read off the curve by interpolation.
+# the Spearman rank correlation between $\mathcal I$ and the terminal RMS (perfect agreement: -1).
+#
+# Then the paper's baseline claim, "substantial improvement over a baseline comparison which utilizes solely
+# control effort". The minimum-impulse plan ($\alpha_h = 0$) spends the least impulse there is, so "better at equal
+# impulse" can only mean: what does each *additional* m/s buy? SCvx has no impulse constraint, but the
+# weighted-sum objective traces the Pareto front, and its impulse grows with $\alpha_h$; solving for the
+# $\alpha_h$ whose optimum spends a prescribed budget (`wolf_jones.solve_for_impulse`: bracketed secant on
+# $\alpha_h$, warm starts from the neighbouring sweep solutions, budget met within 2 %, fixed before solving)
+# imposes the budget with the solver as it is. Each such plan is the most informative one for its impulse, and we
+# compare it with the baseline and with what linear interpolation between the grid points of the front would have
+# claimed.
 
 # %%
 rho_obs = float(spearmanr(mi, term_obs).statistic)
@@ -379,53 +436,102 @@ print(f"baseline alpha_h = 0: {impulse_mps[0]:.3f} m/s, terminal RMS observer {t
       f"{term_tgt[0]:.2f} km, I = {mi[0]:.2f} nats")
 print(f"best information plan alpha_h = {ALPHAS[i_best]:g}: {impulse_mps[i_best]:.2f} m/s, observer "
       f"{term_obs[i_best]:.2f} km, target {term_tgt[i_best]:.2f} km, I = {mi[i_best]:.2f} nats")
-budgets = [b for b in (1.0, 5.0, 10.0, 30.0) if impulse_mps[0] < b <= impulse_mps[-1]]
-for b in budgets:
-    print(f"  at {b:5.1f} m/s (interpolated on the front): target RMS {np.interp(b, impulse_mps, term_tgt):.2f} km "
-          f"({np.interp(b, impulse_mps, term_tgt) / term_tgt[0]:.2f} x baseline), observer "
-          f"{np.interp(b, impulse_mps, term_obs):.2f} km")
+budget_rows = []
+for extra in BUDGETS_EXTRA_MPS:
+    b = impulse_mps[0] + extra
+    j = int(np.searchsorted(impulse_mps, b))
+    if j >= len(ALPHAS):
+        print(f"budget {b:.2f} m/s lies beyond the grid's largest impulse; not solved")
+        continue  # bracket on the sweep: impulse_mps[j-1] < b <= impulse_mps[j]
+    try:
+        hit = wolf_jones.solve_for_impulse(solve, b / MPS, (ALPHAS[j - 1], best[j - 1]), (ALPHAS[j], best[j]),
+                                           rtol=BUDGET_RTOL)
+    except wolf_jones.ImpulseBudgetError as exc:
+        print(f"budget {b:.2f} m/s not reached: {exc.reason}")
+        continue
+    c = wolf_jones.evaluate_crlb(sc, hit.result.x[k_ws])
+    interp = float(np.interp(b, impulse_mps, term_obs))
+    budget_rows.append(dict(budget=b, alpha=hit.alpha, impulse=hit.result.impulse * MPS, rms_obs=c.terminal_rms_km[0],
+                            rms_tgt=c.terminal_rms_km[1], mi=hit.result.information, interp=interp,
+                            solves=len(hit.solves)))
+    print(f"budget {b:6.2f} m/s (baseline + {extra:g}): alpha_h = {hit.alpha:.3e} spends {hit.result.impulse * MPS:.2f}"
+          f" m/s ({len(hit.solves)} solves); terminal RMS observer {c.terminal_rms_km[0]:.2f} km, target "
+          f"{c.terminal_rms_km[1]:.2f} km = {c.terminal_rms_km[0] / term_obs[0]:.2f} x baseline "
+          f"(interpolation on the grid said {interp:.2f} km)")
+
+fig, ax = plt.subplots(figsize=(7, 4.2))
+zoom = impulse_mps <= max([r["budget"] for r in budget_rows] + [impulse_mps[1]]) * 1.6
+ax.plot(impulse_mps, term_obs, "o--", color="0.5", label=r"sweep grid, linear interpolation between $\alpha_h$")
+if budget_rows:
+    ax.plot([r["impulse"] for r in budget_rows], [r["rms_obs"] for r in budget_rows], "*", ms=13, color="C3",
+            label="solved at a prescribed impulse")
+ax.plot(impulse_mps[0], term_obs[0], "s", ms=8, color="k", label=r"baseline $\alpha_h = 0$")
+ax.set(xlabel="total impulse [m/s]", ylabel="observer position RMS at the window end [km]", yscale="log",
+       xlim=(-0.5, impulse_mps[zoom].max() * 1.05), title="Equal-impulse comparison near the baseline")
+ax.legend(fontsize=8, loc="upper right")
+_ = plotting.save_figure(fig, "05_equal_impulse", output_dir=out)
+
 
 # %% [markdown]
 # ## 9 · Paper versus reproduction
 #
 # Tolerances fixed before comparing: "reproduced" for a qualitative claim means the stated behaviour holds for
-# every $\alpha_h$ of the grid; the paper prints no number for test case 1 beyond its inputs (Tables 2-3), so the
-# quantitative rows are "not in paper" or "beyond paper". Slips in the paper are listed with what we used.
+# every $\alpha_h$ of the grid (criterion in the row); day counts of the text within 1 day; "unbounded" CRLB means a
+# terminal RMS above 10 prior sigmas (1000 km). The paper prints no number for test case 1 beyond its inputs
+# (Tables 2-3), so the quantitative rows are "not in paper" or "beyond paper". Slips in the paper are listed with
+# what we used.
 
 # %%
 table.add("observer x_S(t0) (Table 2) is a DRO", "vy0 = 0.528996986",
           f"not periodic (misses itself by {chk.raw_closure:.2f} LU); periodic vy0 = {chk.corrected.x0[4]:.7f}",
           "differs: printed vy0 is a slip", f"as printed it {printed_fate}; corrected state used (notebook 01)")
+x0_wins = reading_miss["x0 held (vy0 corrected)"] <= 1.0 < reading_miss["vy0 held (x0 corrected)"]
+table.add("which digit of x_S(t0) slipped", "case 1 window '12 and 23 days', case 2 'roughly 17 and 32 days'",
+          "; ".join(f"{k}: largest miss of 12/17/32 d {v:.2f} d" for k, v in reading_miss.items()),
+          "derived" if x0_wins else "differs: neither reading fits the day counts",
+          f"tolerance 1 day; vy0 held gives x0 = {vy0_held.x0[0]:.7f}, P = {em.tu_to_days(vy0_held.period):.2f} d")
+w_end = em.tu_to_days(sc.window[1])
 table.add("observation window", "[3P/4, 3P/2]; text: '12 and 23 days'",
-          f"{em.tu_to_days(sc.window[0]):.2f}-{em.tu_to_days(sc.window[1]):.2f} d",
-          "differs: text's 23 d is a slip", "3P/2 = 24.26 d for P = 16.17 d; the last daily measurement is at "
+          f"{em.tu_to_days(sc.window[0]):.2f}-{w_end:.2f} d",
+          "reproduced" if abs(w_end - 23.0) <= 1.0 else "differs: text's 23 d is a slip",
+          f"tolerance 1 day; 3P/2 = {w_end:.2f} d for P = {em.tu_to_days(P):.2f} d; the last daily measurement is at "
           f"{em.tu_to_days(sc.measurement_times[-1]):.2f} d")
 table.add("Fig. 3 alpha_h of the left panel", "text: 5e-2; caption and Fig. 1: 5e-3", "5e-3 shown",
           "differs: text's 5e-2 is a slip", "5e-2 lies outside the paper's grid (up to 2e-2)")
 table.add("process noise Q (Table 3)", "1e-11 'km/s^3'", f"q = {sc.q:g} LU^2/TU^3 (acceleration PSD)",
           "derived", "reading chosen by the CRLB-boundedness test of notebook 06 / cislunar.wolf_jones")
+lit_unbounded = lit[0].terminal_rms_km[0] > 10 * wolf_jones.SIGMA_POS_KM
 table.add("CRLB bounded over the window under Q = 1e-11 km^2/s^3 (literal)", "bounded (Fig. 4)",
-          f"observer {lit[1].rms_km[0, 1]:.0f} -> {lit[1].rms_km[0, -1]:.0f} km over the window, vs "
-          f"{crlb[-1].rms_km[0, 1]:.0f} -> {crlb[-1].rms_km[0, -1]:.1f} km with q = 1e-11 LU^2/TU^3 "
-          f"(alpha_h = {ALPHAS[-1]:g})", "differs: literal reading rejected" if lit[1].rms_km[0, -1] >
-          lit[1].rms_km[0, 1] else "reproduced", "why the non-dimensional reading is used")
+          f"alpha_h = 0: terminal observer RMS {lit[0].terminal_rms_km[0]:.0f} km (adopted q: {term_obs[0]:.0f} km); "
+          f"alpha_h = {ALPHAS[-1]:g}: {lit[1].rms_km[0, 1]:.0f} -> {lit[1].rms_km[0, -1]:.0f} km (adopted: "
+          f"{crlb[-1].rms_km[0, 1]:.0f} -> {crlb[-1].rms_km[0, -1]:.1f} km)",
+          "differs: literal reading rejected" if lit_unbounded else "reproduced",
+          "unbounded = terminal RMS above 10 prior sigmas (1000 km), fixed before comparing; why the "
+          "non-dimensional reading is used")
 table.add("zero thrust in the observation window", "a_max = 0 in the window",
-          f"max |u| in the window {max(window_thrust):.0e}", "reproduced" if max(window_thrust) == 0 else
-          "differs: thrust in the window", "enforced as u_k = 0 at every window node")
+          f"max |u| in the window {max(window_thrust):.0e}", "reproduced" if max(window_thrust) <= 1e-12 else
+          "differs: thrust in the window", "criterion |u| <= 1e-12 at every window node; enforced as u_k = 0 there")
 table.add("SCvx converges for every alpha_h of the grid", "implied (Figs. 2, 5)",
           f"{sum(a['converged'] for a in sweep.attempts)}/{len(sweep.attempts)} runs, largest defect "
           f"{max(r.max_defect for r in best):.0e}",
-          "reproduced" if all(a["converged"] for a in sweep.attempts) else "differs: some runs fail",
-          "augmented Lagrangian + quadratic MI model; the printed L1 penalty creeps (next row)")
+          "reproduced" if all(a["converged"] for a in sweep.attempts) and max(r.max_defect for r in best) <= 1e-9
+          else "differs: some runs fail", "criterion: every run converges with defects <= 1e-9; augmented "
+          "Lagrangian + quadratic MI model; the printed L1 penalty creeps (next row)")
 table.add("printed SCvx (L1 exact penalty) at alpha_h = 5e-3", "method of Eqs. 42-43", pen_outcome[:60],
           "beyond paper", f"best accepted cost {pen_best:.5f} vs {best[i5].cost:.5f}; gamma = 1e3")
 table.add("larger alpha_h -> larger departure from the DRO (Fig. 2)", "yes",
-          f"impulse {impulse_mps[0]:.2f} -> {impulse_mps[-1]:.1f} m/s, monotone: {monotone}",
-          "reproduced" if monotone else "differs: non-monotone front", "best of upward and downward sweeps")
+          "largest distance from the DRO " + ", ".join(f"{a:g}: {d / 1e3:.1f}" for a, d in zip(ALPHAS, departure_km))
+          + " (10^3 km)", "reproduced" if departure_monotone else "differs: departure not monotone",
+          "criterion: non-decreasing over the grid; best of upward and downward sweeps")
+table.add("impulse and MI grow with alpha_h (Fig. 5)", "yes",
+          f"impulse {impulse_mps[0]:.2f} -> {impulse_mps[-1]:.1f} m/s, MI {mi[0]:.1f} -> {mi[-1]:.1f} nats",
+          "reproduced" if monotone else "differs: non-monotone front",
+          "criterion: both non-decreasing over the grid (1e-6 relative)")
 table.add("CRLB transient at the window start, then bounded (Fig. 4)", "yes",
           f"transient: {transient}; final <= second-step RMS: {bounded}",
           "reproduced" if transient and bounded else "differs: see Fig. 4 analogue",
-          "diagonal prior, no correlations (paper's explanation)")
+          "criterion, every alpha_h: RMS grows from the 1st to the 2nd measurement, ends below the 2nd; diagonal "
+          "prior, no correlations (paper's explanation)")
 table.add("more information -> lower terminal RMS (Figs. 4-5)", "observer and target",
           f"observer {term_obs[0]:.1f} -> {term_obs[-1]:.1f} km, target {term_tgt[0]:.1f} -> {term_tgt[-1]:.1f} km",
           "reproduced" if term_obs[-1] < term_obs[0] and term_tgt[-1] < term_tgt[0] else "differs: no gain",
@@ -435,6 +541,16 @@ table.add("MI correlates with estimator performance", "'correlates well'",
           f"{len(ALPHAS)} alpha_h values")
 table.add("single-shooting re-flight of every plan", "-", f"largest terminal miss {max(miss_km):.1e} km",
           "beyond paper", "FOH control alone from x_S(t0), nonlinear CR3BP")
+table.add("node grid (mesh check, alpha_h = 5e-3)", "N not given",
+          f"{N_NODES} nodes: {best[i5].impulse * MPS:.2f} m/s, RMS {mesh_rms[0]:.2f} km; {N_NODES_ALT} nodes: "
+          f"{mesh.impulse * MPS:.2f} m/s, RMS {mesh_rms[1]:.2f} km", "beyond paper",
+          f"impulse changes by {100 * mesh_dimp:.1f} %: near-impulsive plans (|u|/a_max <= {max(max_ratio):.2f})")
+for r in budget_rows:
+    table.add(f"baseline vs information plan at {r['budget']:.1f} m/s (solved)", "'substantial improvement'",
+              f"alpha_h = {r['alpha']:.2e} spends {r['impulse']:.2f} m/s: observer RMS {r['rms_obs']:.1f} km vs "
+              f"{term_obs[0]:.1f} km at {impulse_mps[0]:.2f} m/s ({r['rms_obs'] / term_obs[0]:.2f} x)",
+              "beyond paper", f"budget met within {100 * BUDGET_RTOL:g} %; interpolation on the grid said "
+              f"{r['interp']:.1f} km")
 table.add("Pareto values (impulse, terminal RMS)", "plotted only (Fig. 5), no numbers",
           f"{impulse_mps[-1]:.1f} m/s -> target {term_tgt[-1]:.2f} km at alpha_h = {ALPHAS[-1]:g}", "not in paper",
           "the paper's axes are not quantitatively readable; N and sigma of the nodes are not given either")
