@@ -22,6 +22,13 @@ Continuous-discrete extended Kalman filter on the same noisy angles: RK4 propaga
 covariance through the planar CR3BP Jacobian (:meth:`CR3BP.jacobian`), process noise
 :math:`Q = B_d S_d S_d^T B_d^T\,\Delta t`, measurement :math:`h(x) = [\theta_1, \theta_2]` with wrapped innovations
 and Joseph-form update.
+
+Impacts
+-------
+The truth is an input (propagated by the caller with :func:`cislunar.propagation.propagate`, which refuses
+impacts); the fixed-step RK4 loops here integrate *estimates*, not trajectories, so they carry no surface events.
+An estimate driven through a primary is a filter failure, not an impact: it shows up in the reported estimation
+error, and a non-finite estimate raises ``RuntimeError`` naming the step (both simulators check every step).
 """
 
 from __future__ import annotations
