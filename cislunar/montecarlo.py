@@ -8,6 +8,10 @@ Dask ``distributed.Client`` (anything with ``submit(fn, *args)`` returning a fut
 Seeding costs O(1) per trial whatever the chunking: child ``i`` is built directly from the root's entropy and the
 spawn key ``(i,)`` (:func:`trial_seed_sequence`), which is exactly what ``SeedSequence(seed).spawn(n)[i]`` returns.
 
+A *vectorized* trial (``run_monte_carlo(..., vectorized=True)``) receives the generators of a whole chunk at once
+and returns one result per generator, so the trials of a chunk can run together (e.g. a batched filter in lockstep,
+:func:`cislunar.detection.run_detection_monte_carlo`) while each keeps its own seed.
+
 Failures
 --------
 A trial that raises does not lose the run.  With ``on_error="raise"`` (default) :class:`MonteCarloError` names the

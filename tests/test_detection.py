@@ -195,7 +195,7 @@ def test_monte_carlo_reproducible_and_executor_agnostic(short_setup):
         det.run_detection_monte_carlo(s, None, 2, 1, batch_size=-1)
 
 
-def test_fast_engine_equals_the_reference_batched_ocbe(short_setup):
+def test_fast_engine_equals_the_reference_batched_ocbe(short_setup, monkeypatch):
     """The default engine (block integrator) equals the first batched OCBE (full 12x12 system) on several trials."""
     s = short_setup
     sc = s.scenario
@@ -221,6 +221,10 @@ def test_fast_engine_equals_the_reference_batched_ocbe(short_setup):
     alone = det.ocbe_batch(em, sc.t, args[2][1:2], s.observer_states, sc.model, sc.meas_cov, args[6][1:2],
                            args[7][1], s.control_weight, n_sub=s.n_sub)
     assert abs(alone.z_smooth[0] / fast.z_smooth[1] - 1) < 1e-12
+    monkeypatch.setattr(det, "_LANES", 3)  # integrate the 4 trials in two groups of lanes (3 + 1)
+    split = det.ocbe_batch(*args, n_sub=s.n_sub)
+    assert np.max(np.abs(split.z_smooth / fast.z_smooth - 1)) < 1e-12
+    assert np.max(np.abs(split.x_smooth - fast.x_smooth)) < 1e-12 * np.max(np.abs(fast.x_smooth))
     with pytest.raises(ValueError, match="engine"):
         det.ocbe_batch(*args, engine="slow")
 
