@@ -18,8 +18,9 @@
 #
 # * the distant retrograde orbits (DROs) of Wolf & Jones, test cases 1 and 2 (their Tables 2 and 4);
 # * the southern L2 halo family down into the near-rectilinear halo orbits (NRHOs), with the Gateway 9:2 NRHO
-#   derived from its period and the stable NRHO of stability index 1 (Greaves & Scheeres 2021, "Dynamics",
-#   Table 1 and Fig. 2; the informed-station-keeping paper uses the same 9:2 NRHO);
+#   derived from its period and the two candidates for the stable NRHO (stability index 1): the edge of the stable
+#   band next to the Moon and the most stable member of the family's outer stable band (Greaves & Scheeres 2021,
+#   "Dynamics", Table 1 and Fig. 2; the informed-station-keeping paper uses the same 9:2 NRHO);
 # * the optical observer sites of the maneuver-detection paper (its "Measurements" section, Fig. 3).
 #
 # **Paper sections followed.** Greaves & Scheeres, *Observation and Maneuver Detection for Cislunar Vehicles*
@@ -277,6 +278,22 @@ _ = plotting.save_figure(fig, "01_halo_stability_vs_perilune", output_dir=out)
 # perilune about five times higher than the 9:2 NRHO's and a period of about ten days. Inside the band
 # the stability index is exactly 1 and does not distinguish members; the Broucke indices printed above do
 # (all within $[-1, 1]$, the member chosen is the one farthest from both edges).
+#
+# **Which stable NRHO do notebooks 09 and 10 use, and why?** Both, side by side in every comparison that involves
+# "the stable NRHO", because the paper does not say which it flew. The evidence of their full-mode runs points to
+# the outer band:
+#
+# * notebook 09 (observation strategy, angles + rates from L2): the paper finds its stable NRHO "qualitatively
+#   similar but quantitatively better" than the 9:2 and consistent at every cadence. The outer-band member ends
+#   one period with a final 3-sigma position 0.64-0.79 of the 9:2 NRHO's at every cadence and stays consistent at
+#   6-12 h; the inner-band edge is *worse* determined than the 9:2 at every cadence, and 10-35 % of its runs at
+#   6-12 h lose consistency, with or without rates (its perilune is only about 95 km above the surface);
+# * notebook 10 (maneuver detection): accuracies of all three orbits lie within 97-100 %, which 100 + 100 test
+#   runs cannot separate, and the window-tuned filter is most consistent on the outer-band member.
+#
+# So the outer band's most stable member (`orbits.stable_nrho_outer`) is the reading we favour; the name
+# `orbits.stable_nrho` keeps denoting the inner band's edge, and the closing tables of 09 and 10 carry both rows
+# (the outer band's agreement with the paper's remark is marked "consistent (tuned)", since it was chosen for it).
 #
 # The analogue of Greaves & Scheeres' Fig. 2: NRHO members about the Moon with the 9:2 NRHO and both stable
 # candidates highlighted (Moon-centred axes, as in the paper).
