@@ -115,13 +115,18 @@ axes[1].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
 fig.suptitle("What the L2 observer sees of the 9:2 NRHO over one period (noise-free)")
 fig.tight_layout()
 _ = plotting.save_figure(fig, "09_measurements_from_l2", output_dir=out)
+rate_uas = np.abs(y_demo[:, 2:]) / em.time_unit_s * 1e6  # |azimuth rate|, |elevation rate| [urad/s]
+sig_rate = np.sqrt(R_rates[2, 2]) / em.time_unit_s * 1e6
+k_peri = int(np.argmax(rate_uas.max(axis=1)))
+print(f"largest |rate| {rate_uas.max():.1f} urad/s at day {days[k_peri]:.2f} = {rate_uas.max() / sig_rate:.2f} of the "
+      f"1-sigma rate noise ({sig_rate:.1f} urad/s); |azimuth rate| at apoapsis {rate_uas[0, 0]:.1f} urad/s")
 
 # %% [markdown]
-# Around perilune (day 3.3) the angles swing through tens of degrees in hours and the rates are 1000 times their
-# apolune values: that is where the dynamics are most nonlinear and where, the paper says, linearised filters fail.
-# The grey band is the 1-sigma rate noise of Eq. 13 with a 1 s baseline (14.1 µrad/s): away from perilune the
-# rates themselves are below their noise, and what matters to a filter, their *sensitivity* to a 10-km state
-# error, is smaller still (about $10^{-4}$ of the noise at apolune, notebook 09b Section 1).
+# Seen from L2 the target stays close to the Earth-Moon line (the azimuth only wraps through ±180°), and the line of
+# sight turns fastest around perilune (day 3.3), where the rates peak: that is where the dynamics are most
+# nonlinear and where, the paper says, linearised filters fail. The grey band is the 1-sigma rate noise of Eq. 13
+# with a 1 s baseline (14.1 µrad/s): as printed above, even the peak rates stay inside it, and what matters to a
+# filter, their *sensitivity* to a 10-km state error, is smaller still (at most about $10^{-4}$ of the noise at the periapsis hand-off, notebook 09b Section 1).
 #
 # ## 2 · The OCBE in square-root-information form (Eqs. 14-32)
 #

@@ -326,3 +326,58 @@ def test_bad_arguments_are_named(setup):
         ad.adaptive_ocbe(*args, available=np.ones((3, 1), bool))
     with pytest.raises(ValueError, match="control_weight"):
         ad.adaptive_ocbe(*args[:-1], -1.0)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The figure panels (Figs. 6-13)
+# ---------------------------------------------------------------------------------------------------------------
+def test_panel_series_matches_the_run(setup, big_burn):
+    """Every panel is the run's quantity in display units: errors, 3-sigma, NEES, control, both metrics."""
+    inp, a = big_burn
+    sc = setup.scenario
+    p = ad.panel_series(em, a.result, inp.truth, a.control_weight, inp.y, setup.observer_states, sc.model,
+                        sc.meas_cov)
+    r = a.result
+    L, V = em.length_unit_km, em.velocity_unit_km_s * 1e3
+    assert np.allclose(p.t_days * 86400, r.t * em.time_unit_s)
+    assert np.allclose(p.position_error_km[1], np.linalg.norm(r.x_smooth[:, :3] - inp.truth[:, :3], axis=1) * L)
+    assert np.allclose(p.velocity_error_m_s[0], np.linalg.norm(r.x_filt[:, 3:] - inp.truth[:, 3:], axis=1) * V)
+    # 3-sigma of the norm bound: 3 sqrt(trace P) (position block of the filter at the last epoch)
+    assert p.position_3sigma_km[0, -1] == pytest.approx(3 * np.sqrt(np.trace(r.P_filt[-1, :3, :3])) * L)
+    assert np.allclose(p.nees[0], tracking.nees(r.x_filt, r.P_filt, inp.truth))
+    acc = em.length_unit_km * 1e3 / em.time_unit_s**2
+    assert np.allclose(p.control_norm_m_s2[1], np.linalg.norm(r.control_smooth, axis=-1) * acc)
+    assert np.allclose(p.metric[0], a.metric, equal_nan=True)
+    assert np.allclose(p.metric[1], a.smoothed_metric)
+    assert np.allclose(p.normalized_metric[0] * p.limit, a.metric)
+    assert np.allclose(p.mean_line, 4 / stats.chi2.ppf(0.99, 4))
+    # the 3 m/s burn stands out in both passes' control at the burn (Fig. 7)
+    c = p.spike_contrast(setup.t_maneuver * em.time_unit_days)
+    assert np.all(c > 100)
+
+
+def test_spike_contrast_of_a_known_spike():
+    """A control norm of 1 everywhere except 50 within the window has contrast exactly 50 (and 1 without it)."""
+    t_sub = np.linspace(0, 10, 100).reshape(20, 5)
+    u = np.ones((2,) + t_sub.shape)
+    near = np.abs(t_sub - 5.0) <= 0.5
+    u[1][near] = 50.0
+    z = np.zeros((2, 20))
+    p = ad.PanelSeries(t_sub[:, 0], t_sub, z, z, z, z, u, z, np.ones(20), np.full(20, 4), z)
+    assert p.spike_contrast(5.0, 0.5) == pytest.approx([1.0, 50.0])
+    with pytest.raises(ValueError, match="t_days"):
+        p.spike_contrast(100.0, 0.5)
+
+
+def test_panel_figures_have_units_on_every_axis(setup, big_burn):
+    from cislunar.plotting import axis_label_problems
+
+    inp, a = big_burn
+    sc = setup.scenario
+    p = ad.panel_series(em, a.result, inp.truth, a.control_weight, inp.y, setup.observer_states, sc.model,
+                        sc.meas_cov)
+    for fig in (ad.figure_errors(p, "t", burn_days=3.3, velocity_unit="mm/s"),
+                ad.figure_control_metric(p, "t", detection_days=[3.3], first_pass_metric=a.metric_first_pass,
+                                         first_pass_until=a.detections[0].declared_epoch)):
+        assert axis_label_problems(fig) == []
+        assert len(fig.axes) == 4
