@@ -125,8 +125,9 @@ print(f"largest |rate| {rate_uas.max():.1f} urad/s at day {days[k_peri]:.2f} = {
 # Seen from L2 the target stays close to the Earth-Moon line (the azimuth only wraps through ±180°), and the line of
 # sight turns fastest around perilune (day 3.3), where the rates peak: that is where the dynamics are most
 # nonlinear and where, the paper says, linearised filters fail. The grey band is the 1-sigma rate noise of Eq. 13
-# with a 1 s baseline (14.1 µrad/s): as printed above, even the peak rates stay inside it, and what matters to a
-# filter, their *sensitivity* to a 10-km state error, is smaller still (at most about $10^{-4}$ of the noise at the periapsis hand-off, notebook 09b Section 1).
+# with a 1 s baseline (14.1 µrad/s): as printed above, the rates stay below it except briefly at perilune, where
+# they peak at about 1.3 times it; what matters to a filter, their *sensitivity* to a 10-km state error, is far
+# smaller (at most about $10^{-4}$ of the noise at the periapsis hand-off, notebook 09b Section 1).
 #
 # ## 2 · The OCBE in square-root-information form (Eqs. 14-32)
 #
