@@ -719,9 +719,11 @@ class PanelSeries:
 
     def spike_contrast(self, t_days, half_width_days: float = 4 / 24) -> np.ndarray:
         """How much the control norm stands out near ``t_days``: the largest norm within ``half_width_days`` of
-        it over the median norm farther away, for the forward and the smoothed control (shape (2,)).
+        it over the largest norm farther away, for the forward and the smoothed control (shape (2,)).
 
-        A contrast near 1 means no spike; the paper's Figs. 11 and 13 show a smoothed spike at the burn.
+        A contrast at or below 1 means no spike (something elsewhere is as large); the paper's Figs. 11 and 13 show
+        a smoothed spike at the burn.  Maxima, not medians: the forward (single-step) control is a saw-tooth that
+        restarts every interval, so its peaks, not its typical value, are what a spike must exceed.
         """
         t0 = _checks.real(t_days, "t_days")
         hw = _checks.positive(half_width_days, "half_width_days")
@@ -729,7 +731,7 @@ class PanelSeries:
         if not near.any() or near.all():
             raise ValueError(f"t_days +- half_width_days must cover some but not all of the track; got {t0} +- {hw}")
         u = self.control_norm_m_s2
-        return np.array([u[j][near].max() / np.median(u[j][~near]) for j in range(2)])
+        return np.array([u[j][near].max() / u[j][~near].max() for j in range(2)])
 
 
 def panel_series(system: CR3BP, result, truth, control_weight, y, observer_states, model, meas_cov, *,
