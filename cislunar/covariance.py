@@ -422,7 +422,7 @@ def ekf_predict(P, F, Q) -> np.ndarray:
     positive semi-definite, or the shapes do not match.
     """
     P = check_spd(P, "P")
-    F = _checks.as_array(F, "F")
+    F = _checks.as_array(F, "F", min_size=1)
     Q = check_psd(Q, "Q")
     n = P.shape[-1]
     if F.ndim < 2 or F.shape[-2:] != (n, n) or Q.shape[-1] != n:
@@ -452,7 +452,7 @@ def ekf_update(P, H, R):
         Innovation covariance :math:`HPH^T + R`.
     """
     P = check_spd(P, "P")
-    H = _checks.as_array(H, "H")
+    H = _checks.as_array(H, "H", min_size=1)
     R = _square(R, "R")
     n = P.shape[-1]
     if H.ndim < 2 or H.shape[-1] != n:

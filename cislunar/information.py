@@ -501,8 +501,8 @@ def gaussian_kl(mean_p, cov_p, mean_q, cov_q) -> np.ndarray:
     if cp.ndim != 2 or cp.shape != cq.shape:
         raise ValueError(f"cov_p and cov_q must be (d, d) of the same shape; got {cp.shape} and {cq.shape}")
     d = cp.shape[0]
-    mp = _checks.as_array(mean_p, "mean_p", last=d)
-    mq = _checks.as_array(mean_q, "mean_q", last=d)
+    mp = _checks.as_array(mean_p, "mean_p", last=d, min_size=1)
+    mq = _checks.as_array(mean_q, "mean_q", last=d, min_size=1)
     Lq = np.linalg.cholesky(cq)
     diff = np.moveaxis(np.asarray(mq - mp), -1, 0).reshape(d, -1)
     z = np.linalg.solve(Lq, diff)

@@ -1042,8 +1042,10 @@ def gamma_sweep(lmi: PrecisionLMI, gammas, *, solver: str = "CLARABEL") -> list:
 def _check_abc(A, B, C):
     A = _checks.square(A, "A")
     n = A.shape[0]
-    B = _checks.as_array(B, "B", ndim=(2,))
-    C = _checks.as_array(C, "C", ndim=(2,))
+    if n == 0:
+        raise ValueError("A must be a non-empty square matrix; got shape (0, 0)")
+    B = _checks.as_array(B, "B", ndim=(2,), min_size=1)
+    C = _checks.as_array(C, "C", ndim=(2,), min_size=1)
     if B.shape[0] != n:
         raise ValueError(f"B must have {n} rows (the order of A); got shape {B.shape}")
     if C.shape[1] != n:

@@ -315,7 +315,7 @@ def finite_difference_hessian(gradient, x, step: float = 1e-5, *, g0=None) -> np
         g0 = _checks.as_array(g0, "g0", shape=(n,))
 
     def grad(z):
-        return _checks.as_array(gradient(z), "gradient(x)", shape=(n,), finite=False)
+        return _checks.as_array(gradient(z), "gradient(x)", shape=(n,))
 
     H = np.empty((n, n))
     for i in range(n):
@@ -520,15 +520,15 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
         t1 = time.perf_counter()
         ival, grad = 0.0, np.zeros(6)
         if info is not None:
-            ival = float(info(x[info_node], 0))
+            ival = _checks.real(info(x[info_node], 0), "info(x, 0)")
             if use_info and order >= 1:
                 grad = _checks.as_array(info(x[info_node], 1)[1], "info(x, 1) gradient", shape=(6,))
         t2 = time.perf_counter()
         cvals = []
-        for obj, (node, m) in zip(constraints, con_specs):
+        for i, (obj, (node, m)) in enumerate(zip(constraints, con_specs)):
             c, C = obj(x[node])
-            cvals.append((_checks.as_array(c, "constraint value", shape=(m,)),
-                          _checks.as_array(C, "constraint Jacobian", shape=(m, 6))))
+            cvals.append((_checks.as_array(c, f"constraints[{i}] value", shape=(m,)),
+                          _checks.as_array(C, f"constraints[{i}] Jacobian", shape=(m, 6))))
         return dict(model=model, info=ival, grad=grad, cons=cvals, t_discretize=t1 - t0, t_info=t2 - t1)
 
     def cost_of(x, u, ev):
@@ -746,7 +746,8 @@ def homotopy_sweep(solve, alphas, x_guess, u_guess, *, directions=("up", "down")
                 continue  # re-solving the top from its own solution would only repeat it
             g = (x_guess, u_guess)
         try:
-            res = solve(float(a[i]), g[0], g[1])
+            res = _checks.instance(solve(float(a[i]), g[0], g[1]), "solve(alpha, x_guess, u_guess) result",
+                                   SCvxResult)
         except SCvxError as exc:
             attempts.append(dict(alpha=float(a[i]), direction=direction, converged=False, cost=np.nan,
                                  iterations=len(exc.history), error=exc.reason))

@@ -98,3 +98,13 @@ def test_input_records_validate_their_fields():
     assert box.names == ("rho_1", "rho_2", "rho_3", "rho_4")
     with pytest.raises(ValueError, match="^lower and upper"):
         lpv.ParameterBox(np.zeros(5), np.ones(6))
+
+
+def test_callables_returning_junk_are_named():
+    with pytest.raises(ValueError, match=r"^gradient\(x\) must have shape"):
+        scvx.finite_difference_hessian(lambda x: np.ones(3), np.zeros(2))
+    with pytest.raises(ValueError, match=r"^gradient\(x\) contains NaN"):
+        scvx.finite_difference_hessian(lambda x: np.full(2, np.nan), np.zeros(2))
+    x = np.tile([0.8, 0, 0, 0, 0.52, 0], (3, 1))
+    with pytest.raises(TypeError, match=r"^solve\(alpha, x_guess, u_guess\) result"):
+        scvx.homotopy_sweep(lambda a, x, u: {"cost": 0.0}, [0.0, 0.5], x, np.zeros((3, 3)))
