@@ -38,15 +38,15 @@ OUTPUT_DIR = ""
 
 # %%
 # Sizes derived from QUICK: quick mode shrinks every Monte Carlo; every step still runs.
-N_H0 = 40 if QUICK else 500  # non-maneuvering training runs per policy and orbit (paper: 500)
-N_H1 = 60 if QUICK else 3000  # maneuvering training runs per policy and orbit (paper: 3000)
-N_TEST = 20 if QUICK else 100  # test runs per hypothesis, policy and orbit (paper: 100 + 100)
-N_PILOT = 16 if QUICK else 64  # runs per hypothesis in the tuning sweep
-N_POLICY_DRAWS = 20000 if QUICK else 200000  # draws to check the station-keeping distributions
+N_H0 = 8 if QUICK else 500  # non-maneuvering training runs per policy and orbit (paper: 500)
+N_H1 = 8 if QUICK else 3000  # maneuvering training runs per policy and orbit (paper: 3000)
+N_TEST = 4 if QUICK else 100  # test runs per hypothesis, policy and orbit (paper: 100 + 100)
+N_PILOT = 4 if QUICK else 64  # runs per hypothesis in the tuning sweep
+N_POLICY_DRAWS = 5000 if QUICK else 200000  # draws to check the station-keeping distributions
 TUNING_FACTORS = [0.01, 0.1, 1.0]  # sweep of the window control weight, in units of the variance-matched value
 PM_J_SEEDS = 1 if QUICK else 3  # noise draws per azimuth in the +-j sweep (Section 4)
 BATCH = 8  # trials run in lockstep by the batched OCBE
-N_NEES = 4 if QUICK else 24  # runs per (orbit, policy, hypothesis) of the consistency check of the window tuning
+N_NEES = 2 if QUICK else 24  # runs per (orbit, policy, hypothesis) of the consistency check of the window tuning
 WORKERS = 1 if QUICK else 2  # processes for the Monte Carlo
 
 import time
@@ -66,7 +66,7 @@ out = OUTPUT_DIR or None
 rng = np.random.default_rng(SEED)
 executor = ProcessPoolExecutor(WORKERS, mp_context=mp.get_context("spawn")) if WORKERS > 1 else None
 TUNED = "consistent (tuned)"  # agreement that rests on a choice made while looking at the paper
-table = ComparisonTable("10 Maneuver detection (Greaves & Scheeres 2021, Eqs. 3-5, 33-35, Figs. 12-22, Tables 5-8)")
+table = ComparisonTable("10 Maneuver detection (Greaves & Scheeres 2021, Eqs. 3-5, 33-35, Figs. 10-22, Tables 5-8)")
 OUTER = "stable NRHO (outer band)"
 ORBITS = {"9:2 NRHO": orbits.nrho_9_2(em), "stable NRHO": orbits.stable_nrho(em), OUTER: orbits.stable_nrho_outer(em)}
 STABLE = ("stable NRHO", OUTER)
@@ -101,7 +101,7 @@ for name, pol in POLICIES.items():
     zz = np.linspace(d.ppf(0), d.ppf(1), 300)
     ax[0 if name == "active" else 1].plot(zz * 1e3, d.pdf(zz) / 1e3, "k", lw=1, label="truncnorm PDF")
     ax[0 if name == "active" else 1].set(title=f"{name}: mean {m.mean() * 1e3:.1f}, sd {m.std() * 1e3:.2f} mm/s",
-                                         xlabel="impulse magnitude (mm/s)", ylabel="PDF (1/(mm/s))")
+                                         xlabel="impulse magnitude [mm/s]", ylabel="probability density [1/(mm/s)]")
     print(f"{name}: range [{m.min() * 1e3:.2f}, {m.max() * 1e3:.2f}] mm/s (bounds {(pol.mean_m_s - 3 * pol.sd_m_s) * 1e3:.1f}, "
           f"{(pol.mean_m_s + 3 * pol.sd_m_s) * 1e3:.1f}); sd/sigma_u = {m.std() / pol.sd_m_s:.4f} "
           f"(truncnorm {d.std() / pol.sd_m_s:.4f})")
@@ -111,7 +111,8 @@ ax[2].hist(uz, bins=50, density=True, alpha=0.6, label="Eqs. 3-4 (paper)")
 ax[2].plot(np.linspace(-0.999, 0.999, 200), stats.arcsine(-1, 2).pdf(np.linspace(-0.999, 0.999, 200)), "k", lw=1,
            label="arcsine PDF")
 ax[2].axhline(0.5, color="C3", ls="--", label="uniform sphere")
-ax[2].set(xlabel=r"$\hat k$ component of the impulse direction", ylabel="PDF", ylim=(0, 3), title="pointing")
+ax[2].set(xlabel=r"$\hat k$ component of the impulse direction [-]", ylabel="probability density [-]", ylim=(0, 3),
+          title="pointing")
 ax[0].legend()
 ax[2].legend(fontsize=8)
 _ = plotting.save_figure(fig, "10_station_keeping_policy", output_dir=out)
@@ -165,7 +166,8 @@ for pname, pol in POLICIES.items():
               f" slope {slope:.2f}, corr {np.corrcoef(st.h1.magnitude, st.h1.z)[0, 1]:.2f}")
 
 # %% [markdown]
-# The variance-matched weight ($f = 1$) lets the smoother fit so much measurement noise as control that the H0
+# The sentences below describe the full run (64 runs per hypothesis; the printed lines are this run's). The
+# variance-matched weight ($f = 1$) lets the smoother fit so much measurement noise as control that the H0
 # integrals reach about half of the H1 ones. Shrinking $q_w$ shrinks H0 roughly as $\sqrt{q_w}$ while the H1
 # integral keeps tracking the impulse (slope near 1) down to $f\approx0.1$; at $f = 0.01$ the quiet filter can no
 # longer absorb the burn in the window ($z$ decorrelates from the magnitude, the state estimate lags). For the
@@ -174,75 +176,95 @@ for pname, pol in POLICIES.items():
 # sweep, not a value from the paper. Since $z_{lim}$ scales
 # with this choice, the $z_{lim}$ comparison below checks consistency, not an independent prediction.
 #
-# Below: one quiet-policy run (a 50 mm/s burn along $+\hat j$) filtered with the window tuning and with the same
-# $q_w$ held constant over the whole period (the paper's "constant OCBE tuning", Figs. 10-11). The smoothed control
-# shows the spike at apoapsis (Figs. 12-13); the forward (single-step) control barely sees it.
+# **Figs. 10-13: the same burn under the two tunings.** One quiet-policy run (a 50 mm/s burn along $+\hat j$ at
+# apoapsis, start at the periapsis hand-off) is filtered twice: with $q_w$ held constant over the whole period
+# (the paper's "increased control uncertainty", Figs. 10-11) and with $q_w$ only in the 8-hour apoapsis window and
+# $q_b$ elsewhere (the paper's proposed tuning, Figs. 12-13). For each we draw the paper's two panel sets with
+# `cislunar.adaptive_ocbe` (the layout of notebook 09b's Figs. 6-9): position and velocity error norms with their
+# 3-sigma bounds, forward (left) and smoothed (right); then the control norm (top) and the normalised OCBE metric
+# (bottom; notebook 09b: $\chi^2_4$ under a correct model, limit $\chi^2_{4,0.99} = 13.28$, mean line at
+# $4/13.28 = 0.30$; the smoothed metric's epoch average is 4). The paper does not give its burn direction, its
+# "small maneuver" size in Figs. 12-13, or the control weights; ours are stated above.
 
 # %%
 F_TUNE = 0.1
 setups = {(o, p): det.make_setup(em, ORBITS[o], F_TUNE * det.window_control_weight(POLICIES[p], WINDOW_HOURS),
                                  Q_BASE, window_hours=WINDOW_HOURS) for o in ORBITS for p in POLICIES}
 s_q = setups["9:2 NRHO", "quiet"]
+sc_q = s_q.scenario
 demo = det.draw_trial(np.random.default_rng([SEED, 7]), s_q, magnitude_m_s=0.05, direction=(np.pi / 2, 0.0))
-runs = {"apoapsis window": det.run_trial_filter(s_q, demo),
-        "constant": det.run_trial_filter(s_q, demo, control_weight=s_q.control_weight.max())}
-hours = s_q.scenario.t * em.time_unit_s / 3600
-to_um_s2 = em.length_unit_km / em.time_unit_s**2 * 1e9  # LU/TU^2 -> micro-m/s^2
-fig, ax = plt.subplots(2, 2, figsize=(13, 7), sharex=True)
-for j, (name, r) in enumerate(runs.items()):
-    th = r.t_sub.ravel() * em.time_unit_s / 3600
-    ax[0, j].plot(th, np.linalg.norm(r.control_step, axis=-1).ravel() * to_um_s2, label="forward control")
-    ax[0, j].plot(th, np.linalg.norm(r.control_smooth, axis=-1).ravel() * to_um_s2, label="smoothed control")
-    ax[0, j].axvline(s_q.t_maneuver * em.time_unit_s / 3600, color="k", ls=":", lw=1, label="burn")
-    ax[0, j].set(title=f"{name} tuning: z forward {r.z_step * em.velocity_unit_km_s * 1e6:.1f}, smoothed "
-                 f"{r.z_smooth * em.velocity_unit_km_s * 1e6:.1f} mm/s", ylabel=r"$\|\hat u\|$ ($\mu$m/s$^2$)")
-    for xs, Ps, lab, c in ((r.x_filt, r.P_filt, "forward", "C0"), (r.x_smooth, r.P_smooth, "smoothed", "C1")):
-        err = np.linalg.norm(xs[:, :3] - demo.truth[:, :3], axis=1) * em.length_unit_km
-        sig = 3 * np.sqrt(np.trace(Ps[:, :3, :3], axis1=1, axis2=2)) * em.length_unit_km
-        ax[1, j].semilogy(hours, err, c, label=f"{lab} error")
-        ax[1, j].semilogy(hours, sig, c + "--", lw=1, label=f"{lab} 3-sigma")
-    ax[1, j].set(xlabel="hours since periapsis hand-off", ylabel="position error (km)")
-    nees = tracking.nees(r.x_smooth, r.P_smooth, demo.truth)
-    print(f"{name:16s}: z_smooth = {r.z_smooth * em.velocity_unit_km_s * 1e6:6.2f} mm/s, z_forward = "
-          f"{r.z_step * em.velocity_unit_km_s * 1e6:6.2f} mm/s, mean smoothed NEES = {nees.mean():.1f} (6 if consistent)")
-fig.legend(*ax[0, 0].get_legend_handles_labels(), loc="upper center", ncol=3, fontsize=8, bbox_to_anchor=(0.5, 1.0))
-fig.legend(*ax[1, 0].get_legend_handles_labels(), loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, 0.0))
-fig.tight_layout(rect=(0, 0.05, 1, 0.96))
-_ = plotting.save_figure(fig, "10_tuning_control_spike", output_dir=out)
+q_tunings = {"constant": s_q.control_weight.max(), "apoapsis window": s_q.control_weight}
+runs = {name: det.run_trial_filter(s_q, demo, control_weight=q) for name, q in q_tunings.items()}
+panels = {name: ad.panel_series(em, r, demo.truth, q_tunings[name], demo.y, s_q.observer_states, sc_q.model,
+                                sc_q.meas_cov) for name, r in runs.items()}
+burn_days = s_q.t_maneuver * em.time_unit_days
+nees_q = stats.chi2.ppf(tracking.NEES_PROBABILITY, 6)
+V_MM = em.velocity_unit_km_s * 1e6  # LU/TU -> mm/s
+fig_summary = {}
+for name, r in runs.items():
+    pn = panels[name]
+    over = np.mean(pn.nees > nees_q, axis=1)  # fraction of epochs above the 99.9 % NEES quantile, fwd / smoothed
+    m_norm = pn.normalized_metric[0]
+    fig_summary[name] = dict(over=over, z_f=r.z_step * V_MM, z_s=r.z_smooth * V_MM,
+                             metric_over=int(np.sum(m_norm > 1)), trigger=ad.first_detection(pn.metric[0], pn.limit),
+                             sig_final=(pn.position_3sigma_km[0, -1], pn.velocity_3sigma_m_s[0, -1] * 1e3),
+                             contrast=pn.spike_contrast(burn_days))
+    print(f"{name:16s}: z forward {r.z_step * V_MM:6.2f} mm/s, smoothed {r.z_smooth * V_MM:6.2f} mm/s | epochs above "
+          f"NEES 99.9 %: forward {100 * over[0]:.0f} %, smoothed {100 * over[1]:.0f} % | forward metric above its "
+          f"limit at {fig_summary[name]['metric_over']} of {m_norm.size} epochs (adaptive rule "
+          f"{'would' if fig_summary[name]['trigger'] is not None else 'would not'} fire) | final forward 3-sigma "
+          f"{fig_summary[name]['sig_final'][0]:.2f} km, {fig_summary[name]['sig_final'][1]:.1f} mm/s | control spike "
+          f"contrast at the burn: forward {fig_summary[name]['contrast'][0]:.3g}, smoothed "
+          f"{fig_summary[name]['contrast'][1]:.3g}")
+_ = plotting.save_figure(ad.figure_errors(panels["constant"], "Fig. 10 analogue, constant q_w", burn_days=burn_days,
+                                          velocity_unit="mm/s"), "10_fig10_constant_tuning_errors", output_dir=out)
 
 # %% [markdown]
-# The paper's Figs. 10-13 also show the velocity errors and the normalised OCBE metric (notebook 09b: the metric is
-# $\chi^2_4$ under a correct model, limit $\chi^2_{4,0.99} = 13.28$; the smoothed metric's epoch average is 4).
-# With the burn inside the raised-uncertainty window the forward metric need not exceed its limit at all: the
-# window tuning absorbs the burn as expected control instead of flagging it.
+# **Fig. 10 analogue** (the paper: "both the forwards and smoothed filters produce consistent, but less certain,
+# solutions"). Compare the errors (blue) with their 3-sigma bounds (red) and the NEES fractions printed above.
 
 # %%
-fig, ax = plt.subplots(2, 2, figsize=(13, 7), sharex=True)
-sc_q = s_q.scenario
-for j, (name, r) in enumerate(runs.items()):
-    q_run = s_q.control_weight if name == "apoapsis window" else np.full(sc_q.t.size - 1, s_q.control_weight.max())
-    for xs, Ps, lab, c in ((r.x_filt, r.P_filt, "forward", "C0"), (r.x_smooth, r.P_smooth, "smoothed", "C1")):
-        err = np.linalg.norm(xs[:, 3:] - demo.truth[:, 3:], axis=1) * em.velocity_unit_km_s * 1e6
-        sig = 3 * np.sqrt(np.trace(Ps[:, 3:, 3:], axis1=1, axis2=2)) * em.velocity_unit_km_s * 1e6
-        ax[0, j].semilogy(hours, err, c, label=f"{lab} error")
-        ax[0, j].semilogy(hours, sig, c + "--", lw=1, label=f"{lab} 3-sigma")
-    m_f, dof = ad.forward_metric(r, sc_q.model)
-    m_s = ad.smoothed_metric(r, demo.y, s_q.observer_states, sc_q.model, sc_q.meas_cov, q_run)
-    lim = ad.metric_limit(dof)
-    ax[1, j].semilogy(hours, m_f / lim, "C0.-", ms=3, lw=0.8, label="forward metric / limit")
-    ax[1, j].semilogy(hours, m_s / lim, "C1.-", ms=3, lw=0.8, label="smoothed metric / limit")
-    ax[1, j].axhline(4 / lim[0], color="C3", lw=1, label="mean / limit")
-    ax[1, j].axhline(1.0, color="k", ls="--", lw=0.8, label="99 % limit")
-    for a_ in ax[:, j]:
-        a_.axvline(s_q.t_maneuver * em.time_unit_s / 3600, color="k", ls=":", lw=1)
-    ax[0, j].set(title=f"{name} tuning", ylabel="velocity error (mm/s)")
-    ax[1, j].set(xlabel="hours since periapsis hand-off", ylabel="normalised OCBE metric")
-    print(f"{name:16s}: forward metric above its limit at {int(np.sum(m_f > lim))} of {m_f.size} epochs; "
-          f"{ad.first_detection(m_f, lim) is not None and 'would' or 'would not'} trigger the adaptive rule")
-fig.legend(*ax[0, 0].get_legend_handles_labels(), loc="upper center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, 1.0))
-fig.legend(*ax[1, 0].get_legend_handles_labels(), loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, 0.0))
-fig.tight_layout(rect=(0, 0.05, 1, 0.96))
-_ = plotting.save_figure(fig, "10_tuning_velocity_metric", output_dir=out)
+_ = plotting.save_figure(ad.figure_control_metric(panels["constant"], "Fig. 11 analogue, constant q_w",
+                                                  burn_days=burn_days),
+                         "10_fig11_constant_tuning_control_metric", output_dir=out)
+
+# %% [markdown]
+# **Fig. 11 analogue** (the paper: "the maneuver appears as a spike in estimated control only in the smoothed
+# system"). Top: the forward (single-step, Eq. 32) and smoothed control norms; bottom: the normalised metrics.
+
+# %%
+_ = plotting.save_figure(ad.figure_errors(panels["apoapsis window"], "Fig. 12 analogue, 8-h apoapsis window",
+                                          burn_days=burn_days, velocity_unit="mm/s"),
+                         "10_fig12_window_tuning_errors", output_dir=out)
+
+# %% [markdown]
+# **Fig. 12 analogue** (the paper: the window-tuned filter "still performs well"). Outside the window the
+# control weight is $q_b$, so the bounds shrink as in a ballistic filter and widen only across the window.
+
+# %%
+_ = plotting.save_figure(ad.figure_control_metric(panels["apoapsis window"], "Fig. 13 analogue, 8-h apoapsis window",
+                                                  burn_days=burn_days),
+                         "10_fig13_window_tuning_control_metric", output_dir=out)
+fs_c, fs_w = fig_summary["constant"], fig_summary["apoapsis window"]
+print(f"smoothed over forward z: constant {fs_c['z_s'] / fs_c['z_f']:.1f}, window {fs_w['z_s'] / fs_w['z_f']:.1f}; "
+      f"the window tuning's smoothed z is {fs_w['z_s'] / 50:.2f} of the 50 mm/s burn")
+
+# %% [markdown]
+# **Fig. 13 analogue** (the paper: a consistent filter "with a smoothed control spike around apoapsis that is
+# indicative of a maneuver"). With the window tuning the control is essentially zero outside the window, so the
+# smoothed spike stands alone and its integral $z$ tracks the burn. The forward control rises inside the window
+# too (the estimated control is $-\tilde Q B^\top\mathbf p$, so it scales with $q_w$ whether or not there is a
+# burn), which is where our Fig. 13 differs from the paper's, whose forward panel shows nothing; the printed spike
+# contrasts compare the two passes; with the constant tuning the smoothed control
+# also fits measurement noise all along the orbit, so the same burn is a smaller part of a larger $z$. The
+# forward metric need not exceed its limit in either case: both tunings absorb the burn as expected control
+# instead of flagging it, which is why the paper detects with $z$ and not with the metric.
+#
+# *Where this reproduction differs from the paper's figures.* The paper's runs are single draws with unstated
+# burn direction, noise and control weights, so only the qualitative statements can be compared; the closing
+# table lists them with criteria fixed before looking (consistency: at most 5 % of epochs above the 99.9 % NEES
+# quantile, notebook 09's run criterion; spike: smoothed $z$ above twice the forward $z$). Our time axis is days
+# from the periapsis hand-off (the burn at apoapsis, half a period in); our velocity panels are in mm/s.
 
 # %% [markdown]
 # ## 3 · Control-policy distributions (Eq. 33) and the maximum-likelihood test (Eqs. 34-35)
@@ -269,8 +291,9 @@ studies = {}
 for i, o in enumerate(ORBITS):
     for j, p in enumerate(POLICIES):
         k = OUTER_SIZE if o == OUTER else 1.0
-        studies[o, p] = det.run_policy_study(setups[o, p], POLICIES[p], max(int(k * N_H0), 20),
-                                             max(int(k * N_H1), 20), max(int(N_TEST * (0.5 if o == OUTER else 1)), 10),
+        studies[o, p] = det.run_policy_study(setups[o, p], POLICIES[p], max(int(k * N_H0), min(N_H0, 20)),
+                                             max(int(k * N_H1), min(N_H1, 20)),
+                                             max(int(N_TEST * (0.5 if o == OUTER else 1)), min(N_TEST, 10)),
                                              [SEED, i, j], batch_size=BATCH, executor=executor, label=f"{o} {p}")
 print(f"Monte Carlo wall time so far: {(time.perf_counter() - T_START) / 60:.1f} min")
 
@@ -288,8 +311,9 @@ for col, (key, st) in enumerate(studies.items()):
     ax[1, col].plot(zz, st.threshold.pdf1(zz / unit) / unit, label=r"$PDF_{H1}$")
     for a in ax[:, col]:
         a.axvline(st.threshold.z_lim * unit, color="k", ls=":", lw=1)
-    ax[0, col].set(title=f"{key[0]}, {key[1]}\n{len(st.h0)} H0 + {len(st.h1)} H1 runs", ylabel="count")
-    ax[1, col].set(xlabel=f"z ({ulab})", ylabel=f"PDF (1/({ulab}))",
+    ax[0, col].set(title=f"{key[0]}, {key[1]}\n{len(st.h0)} H0 + {len(st.h1)} H1 runs", ylabel="runs [-]",
+                   xlabel=f"z [{ulab}]")
+    ax[1, col].set(xlabel=f"z [{ulab}]", ylabel=f"probability density [1/({ulab})]",
                    title=f"z_lim = {st.threshold.z_lim * unit:.4g} {ulab}")
 h0h, h0l = ax[0, 0].get_legend_handles_labels()
 h1h, h1l = ax[1, 0].get_legend_handles_labels()
@@ -344,11 +368,22 @@ for (o, p, hyp), v in nees_study.items():
           f"{100 * v['runs_f']:13.0f} % / {100 * v['runs_s']:.0f} %")
 
 # %% [markdown]
-# A mean NEES near or below 6 without a burn (H0) says the window tuning costs no consistency when nothing happens.
-# With a burn (H1) the forward filter can be inconsistent for a few epochs after apoapsis: the factor $f = 0.1$ of
-# Section 2 gives the window a velocity uncertainty of only $\sqrt{0.1}\approx0.32$ of the burn's RMS size, a
-# choice made for detection (it keeps H0's $z$ small), not for consistency. The smoothed estimate, which sees the
-# data after the burn, is the one that should stay consistent; the table records both.
+# %%
+bad_cells = {k: v for k, v in nees_study.items() if max(v["runs_f"], v["runs_s"]) > 0.10}
+print("cells with more than 10 % inconsistent runs (forward / smoothed): "
+      + ("; ".join(f"{o} {p} {h}: {100 * v['runs_f']:.0f} % / {100 * v['runs_s']:.0f} %"
+                   for (o, p, h), v in bad_cells.items()) or "none"))
+print(f"every such cell has a burn (H1): {all(h == 'H1' for _, _, h in bad_cells)}")
+
+# %% [markdown]
+# In the full run (24 runs per cell) no run without a burn (H0) is inconsistent and the H0 mean NEES stays near 6
+# (4.6-7.8): the window tuning costs no consistency when nothing happens. With a burn (H1) the forward filter is
+# inconsistent in a fifth to two thirds of the runs for a few epochs after apoapsis (most for the quiet policy):
+# the factor $f = 0.1$ of Section 2 gives the window a velocity uncertainty of only $\sqrt{0.1}\approx0.32$ of the
+# burn's RMS size, a choice made for detection (it keeps H0's $z$ small), not for consistency. The smoothed
+# estimate, which sees the data after the burn, is consistent on the outer-band stable NRHO but not always on the
+# 9:2 and the inner-band one (12-17 % of H1 runs). The paper shows single consistent runs (Figs. 12-13); the
+# closing table records the worst cell per orbit as "differs" where it exceeds 10 %.
 
 # %% [markdown]
 # ## 4 · Sensitivity of $z$ to the maneuver (Figs. 16-17, 20-21)
@@ -363,16 +398,16 @@ for row, p in enumerate(POLICIES):
     h1 = studies["9:2 NRHO", p].h1
     unit, ulab = (1.0, "m/s") if p == "active" else (1e3, "mm/s")
     sc_ = ax[row, 0].scatter(np.degrees(h1.azimuth), np.degrees(h1.elevation), c=h1.z * unit, s=6, cmap="viridis")
-    fig.colorbar(sc_, ax=ax[row, 0], label=f"z ({ulab})")
-    ax[row, 0].set(xlabel="azimuth (deg)", ylabel="elevation (deg)", title=f"9:2 NRHO, {p}")
+    fig.colorbar(sc_, ax=ax[row, 0], label=f"z [{ulab}]")
+    ax[row, 0].set(xlabel="azimuth [deg]", ylabel="elevation [deg]", title=f"9:2 NRHO, {p}")
     ax[row, 1].scatter(np.degrees(h1.azimuth), h1.z / h1.magnitude, s=4, alpha=0.5)
-    ax[row, 1].set(xlabel="azimuth (deg)", ylabel="z / impulse magnitude")
+    ax[row, 1].set(xlabel="azimuth [deg]", ylabel="z / impulse magnitude [-]")
     for o, mk in zip(ORBITS, ("o", "x")):
         s1 = studies[o, p].h1
         ax[row, 2].scatter(s1.magnitude * unit, s1.z * unit, s=4, alpha=0.4, marker=mk, label=o)
     mm = np.array([0, h1.magnitude.max() * unit])
     ax[row, 2].plot(mm, mm, "k--", lw=1, label="z = magnitude")
-    ax[row, 2].set(xlabel=f"impulse magnitude ({ulab})", ylabel=f"z ({ulab})")
+    ax[row, 2].set(xlabel=f"impulse magnitude [{ulab}]", ylabel=f"z [{ulab}]")
     ax[row, 2].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0), markerscale=3)
 fig.tight_layout()
 _ = plotting.save_figure(fig, "10_z_vs_maneuver", output_dir=out)
@@ -384,7 +419,11 @@ def azimuth_contrast(h1):
     low = e < 45
     side = low & (np.abs(a - 90) < 30)
     axial = low & ((a < 30) | (a > 150))
-    return r[side].mean() / r[axial].mean()
+    return r[side].mean() / r[axial].mean() if side.any() and axial.any() else np.nan  # NaN: a sector is empty
+
+
+def ratio_text(v):
+    return "no burn in a sector (small sample)" if np.isnan(v) else f"{v:.2f}"
 
 
 lin = {}
@@ -393,7 +432,7 @@ for (o, p), st in studies.items():
     slope = np.polyfit(h1.magnitude, h1.z, 1)[0]
     lin[o, p] = (slope, np.corrcoef(h1.magnitude, h1.z)[0, 1], azimuth_contrast(h1), stats.skew(h1.z))
     print(f"{o:12s} {p:7s}: z vs magnitude slope {slope:.2f}, corr {lin[o, p][1]:.3f}; z/|dv| at azimuth +-90 "
-          f"over 0/180 (|el| < 45 deg) = {lin[o, p][2]:.2f}; skewness of H1 z = {lin[o, p][3]:.2f}")
+          f"over 0/180 (|el| < 45 deg) = {ratio_text(lin[o, p][2])}; skewness of H1 z = {lin[o, p][3]:.2f}")
 
 # %% [markdown]
 # **Looking for the $\pm\hat j$ pattern.** Where could the paper's bimodality come from? We fire 1 m/s burns in
@@ -429,11 +468,30 @@ best_pmj = max(pmj.items(), key=lambda kv: kv[1][1])
 # Fresh runs (seeds independent of the training runs) are classified with Eq. 35 and the $z_{lim}$ above.
 
 # %%
+acc = {k: st.score.accuracy for k, st in studies.items()}
 print(f"{'orbit':12s} {'policy':7s} {'H0 -> H0':>9s} {'H0 -> H1':>9s} {'H1 -> H1':>9s} {'H1 -> H0':>9s} {'accuracy':>9s}")
 for (o, p), st in studies.items():
     s = st.score
     print(f"{o:12s} {p:7s} {s.true_negative:9d} {s.false_positive:9d} {s.true_positive:9d} {s.missed_detection:9d} "
           f"{100 * s.accuracy:8.1f}%")
+
+# %% [markdown]
+# **The two stable candidates, side by side.** Detection accuracy (Tables 7-8) and the worst window-tuning NEES cell
+# (Section 3b) per orbit:
+
+# %%
+for o in ORBITS:
+    worst = max((v["runs_f"], v["runs_s"]) for k, v in nees_study.items() if k[0] == o)
+    print(f"{o:25s}: accuracy active {100 * acc[o, 'active']:.1f} %, quiet {100 * acc[o, 'quiet']:.1f} % "
+          f"({studies[o, 'active'].score.n} tests each); worst cell inconsistent runs forward {100 * worst[0]:.0f} %, "
+          f"smoothed {100 * worst[1]:.0f} %")
+
+# %% [markdown]
+# In the full run the accuracies of all three orbits lie within two or three test runs of each other (97-100 %),
+# which the 100 + 100 tests (50 + 50 for the outer band) cannot separate; the window-tuned filter is most
+# consistent on the outer-band member (no inconsistent smoothed run), least on the inner-band one. Detection
+# therefore does not decide between the candidates; notebook 09's determination and consistency results do (the
+# outer band), and both stay in the table.
 
 # %% [markdown]
 # ## 6 · Control as a health metric (Fig. 22)
@@ -453,20 +511,21 @@ sig_h1 = (z_h - ref.h1.z.mean()) / ref.h1.z.std()
 sig_h0 = (z_h - ref.h0.z.mean()) / ref.h0.z.std()
 nees_h = tracking.nees(rh.x_smooth, rh.P_smooth, health.truth)
 fig, ax = plt.subplots(1, 3, figsize=(15, 3.8))
+hours = sc_q.t * em.time_unit_s / 3600
 err = np.linalg.norm(rh.x_smooth[:, :3] - health.truth[:, :3], axis=1) * em.length_unit_km
 sig = 3 * np.sqrt(np.trace(rh.P_smooth[:, :3, :3], axis1=1, axis2=2)) * em.length_unit_km
 ax[0].semilogy(hours, err, label="smoothed error")
 ax[0].semilogy(hours, sig, "--", label="3-sigma")
-ax[0].set(xlabel="hours", ylabel="position error (km)", title="0.5 m/s burn, quiet tuning")
+ax[0].set(xlabel="time from periapsis [h]", ylabel="position error [km]", title="0.5 m/s burn, quiet tuning")
 ax[0].legend()
 ax[1].plot(hours, rh.residual_norms, ".")
 ax[1].axhline(np.sqrt(stats.chi2.ppf(0.99, 4)), color="k", ls=":", label="99% of a 4-dof residual")
-ax[1].set(xlabel="hours", ylabel="whitened residual norm", title="measurement residuals")
+ax[1].set(xlabel="time from periapsis [h]", ylabel="whitened residual norm [-]", title="measurement residuals")
 ax[1].legend()
 ax[2].hist(ref.h1.z, bins=40, alpha=0.6, label="quiet H1")
 ax[2].hist(ref.h0.z, bins=40, alpha=0.6, label="quiet H0")
 ax[2].axvline(z_h, color="C3", label=f"this run: z = {z_h:.3f} m/s")
-ax[2].set(xscale="log", xlabel="z (m/s)", ylabel="count")
+ax[2].set(xscale="log", xlabel="z [m/s]", ylabel="runs [-]")
 ax[2].legend(fontsize=8)
 _ = plotting.save_figure(fig, "10_health_metric", output_dir=out)
 print(f"impulse 0.5 m/s (azimuth {np.degrees(health.azimuth):.0f} deg, elevation {np.degrees(health.elevation):.0f} deg):"
@@ -535,6 +594,27 @@ table.add("OCBE tuning (8-h apoapsis window)", "values missing",
 table.add("Monte Carlo sizes (H0 / H1 / tests per hypothesis)", "500 / 3000 / 100", f"{N_H0} / {N_H1} / {N_TEST}",
           "derived: the paper's sizes" if not QUICK else "differs: quick mode",
           "per policy and orbit; an input; the outer-band stable NRHO runs a fifth (training) and half (tests)")
+sig_mean = {k: float(np.mean(panels[k].position_3sigma_km[0])) for k in panels}
+for fig_no, name, claim in ((10, "constant", "consistent, but less certain (forward and smoothed)"),
+                            (12, "apoapsis window", "consistent (forward and smoothed)")):
+    fs = fig_summary[name]
+    ok = max(fs["over"]) <= tracking.DIVERGED_FRACTION and (name != "constant" or
+                                                            sig_mean["constant"] > sig_mean["apoapsis window"])
+    table.add(f"Fig. {fig_no}: {name} tuning, 50 mm/s burn", claim,
+              f"epochs above NEES 99.9 %: forward {100 * fs['over'][0]:.0f} %, smoothed {100 * fs['over'][1]:.0f} %; "
+              f"mean forward 3-sigma position {sig_mean[name]:.2f} km",
+              "reproduced" if ok else "differs: see the NEES fractions and the bounds",
+              "one run (+j burn); criterion fixed in advance: at most 5 % of epochs above the quantile"
+              + (" and larger bounds than the window tuning" if name == "constant" else ""))
+for fig_no, name in ((11, "constant"), (13, "apoapsis window")):
+    cf, cs = fig_summary[name]["contrast"]
+    table.add(f"Fig. {fig_no}: {name} tuning, control spike at the burn in the smoothed control only",
+              "spike only in the smoothed system", f"spike contrast: smoothed {cs:.3g}, forward {cf:.3g}",
+              "reproduced" if cs >= 2 and cs > cf else "differs: " + ("no smoothed spike" if cs < 2 else
+                                                                       "the forward control spikes as much"),
+              "contrast = mean control norm within 6 h of the burn over the mean elsewhere "
+              "(PanelSeries.spike_contrast); criterion: smoothed at least 2 and above the forward one (chosen after "
+              "seeing the figures, so a description rather than a test)")
 table.add("Smoothed control spike at apoapsis with window tuning (Figs. 12-13)", "spike in smoothed control only",
           f"z smoothed {runs['apoapsis window'].z_smooth * em.velocity_unit_km_s * 1e6:.1f} mm/s vs forward "
           f"{runs['apoapsis window'].z_step * em.velocity_unit_km_s * 1e6:.1f} mm/s for a 50 mm/s burn",
@@ -569,7 +649,6 @@ n_cross = [st.threshold.crossings.size for st in studies.values()]
 table.add("H0 and H1 PDFs cross once", "yes (Figs. 15, 19)", f"crossings per case: {n_cross}",
           "reproduced" if all(c == 1 for c in n_cross) else "differs: KDE tails of the finite sample add crossings",
           "z_lim is the crossing of least total error")
-acc = {k: st.score.accuracy for k, st in studies.items()}
 for key, paper in ((("9:2 NRHO", "active"), 1.00), (("9:2 NRHO", "quiet"), 0.97)):
     a = acc[key]
     ok = abs(a - paper) <= max(0.02, 2 * np.sqrt(paper * (1 - paper) / N_TEST / 2) + 1 / (2 * N_TEST))
@@ -580,24 +659,31 @@ for key, paper in ((("9:2 NRHO", "active"), 1.00), (("9:2 NRHO", "quiet"), 0.97)
 for o in STABLE:
     for p in POLICIES:
         a_s, a_n = acc[o, p], acc["9:2 NRHO", p]
+        n_s, n_n = studies[o, p].score.n, studies["9:2 NRHO", p].score.n
+        se = np.sqrt(max(a_s * (1 - a_s), 1 / n_s) / n_s + max(a_n * (1 - a_n), 1 / n_n) / n_n)
         table.add(f"Detection accuracy, {o}, {p} (Table 8)",
                   "marginally better than 9:2" + (" (quiet: 200/200)" if p == "quiet" else ""),
-                  f"{100 * a_s:.1f} % of {studies[o, p].score.n} tests (9:2: {100 * a_n:.1f} %)",
-                  "reproduced" if a_s >= a_n else "differs: not better than the 9:2 NRHO in our test sets",
-                  "outer-band candidate, half the test runs" if o == OUTER else "")
+                  f"{100 * a_s:.1f} % of {n_s} tests (9:2: {100 * a_n:.1f} % of {n_n})",
+                  "reproduced" if a_s >= a_n else
+                  "differs: not better than the 9:2, but within 2 standard errors of it" if a_n - a_s <= 2 * se else
+                  "differs: worse than the 9:2 NRHO",
+                  ("outer-band candidate, half the test runs; " if o == OUTER else "")
+                  + f"standard error of the difference {100 * se:.1f} points; 'marginally better' cannot be resolved "
+                  "with this many tests")
 for p in POLICIES:
     sl, cr, ctr, sk = lin["9:2 NRHO", p]
     table.add(f"z nearly linear in the magnitude, {p} (Figs. 17, 21)", "apparently linear",
               f"slope {sl:.2f}, corr {cr:.3f}", "reproduced" if cr > 0.8 else "differs: weak correlation")
 ctr_a, ctr_q = lin["9:2 NRHO", "active"][2], lin["9:2 NRHO", "quiet"][2]
 table.add("Largest z for burns at azimuth +-90 deg, active (Fig. 16)", "bimodal, peaks at +-j",
-          f"z/|dv| at +-90 deg over 0/180 deg: {ctr_a:.2f}",
+          f"z/|dv| at +-90 deg over 0/180 deg: {ratio_text(ctr_a)}",
           "reproduced" if ctr_a > 1.1 else "differs: no clear +-j preference in our runs")
 table.add("Conditions for the +-j pattern (sweep over f and angle noise, 1 m/s in-plane burns)", "not discussed",
           f"largest contrast {best_pmj[1][1]:.2f} at f = {best_pmj[0][0]:g}, {best_pmj[0][1] * 1e6:g} urad; "
           f"range {min(v[1] for v in pmj.values()):.2f}-{max(v[1] for v in pmj.values()):.2f}", "beyond paper",
           f"{PM_J_SEEDS} noise draw(s) per azimuth; a contrast near 1 means no +-j preference")
-table.add("Quiet policy: pattern less bimodal (Fig. 20)", "more uniform", f"ratio {ctr_q:.2f} (active {ctr_a:.2f})",
+table.add("Quiet policy: pattern less bimodal (Fig. 20)", "more uniform",
+          f"ratio {ratio_text(ctr_q)} (active {ratio_text(ctr_a)})",
           "reproduced" if ctr_a > 1.1 and ctr_q < ctr_a else
           "differs: neither policy shows the +-j pattern clearly, so there is nothing to weaken")
 table.add("H1 z approximately Gaussian, active (Fig. 15)", "approximately Gaussian",
