@@ -110,6 +110,7 @@ def _expected_seconds(config, stem: str) -> float:
     return float(QUICK_SECONDS.get(stem.split("_")[0], 60))  # an unknown notebook: assume long, start it early
 
 
+@pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which turns xdist_group marks into scheduling scopes
 def pytest_collection_modifyitems(config, items):
     def module_group(item):
         info = getattr(item, "_fixtureinfo", None)
