@@ -481,7 +481,7 @@ for (o, p), st in studies.items():
 
 # %%
 for o in ORBITS:
-    worst = max((v["runs_f"], v["runs_s"]) for k, v in nees_study.items() if k[0] == o)
+    worst = [max(v[r] for k, v in nees_study.items() if k[0] == o) for r in ("runs_f", "runs_s")]
     print(f"{o:25s}: accuracy active {100 * acc[o, 'active']:.1f} %, quiet {100 * acc[o, 'quiet']:.1f} % "
           f"({studies[o, 'active'].score.n} tests each); worst cell inconsistent runs forward {100 * worst[0]:.0f} %, "
           f"smoothed {100 * worst[1]:.0f} %")
