@@ -580,7 +580,7 @@ def _check_linear_system(P0, F, Q, H, R, *, chol_R: bool = False):
 
 def position_sigma_km(P, index: int, system: CR3BP) -> np.ndarray:
     """RMS position error :math:`\\sqrt{\\mathrm{tr} P_{rr}}` (km) of object ``index`` (0 = observer) in augmented covariances ``(..., n, n)``."""
-    P = _checks.spd(P, "P", batch=True)
+    P = _checks.psd(P, "P", batch=True)  # a negative covariance would give NaN (round-off negatives pass)
     _check_system(system)
     i = _checks.integer(index, "index", minimum=0)
     if 6 * (i + 1) > P.shape[-1]:
