@@ -183,8 +183,7 @@ def _run_chunk(trial, seed, indices, args, kwargs, token=None, collect=False, ve
         if token is not None and token in _STOPPED:
             return []
         try:
-            rngs = [np.random.default_rng(np.random.SeedSequence(root.entropy, spawn_key=base + (offset + i,),
-                                                                 pool_size=root.pool_size)) for i in indices]
+            rngs = [np.random.default_rng(_child(root, base, offset, i)) for i in indices]
             res = list(trial(rngs, *args, **kwargs))
             if len(res) != len(rngs):
                 raise ValueError(f"a vectorized trial must return one result per generator: got {len(res)} for "
@@ -194,14 +193,14 @@ def _run_chunk(trial, seed, indices, args, kwargs, token=None, collect=False, ve
             if len(indices) > 1:
                 return _run_chunk(functools.partial(_first_of_vectorized, trial), seed, indices, args, kwargs, token,
                                   collect)
-            ss = np.random.SeedSequence(root.entropy, spawn_key=base + (offset + indices[0],), pool_size=root.pool_size)
+            ss = _child(root, base, offset, indices[0])
             seed_txt = f"SeedSequence(entropy={ss.entropy}, spawn_key={tuple(ss.spawn_key)})"
             return [(indices[0], False, TrialFailure(indices[0], seed_txt, _picklable(exc), traceback.format_exc()))]
     out = []
     for i in indices:
         if token is not None and token in _STOPPED:
             break
-        ss = np.random.SeedSequence(root.entropy, spawn_key=base + (offset + i,), pool_size=root.pool_size)
+        ss = _child(root, base, offset, i)
         try:
             out.append((i, True, trial(np.random.default_rng(ss), *args, **kwargs)))
         except Exception as exc:  # noqa: BLE001 - reported with index, seed and traceback
@@ -210,6 +209,11 @@ def _run_chunk(trial, seed, indices, args, kwargs, token=None, collect=False, ve
             if not collect:
                 break
     return out
+
+
+def _child(root, base, offset, i) -> np.random.SeedSequence:
+    """Child ``i`` of ``root`` (spawn key ``base + (offset + i,)``), built directly."""
+    return np.random.SeedSequence(root.entropy, spawn_key=base + (offset + i,), pool_size=root.pool_size)
 
 
 def _first_of_vectorized(trial, rng, *args, **kwargs):
