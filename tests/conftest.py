@@ -139,6 +139,22 @@ def pytest_collection_modifyitems(config, items):
     items[:] = [it for _, it in sorted(enumerate(items), key=lambda p: (rank(p[1]), p[0]))]
 
 
+@pytest.hookimpl(trylast=True, specname="pytest_collection_modifyitems")
+def pytest_collection_modifyitems_xdist_scopes(config, items):
+    """Make ``--dist loadgroup`` group again: xdist 3.8 marks a group by appending ``@group`` to ``item._nodeid``,
+    which pytest 9 no longer reads (the node id lives in ``item._id``), so every test was its own scope and
+    ``xdist_group`` had no effect.  Done here on the worker side, as xdist intends, when a worker runs loadgroup."""
+    if not getattr(config.option, "loadgroup", False):  # set on xdist workers running --dist loadgroup
+        return
+    from _pytest.nodeid import NodeId
+
+    for item in items:
+        names = sorted({str(m.args[0] if m.args else m.kwargs.get("name", "default"))
+                        for m in item.iter_markers("xdist_group")})
+        if names and "@" not in item.nodeid and hasattr(item, "_id"):
+            item._id = NodeId.parse(f"{item.nodeid}@{'_'.join(names)}")
+
+
 def pytest_sessionfinish(session):
     """Remember how long each quick notebook took (rule 3), from the shared run records of this session."""
     if os.environ.get("PYTEST_XDIST_WORKER") or getattr(session.config, "cache", None) is None:
