@@ -627,11 +627,13 @@ class ScenarioSolver:
         Default: :meth:`Scenario.information_model` (process noise fixed along the ballistic window arc).
     keep_out : bool
         Impose :meth:`Scenario.keep_out` (test case 2).
+    d_min_km : float, optional
+        Keep-out radius, km (default :attr:`Scenario.keep_out_km`; used with ``keep_out=True``).
     settings : cislunar.scvx.SCvxSettings, optional
     """
 
     def __init__(self, scenario: Scenario, t_nodes, k_window: int, *, information=None, keep_out: bool = False,
-                 settings=None):
+                 d_min_km: float | None = None, settings=None):
         if not isinstance(scenario, Scenario):
             raise ValueError(f"scenario must be a Scenario; got {type(scenario).__name__}")
         self.scenario = scenario
@@ -641,7 +643,9 @@ class ScenarioSolver:
             raise ValueError(f"k_window must index the window-start node; got {k_window}")
         self.information = (scenario.information_model() if information is None
                             else _checks.callable_(information, "information"))
-        self.constraints = (scenario.keep_out(self.k_window),) if _checks.boolean(keep_out, "keep_out") else ()
+        d_min = None if d_min_km is None else _checks.positive(d_min_km, "d_min_km")
+        self.constraints = ((scenario.keep_out(self.k_window, d_min),) if _checks.boolean(keep_out, "keep_out")
+                            else ())
         if settings is not None:
             from .scvx import SCvxSettings
 

@@ -34,12 +34,20 @@ OUTPUT_DIR = ""
 
 # %%
 # Sizes derived from QUICK: quick mode uses fewer SCvx nodes and alphas; the seeds and every study still run.
-N_NODES = 20 if QUICK else 30  # Sundman nodes over the three periods (window ends moved onto nodes)
+N_NODES = 16 if QUICK else 30  # Sundman nodes over the three periods (window ends moved onto nodes)
 MAX_ITER = 100 if QUICK else 150  # SCvx iteration limit per run
+FREE_ITER = 15 if QUICK else 75  # iterations granted to the run without keep-out (it does not converge)
 SIGMA = 1.0  # Sundman exponent (notebook 04)
-# homotopy grid: 8 values including 0 and the weights of Figs. 6-8 (quick mode: 5)
-ALPHAS = [0.0, 1e-3, 5e-3, 1e-2, 2e-2] if QUICK else [0.0, 5e-4, 1e-3, 2e-3, 5e-3, 7e-3, 1e-2, 2e-2]
-WORKERS = 2  # processes for the independent upward/downward sweeps and the seeded runs
+# homotopy grid: 8 values including 0 and the weights of Figs. 6-8 (quick mode: 3; figures asking for an alpha_h
+# outside the grid show the nearest one and say so)
+ALPHAS = [0.0, 5e-3, 1e-2] if QUICK else [0.0, 5e-4, 1e-3, 2e-3, 5e-3, 7e-3, 1e-2, 2e-2]
+SEED_ALPHAS = [] if QUICK else [5e-3, 7e-3]  # Fig. 7's pair, solved from +z and -z seeds (full mode)
+MIRROR_ALPHA = 5e-3  # the sweep's optimum there, mirrored and solved again (both modes)
+D_MIN_KM = [1500.0] if QUICK else [10.0, 141.0, 1000.0, 1500.0, 2500.0]  # keep-out radii swept (besides 424 km)
+SCAN_POINTS = 8 if QUICK else 20  # closest-approach scan of section 3
+BUDGET_EXTRA_MPS = 5.0  # impulse budget above the baseline's for the equal-impulse solve (section 11)
+BUDGET_RTOL = 0.02  # a budget counts as met within 2 % (fixed before solving)
+WORKERS = 2  # processes for the independent upward/downward sweeps and the other independent runs
 
 import multiprocessing
 import time
@@ -60,6 +68,7 @@ out = OUTPUT_DIR or None
 rng = np.random.default_rng(SEED)  # no random draws below; kept for the common parameter interface
 table = ComparisonTable("06 Test case 2 (Wolf & Jones Tables 4-5, Figs. 6-10)")
 t_start = time.perf_counter()
+
 executor = ProcessPoolExecutor(max_workers=WORKERS, mp_context=multiprocessing.get_context("spawn"))
 
 # %% [markdown]
@@ -161,7 +170,7 @@ def observer_passing_at(d_km, x0, iterations=6):
     return x
 
 
-d_scan = np.geomspace(1e-6, 3000.0, 12 if QUICK else 20)
+d_scan = np.geomspace(1e-6, 3000.0, SCAN_POINTS)
 mi_scan = np.array([info(observer_passing_at(d, x_ws_ball)) for d in d_scan])
 ko = sc.keep_out(k_ws)
 fig, ax = plt.subplots(figsize=(6, 3.8))
@@ -169,7 +178,7 @@ ax.semilogx(d_scan, mi_scan - I0, "o-")
 ax.axvline(sc.keep_out_km, color="C3", ls="--", label=f"keep-out {sc.keep_out_km:.0f} km (3 prior sigma)")
 ax.set(xlabel="closest approach to target 1 at the middle measurement [km]",
        ylabel=r"$\mathcal{I} - \mathcal{I}_{ballistic}$ [nats]", title="The MI rewards flying through a target")
-ax.legend(loc="lower left")
+ax.legend(loc="upper right")
 _ = plotting.save_figure(fig, "06_keep_out_motivation", output_dir=out)
 for d_show in (1000.0, 424.0, 1.0, 0.1, 1e-3, 1e-6):
     print(f"pass at {d_show:8.0e} km: MI gain {np.interp(np.log(d_show), np.log(d_scan), mi_scan) - I0:+.2f} nats")
@@ -186,6 +195,9 @@ for d_show in (1000.0, 424.0, 1.0, 0.1, 1e-3, 1e-6):
 # %%
 solver = wj.ScenarioSolver(sc, t, k_ws, information=info, keep_out=True,
                            settings=scvx.SCvxSettings(max_iter=MAX_ITER))
+# the seeded runs of section 7 do not depend on the sweep: queue them behind its two chains
+seeds = {s: sc.seeded_guess(t, s) for s in (+1, -1)}
+seed_jobs = {(a, s): executor.submit(solver, a, *seeds[s]) for a in SEED_ALPHAS for s in (+1, -1)}
 t0 = time.perf_counter()
 sweep = wj.sweep_both_ways(solver, ALPHAS, x_ball, u_ball, executor=executor)
 t_sweep = time.perf_counter() - t0
@@ -299,19 +311,26 @@ print("largest departure from the reference [km]:",
 # measurements are all invariant under $z\to-z$, $\dot z\to-\dot z$; so for every optimum its mirror image is an
 # optimum with exactly the same cost. We start SCvx from $+z$ and $-z$ seeds (a small out-of-plane thrust before
 # the window) at both weights and compare the two answers: equal costs and mirror-image trajectories answer the
-# question with numbers.
+# question with numbers. A sharper check runs in both modes: the sweep's optimum at $\alpha_h = 5\times10^{-3}$,
+# mirrored ($z, \dot z, a_z \to -z, -\dot z, -a_z$) and handed to SCvx as its guess, must be accepted as an
+# optimum with the same cost. (Quick mode runs only this check; the seeded runs are full mode.)
 
 # %%
 mirror = np.diag([1, 1, -1, 1, 1, -1.0])
-seed_alphas = [7e-3] if QUICK else [5e-3, 7e-3]  # Fig. 7's pair (quick mode: one of them)
-seeds = {s: sc.seeded_guess(t, s) for s in (+1, -1)}
-jobs = {(a, s): executor.submit(solver, a, *seeds[s]) for a in seed_alphas for s in (+1, -1)}
+seed_alphas = SEED_ALPHAS  # submitted to the pool in section 4
 seeded = {}
-for key, fut in jobs.items():
+for key, fut in seed_jobs.items():
     try:
         seeded[key] = fut.result()
     except scvx.SCvxError as exc:
         seeded[key] = exc
+mirror_u = np.diag([1, 1, -1.0])
+row_m = pick(MIRROR_ALPHA)
+twin = solver(row_m["alpha"], row_m["res"].x @ mirror, row_m["res"].u @ mirror_u)
+twin_dcost = abs(twin.cost - row_m["res"].cost) / abs(row_m["res"].cost)
+twin_km = float(np.max(np.linalg.norm((twin.x - row_m["res"].x @ mirror)[:, :3], axis=1)) * em.length_unit_km)
+print(f"mirrored optimum of alpha {row_m['alpha']:g}: {twin.iterations} iterations, relative cost difference "
+      f"{twin_dcost:.1e}, largest distance from the exact mirror {twin_km:.3f} km")
 mirror_rows = []
 for a in seed_alphas:
     p, m = seeded[(a, +1)], seeded[(a, -1)]
@@ -328,12 +347,14 @@ for a in seed_alphas:
           f"largest distance between one and the mirror of the other {mis_km:.2f} km; "
           f"cost {min(p.cost, m.cost):.6f} vs best of sweeps {best_sweep:.6f}")
 fig, axes = plt.subplots(1, 2, figsize=(12, 4))
-for (a, s), res in seeded.items():
+curves = {(row_m["alpha"], "sweep optimum"): row_m["res"], (row_m["alpha"], "its mirror, re-solved"): twin}
+curves.update({(a, f"{'+' if s_ > 0 else '-'}z seed"): res for (a, s_), res in seeded.items()})
+for n_, ((a, what), res) in enumerate(curves.items()):
     if isinstance(res, Exception):
         continue
     tf, xf = wj.fly(sc, t, res.u, refine=4)
-    style = dict(lw=1.2, ls="-" if s > 0 else "--", color="C0" if a == seed_alphas[0] else "C1",
-                 label=rf"$\alpha_h$ = {a:g}, {'+' if s > 0 else '-'}z seed")
+    style = dict(lw=1.2, ls="-" if n_ % 2 == 0 else "--", color=f"C{n_ // 2}",
+                 label=rf"$\alpha_h$ = {a:g}, {what}")
     axes[0].plot(em.tu_to_days(tf), xf[:, 2] * em.length_unit_km, **style)
     axes[1].plot(xf[:, 1] * em.length_unit_km, xf[:, 2] * em.length_unit_km, **style)
 axes[0].axvspan(ws_d, we_d, color="0.9", zorder=0)
@@ -341,7 +362,7 @@ axes[0].set(xlabel="time [days] (window shaded)", ylabel="z [km]")
 axes[1].set(xlabel="y [km]", ylabel="z [km]")
 fig.legend(*axes[0].get_legend_handles_labels(), loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, -0.02))
 fig.tight_layout(rect=(0, 0.07, 1, 0.95))
-fig.suptitle("Seeded +z / -z solutions: exact mirror images with equal cost")
+fig.suptitle("z-mirror: an optimum and its mirror image (and, full mode, the +z / -z seeded solutions)")
 _ = plotting.save_figure(fig, "06_z_mirror", output_dir=out)
 
 # %% [markdown]
@@ -401,7 +422,7 @@ print("mean RMS over the window, observer vs targets [km]:",
 # initial transient "subsequent measurements serve to bound the expected error". Below, the CRLB of test case 1's
 # ballistic observer (where the evidence is sharpest) and the terminal RMS of this case's ballistic and
 # $\alpha_h = 10^{-2}$ trajectories under each reading. The 1e-11 km²/s³ reading lets test case 1's errors grow to
-# tens of thousands of km (a one-day velocity random walk of 0.9 m/s, comparable to the 1.6 m/s minimum-impulse budget);
+# tens of thousands of km (a one-day velocity random walk of 0.9 m/s, comparable to test case 1's 0.4 m/s minimum-impulse budget);
 # the three small readings stay bounded and differ little. We adopt the normalised one (`PROCESS_NOISE_PSD_ND`; the
 # figures cannot separate it from the SI one, a factor 2.8 in q).
 
@@ -440,9 +461,9 @@ rms_tgt = np.array([r["crlb"].terminal_rms_km[1:] for r in ok])
 mis = np.array([r["mi"] for r in ok])
 fig, axes = plt.subplots(1, 3, figsize=(15, 4))
 axes[0].loglog(np.maximum(dvs, 1e-3), rms_obs, "o-")
-for n_, (r, x_, y_) in enumerate(zip(ok, dvs, rms_obs)):  # labels alternate above/below the front
-    axes[0].annotate(f"{r['alpha']:g}", (x_, y_), textcoords="offset points", xytext=(4, 5 if n_ % 2 else -11),
-                     fontsize=7)
+for n_, (r, x_, y_) in enumerate(zip(ok, dvs, rms_obs)):  # labels right of the points, alternately above/below
+    axes[0].annotate(f"{r['alpha']:g}", (x_, y_), textcoords="offset points", xytext=(5, 6 if n_ % 2 == 0 else -12),
+                     ha="left", fontsize=7)
 axes[0].set(xlabel=r"total impulse $\Delta V$ [m/s]", ylabel="terminal position RMS [km]", title="observer")
 for i in range(3):
     axes[1].loglog(np.maximum(dvs, 1e-3), rms_tgt[:, i], "o-", label=f"target {i + 1}")
@@ -453,7 +474,9 @@ axes[2].semilogy(mis, rms_tgt.mean(axis=1), "s--", label="targets (mean)")
 axes[2].set(xlabel="mutual information of the window [nats]", ylabel="terminal position RMS [km]",
             title="MI against CRLB")
 axes[2].legend(fontsize=8, loc="upper right")
-for ax in axes[:2]:
+for ax in axes[:2]:  # plain impulse ticks (a log axis spanning one decade would print a single label)
+    ticks = [v for v in (1, 2, 5, 10, 20, 50, 100, 200) if 0.7 * dvs.min() <= v <= 1.4 * dvs.max()]
+    ax.set_xticks(ticks, [f"{v:g}" for v in ticks])
     ax.xaxis.set_minor_formatter(plt.NullFormatter())
 _ = plotting.save_figure(fig, "06_fig10_pareto", output_dir=out)
 rank_obs = spearmanr(mis, rms_obs).statistic
@@ -469,14 +492,21 @@ print(f"Spearman rank correlation MI vs terminal RMS: observer {rank_obs:.3f}, t
 # **Re-flight.** Each converged control is flown by single shooting from the initial state (table in section 4:
 # terminal miss in km), so the trajectories are real and not an artefact of the virtual control.
 #
-# **Baseline against information trajectories.** The paper claims "substantial improvement over a baseline
-# comparison which utilizes solely control effort". The $\alpha_h = 0$ baseline is the minimum-impulse transfer;
-# we compare it with the cheapest information trajectory (smallest $\alpha_h > 0$) and with the best one, in
-# impulse and terminal RMS.
+# **Baseline against information trajectories, at equal impulse.** The paper claims "substantial improvement over
+# a baseline comparison which utilizes solely control effort". The $\alpha_h = 0$ baseline is the minimum-impulse
+# transfer: nothing spends less, so the fair question is what a given *extra* impulse buys. SCvx has no impulse
+# constraint, but the weighted-sum front's impulse grows with $\alpha_h$, so solving for the $\alpha_h$ whose
+# optimum spends a prescribed budget (`wolf_jones.solve_for_impulse`, budget met within 2 %, fixed before
+# solving) gives the most informative plan at that impulse. We do it for the baseline's impulse plus 5 m/s.
 #
-# **Keep-out off.** One run at the Fig. 6 weight without the keep-out shows what it prevents.
+# **The keep-out radius, swept.** The 424 km keep-out is our choice, not the paper's, and it is active in several
+# solutions of the sweep (section 4: closest approach 424.3 km). Which of the paper's claims rest on it? At the
+# Fig. 6 weight we solve from the ballistic guess with other radii, and once without any keep-out: does the
+# optimum follow the keep-out towards the target as it shrinks, and what happens to impulse, information and
+# terminal RMS?
 #
-# **a_max readings.** One run at the Fig. 6 weight under each reading of Table 5's "1x5^-7".
+# **a_max readings.** One run at the Fig. 6 weight under each reading of Table 5's "1x5^-7" (warm-started from
+# the adopted solution).
 
 # %%
 base = by_alpha.get(0.0)
@@ -487,13 +517,41 @@ if base and cheap:
           f"alpha {cheap['alpha']:g}: dV {cheap['dv']:.2f} m/s (+{cheap['dv'] - base['dv']:.2f}), RMS "
           f"{cheap['crlb'].terminal_rms_km[0]:.0f} km ({base['crlb'].terminal_rms_km[0] / cheap['crlb'].terminal_rms_km[0]:.0f}x "
           f"better); best alpha {best['alpha']:g}: dV {best['dv']:.2f} m/s, RMS {best['crlb'].terminal_rms_km[0]:.1f} km")
+# queue the independent runs (keep-out off, other radii, a_max readings); the budget search runs meanwhile here
 free = wj.ScenarioSolver(sc, t, k_ws, information=info, keep_out=False,
-                         settings=scvx.SCvxSettings(max_iter=MAX_ITER // 2))
+                         settings=scvx.SCvxSettings(max_iter=FREE_ITER))
+radius_solvers = {d: wj.ScenarioSolver(sc, t, k_ws, information=info, keep_out=True, d_min_km=d,
+                                       settings=solver.settings) for d in D_MIN_KM}
 amax_solvers = {label: wj.ScenarioSolver(wj.test_case_2(a_max_km_s2=a_km), t, k_ws, information=info, keep_out=True,
                                          settings=solver.settings)
                 for label, a_km in wj.A_MAX_READINGS_CASE2_KM_S2.items() if a_km != wj.A_MAX_CASE2_KM_S2}
 jobs = {"no keep-out": executor.submit(free, a6, x_ball, u_ball)}
-jobs.update({label: executor.submit(s_, a6, x_ball, u_ball) for label, s_ in amax_solvers.items()})
+jobs.update({("d_min", d): executor.submit(s_, a6, x_ball, u_ball) for d, s_ in radius_solvers.items()})
+jobs.update({label: executor.submit(s_, a6, row6["res"].x, row6["res"].u) for label, s_ in amax_solvers.items()})
+
+budget_row = None
+if base:
+    b_mps = base["dv"] + BUDGET_EXTRA_MPS
+    j = next((i for i, r in enumerate(ok) if r["dv"] >= b_mps), None)
+    if j is None or j == 0:
+        print(f"budget {b_mps:.2f} m/s outside the swept front; not solved")
+    else:
+        try:
+            hit = wj.solve_for_impulse(solver, b_mps / (em.velocity_unit_km_s * 1e3),
+                                       (ok[j - 1]["alpha"], ok[j - 1]["res"]), (ok[j]["alpha"], ok[j]["res"]),
+                                       rtol=BUDGET_RTOL)
+            c_hit = wj.evaluate_crlb(sc, hit.result.x[k_ws])
+            budget_row = dict(budget=b_mps, alpha=hit.alpha, dv=dv(hit.result), rms=c_hit.terminal_rms_km[0],
+                              rms_tgt=float(np.mean(c_hit.terminal_rms_km[1:])), solves=len(hit.solves),
+                              interp=float(np.exp(np.interp(b_mps, [r["dv"] for r in ok],
+                                                            np.log([r["crlb"].terminal_rms_km[0] for r in ok])))))
+            print(f"budget {b_mps:.2f} m/s (baseline + {BUDGET_EXTRA_MPS:g}): alpha_h = {hit.alpha:.3e} spends "
+                  f"{budget_row['dv']:.2f} m/s ({budget_row['solves']} solves); observer RMS {budget_row['rms']:.1f} km"
+                  f" vs {base['crlb'].terminal_rms_km[0]:.0f} km at the baseline's {base['dv']:.2f} m/s "
+                  f"(log-interpolation on the grid said {budget_row['interp']:.1f} km)")
+        except (wj.ImpulseBudgetError, scvx.SCvxError) as exc:
+            print(f"budget {b_mps:.2f} m/s not reached: {exc}")
+
 extra = {}
 for key, fut in jobs.items():
     try:
@@ -503,14 +561,49 @@ for key, fut in jobs.items():
 nk = extra["no keep-out"]
 if isinstance(nk, scvx.SCvxError):
     nk_range = np.nan
-    print(f"without the keep-out SCvx did not converge: {nk.reason}")
+    nk_hist = nk.history
+    print(f"without the keep-out SCvx did not converge: {nk.reason}; last accepted costs "
+          + ", ".join(f"{h['new_cost']:.4f}" for h in nk_hist if h.get("accepted"))[-80:])
 else:
     nk_range = float(ko.ranges(nk.x[k_ws]).min() * em.length_unit_km)
     print(f"without the keep-out (alpha {a6:g}): closest approach {nk_range:.3f} km at a measurement, MI "
           f"{nk.information:.2f} nats vs {row6['mi']:.2f} with it")
+radius_rows = [dict(d=sc.keep_out_km, src="sweep", dv=row6["dv"], mi=row6["mi"], rms=row6["crlb"].terminal_rms_km[0],
+                    closest=row6["min_range_km"], z=row6["z_max_km"])]
+for d in D_MIN_KM:
+    res = extra[("d_min", d)]
+    if isinstance(res, scvx.SCvxError):
+        print(f"keep-out {d:g} km: no convergence ({res.reason})")
+        continue
+    radius_rows.append(dict(d=d, src="cold", dv=dv(res), mi=res.information,
+                            rms=wj.evaluate_crlb(sc, res.x[k_ws]).terminal_rms_km[0],
+                            closest=float(ko.ranges(res.x[k_ws]).min() * em.length_unit_km),
+                            z=float(np.max(np.abs(res.x[:, 2])) * em.length_unit_km)))
+radius_rows.sort(key=lambda r: r["d"])
+print(f"alpha_h = {a6:g}: {'keep-out [km]':>13} {'start':>6} {'dV [m/s]':>9} {'MI [nats]':>10} {'RMS obs [km]':>13} "
+      f"{'closest [km]':>13} {'binds':>6} {'max|z| [km]':>11}")
+for r in radius_rows:
+    r["binds"] = r["closest"] <= r["d"] * (1 + 1e-3)
+    print(f"{'':>14}{r['d']:>13.0f} {r['src']:>6} {r['dv']:>9.2f} {r['mi']:>10.2f} {r['rms']:>13.1f} "
+          f"{r['closest']:>13.1f} {str(r['binds']):>6} {r['z']:>11.0f}")
+fig, axes = plt.subplots(1, 2, figsize=(12, 3.8))
+dd = np.array([r["d"] for r in radius_rows])
+for ax, key, lab in ((axes[0], "mi", "mutual information of the window [nats]"),
+                     (axes[1], "rms", "terminal observer position RMS [km]")):
+    yy = np.array([r[key] for r in radius_rows])
+    bind = np.array([r["binds"] for r in radius_rows])
+    ax.semilogx(dd, yy, "-", color="0.6")
+    ax.semilogx(dd[bind], yy[bind], "o", color="C3", label="keep-out active at the optimum")
+    ax.semilogx(dd[~bind], yy[~bind], "o", mfc="white", color="C0", label="keep-out inactive")
+    ax.axvline(sc.keep_out_km, color="0.5", ls=":", lw=1)
+    ax.set(xlabel="keep-out radius d_min [km]", ylabel=lab)
+axes[0].legend(fontsize=8, loc="lower left")
+fig.suptitle(rf"Keep-out radius swept at $\alpha_h$ = {a6:g} (dotted: adopted 424 km)")
+fig.tight_layout()
+_ = plotting.save_figure(fig, "06_keep_out_sweep", output_dir=out)
 amax_rows = []
 for label, res in extra.items():
-    if label == "no keep-out":
+    if label not in amax_solvers:
         continue
     s_ = amax_solvers[label]
     if isinstance(res, scvx.SCvxError):
@@ -572,16 +665,25 @@ table.add("Fig. 6: out-of-plane motion at alpha_h = 1e-2", "yes", f"max |z| = {z
 table.add("Fig. 7: departure grows with alpha_h", "generally", f"Spearman(alpha, max departure) = {rho_dep:.2f}; "
           + ", ".join(f"{r['alpha']:g}: {d_ / 1e3:.1f}" for r, d_ in zip(ok, dep_max)) + " (10^3 km)",
           "reproduced" if rho_dep > 0.8 else "differs: departure not monotone in alpha",
-          "largest distance from the reference DRO over the scenario; threshold Spearman 0.8")
+          "largest distance from the reference DRO over the scenario; threshold Spearman 0.8"
+          + ("" if rho_dep > 0.8 else "; the departure plateaus where the 424 km keep-out binds (closest approach "
+             + ", ".join(f"{r['alpha']:g}: {r['min_range_km']:.0f} km" for r in ok if r["alpha"] > 0)
+             + "), see the keep-out sweep"))
+table.add("Fig. 7 z-mirror: the mirror of an optimum is an optimum", "postulated family of symmetric optima",
+          f"alpha {row_m['alpha']:g}: mirrored optimum re-solved in {twin.iterations} iterations, cost difference "
+          f"{twin_dcost:.0e}, distance to the exact mirror {twin_km:.2f} km", "beyond paper",
+          "exact z-symmetry of CR3BP, planar DROs and range/range-rate; criterion: cost within 1e-6 relative and "
+          f"trajectory within 1 km of the mirror: {twin_dcost <= 1e-6 and twin_km <= 1.0}")
 if mirror_rows:
     worst_mis = max(m_[4] for m_ in mirror_rows)
     worst_dc = max(m_[3] for m_ in mirror_rows)
-    table.add("Fig. 7 z-mirror of alpha_h = 5e-3 and 7e-3", "postulated family of symmetric optima",
-              f"+z and -z seeds converge to mirror images: cost difference {worst_dc:.0e}, distance to mirror "
-              f"{worst_mis:.2f} km; seeded costs " + ", ".join(f"{m_[5]:.4f} (sweep best {m_[6]:.4f})"
-                                                              for m_ in mirror_rows), "beyond paper",
-              "exact z-symmetry of CR3BP, planar DROs and range/range-rate: every optimum has a mirror twin; the "
-              "planar guess is a saddle, the sign is picked by round-off")
+    same = worst_mis <= 1.0 and worst_dc <= 1e-6
+    table.add("Fig. 7: +z and -z seeds at alpha_h = 5e-3 and 7e-3", "near-mirror solutions (Fig. 7)",
+              ("seeds converge to mirror images" if same else "seeds converge to different local optima")
+              + f": cost difference {worst_dc:.0e}, distance to mirror {worst_mis:.2f} km; seeded costs "
+              + ", ".join(f"{m_[5]:.4f} (sweep best {m_[6]:.4f})" for m_ in mirror_rows), "beyond paper",
+              "criterion: within 1 km and 1e-6 relative cost; the planar guess is a saddle, the sign is picked by "
+              "round-off or the seed")
 table.add("Fig. 8: zero thrust in the window, out-of-plane thrust", "yes",
           f"max |u| in window {max(r['u_window'] for r in ok):.0e}; a_z used: "
           f"{any(np.max(np.abs(r['res'].u[:, 2])) > 1e-3 * sc.a_max for r in ok if r['alpha'] > 0)}",
@@ -609,15 +711,27 @@ table.add("Fig. 10: impulse and MI grow with alpha_h", "yes",
 table.add("Impulse and terminal RMS values (Figs. 8-10)", "plotted, no numbers printed",
           f"alpha 0: {dvs[0]:.2f} m/s, {rms_obs[0]:.0f} km; alpha {ok[-1]['alpha']:g}: {dvs[-1]:.1f} m/s, "
           f"{rms_obs[-1]:.1f} km", "not in paper", "the figures carry no readable values in the text version")
-if base and cheap:
+if base and budget_row:
+    table.add(f"Improvement over the minimum-impulse baseline at {budget_row['budget']:.1f} m/s (solved)",
+              "substantial", f"alpha_h = {budget_row['alpha']:.2e} spends {budget_row['dv']:.2f} m/s: observer RMS "
+              f"{budget_row['rms']:.1f} km vs {base['crlb'].terminal_rms_km[0]:.0f} km for the baseline's "
+              f"{base['dv']:.2f} m/s ({base['crlb'].terminal_rms_km[0] / budget_row['rms']:.0f}x lower)",
+              "beyond paper", f"budget = baseline + {BUDGET_EXTRA_MPS:g} m/s, met within {100 * BUDGET_RTOL:g} %; "
+              f"log-interpolation on the grid said {budget_row['interp']:.1f} km")
+elif base and cheap:
     table.add("Improvement over the minimum-impulse baseline", "substantial",
               f"alpha {cheap['alpha']:g}: +{cheap['dv'] - base['dv']:.1f} m/s buys "
               f"{base['crlb'].terminal_rms_km[0] / cheap['crlb'].terminal_rms_km[0]:.0f}x lower observer RMS",
-              "beyond paper", "cheapest information trajectory against the alpha_h = 0 transfer")
-table.add("Keep-out radius", "not in paper (needed: Jacobian ~ 1/range)",
-          f"{sc.keep_out_km:.0f} km = 3 sqrt(2) x 100 km; without it: "
-          + (f"closest approach {nk_range:.2f} km" if np.isfinite(nk_range) else "no convergence"),
-          "beyond paper", "target outside the prior 3-sigma relative-position sphere (section 3)")
+              "beyond paper", "cheapest information trajectory against the alpha_h = 0 transfer (budget solve failed)")
+rms_span = max(r["rms"] for r in radius_rows) / min(r["rms"] for r in radius_rows)
+weak_all = base is not None and all(base["crlb"].terminal_rms_km[0] >= 5 * r["rms"] for r in radius_rows)
+table.add("Keep-out radius (unstated input), swept at the Fig. 6 weight", "not in paper",
+          "; ".join(f"{r['d']:.0f} km: {r['dv']:.1f} m/s, RMS {r['rms']:.0f} km, closest {r['closest']:.0f} km"
+                    + (" (binds)" if r["binds"] else "") for r in radius_rows)
+          + "; none: " + (f"closest approach {nk_range:.2f} km" if np.isfinite(nk_range) else
+                          f"no convergence in {FREE_ITER} iterations"),
+          "beyond paper", f"terminal RMS varies {rms_span:.1f}x over the radii; the alpha_h = 0 baseline stays >= 5x "
+          f"worse at every radius: {weak_all}; adopted 424 km = target outside the prior 3-sigma sphere")
 table.add("MI gradient (Eqs. 44-52) vs central differences, case 2 window", "formula only",
           f"max rel. difference {grad_err:.1e}", "beyond paper" if grad_err < 1e-5 else
           "differs: gradient and value disagree", "process noise held fixed in both (same function)")

@@ -132,7 +132,7 @@ def specs(Spec, lazy):
     # ScenarioSolver (construction only: a call runs SCvx, whose arguments are swept by the scvx plugin)
     s.append(S("ScenarioSolver", W.ScenarioSolver,
                dict(scenario=lazy(case1), t_nodes=lazy(lambda: nodes()[0]), k_window=lazy(lambda: nodes()[1]),
-                    information=lazy(info_model), keep_out=False, settings=None),
+                    information=lazy(info_model), keep_out=True, d_min_km=424.0, settings=None),
                dict(scenario="instance", t_nodes="grid", k_window="int1", information="callable_opt",
-                    keep_out="bool", settings="instance_opt")))
+                    keep_out="bool", d_min_km="pos_opt", settings="instance_opt")))
     return s
