@@ -97,7 +97,7 @@ fig, ax = plt.subplots(1, 3, figsize=(14, 3.8))
 for name, pol in POLICIES.items():
     m = pol.sample_magnitude(rng, N_POLICY_DRAWS)
     d = pol.magnitude_distribution
-    ax[0 if name == "active" else 1].hist(m * 1e3, bins=60, density=True, alpha=0.6, label="draws")
+    ax[0 if name == "active" else 1].hist(m * 1e3, bins=60, density=True, alpha=0.6, histtype="stepfilled", label="draws")
     zz = np.linspace(d.ppf(0), d.ppf(1), 300)
     ax[0 if name == "active" else 1].plot(zz * 1e3, d.pdf(zz) / 1e3, "k", lw=1, label="truncnorm PDF")
     ax[0 if name == "active" else 1].set(title=f"{name}: mean {m.mean() * 1e3:.1f}, sd {m.std() * 1e3:.2f} mm/s",
@@ -107,7 +107,7 @@ for name, pol in POLICIES.items():
           f"(truncnorm {d.std() / pol.sd_m_s:.4f})")
 az, el = det.StationKeepingPolicy.sample_pointing(rng, N_POLICY_DRAWS)
 uz = det.pointing_vector(az, el)[:, 2]
-ax[2].hist(uz, bins=50, density=True, alpha=0.6, label="Eqs. 3-4 (paper)")
+ax[2].hist(uz, bins=50, density=True, alpha=0.6, histtype="stepfilled", label="Eqs. 3-4 (paper)")
 ax[2].plot(np.linspace(-0.999, 0.999, 200), stats.arcsine(-1, 2).pdf(np.linspace(-0.999, 0.999, 200)), "k", lw=1,
            label="arcsine PDF")
 ax[2].axhline(0.5, color="C3", ls="--", label="uniform sphere")
@@ -304,8 +304,8 @@ for col, (key, st) in enumerate(studies.items()):
     ulab = "m/s" if key[1] == "active" else "mm/s"
     lo, hi = 0.0, max(st.h0.z.max(), st.h1.z.max()) * unit * 1.05
     bins = np.linspace(lo, hi, 50)
-    ax[0, col].hist(st.h0.z * unit, bins=bins, alpha=0.6, label="no maneuver (H0)")
-    ax[0, col].hist(st.h1.z * unit, bins=bins, alpha=0.6, label="maneuver (H1)")
+    ax[0, col].hist(st.h0.z * unit, bins=bins, alpha=0.6, histtype="stepfilled", label="no maneuver (H0)")
+    ax[0, col].hist(st.h1.z * unit, bins=bins, alpha=0.6, histtype="stepfilled", label="maneuver (H1)")
     zz = np.linspace(lo, hi, 600)
     ax[1, col].plot(zz, st.threshold.pdf0(zz / unit) / unit, label=r"$PDF_{H0}$")
     ax[1, col].plot(zz, st.threshold.pdf1(zz / unit) / unit, label=r"$PDF_{H1}$")
@@ -522,8 +522,8 @@ ax[1].plot(hours, rh.residual_norms, ".")
 ax[1].axhline(np.sqrt(stats.chi2.ppf(0.99, 4)), color="k", ls=":", label="99% of a 4-dof residual")
 ax[1].set(xlabel="time from periapsis [h]", ylabel="whitened residual norm [-]", title="measurement residuals")
 ax[1].legend()
-ax[2].hist(ref.h1.z, bins=40, alpha=0.6, label="quiet H1")
-ax[2].hist(ref.h0.z, bins=40, alpha=0.6, label="quiet H0")
+ax[2].hist(ref.h1.z, bins=40, alpha=0.6, histtype="stepfilled", label="quiet H1")
+ax[2].hist(ref.h0.z, bins=40, alpha=0.6, histtype="stepfilled", label="quiet H0")
 ax[2].axvline(z_h, color="C3", label=f"this run: z = {z_h:.3f} m/s")
 ax[2].set(xscale="log", xlabel="z [m/s]", ylabel="runs [-]")
 ax[2].legend(fontsize=8)
