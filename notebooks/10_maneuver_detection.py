@@ -113,7 +113,7 @@ ax[2].plot(np.linspace(-0.999, 0.999, 200), stats.arcsine(-1, 2).pdf(np.linspace
 ax[2].axhline(0.5, color="C3", ls="--", label="uniform sphere")
 ax[2].set(xlabel=r"$\hat k$ component of the impulse direction [-]", ylabel="probability density [-]", ylim=(0, 3),
           title="pointing")
-ax[0].legend()
+ax[0].legend(loc="upper left")
 ax[2].legend(fontsize=8)
 _ = plotting.save_figure(fig, "10_station_keeping_policy", output_dir=out)
 ks_sphere = stats.kstest(uz, stats.uniform(-1, 2).cdf).pvalue
@@ -517,7 +517,7 @@ sig = 3 * np.sqrt(np.trace(rh.P_smooth[:, :3, :3], axis1=1, axis2=2)) * em.lengt
 ax[0].semilogy(hours, err, label="smoothed error")
 ax[0].semilogy(hours, sig, "--", label="3-sigma")
 ax[0].set(xlabel="time from periapsis [h]", ylabel="position error [km]", title="0.5 m/s burn, quiet tuning")
-ax[0].legend()
+ax[0].legend(loc="upper left")
 ax[1].plot(hours, rh.residual_norms, ".")
 ax[1].axhline(np.sqrt(stats.chi2.ppf(0.99, 4)), color="k", ls=":", label="99% of a 4-dof residual")
 ax[1].set(xlabel="time from periapsis [h]", ylabel="whitened residual norm [-]", title="measurement residuals")
