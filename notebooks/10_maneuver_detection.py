@@ -517,7 +517,7 @@ sig = 3 * np.sqrt(np.trace(rh.P_smooth[:, :3, :3], axis1=1, axis2=2)) * em.lengt
 ax[0].semilogy(hours, err, label="smoothed error")
 ax[0].semilogy(hours, sig, "--", label="3-sigma")
 ax[0].set(xlabel="time from periapsis [h]", ylabel="position error [km]", title="0.5 m/s burn, quiet tuning")
-ax[0].legend(loc="upper left")
+ax[0].legend(loc="lower center")
 ax[1].plot(hours, rh.residual_norms, ".")
 ax[1].axhline(np.sqrt(stats.chi2.ppf(0.99, 4)), color="k", ls=":", label="99% of a 4-dof residual")
 ax[1].set(xlabel="time from periapsis [h]", ylabel="whitened residual norm [-]", title="measurement residuals")
