@@ -97,24 +97,30 @@ def save_figure(fig, name: str, *, output_dir=None, formats=("png",)) -> list[Pa
 
 
 _BRACKETED = re.compile(r"\[[^\[\]]*\S[^\[\]]*\]")  # "[km]", "[-]", "[10³ km]", "[$\mathrm{m\,s^{-1}}$]"
-_TRAILING_PARENS = re.compile(r"\(([^()]*\S[^()]*)\)\s*$")  # "range (km)": accepted at the end of the label
+# "range (km)", "x (10³ km)": a short parenthesised unit (at most 16 characters, one space) at the end of the label;
+# "orbit (sorted by size)" or "(micro-rad, Eq. 20)" are remarks, not units.
+_TRAILING_PARENS = re.compile(r"\(\s*([^()\s]+(?: [^()\s]+)?)\s*\)\s*$")
 
 
 def has_unit(label: str) -> bool:
     """Whether an axis label carries a unit: a bracketed part ``[km]`` (``[-]`` if dimensionless) anywhere, or a
-    parenthesised one ``(km)`` at its end.
+    short parenthesised one ``(km)`` at its end (at most 16 characters and one space, so that a remark such as
+    ``"orbit (sorted by size)"`` is not taken for a unit).
 
     Examples
     --------
     >>> has_unit("range [km]"), has_unit("stability index ν [-]"), has_unit("Δv (m/s)")
     (True, True, True)
-    >>> has_unit("range"), has_unit("x (Moon-centred) position"), has_unit("epoch []")
-    (False, False, False)
+    >>> has_unit("range"), has_unit("x (Moon-centred) position"), has_unit("epoch []"), has_unit("orbit (sorted by r)")
+    (False, False, False, False)
     """
     if not isinstance(label, str):
         raise TypeError(f"label must be a str; got {type(label).__name__}")
     text = label.strip()
-    return bool(_BRACKETED.search(text) or _TRAILING_PARENS.search(text))
+    if _BRACKETED.search(text):
+        return True
+    match = _TRAILING_PARENS.search(text)
+    return match is not None and len(match.group(1)) <= 16
 
 
 def _shows_data(ax) -> bool:

@@ -191,7 +191,7 @@ axes[1].set_xlabel("time since the burn epoch (h)")
 axes[1].set_ylabel("agent-target range (km)", color="tab:blue")
 ax2 = axes[1].twinx()
 ax2.plot(hours, base.sigma_theta_rad[0] * 1e6, color="tab:orange")
-ax2.set_ylabel(r"$\sigma_\theta$ (micro-rad, Eq. 20)", color="tab:orange")
+ax2.set_ylabel(r"$\sigma_\theta$ (Eq. 20) [µrad]", color="tab:orange")
 axes[1].axvline(LEAD_DAYS * 24, color="0.6", ls=":", lw=1)
 axes[1].text(LEAD_DAYS * 24 + 1, 0.5, "apolune", transform=axes[1].get_xaxis_transform(), va="center", fontsize=8,
              color="0.4")

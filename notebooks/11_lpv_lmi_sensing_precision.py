@@ -34,11 +34,11 @@ OUTPUT_DIR = ""
 # Sizes derived from QUICK: quick mode samples more coarsely but solves and verifies every problem.
 N_ORBIT = 600 if QUICK else 4000  # samples along the orbit that bound rho
 N_CHECK = 300 if QUICK else 5000  # random states for the exactness checks
-N_VERIFY = 40 if QUICK else 1000  # random interior points of the polytope in the verification
+N_VERIFY = 20 if QUICK else 1000  # random interior points of the polytope in the verification
 N_STUDY = 400 if QUICK else 1000  # samples per orbit period in the sensitivity study
 STUDY_ORBITS = [(3, 1, 0.3), (2, 1, 0.3), (2, 1, 0.4)] if QUICK else None  # None: all lpv.RESONANT_CANDIDATES
 STUDY_LEVELS = [0.0, 1e-3] if QUICK else [0.0, 1e-4, 1e-3, 1e-2]
-N_GAMMA = 5 if QUICK else 13  # gammas on the trade curve
+N_GAMMA = 4 if QUICK else 13  # gammas on the trade curve
 R_LIST = [200.0, 1000.0, 5000.0] if QUICK else [100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0]  # 1/TU
 R_BW = 1000.0  # 1/TU: the H-infinity bandwidth bound used for the comparison (about 1 per 6 min)
 
@@ -402,7 +402,7 @@ for i, nm in enumerate(names):
           f"{dt01[i, 0, j] * TU_MIN:26.0f} {dteq[i, 0, j] * TU_MIN:25.0f}")
 
 # %%
-fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+fig, ax = plt.subplots(1, 3, figsize=(16, 4.6), layout="constrained")
 order = np.argsort(study.r13_max)
 ax[0].plot(study.r13_max[order], hinf[order, 0, j], "o-", label=r"H$_\infty$, R = 1000/TU")
 rr = np.linspace(study.r13_max.min(), study.r13_max.max(), 100)
@@ -418,7 +418,7 @@ for s_i, structure in enumerate(study.structures):
                    mfc=None if s_i == 0 else "none", label=f"{structure}, level {lvl:g}")
 ax[1].set_xticks(xo, [f"{names[i]}\n{study.r13_max[i]:.2f} LU" for i in order], fontsize=7, rotation=45)
 ax[1].set_ylim(0, 1.45 * float(np.nanmax(h2i)))
-ax[1].set_xlabel(r"orbit (sorted by $\max r_{13}$)")
+ax[1].set_xlabel(r"orbit, sorted by $\max r_{13}$ [-]")
 ax[1].set_ylabel("H2 allowance read as an angle [deg]")
 ax[1].set_title("H2: intensity (filled: accelerations, open: all states)", fontsize=10)
 ax[1].legend(fontsize=6.5, loc="upper left", ncol=2)

@@ -115,7 +115,8 @@ def _labelled(ax, x="time [d]", y="range [km]"):
     ("range [km]", True), ("stability index ν [-]", True), ("x (Moon-centred) [10³ km]", True),
     (r"$\Delta v$ [$\mathrm{m\,s^{-1}}$]", True), ("Δv (m/s)", True), (r"$\sqrt{J_\rho}$ after 12 h (km)", True),
     ("range", False), ("", False), ("x (Moon-centred) position", False), ("epoch []", False), ("epoch [ ]", False),
-    ("(km) range", False),
+    ("(km) range", False), ("x (1000 km)", True), (r"$\log_{10}\sqrt{J_\rho}$ (m)", True),
+    (r"orbit (sorted by $\max r_{13}$)", False), ("sigma (micro-rad, Eq. 20)", False), ("phase (normalised by 2 pi)", False),
 ])
 def test_has_unit(label, ok):
     assert plotting.has_unit(label) is ok
