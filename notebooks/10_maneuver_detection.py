@@ -345,23 +345,25 @@ for io, o in enumerate(ORBITS):
     for ip, p in enumerate(POLICIES):
         s_ = setups[o, p]
         sc_ = s_.scenario
+        inputs = []  # N_NEES runs without a burn, then N_NEES with one; one lockstep batch sequence for both
         for hyp, pol in (("H0", None), ("H1", POLICIES[p])):
             rng_n = np.random.default_rng([SEED, 55, io, ip, int(hyp == "H1")])
-            inputs = [det.draw_trial(rng_n, s_, pol) for _ in range(N_NEES)]
-            nf, ns = [], []
-            for i0 in range(0, N_NEES, BATCH):
-                chunk = inputs[i0:i0 + BATCH]
-                rb = det.ocbe_batch(em, sc_.t, np.array([c.y for c in chunk]), s_.observer_states, sc_.model,
-                                    sc_.meas_cov, np.array([c.x0 for c in chunk]), chunk[0].P0, s_.control_weight,
-                                    n_sub=s_.n_sub, tol=s_.tol)
-                for b, c in enumerate(chunk):
-                    nf.append(tracking.nees(rb.x_filt[b], rb.P_filt[b], c.truth))
-                    ns.append(tracking.nees(rb.x_smooth[b], rb.P_smooth[b], c.truth))
-            nf, ns = np.array(nf), np.array(ns)
+            inputs += [det.draw_trial(rng_n, s_, pol) for _ in range(N_NEES)]
+        nf, ns = [], []
+        for i0 in range(0, len(inputs), BATCH):
+            chunk = inputs[i0:i0 + BATCH]
+            rb = det.ocbe_batch(em, sc_.t, np.array([c.y for c in chunk]), s_.observer_states, sc_.model,
+                                sc_.meas_cov, np.array([c.x0 for c in chunk]), chunk[0].P0, s_.control_weight,
+                                n_sub=s_.n_sub, tol=s_.tol)
+            for b, c in enumerate(chunk):
+                nf.append(tracking.nees(rb.x_filt[b], rb.P_filt[b], c.truth))
+                ns.append(tracking.nees(rb.x_smooth[b], rb.P_smooth[b], c.truth))
+        for h, hyp in enumerate(("H0", "H1")):
+            f_, s_n = np.array(nf[h * N_NEES:(h + 1) * N_NEES]), np.array(ns[h * N_NEES:(h + 1) * N_NEES])
             nees_study[o, p, hyp] = dict(
-                mean_f=float(nf.mean()), mean_s=float(ns.mean()),
-                runs_f=float(np.mean(np.mean(nf > nees_lim, axis=1) > tracking.DIVERGED_FRACTION)),
-                runs_s=float(np.mean(np.mean(ns > nees_lim, axis=1) > tracking.DIVERGED_FRACTION)))
+                mean_f=float(f_.mean()), mean_s=float(s_n.mean()),
+                runs_f=float(np.mean(np.mean(f_ > nees_lim, axis=1) > tracking.DIVERGED_FRACTION)),
+                runs_s=float(np.mean(np.mean(s_n > nees_lim, axis=1) > tracking.DIVERGED_FRACTION)))
 print(f"{'orbit':12s} {'policy':7s} {'hyp':4s} {'NEES fwd':>9s} {'NEES smo':>9s} {'inconsistent runs fwd / smo':>28s}")
 for (o, p, hyp), v in nees_study.items():
     print(f"{o:12s} {p:7s} {hyp:4s} {v['mean_f']:9.2f} {v['mean_s']:9.2f} "
