@@ -91,7 +91,8 @@ from .dynamics import CR3BP
 from .propagation import DEFAULT_TOL, _check_tol
 
 __all__ = ["DETECTION_PROBABILITY", "CONSECUTIVE_EPOCHS", "metric_law", "metric_limit", "MetricTerms",
-           "RESET_RULES", "metric_terms", "forward_metric", "smoothed_metric", "first_detection", "Detection", "reset_factor",
+           "RESET_RULES", "metric_terms", "forward_metric", "smoothed_metric", "first_detection", "Detection",
+           "reset_factor",
            "AdaptiveOCBEResult", "adaptive_ocbe", "adaptive_ocbe_batch", "ResetError", "PASSES", "PanelSeries",
            "panel_series", "figure_errors", "figure_control_metric"]
 

@@ -111,7 +111,8 @@ n_resets_null = sum(len(d) for d in dets0)
 nees0 = np.array([tracking.nees(res0.x_filt[b], res0.P_filt[b], draws[b].truth) for b in range(N_NULL)])
 fig, ax = plt.subplots(1, 2, figsize=(11, 3.8))
 xx = np.linspace(0, 20, 300)
-ax[0].hist(pooled, bins=40, range=(0, 20), density=True, alpha=0.6, histtype="stepfilled", label=f"{pooled.size} epochs, {N_NULL} runs")
+ax[0].hist(pooled, bins=40, range=(0, 20), density=True, alpha=0.6, histtype="stepfilled",
+           label=f"{pooled.size} epochs, {N_NULL} runs")
 ax[0].plot(xx, law.pdf(xx), "k", lw=1.2, label=r"$\chi^2_4$ (derived)")
 ax[0].axvline(ad.metric_limit(4), color="C3", ls="--", label="99 % limit 13.28")
 ax[0].set(xlabel="OCBE metric $M$ [-]", ylabel="probability density [-]", title=f"no maneuver: KS p = {ks_p:.2f}")
@@ -145,7 +146,8 @@ print("state-driven spread / noise: az %.2g, el %.2g, az-rate %.2g, el-rate %.2g
 # %% [markdown]
 # The rates are noise by four to five orders of magnitude (the ratios above, set by the hand-off covariance, are
 # the same in both modes): in this scenario the filter is effectively angles-only plus two pure-noise components
-# (notebook 09 discusses what that means for the paper's observation-strategy claim). For the metric this is harmless (it is still $\chi^2_4$), but it matters for the reset.
+# (notebook 09 discusses what that means for the paper's observation-strategy claim). For the metric this is
+# harmless (it is still $\chi^2_4$), but it matters for the reset.
 #
 # ## 2 · Detection and reset
 #

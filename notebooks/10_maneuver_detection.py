@@ -97,7 +97,8 @@ fig, ax = plt.subplots(1, 3, figsize=(14, 3.8))
 for name, pol in POLICIES.items():
     m = pol.sample_magnitude(rng, N_POLICY_DRAWS)
     d = pol.magnitude_distribution
-    ax[0 if name == "active" else 1].hist(m * 1e3, bins=60, density=True, alpha=0.6, histtype="stepfilled", label="draws")
+    ax[0 if name == "active" else 1].hist(m * 1e3, bins=60, density=True, alpha=0.6, histtype="stepfilled",
+                                          label="draws")
     zz = np.linspace(d.ppf(0), d.ppf(1), 300)
     ax[0 if name == "active" else 1].plot(zz * 1e3, d.pdf(zz) / 1e3, "k", lw=1, label="truncnorm PDF")
     ax[0 if name == "active" else 1].set(title=f"{name}: mean {m.mean() * 1e3:.1f}, sd {m.std() * 1e3:.2f} mm/s",
