@@ -89,8 +89,8 @@ class QuickRuns:
 #    so the fixture is computed once instead of once per worker.
 # 2. Work units are handed out in collection order (xdist's default reorders them by size, which put the six book
 #    tests first: their worker then ran every notebook alone while the other did unit tests): the notebook runs come
-#    first, longest first, then the module groups, then the single tests, and the book tests last, when every
-#    notebook has run.
+#    first, longest first, then the module groups, then the book tests (every notebook has run by then), and the
+#    single tests last, so that many small units even out the workers' finish.
 # 3. The expected quick-mode seconds of each notebook come from the last run (pytest's cache) or, on a fresh clone,
 #    from the table below (quick mode on an idle core, issue 12 budget <= 30 s each).
 QUICK_SECONDS = {"01": 7, "02": 8, "03": 9, "04": 7, "05": 30, "06": 30, "07": 20, "08": 21, "09": 30, "09b": 30,
@@ -129,8 +129,8 @@ def pytest_collection_modifyitems(config, items):
         if item.get_closest_marker("notebook") and marker is None and isinstance(source, Path):
             return (0, -_expected_seconds(config, source.stem))  # one notebook per unit, longest first
         if marker is None:
-            return (2, 0.0)
-        return (3, 0.0) if marker.args and marker.args[0] == "book" else (1, 0.0)
+            return (3, 0.0)  # single tests last: many small units even out the two workers' finish
+        return (2, 0.0) if marker.args and marker.args[0] == "book" else (1, 0.0)
 
     for item in items:
         group = module_group(item)
