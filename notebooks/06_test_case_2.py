@@ -144,10 +144,10 @@ print(f"Hessian diagonal (z, vz): {H[2, 2]:.3e}, {H[5, 5]:.3e}; "
 # it grows without bound as the range $\rho$ shrinks, and so does the linear-Gaussian MI. Below we move the
 # observer's window-start state (Newton on the STM) so that it passes target 1 at a chosen distance at the middle
 # measurement of the window and evaluate the MI: nearly flat down to about a hundred metres, the reward then
-# grows without bound (like $\ln(1/\rho)$), so a maximiser that finds this region would fly through the target, and
-# SCvx iterates that wander into it see a model error that makes the iteration creep (section 11: the run without
-# keep-out does not converge, while a 10 km keep-out, inactive at the optimum, does). Well before that singularity
-# the reward stops being
+# grows without bound (like $\ln(1/\rho)$), so a maximiser that finds this region flies through the target
+# (section 11: without a keep-out SCvx does not converge, its cost sinks below the constrained optimum's while the
+# defects stay open; with a keep-out of only 10 km it converges, to a plan that stays 411 km away). Well before
+# that singularity the reward stops being
 # trustworthy: the MI linearises the measurement about the *true* states, while the prior
 # uncertainty of the relative position is $\sigma_{rel} = \sqrt2\cdot 100$ km = 141 km per axis; the
 # line-of-sight direction that carries the range-rate information is uncertain by about $\sigma_{rel}/\rho$ rad. We
@@ -505,10 +505,10 @@ print(f"Spearman rank correlation MI vs terminal RMS: observer {rank_obs:.3f}, t
 # solutions of the sweep (section 4: closest approach 424.3 km). Which of the paper's claims rest on it? At the
 # Fig. 6 weight we solve from the ballistic guess with other radii, and once without any keep-out: does the
 # optimum follow the keep-out towards the target as it shrinks, and what happens to impulse, information and
-# terminal RMS? (Full mode, last session: with 10 km the optimum is that of 424 km to 0.1 m/s with its closest
-# approach at 411 km, so the active 424 km keep-out only nudges an optimum that exists without it; 141 km lands
-# in another local optimum; larger radii bind and cost impulse. The run without keep-out creeps: its cost after
-# 75 iterations is still above the constrained optimum's.)
+# terminal RMS? (Full mode, this session: with 10 km the optimum is that of 424 km to 0.1 m/s with its closest
+# approach at 411 km, so the active 424 km keep-out only nudges a local optimum that exists without it; 141 km
+# lands in another local optimum; larger radii bind and cost impulse. Without any keep-out the iterates reach a
+# cost below the constrained optimum's with defects still open: they head for the close-approach singularity.)
 #
 # **a_max readings.** One run at the Fig. 6 weight under each reading of Table 5's "1x5^-7" (warm-started from
 # the adopted solution).
