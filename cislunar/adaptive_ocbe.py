@@ -83,7 +83,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize, stats
+from scipy import linalg, optimize, stats
 from scipy.integrate import simpson
 
 from . import _checks, ocbe, srif
@@ -465,10 +465,16 @@ def reset_factor(system: CR3BP, t, k: int, x_filt_prev, P_filt_prev, y_k, observ
     m1 = metric(0.0)
     hi = np.log(_checks.positive(max_factor, "max_factor"))
     if rule == "likelihood":
-        # log det C = log det R + 2 sum log diag S_new - 2 sum log diag S_bar (determinant lemma, SRI form)
+        # The innovation covariance C(alpha) is m x m and R keeps it SPD for every alpha, so its Cholesky factor gives
+        # log det C and the whitened innovation directly.  (The determinant lemma on the SRI factors is equivalent
+        # but its time-updated factor underflows once alpha Q dwarfs the prior, alpha ~ 1e30 here.)
+        HPH = H @ Phi @ P @ Phi.T @ H.T
+        HQH = H @ Q @ H.T
+
         def nll(la):
-            S_bar, S_new, m = update(la)
-            return 2 * np.sum(np.log(np.abs(np.diag(S_new)))) - 2 * np.sum(np.log(np.abs(np.diag(S_bar)))) + m
+            L = np.linalg.cholesky(HPH + np.exp(la) * HQH + Rk)
+            w = linalg.solve_triangular(L, dy, lower=True)
+            return 2 * np.sum(np.log(np.diag(L))) + float(w @ w)
 
         grid = np.linspace(0.0, hi, 161)
         vals = np.array([nll(g) for g in grid])
