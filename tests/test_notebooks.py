@@ -5,7 +5,9 @@ notebook runs once per session: the book tests (tests/test_book.py) render the s
 """
 
 import os
+import re
 
+import nbformat
 import pytest
 
 from cislunar import notebooks, paths
@@ -29,7 +31,35 @@ def test_notebook_quick(source, quick_runs):
         assert "failed" not in cells[3], f"{source.stem}: a check failed: {row}"
     executed = quick_runs.build / "notebooks" / f"{source.stem}.ipynb"
     assert executed.is_file()
+    warned = printed_warnings(executed)
+    assert not warned, f"{source.stem}: cells print warnings (they reach the book): {warned}"
     assert (paths.repo_root() / "build").resolve() not in executed.resolve().parents
+
+
+WARNING = re.compile(r"\b\w*Warning: ")
+
+
+def printed_warnings(path):
+    """``[(cell index, first line of the warning), ...]`` of an executed notebook's outputs."""
+    out = []
+    for i, cell in enumerate(nbformat.read(path, as_version=4).cells):
+        for o in cell.get("outputs", []):
+            text = o.get("text", "") if o.get("output_type") == "stream" else ""
+            for line in text.splitlines():
+                if WARNING.search(line):
+                    out.append((i, line.strip()[:160]))
+    return out
+
+
+def test_printed_warnings_are_found(tmp_path):
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [nbformat.v4.new_code_cell("1"), nbformat.v4.new_code_cell("2")]
+    nb.cells[0].outputs = [nbformat.v4.new_output("stream", name="stderr", text="progress: 100%|####| 3/3\n")]
+    nb.cells[1].outputs = [nbformat.v4.new_output(
+        "stream", name="stderr", text="/x/y.py:471: RuntimeWarning: divide by zero encountered in log\n  return\n")]
+    path = tmp_path / "w.ipynb"
+    nbformat.write(nb, path)
+    assert printed_warnings(path) == [(1, "/x/y.py:471: RuntimeWarning: divide by zero encountered in log")]
 
 
 def test_quick_runs_never_write_into_build(tmp_path):
