@@ -375,7 +375,7 @@ def process_noise_lyapunov(system: CR3BP, x0, dt: float, q: float, *, rtol: floa
     reference trajectory that reaches the surface of the Moon or the Earth raises
     :class:`cislunar.propagation.ImpactError` (terminal ``solve_ivp`` events on the squared distances).
     """
-    from .propagation import ImpactError, check_outside_primaries
+    from .propagation import check_outside_primaries, raise_scipy_impact, scipy_impact_events
 
     _check_system(system)
     x0 = _checks.as_state(x0, "x0", batch=False)
@@ -393,20 +393,9 @@ def process_noise_lyapunov(system: CR3BP, x0, dt: float, q: float, *, rtol: floa
         A = system.jacobian(xs)
         return np.concatenate([system.eom(xs), (A @ Q + Q @ A.T + W).ravel()])
 
-    def hit_moon(_t, y):
-        return (y[0] - 1.0 + system.mu) ** 2 + y[1] ** 2 + y[2] ** 2 - system.secondary_radius ** 2
-
-    def hit_earth(_t, y):
-        return (y[0] + system.mu) ** 2 + y[1] ** 2 + y[2] ** 2 - system.primary_radius ** 2
-
-    for ev in (hit_moon, hit_earth):
-        ev.terminal, ev.direction = True, -1.0
     sol = solve_ivp(rhs, (0.0, dt), np.r_[x0, np.zeros(36)], method="DOP853", rtol=rtol, atol=atol,
-                    events=[hit_moon, hit_earth])
-    if sol.status == 1:
-        for body, te, ye in zip(("Moon", "Earth"), sol.t_events, sol.y_events):
-            if len(te):
-                raise ImpactError(body, float(te[0]), None, ye[0][:6])
+                    events=scipy_impact_events(system))
+    raise_scipy_impact(sol)
     if not sol.success:  # pragma: no cover
         raise RuntimeError(f"solve_ivp failed: {sol.message}")
     return symmetrize(sol.y[6:, -1].reshape(6, 6))

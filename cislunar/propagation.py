@@ -516,27 +516,42 @@ def propagate_scipy(system: CR3BP, x0, t, *, stm: bool = False, rtol: float = 1e
             return system.eom(y)
 
         y0 = x0
-    events = None
+    sol = solve_ivp(rhs, (grid[0], grid[-1]), y0, method=method, t_eval=grid, rtol=rtol, atol=atol,
+                    events=scipy_impact_events(system) if impact else None)
     if impact:
-        def hit_moon(_t, y):
-            return (y[0] - 1.0 + system.mu) ** 2 + y[1] ** 2 + y[2] ** 2 - system.secondary_radius ** 2
-
-        def hit_earth(_t, y):
-            return (y[0] + system.mu) ** 2 + y[1] ** 2 + y[2] ** 2 - system.primary_radius ** 2
-
-        for ev in (hit_moon, hit_earth):
-            ev.terminal, ev.direction = True, -1.0
-        events = [hit_moon, hit_earth]
-    sol = solve_ivp(rhs, (grid[0], grid[-1]), y0, method=method, t_eval=grid, rtol=rtol, atol=atol, events=events)
-    if impact and sol.status == 1:
-        for body, te, ye in zip(("Moon", "Earth"), sol.t_events, sol.y_events):
-            if len(te):
-                raise ImpactError(body, float(te[0]), None, ye[0][:6])
+        raise_scipy_impact(sol)
     if not sol.success or sol.y.shape[1] != grid.size:
         raise PropagationError(float(sol.t[-1]) if sol.t.size else grid[0], grid[-1], None,
                                f"solve_ivp: {sol.message}")
     y = sol.y.T
     return Trajectory(t=grid, x=y[:, :6], stm=y[:, 6:].reshape(-1, 6, 6) if stm else None)
+
+
+def scipy_impact_events(system: CR3BP) -> list:
+    """Terminal ``solve_ivp`` events for crossing the Moon's then the Earth's surface, inward only.
+
+    Each event is a function of ``(t, y)`` whose first three entries of ``y`` are the rotating-frame position (LU);
+    pass the result of ``solve_ivp`` to :func:`raise_scipy_impact`.
+    """
+    _checks.system(system)
+    def hit_moon(_t, y):
+        return (y[0] - 1.0 + system.mu) ** 2 + y[1] ** 2 + y[2] ** 2 - system.secondary_radius ** 2
+
+    def hit_earth(_t, y):
+        return (y[0] + system.mu) ** 2 + y[1] ** 2 + y[2] ** 2 - system.primary_radius ** 2
+
+    for ev in (hit_moon, hit_earth):
+        ev.terminal, ev.direction = True, -1.0
+    return [hit_moon, hit_earth]
+
+
+def raise_scipy_impact(sol) -> None:
+    """Raise :class:`ImpactError` when a ``solve_ivp`` run with :func:`scipy_impact_events` stopped at a surface."""
+    if sol.status != 1:
+        return
+    for body, te, ye in zip(("Moon", "Earth"), sol.t_events, sol.y_events):
+        if len(te):
+            raise ImpactError(body, float(te[0]), None, ye[0][:6])
 
 
 @dataclass(frozen=True)
@@ -645,31 +660,31 @@ def default_threads() -> int:
     return n
 
 
+def _central_difference_batch(system, x0, t_final, h):
+    """Validated ``x0 + h e_j`` then ``x0 - h e_j`` (12 states) and the time span ``[0, t_final]``."""
+    _checks.system(system)
+    x0 = _checks.as_state(x0, "x0", batch=False)
+    h = _checks.positive(h, "h")
+    t_final = _checks.real(t_final, "t_final")
+    if t_final == 0:
+        raise ValueError("t_final must be non-zero")
+    E = h * np.eye(6)
+    return np.vstack([x0 + E, x0 - E]), np.array([0.0, float(t_final)])
+
+
 def stm_finite_difference(system: CR3BP, x0, t_final: float, h: float, *, tol: float = DEFAULT_TOL) -> np.ndarray:
     """Central-difference STM :math:`[x(t; x_0 + h e_j) - x(t; x_0 - h e_j)] / 2h` (one batch of 12 states).
 
     Used to verify :func:`propagate_stm`; the error versus ``h`` shows truncation (``h^2``) and round-off
     (``eps/h``) regimes.
     """
-    _checks.system(system)
-    x0 = _checks.as_state(x0, "x0", batch=False)
-    h = _checks.positive(h, "h")
-    t_final = _checks.real(t_final, "t_final")
-    if t_final == 0:
-        raise ValueError("t_final must be non-zero")
-    E = h * np.eye(6)
-    out = propagate(system, np.vstack([x0 + E, x0 - E]), np.array([0.0, float(t_final)]), tol=tol).x[:, -1]
+    x_pm, span = _central_difference_batch(system, x0, t_final, h)
+    out = propagate(system, x_pm, span, tol=tol).x[:, -1]
     return (out[:6] - out[6:]).T / (2.0 * h)
 
 
 def stt_finite_difference(system: CR3BP, x0, t_final: float, h: float, *, tol: float = DEFAULT_TOL) -> np.ndarray:
     """Central-difference STT :math:`\\Psi_{:,:,k} = [\\Phi(x_0 + h e_k) - \\Phi(x_0 - h e_k)] / 2h`."""
-    _checks.system(system)
-    x0 = _checks.as_state(x0, "x0", batch=False)
-    h = _checks.positive(h, "h")
-    t_final = _checks.real(t_final, "t_final")
-    if t_final == 0:
-        raise ValueError("t_final must be non-zero")
-    E = h * np.eye(6)
-    phis = propagate_stm(system, np.vstack([x0 + E, x0 - E]), np.array([0.0, float(t_final)]), tol=tol).stm[:, -1]
+    x_pm, span = _central_difference_batch(system, x0, t_final, h)
+    phis = propagate_stm(system, x_pm, span, tol=tol).stm[:, -1]
     return np.moveaxis((phis[:6] - phis[6:]) / (2.0 * h), 0, -1)
