@@ -85,19 +85,30 @@ def control_weights(control_weight, n_intervals: int, name: str = "control_weigh
     return np.broadcast_to(q, target).astype(float)
 
 
-@functools.lru_cache(maxsize=4)
-def _ocbe_template(tol: float):
-    """Compile (once per process) the variational system of the OCBE Hamiltonian dynamics."""
-    hy = _heyoka()
-    x, y, z, vx, vy, vz = hy.make_vars("x", "y", "z", "vx", "vy", "vz")
-    p = hy.make_vars("px", "py", "pz", "pvx", "pvy", "pvz")
+def _potential_expressions(hy):
+    """heyoka state variables, the control-weight parameter and the CR3BP effective potential's derivatives.
+
+    Returns ``(x, y, z, vx, vy, vz), q, grad, hess`` with parameters ``par[0] = mu``, ``par[1] = q`` and
+    :math:`U = (x^2 + y^2)/2 + (1-\\mu)/r_1 + \\mu/r_2` (rotating frame, LU/TU): ``grad[i]`` is
+    :math:`\\partial U/\\partial r_i`, ``hess[i][j]`` :math:`\\partial^2 U/\\partial r_i\\partial r_j`.
+    """
+    state = hy.make_vars("x", "y", "z", "vx", "vy", "vz")
+    x, y, z = state[:3]
     mu, q = hy.par[0], hy.par[1]
     r1 = ((x + mu) ** 2 + y**2 + z**2) ** 0.5
     r2 = ((x - 1.0 + mu) ** 2 + y**2 + z**2) ** 0.5
     U = 0.5 * (x**2 + y**2) + (1.0 - mu) / r1 + mu / r2
-    pos = (x, y, z)
-    grad = [hy.diff(U, v) for v in pos]
-    hess = [[hy.diff(g, v) for v in pos] for g in grad]
+    grad = [hy.diff(U, v) for v in (x, y, z)]
+    hess = [[hy.diff(g, v) for v in (x, y, z)] for g in grad]
+    return state, q, grad, hess
+
+
+@functools.lru_cache(maxsize=4)
+def _ocbe_template(tol: float):
+    """Compile (once per process) the variational system of the OCBE Hamiltonian dynamics."""
+    hy = _heyoka()
+    (x, y, z, vx, vy, vz), q, grad, hess = _potential_expressions(hy)
+    p = hy.make_vars("px", "py", "pz", "pvx", "pvy", "pvz")
     px, py, pz, pvx, pvy, pvz = p
     # u = -q B^T p = -q p_v ; f(x) = [v; grad U + 2 Omega v] with Omega v = (vy, -vx, 0)
     ax = grad[0] + 2.0 * vy - q * pvx
@@ -138,14 +149,7 @@ BLOCK_LAYOUT = {"x": slice(0, 6), "phi_xx": slice(6, 42), "phi_xp": slice(42, 78
 def _block_system():
     """Expressions of :func:`block_variational_system` (built once per process)."""
     hy = _heyoka()
-    x, y, z, vx, vy, vz = hy.make_vars("x", "y", "z", "vx", "vy", "vz")
-    mu, q = hy.par[0], hy.par[1]
-    r1 = ((x + mu) ** 2 + y**2 + z**2) ** 0.5
-    r2 = ((x - 1.0 + mu) ** 2 + y**2 + z**2) ** 0.5
-    U = 0.5 * (x**2 + y**2) + (1.0 - mu) / r1 + mu / r2
-    pos = (x, y, z)
-    grad = [hy.diff(U, v) for v in pos]
-    hess = [[hy.diff(g, v) for v in pos] for g in grad]
+    (x, y, z, vx, vy, vz), q, grad, hess = _potential_expressions(hy)
 
     def a_col(i, c):
         """Row i of A c for a column c (6 expressions); A = [[0, I], [U_rr, 2 Omega]], 2 Omega v = (2vy, -2vx, 0)."""
