@@ -1,6 +1,7 @@
 """Adaptive OCBE: the metric's three-term identity and chi-square law, the detection rule, the reset, batch = single."""
 
 import pickle
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -9,7 +10,7 @@ from scipy.integrate import simpson
 
 from cislunar import adaptive_ocbe as ad
 from cislunar import detection as det
-from cislunar import ocbe, orbits, srif, tracking
+from cislunar import measurements, ocbe, orbits, srif, tracking
 from cislunar.dynamics import EARTH_MOON as em
 
 
@@ -89,7 +90,9 @@ def _linear_run(rng, N=600, n=6, m=4):
 def test_metric_law_is_chi_square_m_kolmogorov_smirnov():
     m = 4
     res, Phis, Qs, Hs, Rs, ys = _linear_run(np.random.default_rng(20261122), m=m)
-    metric = res.residuals**2
+    # the package's metric of the run (forward_metric reads the whitened innovation norms; the model only sets m)
+    metric, dof = ad.forward_metric(SimpleNamespace(residual_norms=res.residuals), measurements.ANGLES_AND_RATES)
+    assert np.all(dof == m) and np.array_equal(metric, res.residuals**2)
     # the three-term form gives the same numbers (checked at a sample of epochs)
     for k in range(1, 600, 97):
         S = srif.sri_from_covariance(np.zeros(6), res.P_filt[k - 1])[0]
@@ -228,6 +231,38 @@ def test_batched_adaptive_equals_single_trial(setup):
         assert np.allclose(metric[b], one.metric, rtol=1e-6, atol=1e-9)
         assert np.max(np.abs(res.x_filt[b] - one.result.x_filt)) < 1e-9 * np.max(np.abs(one.result.x_filt))
         assert np.max(np.abs(res.x_smooth[b] - one.result.x_smooth)) < 1e-9 * np.max(np.abs(one.result.x_smooth))
+
+
+def _two_burns(setup, seed, magnitudes=(3.0, 30.0)):
+    """Burns at apoapsis and in the next interval (random pointing): truth, measurements, hand-off."""
+    sc = setup.scenario
+    rng = np.random.default_rng(seed)
+    k = int(np.searchsorted(sc.t, setup.t_maneuver, side="right"))
+    dv = [det.pointing_vector(*det.StationKeepingPolicy.sample_pointing(rng)) * m * 1e-3 / em.velocity_unit_km_s
+          for m in magnitudes]
+    truth = tracking.simulate_truth(em, sc.x_start, sc.t, [(setup.t_maneuver, dv[0]),
+                                                          (0.5 * (sc.t[k] + sc.t[k + 1]), dv[1])])
+    y = tracking.simulate_measurements(sc, truth, rng)[:, 0]
+    x0, P0 = tracking.initial_estimate(em, truth[0], rng)
+    return k, y, x0, P0
+
+
+@pytest.mark.parametrize("reset", ad.RESET_RULES)
+def test_burns_in_consecutive_intervals_are_dated_to_consecutive_epochs(setup, reset):
+    """After a reset at epoch k the search resumes at k + 1: a second, larger burn in the next interval is dated
+    to k + 1 (not k + 2), by the single-trial and the batched adaptive filter alike."""
+    sc = setup.scenario
+    runs = [_two_burns(setup, seed) for seed in (0, 2)]
+    for k, y, x0, P0 in runs:
+        a = ad.adaptive_ocbe(em, sc.t, y, setup.observer_states, sc.model, sc.meas_cov, x0, P0,
+                             setup.control_weight, reset=reset, smooth=False)
+        assert [d.epoch for d in a.detections] == [k, k + 1]
+        assert a.control_weight[k - 1] > 1e4 * setup.control_weight[k - 1]
+        assert a.control_weight[k] > 1e4 * setup.control_weight[k]
+    _, _, _, dets = ad.adaptive_ocbe_batch(em, sc.t, np.array([r[1] for r in runs]), setup.observer_states, sc.model,
+                                           sc.meas_cov, np.array([r[2] for r in runs]), runs[0][3],
+                                           setup.control_weight, reset=reset)
+    assert [[d.epoch for d in dd] for dd in dets] == [[r[0], r[0] + 1] for r in runs]
 
 
 def test_reset_factor_consistency_and_errors(setup, big_burn):
