@@ -92,9 +92,8 @@ from .propagation import DEFAULT_TOL, _check_tol
 
 __all__ = ["DETECTION_PROBABILITY", "CONSECUTIVE_EPOCHS", "metric_law", "metric_limit", "MetricTerms",
            "RESET_RULES", "metric_terms", "forward_metric", "smoothed_metric", "first_detection", "Detection",
-           "reset_factor",
-           "AdaptiveOCBEResult", "adaptive_ocbe", "adaptive_ocbe_batch", "ResetError", "PASSES", "PanelSeries",
-           "panel_series", "figure_errors", "figure_control_metric"]
+           "reset_factor", "AdaptiveOCBEResult", "adaptive_ocbe", "adaptive_ocbe_batch", "first_pass_detections",
+           "ResetError", "PASSES", "PanelSeries", "panel_series", "figure_errors", "figure_control_metric"]
 
 #: Probability of the metric's detection limit (the paper's 99 %).
 DETECTION_PROBABILITY = 0.99
@@ -663,6 +662,36 @@ def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x
             dets[b].append(Detection(k, k + consecutive - 1, float(t[k]), factor, m0, float(metric[b, k])))
             start[b] = k + 1
     return res, q, metric, [tuple(d) for d in dets]
+
+
+def first_pass_detections(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *,
+                          probability: float = DETECTION_PROBABILITY, consecutive: int = CONSECUTIVE_EPOCHS,
+                          n_sub: int = 9, tol: float = DEFAULT_TOL) -> np.ndarray:
+    """Epoch of the adaptive OCBE's first detection for B trials, from one batched pass (-1 where none).
+
+    Until its first reset the adaptive filter is the plain OCBE with the starting tuning, so its first detection
+    (and with it the detection delay of a single maneuver) does not depend on the reset rule: one pass of
+    :func:`cislunar.detection.ocbe_batch` and the three-epoch rule (:func:`first_detection`, from epoch 1) give it
+    for every trial.  Arguments as in :func:`adaptive_ocbe_batch` (one observer).
+
+    Returns
+    -------
+    ndarray of int, shape (B,)
+        Epoch the first detection is dated to, or -1 when the metric never stays above its limit for
+        ``consecutive`` epochs within the track.
+    """
+    from . import detection
+
+    _checks.system(system)
+    model = ocbe.check_model(model)
+    consecutive = _checks.integer(consecutive, "consecutive", minimum=1)
+    _checks.in_range(probability, "probability", 0.0, 1.0, closed=False)
+    res = detection.ocbe_batch(system, t, y, observer_states, model, meas_cov, x0, P0, control_weight, n_sub=n_sub,
+                               tol=tol)
+    metric, dof = forward_metric(res, model)
+    limit = metric_limit(dof, probability)
+    out = [first_detection(m, limit, consecutive=consecutive) for m in metric]
+    return np.array([-1 if k is None else k for k in out], dtype=int)
 
 
 # ---------------------------------------------------------------------------------------------------------------

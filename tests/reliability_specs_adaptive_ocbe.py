@@ -96,6 +96,10 @@ def specs(Spec, lazy):
     okb = {n: lazy(functools.partial(_batch, n)) for n in ok}
     s.append(S("adaptive_ocbe_batch", adaptive_ocbe.adaptive_ocbe_batch,
                dict(okb, probability=0.99, consecutive=3, reset="mean", max_resets=5), common, baseline=False))
+    okf = {n: okb[n] for n in ok if n != "n_sub"}
+    s.append(S("first_pass_detections", adaptive_ocbe.first_pass_detections,
+               dict(okf, probability=0.99, consecutive=3, n_sub=2),
+               {n: common[n] for n in list(okf) + ["probability", "consecutive", "n_sub"]}))
     s.append(S("panel_series", adaptive_ocbe.panel_series,
                dict(system=em, result=lazy(_result), truth=kw("truth"), control_weight=1e-8, y=kw("y"),
                     observer_states=kw("observer_states"), model=kw("model"), meas_cov=kw("meas_cov"),

@@ -265,6 +265,27 @@ def test_burns_in_consecutive_intervals_are_dated_to_consecutive_epochs(setup, r
     assert [[d.epoch for d in dd] for dd in dets] == [[r[0], r[0] + 1] for r in runs]
 
 
+def test_first_pass_detections_match_the_adaptive_filter(setup):
+    """The batched first-pass detection epoch is the adaptive filter's first detection, whatever the reset rule."""
+    sc = setup.scenario
+    inputs = [det.draw_trial(np.random.default_rng(s), setup, magnitude_m_s=m)
+              for s, m in ((11, 3.0), (12, None), (13, 0.3), (14, 0.05))]
+    epochs = ad.first_pass_detections(em, sc.t, np.array([i.y for i in inputs]), setup.observer_states, sc.model,
+                                      sc.meas_cov, np.array([i.x0 for i in inputs]), inputs[0].P0,
+                                      setup.control_weight)
+    assert epochs.dtype.kind == "i" and epochs.shape == (4,)
+    assert epochs[1] == -1 and epochs[0] > 0  # no burn: none; 3 m/s: detected
+    for e, inp in zip(epochs, inputs):
+        for reset in ad.RESET_RULES:
+            a = _adaptive(setup, inp, reset=reset, smooth=False)
+            assert e == (a.detections[0].epoch if a.detections else -1)
+    # a stricter rule (more consecutive epochs) never detects earlier
+    later = ad.first_pass_detections(em, sc.t, np.array([i.y for i in inputs]), setup.observer_states, sc.model,
+                                     sc.meas_cov, np.array([i.x0 for i in inputs]), inputs[0].P0,
+                                     setup.control_weight, consecutive=5)
+    assert all(lt == -1 or (e != -1 and lt >= e) for e, lt in zip(epochs, later))
+
+
 def test_reset_factor_consistency_and_errors(setup, big_burn):
     inp, a = big_burn
     sc = setup.scenario
