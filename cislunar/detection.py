@@ -21,10 +21,16 @@ Pieces, in the order of the paper:
   the ``engine="reference"`` path keeps).  Both equal the single-trial filter to round-off
   (``tests/test_detection.py``); :func:`run_detection_monte_carlo` runs several batches per lockstep call.  The
   Monte Carlo is about four times faster than with the first batched OCBE (``benchmarks/bench_detection.py``).
+  Every Monte Carlo trial also records the NEES of its forward and smoothed estimates against its truth, so each
+  training or test set doubles as a consistency check of the tuning (:attr:`MonteCarloSample.inconsistent_runs`).
 * **Hypothesis test** (Eqs. 34-35): Gaussian kernel density estimates of :math:`z` under :math:`\mathcal H_0`
   (no maneuver) and :math:`\mathcal H_1` (maneuver), the threshold :math:`z_{lim}` where the two PDFs cross,
   false-positive rate :math:`\int_{z_{lim}}^\infty PDF_{\mathcal H_0}` and missed-detection rate
   :math:`\int_{-\infty}^{z_{lim}} PDF_{\mathcal H_1}`, and accuracy on independent test sets.
+* **Studies beyond the paper's runs**: the control integral of burns in chosen directions, at a chosen time in the
+  window (:func:`direction_response`, the conditions of the paper's :math:`\pm\hat j` pattern, Fig. 16), and the
+  "health metric" race between the control integral and the measurement residuals after an unexpected burn
+  (:func:`health_lead_study`, Fig. 22).
 
 Units: maneuver magnitudes and :math:`z` in m/s in all results; control weights given in km^2/s^3 (acceleration
 power spectral density) and converted to LU^2/TU^3 for the filter; angles in rad.
@@ -72,6 +78,10 @@ __all__ = [
     "detection_accuracy",
     "PolicyStudy",
     "run_policy_study",
+    "filter_trials",
+    "direction_response",
+    "HealthLeadStudy",
+    "health_lead_study",
 ]
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -148,7 +158,7 @@ class StationKeepingPolicy:
 
     @staticmethod
     def sample_pointing(rng: np.random.Generator, size=None) -> tuple[np.ndarray, np.ndarray]:
-        """Azimuth :math:`\\mathcal U[-\\pi,\\pi]` (Eq. 3) and elevation :math:`\\mathcal U[-\\pi/2,\\pi/2]` (Eq. 4), rad."""
+        """Azimuth :math:`\\mathcal U[-\\pi,\\pi]` and elevation :math:`\\mathcal U[-\\pi/2,\\pi/2]` (Eqs. 3-4), rad."""
         _checks.rng(rng)
         size = _size(size)
         return rng.uniform(-np.pi, np.pi, size), rng.uniform(-np.pi / 2, np.pi / 2, size)
@@ -342,6 +352,12 @@ class TrialResult:
         Eq. 33 on the single-step-smoothed (forward) control, m/s.
     magnitude_m_s, azimuth, elevation : float
         Maneuver parameters (0 and NaN without a maneuver), m/s and rad.
+    nees_over_fwd, nees_over_smooth : float
+        Fraction of epochs whose NEES (6 dof, forward / smoothed estimate against the truth) exceeds its
+        :data:`cislunar.tracking.NEES_PROBABILITY` chi-square quantile; the run is inconsistent when it is above
+        :data:`cislunar.tracking.DIVERGED_FRACTION` (notebook 09's criterion).
+    nees_mean_fwd, nees_mean_smooth : float
+        Mean NEES over the epochs (6 for a consistent filter).
     """
 
     z_m_s: float
@@ -349,10 +365,14 @@ class TrialResult:
     magnitude_m_s: float
     azimuth: float
     elevation: float
+    nees_over_fwd: float = np.nan
+    nees_over_smooth: float = np.nan
+    nees_mean_fwd: float = np.nan
+    nees_mean_smooth: float = np.nan
 
 
 def draw_trial(rng: np.random.Generator, setup: DetectionSetup, policy: StationKeepingPolicy | None = None, *,
-               magnitude_m_s: float | None = None, direction=None) -> TrialInputs:
+               magnitude_m_s: float | None = None, direction=None, burn_offset_hours: float = 0.0) -> TrialInputs:
     """Draw one trial: maneuver (if any), truth, measurements, hand-off estimate, in that order.
 
     Parameters
@@ -365,11 +385,17 @@ def draw_trial(rng: np.random.Generator, setup: DetectionSetup, policy: StationK
         Override the drawn magnitude (the pointing is still drawn unless ``direction`` is given), m/s.
     direction : array_like (2,), optional
         ``(azimuth, elevation)`` in rad overriding the drawn pointing.
+    burn_offset_hours : float
+        Time of the burn after the apoapsis (``setup.t_maneuver``), hours; the tuning window stays where it is.
+        The burn must fall strictly inside the track.  The draws do not depend on it.
     """
     _checks.rng(rng)
     _check_setup(setup)
     _check_policy(policy, optional=True)
     em, sc = setup.system, setup.scenario
+    t_burn = setup.t_maneuver + _checks.real(burn_offset_hours, "burn_offset_hours") * 3600.0 / em.time_unit_s
+    if not sc.t[0] < t_burn < sc.t[-1]:
+        raise ValueError(f"burn_offset_hours puts the burn outside the track; got {burn_offset_hours!r}")
     maneuvers, mag, az, el = [], 0.0, np.nan, np.nan
     if policy is not None or magnitude_m_s is not None:
         if policy is not None:
@@ -381,7 +407,7 @@ def draw_trial(rng: np.random.Generator, setup: DetectionSetup, policy: StationK
         if direction is not None:
             az, el = (float(v) for v in _checks.as_array(direction, "direction", shape=(2,)))
         dv = pointing_vector(az, el) * mag * 1e-3 / em.velocity_unit_km_s
-        maneuvers = [(setup.t_maneuver, dv)]
+        maneuvers = [(t_burn, dv)]
     truth = tracking.simulate_truth(em, sc.x_start, sc.t, maneuvers)
     y = tracking.simulate_measurements(sc, truth, rng)
     y = y[:, 0] if y.ndim == 3 else y  # one observer
@@ -398,14 +424,26 @@ def run_trial_filter(setup: DetectionSetup, inputs: TrialInputs, control_weight=
     _checks.instance(inputs, "inputs", TrialInputs, "a cislunar.detection.TrialInputs (draw_trial)")
     sc = setup.scenario
     q = setup.control_weight if control_weight is None else control_weight
-    return ocbe.ocbe_filter_smoother(setup.system, sc.t, inputs.y, setup.observer_states, sc.model, sc.meas_cov, inputs.x0,
-                                     inputs.P0, q, n_sub=setup.n_sub, smooth=True, tol=setup.tol)
+    return ocbe.ocbe_filter_smoother(setup.system, sc.t, inputs.y, setup.observer_states, sc.model, sc.meas_cov,
+                                     inputs.x0, inputs.P0, q, n_sub=setup.n_sub, smooth=True, tol=setup.tol)
 
 
-def _result(setup, inputs, z_smooth, z_step) -> TrialResult:
+#: 99.9 % quantile of the 6-dof chi-square law: an epoch's NEES above it counts as inconsistent.
+_NEES_LIMIT = float(stats.chi2.ppf(tracking.NEES_PROBABILITY, 6))
+
+
+def _nees(x, P, truth) -> np.ndarray:
+    """Stacked NEES ``e^T P^-1 e`` over the last two axes (no argument checks: internal, finite inputs)."""
+    e = x - truth
+    return np.einsum("...i,...i->...", e, np.linalg.solve(P, e[..., None])[..., 0])
+
+
+def _result(setup, inputs, z_smooth, z_step, x_filt, P_filt, x_smooth, P_smooth) -> TrialResult:
     v = setup.system.velocity_unit_km_s * 1e3
+    nf, ns = _nees(x_filt, P_filt, inputs.truth), _nees(x_smooth, P_smooth, inputs.truth)
     return TrialResult(float(z_smooth) * v, float(z_step) * v, inputs.magnitude_m_s, inputs.azimuth,
-                       inputs.elevation)
+                       inputs.elevation, float(np.mean(nf > _NEES_LIMIT)), float(np.mean(ns > _NEES_LIMIT)),
+                       float(np.mean(nf)), float(np.mean(ns)))
 
 
 def detection_trial(rng: np.random.Generator, setup: DetectionSetup,
@@ -421,7 +459,7 @@ def detection_trial(rng: np.random.Generator, setup: DetectionSetup,
     """
     inputs = draw_trial(rng, setup, policy)
     res = run_trial_filter(setup, inputs)
-    return _result(setup, inputs, res.z_smooth, res.z_step)
+    return _result(setup, inputs, res.z_smooth, res.z_step, res.x_filt, res.P_filt, res.x_smooth, res.P_smooth)
 
 
 def detection_trial_batch(rng: np.random.Generator, setup: DetectionSetup, policy: StationKeepingPolicy | None,
@@ -455,7 +493,8 @@ def _detection_batches(rngs, setup, policy, batch_size) -> list:
     res = ocbe_batch(setup.system, sc.t, np.array([i.y for i in inputs]), setup.observer_states, sc.model, sc.meas_cov,
                      np.array([i.x0 for i in inputs]), np.array([i.P0 for i in inputs]), setup.control_weight,
                      n_sub=setup.n_sub, tol=setup.tol)
-    flat = [_result(setup, inp, zs, zf) for inp, zs, zf in zip(inputs, res.z_smooth, res.z_step)]
+    flat = [_result(setup, inp, res.z_smooth[b], res.z_step[b], res.x_filt[b], res.P_filt[b], res.x_smooth[b],
+                    res.P_smooth[b]) for b, inp in enumerate(inputs)]
     return [flat[k * B:(k + 1) * B] for k in range(len(rngs))]
 
 
@@ -476,6 +515,10 @@ class MonteCarloSample:
         Forward (single-step smoothed) control integral, m/s.
     magnitude, azimuth, elevation : ndarray
         Maneuver parameters, m/s and rad (0 and NaN without maneuver).
+    nees_over_fwd, nees_over_smooth : ndarray
+        Per run, the fraction of epochs whose forward / smoothed NEES exceeds its 99.9 % quantile.
+    nees_mean_fwd, nees_mean_smooth : ndarray
+        Per run, the mean NEES over the epochs.
     """
 
     z: np.ndarray
@@ -483,14 +526,29 @@ class MonteCarloSample:
     magnitude: np.ndarray
     azimuth: np.ndarray
     elevation: np.ndarray
+    nees_over_fwd: np.ndarray
+    nees_over_smooth: np.ndarray
+    nees_mean_fwd: np.ndarray
+    nees_mean_smooth: np.ndarray
 
     @classmethod
     def from_results(cls, results) -> "MonteCarloSample":
-        cols = np.array([[r.z_m_s, r.z_step_m_s, r.magnitude_m_s, r.azimuth, r.elevation] for r in results])
+        cols = np.array([[r.z_m_s, r.z_step_m_s, r.magnitude_m_s, r.azimuth, r.elevation, r.nees_over_fwd,
+                          r.nees_over_smooth, r.nees_mean_fwd, r.nees_mean_smooth] for r in results])
         return cls(*cols.T.copy())
 
     def __len__(self) -> int:
         return self.z.size
+
+    @property
+    def inconsistent_runs(self) -> tuple[float, float]:
+        """Fractions of runs that are NEES-inconsistent, ``(forward, smoothed)``.
+
+        A run is inconsistent when more than :data:`cislunar.tracking.DIVERGED_FRACTION` of its epochs exceed the
+        99.9 % quantile of the 6-dof chi-square law (notebook 09's criterion).
+        """
+        lim = tracking.DIVERGED_FRACTION
+        return float(np.mean(self.nees_over_fwd > lim)), float(np.mean(self.nees_over_smooth > lim))
 
 
 def run_detection_monte_carlo(setup: DetectionSetup, policy: StationKeepingPolicy | None, n_trials: int, seed, *,
@@ -1176,3 +1234,245 @@ def run_policy_study(setup: DetectionSetup, policy: StationKeepingPolicy, n_h0: 
         t1 = mc(policy, n_test, 3, "H1 test")
         score = detection_accuracy(t0.z, t1.z, th.z_lim)
     return PolicyStudy(h0, h1, t0, t1, th, score)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Studies beyond the paper's runs: filtering given trials, burn directions, the health-metric race (Fig. 22)
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def _check_inputs(inputs, name: str = "inputs") -> list:
+    if isinstance(inputs, TrialInputs):
+        raise _checks.ArgumentTypeError(f"{name} must be a sequence of TrialInputs, not a single one")
+    try:
+        items = list(inputs)
+    except TypeError:
+        raise _checks.ArgumentTypeError(f"{name} must be a sequence of cislunar.detection.TrialInputs; got "
+                                        f"{type(inputs).__name__}") from None
+    if not items:
+        raise ValueError(f"{name} must hold at least one trial")
+    for i, item in enumerate(items):
+        _checks.instance(item, f"{name}[{i}]", TrialInputs, "a cislunar.detection.TrialInputs (draw_trial)")
+    return items
+
+
+def filter_trials(setup: DetectionSetup, inputs, *, n_epochs: int | None = None) -> BatchOCBEResult:
+    """The batched OCBE (:func:`ocbe_batch`) on given trials, in lockstep groups of :data:`LOCKSTEP_TRIALS`.
+
+    Parameters
+    ----------
+    setup : DetectionSetup
+    inputs : sequence of TrialInputs
+        Trials drawn with :func:`draw_trial` for this setup.
+    n_epochs : int, optional
+        Filter and smooth only the first ``n_epochs`` epochs (at least 2): the estimate an analyst has at epoch
+        ``n_epochs - 1``, e.g. to follow the smoothed control integral as the data arrive.  Default: the whole
+        track.
+
+    Returns
+    -------
+    BatchOCBEResult
+        One entry per trial on the leading axis, in the order of ``inputs``.
+    """
+    _check_setup(setup)
+    items = _check_inputs(inputs)
+    sc = setup.scenario
+    N = sc.t.size if n_epochs is None else _checks.integer(n_epochs, "n_epochs", minimum=2, maximum=sc.t.size)
+    parts = []
+    for a in range(0, len(items), LOCKSTEP_TRIALS):
+        chunk = items[a:a + LOCKSTEP_TRIALS]
+        parts.append(ocbe_batch(setup.system, sc.t[:N], np.array([i.y[:N] for i in chunk]),
+                                setup.observer_states[:N], sc.model, sc.meas_cov, np.array([i.x0 for i in chunk]),
+                                np.array([i.P0 for i in chunk]), setup.control_weight[:N - 1], n_sub=setup.n_sub,
+                                tol=setup.tol))
+    if len(parts) == 1:
+        return parts[0]
+    fields = {f: np.concatenate([getattr(p, f) for p in parts]) for f in BatchOCBEResult.__dataclass_fields__
+              if f != "t_sub"}
+    return BatchOCBEResult(t_sub=parts[0].t_sub, **fields)
+
+
+def direction_response(setup: DetectionSetup, directions, magnitude_m_s: float, n_repeats: int, seed, *,
+                       burn_offset_hours: float = 0.0) -> np.ndarray:
+    """Smoothed control integral :math:`z` (m/s) of burns of one size in given directions.
+
+    Repeat ``k`` draws its measurement noise and hand-off error with the generator ``[*seed, k]``, the same for
+    every direction, so that directions are compared on the same data noise (paired comparison).
+
+    Parameters
+    ----------
+    setup : DetectionSetup
+    directions : array_like, shape (n, 2)
+        ``(azimuth, elevation)`` pairs in the rotating frame, rad.
+    magnitude_m_s : float
+        Burn size, m/s (positive).
+    n_repeats : int
+        Noise draws per direction.
+    seed : int or list of int
+    burn_offset_hours : float
+        Burn time after the apoapsis, hours (:func:`draw_trial`).
+
+    Returns
+    -------
+    ndarray, shape (n_repeats, n)
+    """
+    _check_setup(setup)
+    dirs = _checks.as_array(directions, "directions", ndim=(2,), last=2, min_size=2)
+    mag = _checks.positive(magnitude_m_s, "magnitude_m_s")
+    n_rep = _checks.integer(n_repeats, "n_repeats", minimum=1)
+    _checks.seed_entropy(seed, "seed")
+    if isinstance(seed, np.random.SeedSequence):
+        raise _checks.ArgumentTypeError("seed must be an int or a list of ints here (repeats append an index)")
+    base = [int(v) for v in np.atleast_1d(seed)]
+    off = _checks.real(burn_offset_hours, "burn_offset_hours")
+    inputs = [draw_trial(np.random.default_rng(base + [k]), setup, magnitude_m_s=mag, direction=d,
+                         burn_offset_hours=off) for k in range(n_rep) for d in dirs]
+    z = filter_trials(setup, inputs).z_smooth * setup.system.velocity_unit_km_s * 1e3
+    return z.reshape(n_rep, len(dirs))
+
+
+@dataclass(frozen=True)
+class HealthLeadStudy:
+    """Which reacts first to an unexpected burn: the control integral or the measurement residuals? (Fig. 22)
+
+    Both tests are online (they use only the data received so far) and are evaluated at the epochs following
+    the burn, up to a horizon; each fires at the first epoch where its statistic passes the same per-epoch tail
+    probability ``tail_probability`` of its no-burn distribution:
+
+    * *control test*: the smoothed control integral over the arc received so far,
+      :math:`z_k = \\int_{t_0}^{t_k}\\|\\hat{\\mathbf u}\\|dt` (the fixed-interval smoother rerun on the data up to
+      epoch :math:`k`), above the upper ``tail_probability`` quantile of a log-normal law fitted to the
+      no-burn (H0) calibration runs at the same epoch;
+    * *residual test*: the squared whitened innovation of epoch :math:`k` (the forward OCBE metric,
+      :math:`\\chi^2_m` for a correct model) above its ``tail_probability`` quantile.
+
+    Attributes
+    ----------
+    magnitudes_m_s : ndarray, shape (M,)
+        Burn sizes, m/s (random pointing, Eqs. 3-4).
+    delay_hours : ndarray, shape (K,)
+        Time from the burn to each epoch of the horizon, hours.
+    control_epoch, residual_epoch : ndarray of int, shape (M, n_h1)
+        Index into ``delay_hours`` of the epoch at which each test first fires, -1 if it does not fire within the
+        horizon.
+    false_alarm_control, false_alarm_residual : float
+        Fraction of independent no-burn validation runs in which the test fires within the horizon.
+    z_final_m_s : ndarray, shape (M, n_h1)
+        Smoothed control integral of the whole track, m/s (the paper's health value, Eq. 33).
+    z_h0_final_m_s : ndarray, shape (n_h0,)
+        The same for the no-burn calibration runs.
+    tail_probability : float
+    """
+
+    magnitudes_m_s: np.ndarray
+    delay_hours: np.ndarray
+    control_epoch: np.ndarray
+    residual_epoch: np.ndarray
+    false_alarm_control: float
+    false_alarm_residual: float
+    z_final_m_s: np.ndarray
+    z_h0_final_m_s: np.ndarray
+    tail_probability: float
+
+    def outcome_fractions(self) -> dict:
+        """Per burn size, the fractions of runs in which the control test fires first, the residual test fires
+        first, both fire at the same epoch, or neither fires within the horizon (each an array of shape (M,))."""
+        c, r = self.control_epoch, self.residual_epoch
+        big = np.iinfo(np.int64).max
+        cc, rr = np.where(c >= 0, c, big), np.where(r >= 0, r, big)
+        return {"control first": np.mean(cc < rr, axis=1), "residual first": np.mean(rr < cc, axis=1),
+                "same epoch": np.mean((cc == rr) & (c >= 0), axis=1),
+                "neither": np.mean((c < 0) & (r < 0), axis=1)}
+
+    def median_delay_hours(self, test: str) -> np.ndarray:
+        """Median time from the burn to the firing of ``test`` ('control' or 'residual') among the runs in which
+        it fires, per burn size, hours (NaN when it never fires)."""
+        test = _checks.choice(test, "test", ("control", "residual"))
+        k = self.control_epoch if test == "control" else self.residual_epoch
+        out = np.full(k.shape[0], np.nan)
+        for i, row in enumerate(k):
+            if np.any(row >= 0):
+                out[i] = float(np.median(self.delay_hours[row[row >= 0]]))
+        return out
+
+
+def _first_true(mask) -> np.ndarray:
+    """Index of the first True along the last axis, -1 where there is none."""
+    mask = np.asarray(mask, bool)
+    return np.where(mask.any(axis=-1), np.argmax(mask, axis=-1), -1)
+
+
+def health_lead_study(setup: DetectionSetup, magnitudes_m_s, n_h0: int, n_h1: int, seed, *,
+                      horizon_hours: float = 24.0, tail_probability: float = float(stats.norm.sf(3.0)),
+                      executor=None, progress: bool = False) -> HealthLeadStudy:
+    """Race between the control integral and the residuals after a burn the tuning does not expect (Fig. 22).
+
+    ``n_h0`` no-burn runs calibrate the control test (seed ``[*seed, 0]``), ``n_h0`` more measure both tests'
+    false alarms (``[*seed, 1]``), and ``n_h1`` randomly pointed burns of each size (``[*seed, 2, i]``) are
+    followed epoch by epoch over the horizon; see :class:`HealthLeadStudy` for the two tests.  The smoother is
+    rerun on the growing data arc at every epoch of the horizon (through ``executor`` when given).
+
+    Parameters
+    ----------
+    setup : DetectionSetup
+        Scenario and tuning (e.g. the quiet policy's window tuning).
+    magnitudes_m_s : array_like, shape (M,)
+        Burn sizes, m/s (positive).
+    n_h0, n_h1 : int
+        Runs per no-burn set (calibration and validation; at least 10) and per burn size.
+    seed : int or list of int
+    horizon_hours : float
+        How long after the burn the tests are followed, hours; the horizon must end inside the track.
+    tail_probability : float
+        Per-epoch tail probability of both tests under no burn (default: the 3-sigma tail, 0.00135).
+    executor : concurrent.futures-style executor, optional
+    progress : bool
+    """
+    from .montecarlo import map_tasks
+
+    _check_setup(setup)
+    mags = _checks.as_array(magnitudes_m_s, "magnitudes_m_s", ndim=(1,), min_size=1)
+    if np.any(mags <= 0):
+        raise ValueError("magnitudes_m_s must be positive")
+    n0 = _checks.integer(n_h0, "n_h0", minimum=10)
+    n1 = _checks.integer(n_h1, "n_h1", minimum=1)
+    _checks.seed_entropy(seed, "seed")
+    if isinstance(seed, np.random.SeedSequence):
+        raise _checks.ArgumentTypeError("seed must be an int or a list of ints here (the sets append an index)")
+    base = [int(v) for v in np.atleast_1d(seed)]
+    horizon = _checks.positive(horizon_hours, "horizon_hours")
+    p = _checks.in_range(tail_probability, "tail_probability", 0.0, 0.5, closed=False)
+    _checks.boolean(progress, "progress")
+    sc, em = setup.scenario, setup.system
+    hours = (sc.t - setup.t_maneuver) * em.time_unit_s / 3600.0
+    k0 = int(np.searchsorted(sc.t, setup.t_maneuver, side="right"))  # first epoch that sees the burn
+    ks = np.flatnonzero((hours > 0) & (hours <= horizon))
+    if ks.size == 0 or ks[-1] >= sc.t.size - 1 or ks[0] != k0:
+        raise ValueError(f"horizon_hours must leave the horizon inside the track; got {horizon_hours!r}")
+    cal = [draw_trial(r, setup) for r in (np.random.default_rng(base + [0]).spawn(n0))]
+    val = [draw_trial(r, setup) for r in (np.random.default_rng(base + [1]).spawn(n0))]
+    burns = [draw_trial(r, setup, magnitude_m_s=float(m))
+             for i, m in enumerate(mags) for r in np.random.default_rng(base + [2, i]).spawn(n1)]
+    everything = cal + val + burns
+    tasks = [(setup, everything, int(k) + 1) for k in ks] + [(setup, everything, None)]
+    arcs = map_tasks(_arc_statistics, tasks, executor=executor, progress=progress, desc="health arcs")
+    z_arc = np.array([a[0] for a in arcs[:-1]]).T  # (runs, K) smoothed z of the arc up to each epoch, m/s
+    z_full, resid2 = arcs[-1]
+    r2 = resid2[:, ks]  # squared whitened innovations at the horizon epochs
+    logz = np.log(z_arc[:n0])
+    lim_c = np.exp(logz.mean(axis=0) + stats.norm.isf(p) * logz.std(axis=0, ddof=1))
+    lim_r = stats.chi2.isf(p, sc.model.dim)
+    fire_c, fire_r = _first_true(z_arc > lim_c), _first_true(r2 > lim_r)
+    v = slice(n0, 2 * n0)
+    b = slice(2 * n0, None)
+    M = mags.size
+    return HealthLeadStudy(mags, hours[ks], fire_c[b].reshape(M, n1), fire_r[b].reshape(M, n1),
+                           float(np.mean(fire_c[v] >= 0)), float(np.mean(fire_r[v] >= 0)),
+                           z_full[b].reshape(M, n1), z_full[:n0], p)
+
+
+def _arc_statistics(task):
+    """``(z_smooth in m/s, squared whitened innovations)`` of every trial on the first ``n_epochs`` epochs."""
+    setup, inputs, n_epochs = task
+    res = filter_trials(setup, inputs, n_epochs=n_epochs)
+    return res.z_smooth * setup.system.velocity_unit_km_s * 1e3, res.residual_norms**2

@@ -246,3 +246,128 @@ def test_lockstep_groups_equal_separate_batches_and_any_executor(short_setup):
         procs = det.run_detection_monte_carlo(s, det.QUIET_POLICY, n, 21, batch_size=B, executor=ex, progress=False)
     for name in ("z", "z_step", "magnitude", "azimuth", "elevation"):
         assert np.array_equal(getattr(mc, name), getattr(procs, name), equal_nan=True), name
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Consistency readout, burn timing, filtering given trials, direction response, health-metric race
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def test_trial_nees_equals_the_nees_of_the_filter_output(short_setup):
+    """The NEES fields of a Monte Carlo trial are those of tracking.nees on the single-trial filter's estimates."""
+    from cislunar import tracking
+
+    s = short_setup
+    lim = stats.chi2.ppf(tracking.NEES_PROBABILITY, 6)
+    batch = det.detection_trial_batch(np.random.default_rng(31), s, det.QUIET_POLICY, 2)
+    for res, kid in zip(batch, np.random.default_rng(31).spawn(2)):
+        inp = det.draw_trial(kid, s, det.QUIET_POLICY)
+        one = det.run_trial_filter(s, inp)
+        nf = tracking.nees(one.x_filt, one.P_filt, inp.truth)
+        ns = tracking.nees(one.x_smooth, one.P_smooth, inp.truth)
+        assert np.isclose(res.nees_mean_fwd, nf.mean(), rtol=1e-8)
+        assert np.isclose(res.nees_mean_smooth, ns.mean(), rtol=1e-8)
+        assert res.nees_over_fwd == np.mean(nf > lim) and res.nees_over_smooth == np.mean(ns > lim)
+    single = det.detection_trial(np.random.default_rng(32), s, None)
+    inp = det.draw_trial(np.random.default_rng(32), s, None)
+    one = det.run_trial_filter(s, inp)
+    assert np.isclose(single.nees_mean_smooth, tracking.nees(one.x_smooth, one.P_smooth, inp.truth).mean(), rtol=1e-12)
+    # a run is inconsistent when more than 5 % of its epochs are above the quantile (strictly)
+    r = [det.TrialResult(1.0, 1.0, 0.0, np.nan, np.nan, f, g, 6.0, 6.0)
+         for f, g in ((0.0, 0.0), (0.05, 0.2), (0.06, 0.0), (0.5, 0.051))]
+    mc = det.MonteCarloSample.from_results(r)
+    assert mc.inconsistent_runs == (0.5, 0.5)
+
+
+def test_burn_offset_moves_the_impulse_and_nothing_else(short_setup):
+    from cislunar import propagation
+
+    s = short_setup
+    sc = s.scenario
+    dv_m_s, direction = 2.0, (0.3, -0.4)
+    plain = det.draw_trial(np.random.default_rng(6), s)
+    at_apoapsis = det.draw_trial(np.random.default_rng(6), s, magnitude_m_s=dv_m_s, direction=direction)
+    k = int(np.searchsorted(sc.t, s.t_maneuver, side="right"))  # first epoch after the apoapsis
+    lag_h = (sc.t[k] - s.t_maneuver) * em.time_unit_s / 3600
+    for offset in (-3.0, 0.0, lag_h / 2):
+        inp = det.draw_trial(np.random.default_rng(6), s, magnitude_m_s=dv_m_s, direction=direction,
+                             burn_offset_hours=offset)
+        t_b = s.t_maneuver + offset * 3600 / em.time_unit_s
+        kb = int(np.searchsorted(sc.t, t_b, side="right"))
+        assert np.array_equal(inp.truth[:kb], plain.truth[:kb]) and np.array_equal(inp.x0, at_apoapsis.x0)
+        # back-propagated from the next epoch to the burn time, the truth differs from the no-burn state by dv only
+        before = propagation.propagate(em, plain.truth[kb], [sc.t[kb], t_b]).x[-1]
+        after = propagation.propagate(em, inp.truth[kb], [sc.t[kb], t_b]).x[-1]
+        dv = det.pointing_vector(*direction) * dv_m_s * 1e-3 / em.velocity_unit_km_s
+        assert np.allclose(after - before, np.r_[np.zeros(3), dv], rtol=0, atol=1e-9 * np.abs(dv).max())
+    late = det.draw_trial(np.random.default_rng(6), s, magnitude_m_s=dv_m_s, direction=direction,
+                          burn_offset_hours=lag_h + 1.0)  # after the first post-apoapsis epoch
+    assert np.array_equal(late.truth[:k + 1], plain.truth[:k + 1])
+    with pytest.raises(ValueError, match="burn_offset_hours"):
+        det.draw_trial(np.random.default_rng(6), s, magnitude_m_s=1.0, burn_offset_hours=1e4)
+
+
+def test_filter_trials_equals_ocbe_batch_on_the_whole_and_on_a_truncated_arc(short_setup, monkeypatch):
+    s = short_setup
+    sc = s.scenario
+    inputs = [det.draw_trial(k, s, det.ACTIVE_POLICY) for k in np.random.default_rng(9).spawn(3)]
+
+    def direct(n):
+        return det.ocbe_batch(em, sc.t[:n], np.array([i.y[:n] for i in inputs]), s.observer_states[:n], sc.model,
+                              sc.meas_cov, np.array([i.x0 for i in inputs]), inputs[0].P0, s.control_weight[:n - 1],
+                              n_sub=s.n_sub, tol=s.tol)
+
+    monkeypatch.setattr(det, "LOCKSTEP_TRIALS", 2)  # 3 trials in two lockstep groups, concatenated
+    for n in (None, sc.t.size, 5):
+        got, ref = det.filter_trials(s, inputs, n_epochs=n), direct(sc.t.size if n is None else n)
+        assert got.x_smooth.shape == ref.x_smooth.shape and np.array_equal(got.t_sub, ref.t_sub)
+        assert np.max(np.abs(got.z_smooth / ref.z_smooth - 1)) < 1e-12
+        assert np.max(np.abs(got.P_smooth - ref.P_smooth)) <= 1e-12 * np.max(np.abs(ref.P_smooth))
+    # the forward pass does not look ahead: a truncated arc has the same filtered states on its epochs
+    short = det.filter_trials(s, inputs, n_epochs=5)
+    full = det.filter_trials(s, inputs)
+    assert np.allclose(short.x_filt, full.x_filt[:, :5], rtol=0, atol=1e-12)
+    with pytest.raises(ValueError, match="n_epochs"):
+        det.filter_trials(s, inputs, n_epochs=1)
+    with pytest.raises(ValueError, match="inputs"):
+        det.filter_trials(s, [])
+    with pytest.raises(TypeError, match="inputs"):
+        det.filter_trials(s, inputs[0])
+
+
+def test_direction_response_pairs_the_noise_across_directions(short_setup):
+    s = short_setup
+    dirs = np.array([[0.0, 0.0], [np.pi / 2, 0.0], [0.0, 0.0]])
+    z = det.direction_response(s, dirs, 1.0, 2, [4, 1])
+    assert z.shape == (2, 3) and np.allclose(z[:, 0], z[:, 2], rtol=1e-12)  # same direction, same noise
+    assert not np.isclose(z[0, 0], z[1, 0])  # repeats have different noise
+    one = det.draw_trial(np.random.default_rng([4, 1, 1]), s, magnitude_m_s=1.0, direction=dirs[1])
+    ref = det.run_trial_filter(s, one).z_smooth * em.velocity_unit_km_s * 1e3
+    assert abs(z[1, 1] / ref - 1) < 1e-9
+    with pytest.raises(ValueError, match="magnitude_m_s"):
+        det.direction_response(s, dirs, 0.0, 1, 0)
+    with pytest.raises(ValueError, match="directions"):
+        det.direction_response(s, np.zeros(3), 1.0, 1, 0)
+
+
+def test_health_lead_study_outcomes_partition_and_a_large_burn_is_seen_at_once():
+    s = det.make_setup(em, orbits.nrho_9_2(em), 0.1 * det.window_control_weight(det.QUIET_POLICY, 16.0), 1e-18,
+                       cadence_hours=8.0, window_hours=16.0, periods=0.8)
+    h = det.health_lead_study(s, [0.02, 5.0], 10, 4, 2, horizon_hours=20.0)
+    sc = s.scenario
+    k0 = int(np.searchsorted(sc.t, s.t_maneuver, side="right"))
+    assert np.allclose(h.delay_hours, (sc.t[k0:k0 + h.delay_hours.size] - s.t_maneuver) * em.time_unit_s / 3600)
+    assert h.delay_hours[0] > 0 and h.delay_hours[-1] <= 20.0
+    fr = h.outcome_fractions()
+    assert np.allclose(sum(fr.values()), 1.0)  # every run falls in exactly one outcome
+    # a 5 m/s burn, a hundred times the quiet policy's, trips both tests at the first epoch after it
+    assert np.all(h.control_epoch[1] == 0) and np.all(h.residual_epoch[1] == 0)
+    assert fr["same epoch"][1] == 1.0 and np.allclose(h.median_delay_hours("control")[1], h.delay_hours[0])
+    assert h.z_final_m_s[1].min() > h.z_h0_final_m_s.max()
+    assert 0 <= h.false_alarm_control <= 1 and h.tail_probability == pytest.approx(stats.norm.sf(3.0))
+    with pytest.raises(ValueError, match="horizon_hours"):
+        det.health_lead_study(s, [0.1], 10, 2, 0, horizon_hours=1e4)
+    with pytest.raises(ValueError, match="magnitudes_m_s"):
+        det.health_lead_study(s, [-0.1], 10, 2, 0)
+    with pytest.raises(ValueError, match="test"):
+        h.median_delay_hours("metric")
