@@ -79,6 +79,7 @@ __all__ = [
     "PolicyStudy",
     "run_policy_study",
     "filter_trials",
+    "control_spike_contrast",
     "direction_response",
     "HealthLeadStudy",
     "health_lead_study",
@@ -1290,6 +1291,44 @@ def filter_trials(setup: DetectionSetup, inputs, *, n_epochs: int | None = None)
     fields = {f: np.concatenate([getattr(p, f) for p in parts]) for f in BatchOCBEResult.__dataclass_fields__
               if f != "t_sub"}
     return BatchOCBEResult(t_sub=parts[0].t_sub, **fields)
+
+
+def control_spike_contrast(setup: DetectionSetup, result: BatchOCBEResult, *, half_width_hours: float = 6.0,
+                           burn_offset_hours: float = 0.0) -> np.ndarray:
+    """How much the estimated control stands out at the burn time, per trial: forward and smoothed.
+
+    The contrast is the mean control norm on the sub-grid points within ``half_width_hours`` of the burn time over
+    the mean farther away (1: no spike), the definition of
+    :meth:`cislunar.adaptive_ocbe.PanelSeries.spike_contrast` (Figs. 11 and 13: a maneuver "appears as a spike in
+    estimated control only in the smoothed system").  The default half width covers the intervals that touch an
+    8-hour window centred on the burn at a 2-hour cadence.
+
+    Parameters
+    ----------
+    setup : DetectionSetup
+    result : BatchOCBEResult
+        Output of :func:`filter_trials` (or :func:`ocbe_batch`) on the setup's epochs.
+    half_width_hours : float
+    burn_offset_hours : float
+        Burn time after the apoapsis, hours (for runs without a burn: the time the test looks at).
+
+    Returns
+    -------
+    ndarray, shape (B, 2)
+        Column 0 the forward (single-step, Eq. 32) control, column 1 the smoothed control.
+    """
+    _check_setup(setup)
+    _checks.instance(result, "result", BatchOCBEResult, "a cislunar.detection.BatchOCBEResult (filter_trials)")
+    hw = _checks.positive(half_width_hours, "half_width_hours") * 3600.0 / setup.system.time_unit_s
+    t_b = setup.t_maneuver + _checks.real(burn_offset_hours, "burn_offset_hours") * 3600.0 / setup.system.time_unit_s
+    near = np.abs(result.t_sub - t_b) <= hw
+    if not near.any() or near.all():
+        raise ValueError("half_width_hours and burn_offset_hours must select some but not all of the track")
+    out = np.empty((result.z_smooth.size, 2))
+    for j, u in enumerate((result.control_step, result.control_smooth)):
+        norm = np.linalg.norm(u, axis=-1)
+        out[:, j] = norm[:, near].mean(axis=-1) / norm[:, ~near].mean(axis=-1)
+    return out
 
 
 def direction_response(setup: DetectionSetup, directions, magnitude_m_s: float, n_repeats: int, seed, *,

@@ -28,6 +28,11 @@ def _inputs():
     return [detection.draw_trial(np.random.default_rng(k), _setup(), detection.QUIET_POLICY) for k in range(2)]
 
 
+@functools.lru_cache(maxsize=None)
+def _filtered():
+    return detection.filter_trials(_setup(), _inputs())
+
+
 def specs(Spec, lazy):
     S = Spec
     s = []
@@ -37,6 +42,9 @@ def specs(Spec, lazy):
                dict(burn_offset_hours="real")))
     s.append(S("filter_trials", detection.filter_trials, dict(setup=lazy(_setup), inputs=lazy(_inputs), n_epochs=4),
                dict(setup="instance", inputs="iterable", n_epochs="int2_opt")))
+    s.append(S("control_spike_contrast", detection.control_spike_contrast,
+               dict(setup=lazy(_setup), result=lazy(_filtered), half_width_hours=6.0, burn_offset_hours=0.0),
+               dict(setup="instance", result="instance", half_width_hours="pos", burn_offset_hours="real")))
     s.append(S("direction_response", detection.direction_response,
                dict(setup=lazy(_setup), directions=np.array([[0.0, 0.0], [1.5, 0.2]]), magnitude_m_s=0.5,
                     n_repeats=1, seed=3, burn_offset_hours=0.0),

@@ -371,3 +371,22 @@ def test_health_lead_study_outcomes_partition_and_a_large_burn_is_seen_at_once()
         det.health_lead_study(s, [-0.1], 10, 2, 0)
     with pytest.raises(ValueError, match="test"):
         h.median_delay_hours("metric")
+
+
+def test_control_spike_contrast_of_a_known_spike(short_setup):
+    s = short_setup
+    N = s.scenario.t.size
+    t_sub = np.array([np.linspace(s.scenario.t[n], s.scenario.t[n + 1], 5) for n in range(N - 1)])
+    near = np.abs(t_sub - s.t_maneuver) <= 6 * 3600 / em.time_unit_s
+    u = np.zeros((2, N - 1, 5, 3))
+    u[..., 0] = 1.0  # unit norm everywhere ...
+    u[0, near, 1] = np.sqrt(99.0)  # ... norm 10 near the burn in trial 0
+    z = np.zeros(2)
+    res = det.BatchOCBEResult(*(np.zeros((2, N, 6)),) * 2, np.zeros((2, N, 6, 6)), np.zeros((2, N, 6)),
+                              np.zeros((2, N, 6, 6)), t_sub, np.full_like(u, 0.5), u, z, z, np.zeros((2, N)))
+    c = det.control_spike_contrast(s, res)
+    assert np.allclose(c[:, 1], [10.0, 1.0]) and np.allclose(c[:, 0], [1.0, 1.0])
+    with pytest.raises(ValueError, match="half_width_hours"):
+        det.control_spike_contrast(s, res, half_width_hours=1e5)
+    with pytest.raises(TypeError, match="result"):
+        det.control_spike_contrast(s, object())
