@@ -130,7 +130,7 @@ print(f"Eq. 18 dense: {dense_toy:.12f} nats; chain rule: {total_toy:.12f} nats =
 # $D$ = 4 m = 0.004 km): resolution dominates below $D/\sigma_{min}$ = 0.004 km / 10 µrad = 400 km, pointing above.
 
 # %%
-rho_km = np.logspace(-2, 5, 200)
+rho_km = np.logspace(0, 5, 200)  # 1 km up: below it the noise exceeds 4 mrad, of no use for tracking
 sig = meas.angular_sigma(rho_km, meas.AMOS_SIGMA_MIN_RAD, meas.AMOS_RESOLUTION_KM)
 fig, ax = plt.subplots(figsize=(5.5, 3.5))
 ax.loglog(rho_km, sig * 1e6, label=r"$\sqrt{\sigma_{min}^2 + D^2/\rho^2}$ (AMOS Eq. 20)")
@@ -145,10 +145,11 @@ print(f"sigma_theta at 215 km: {meas.angular_sigma(215.0, meas.AMOS_SIGMA_MIN_RA
 # ## 4 · Test case 2: the observation window and its CRLB
 #
 # Three targets on the Table 4 DROs and an observer; window $[P_{ref}, 2P_{ref}]$ with one range/range-rate pair
-# per target per day, initial 100 km / 1 cm/s per axis (Table 5). **Choice:** the printed observer row
-# ($\dot y_0$ = 0.528996986) does not close as a periodic orbit (notebook 01), and the paper's optimised observer
-# trajectory is not published, so the observer here coasts on the `observer_tf` DRO of Table 4 (which closes) —
-# the un-manoeuvred reference, i.e. the paper's minimum-ΔV end of the trade. $P_{ref}$ is the period of that DRO.
+# per target per day, initial errors 100 km and $10^{-2}$ km/s = 10 m/s per axis (Table 5). **Choice:** the printed
+# observer row ($\dot y_0$ = 0.528996986) does not close as a periodic orbit (notebook 01), and the paper's
+# optimised observer trajectory is not published, so the observer here coasts on the `observer_tf` DRO of Table 4
+# (which closes) — the un-manoeuvred reference, i.e. the paper's minimum-ΔV end of the trade. $P_{ref}$ is the
+# period of that DRO.
 #
 # Process noise: Table 5 prints "$Q$ [km/s³] = $10^{-11}$"; the PSD of an acceleration has units km²/s³. Read as
 # $10^{-11}$ km²/s³ the CRLB of test case 1 grows without bound, against the paper's text, so we adopt the same
@@ -185,23 +186,52 @@ print(f"I(X;Y): dense Eq. 18 = {mi_dense:.9f} nats, chain rule = {mi_struct:.9f}
 # $\bar P_{k+1} = \Phi\hat P_k\Phi^T + Q$, $\hat P_k = (I-K_kH_k)\bar P_k$ (Joseph form here) gives the CRLB
 # (Taylor 1978), as in the paper's "Performance Evaluation". The same recursion produced the per-measurement
 # information gains above.
+#
+# **Why the four position RMS curves coincide.** Here all four spacecraft fly planar DROs, so every relative
+# position lies in the $x$-$y$ plane and the range and range-rate Jacobians have zero $z$ and $\dot z$ columns
+# (printed below). In the CR3BP the out-of-plane motion about a planar orbit is decoupled from the in-plane motion
+# to first order, so no measurement reaches the $z$ errors: each object's $\sigma_z$ is its free-flight
+# propagation of the identical prior (100 km, 10 m/s), an oscillation with the orbit that is nearly the same on
+# the four neighbouring DROs. It dominates the total RMS once the measurements have shrunk the in-plane error. This
+# is the paper's remark that the minimum-ΔV case of test case 2 is "weakly observable" and that range needs
+# out-of-plane observer motion. The figure therefore splits the RMS: total (as in Fig. 9), in-plane per object,
+# and the out-of-plane part; the middle panel compares each target's in-plane RMS with the observer's, which is
+# where the paper's "the observer exhibits a smaller position RMS, as it gains information from all three targets"
+# could show.
 
 # %%
 hist = cov.covariance_analysis(*lin.arrays)
 days = em.tu_to_days(t_win)
-fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.6))
 names = ["observer", "target 1", "target 2", "target 3"]
 sig_post = np.array([cov.position_sigma_km(hist.posterior, i, em) for i in range(4)])
 sig_prior = np.array([cov.position_sigma_km(hist.prior, i, em) for i in range(4)])
+sig_z = np.sqrt(hist.posterior[:, 2::6, 2::6].diagonal(axis1=-2, axis2=-1).T) * em.length_unit_km  # (4, N)
+sig_xy = np.sqrt(np.maximum(sig_post**2 - sig_z**2, 0.0))  # in-plane RMS per object
+z_cols = np.abs(lin.H[..., [6 * i + j for i in range(4) for j in (2, 5)]]).max()
+print(f"largest |dH/dz|, |dH/dvz| over the window: {z_cols:.1e} (out-of-plane errors unobserved)")
+fig, (ax1, ax2, ax3) = plt.subplots(1, 3, figsize=(14, 4.0), layout="constrained")
 for i, name in enumerate(names):
-    ax1.semilogy(days, sig_post[i], "o-", ms=3, label=name)
+    ax1.semilogy(days, sig_post[i], "-", lw=2.5, color="0.8", label="total, all four (coincide)" if i == 0 else None,
+                 zorder=1)
+for i, name in enumerate(names):
+    ax1.semilogy(days, sig_xy[i], "o-", ms=3, lw=1, color=f"C{i}", label=f"in-plane, {name}", zorder=3)
+ax1.semilogy(days, sig_z[0], "k--", lw=1, label=r"out-of-plane $\sigma_z$ (free flight)", zorder=2)
 ax1.set(xlabel="time [days]", ylabel="position RMS (CRLB) [km]", title="CRLB along the window (cf. Fig. 9)")
-ax1.legend(fontsize=8)
-ax2.bar(days, gains, width=0.6)
-ax2.set(xlabel="time [days]", ylabel="information gain [nats]", title=r"per-measurement $\mathcal{I}_k$ (chain rule)")
-plotting.save_figure(fig, "02_test_case_2_crlb_and_gains", output_dir=out)
+ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=2, frameon=False)
+for i in range(1, 4):
+    ax2.plot(days, sig_xy[i] / sig_xy[0], "o-", ms=3, lw=1, color=f"C{i}", label=names[i])
+ax2.axhline(1.0, color="0.4", lw=0.8, ls=":")
+ax2.set(xlabel="time [days]", ylabel="in-plane RMS, target / observer [-]",
+        title="above 1: observer better determined")
+ax2.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=3, frameon=False)
+ax3.bar(days, gains, width=0.6)
+ax3.set(xlabel="time [days]", ylabel="information gain [nats]", title=r"per-measurement $\mathcal{I}_k$ (chain rule)")
+_ = plotting.save_figure(fig, "02_test_case_2_crlb_and_gains", output_dir=out)
 print("terminal position RMS [km]:", dict(zip(names, np.round(sig_post[:, -1], 3))))
 print("mean position RMS over the window [km]:", dict(zip(names, np.round(sig_post.mean(axis=1), 3))))
+print("mean in-plane RMS over the window [km]:", dict(zip(names, np.round(sig_xy.mean(axis=1), 3))))
+print(f"out-of-plane share of the summed position variance at the window end: "
+      f"{np.sum(sig_z[:, -1]**2) / np.sum(sig_post[:, -1]**2):.2%}")
 transient = sig_post[:, 1] > sig_post[:, 0]
 
 # %% [markdown]
@@ -279,7 +309,7 @@ t_base = np.arange(0.0, P_tgt + 1e-12, day)
 P0_pair = cov.block_diag([P_obj] * 2)
 models = {"relative position (100 m)": (meas.RELATIVE_POSITION, meas.relative_position_noise(0.1, em)),
           "range + range rate": (meas.RANGE_RANGE_RATE, R_rr)}
-study = {name: {"baseline": [], "mi": [], "obs": [], "tgt": []} for name in models}
+study = {name: {"baseline": [], "mi": [], "obs": [], "tgt": [], "obs_z": []} for name in models}
 for name, (model, noise) in models.items():
     for xo in obs_starts:
         lb = cov.linearize_augmented(em, xo, tgt[None], t_base, model, noise, P0_pair, q=q_nd)
@@ -288,24 +318,44 @@ for name, (model, noise) in models.items():
         study[name]["mi"].append(info.mutual_information(*lb.arrays))
         study[name]["obs"].append(cov.position_sigma_km(hb.posterior[-1], 0, em))
         study[name]["tgt"].append(cov.position_sigma_km(hb.posterior[-1], 1, em))
+        study[name]["obs_z"].append(np.sqrt(hb.posterior[-1, 2, 2]) * em.length_unit_km)  # observer's sigma_z
 study = {k: {kk: np.array(vv) for kk, vv in v.items()} for k, v in study.items()}
 fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.6))
-for name, res in study.items():
+for k, (name, res) in enumerate(study.items()):
     b_km = em.lu_to_km(res["baseline"])
-    ax1.semilogx(b_km, res["mi"] - res["mi"][0], "o-", label=f"{name} (I at shortest = {res['mi'][0]:.1f} nats)")
-    ax2.loglog(b_km, res["obs"], "o-", label=f"observer, {name}")
-    ax2.loglog(b_km, res["tgt"], "s--", label=f"target, {name}")
+    ax1.semilogx(b_km, res["mi"] - res["mi"][0], "o-", color=f"C{k}",
+                 label=f"{name} (I at shortest = {res['mi'][0]:.1f} nats)")
+    # target first, as large open squares, so the observer's filled dots stay visible where the two coincide
+    ax2.loglog(b_km, res["tgt"], "s", ms=9, mfc="none", mew=1.2, color=f"C{k}")
+    ax2.loglog(b_km, res["obs"], "o-", ms=4, color=f"C{k}", zorder=3)
+rr = study["range + range rate"]
+ax2.loglog(em.lu_to_km(rr["baseline"]), rr["obs_z"], "-", lw=6, color="C1", alpha=0.3, zorder=1)
 ax1.set(xlabel="mean baseline [km]", ylabel=r"$\mathcal{I} - \mathcal{I}_{shortest}$ [nats]", title="MI gain vs baseline")
-ax2.set(xlabel="mean baseline [km]", ylabel="terminal position RMS [km]", title="CRLB vs baseline")
+ax2.set(xlabel="mean baseline [km]", ylabel="terminal position RMS [km]", title="CRLB vs baseline (colours as left)")
 ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)  # legends below the axes
-ax2.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, frameon=False)
+roles = [plt.Line2D([], [], marker="o", ms=4, color="0.3", label="observer"),
+         plt.Line2D([], [], marker="s", ms=9, mfc="none", ls="none", color="0.3", label="target"),
+         plt.Line2D([], [], lw=6, color="C1", alpha=0.3,
+                    label=r"observer's out-of-plane $\sigma_z$ (range + range rate)")]
+ax2.legend(handles=roles, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)
 _ = plotting.save_figure(fig, "02_baseline_study", output_dir=out)
 for name, res in study.items():
     print(name, "\n  baseline [km]:", np.round(em.lu_to_km(res["baseline"])), "\n  MI [nats]:", np.round(res["mi"], 2),
-          "\n  observer RMS [km]:", np.round(res["obs"], 3))
+          "\n  observer RMS [km]:", np.round(res["obs"], 3), "\n  target RMS [km]:  ", np.round(res["tgt"], 3),
+          "\n  observer sigma_z [km]:", np.round(res["obs_z"], 3))
 gain = {name: float(res["mi"].max() - res["mi"][0]) for name, res in study.items()}
 rms_drop = {name: float(res["obs"][0] / res["obs"].min()) for name, res in study.items()}
 peak = {name: float(em.lu_to_km(res["baseline"][np.argmax(res["mi"])])) for name, res in study.items()}
+
+# %% [markdown]
+# **Reading the right panel.** For each measurement type the observer's dots sit inside the target's squares, for
+# two different reasons. A relative-position measurement fixes $x_{\mathcal T} - x_{\mathcal S}$ to 100 m, so the
+# absolute error that remains is shared by the two spacecraft and their RMS values agree to a fraction of a
+# kilometre (printed above). With range and range rate on one planar DRO the out-of-plane errors are not observed
+# at all (section 4): both terminal RMS values are the free-flight $\sigma_z$ of the identical prior (the pale band
+# under the observer's curve), and the baseline can only shrink the in-plane part, a small share of the total.
+# The observer's rise at the longest baselines is out-of-plane error too: a spacecraft starting at another point of
+# the DRO ends the period at another phase of its $z$ oscillation.
 
 # %% [markdown]
 # ## 7 · Cost: dense Eq. 18 versus the chain rule
@@ -313,9 +363,12 @@ peak = {name: float(em.lu_to_km(res["baseline"][np.argmax(res["mi"])])) for name
 # The same test-case-2 geometry, one DRO period, with the cadence changed so the window holds $N$ measurement
 # times. The dense form builds $\tilde H$ ($6N\times24N$) and factorises $\tilde S$: $O(N^3)$. The chain rule runs
 # $N$ Kalman steps on $24\times24$ matrices: $O(N)$, in square-root form (two QR factorisations per step, which
-# keep the ~10 digits the covariance form lost on test case 2's windows; a QR costs more than the Cholesky update
-# it replaces, so the crossover with the dense form sits near the paper's N = 17). Times are best-of-3 wall clock
-# on one BLAS thread (the machine is shared, so absolute numbers vary by tens of percent).
+# keep the ~10 digits the covariance form lost on test case 2's windows). A QR costs more than the Cholesky update
+# it replaces, so for short windows the dense form can be the faster one; the cell below finds the window size at
+# which the chain rule overtakes it (the *crossover*, interpolated between the sizes run on log-log axes, for the
+# value alone and for value plus gradient) from this run's own times, and compares with test case 2's
+# $N$ = 17. Times are best-of-3 wall clock on one BLAS thread (the machine is shared, so absolute numbers vary by
+# tens of percent, and the crossover moves with them).
 
 # %%
 timings = []
@@ -341,6 +394,24 @@ for N, r in zip(TIMING_SIZES, timings):
     print(f"N = {N:3d}: MI {r.ratio_value:5.1f}x, MI + gradient {r.ratio_gradient:5.1f}x faster structured "
           f"(dense {1e3 * r.dense_gradient:.2f} ms, structured {1e3 * r.structured_gradient:.2f} ms)")
 r17 = timings[TIMING_SIZES.index(17)]
+
+
+def crossover(sizes, ratios):
+    """Window size where the dense/structured time ratio first reaches 1 (log-log interpolation), as text."""
+    ratios = np.asarray(ratios)
+    if ratios[0] >= 1.0:
+        return f"at or below N = {sizes[0]}"
+    j = int(np.argmax(ratios >= 1.0))
+    if ratios[j] < 1.0:
+        return f"above N = {sizes[-1]} (not reached)"
+    n_star = np.exp(np.interp(0.0, np.log(ratios[j - 1:j + 1]), np.log(sizes[j - 1:j + 1])))
+    return f"N = {n_star:.0f} (between {sizes[j - 1]} and {sizes[j]})"
+
+
+cross_value = crossover(TIMING_SIZES, [r.ratio_value for r in timings])
+cross_gradient = crossover(TIMING_SIZES, [r.ratio_gradient for r in timings])
+print(f"chain rule faster than dense from {cross_value} for the MI, from {cross_gradient} for MI + gradient; "
+      f"at N = 17: {r17.ratio_value:.1f}x and {r17.ratio_gradient:.1f}x")
 
 # %% [markdown]
 # ## 8 · Paper versus reproduction
@@ -375,7 +446,9 @@ obs_better = sig_post[0].mean() < sig_post[1:].mean()
 table.add("Observer RMS below targets on average (Fig. 9)", "yes",
           f"observer {sig_post[0].mean():.2f} km vs targets {sig_post[1:].mean():.2f} km (mean over window)",
           "reproduced" if obs_better else "differs: observer is not better determined than the targets here",
-          "un-manoeuvred observer, so only qualitative")
+          "un-manoeuvred observer, so only qualitative; the total is the unobserved out-of-plane error, the same "
+          f"for all four; in-plane: observer {sig_xy[0].mean():.1f} km vs targets "
+          f"{', '.join(f'{v:.1f}' for v in sig_xy[1:].mean(axis=1))} km")
 for name, res in study.items():
     b_km, obs_rms, mi = em.lu_to_km(res["baseline"]), res["obs"], res["mi"]
     k_best = int(np.argmin(obs_rms))
@@ -389,10 +462,13 @@ for name, res in study.items():
               f"MI +{gain[name]:.2f} nats up to {peak[name]:.0f} km (then -{mi_drop:.2f}); observer RMS "
               f"{obs_rms[0]:.0f} -> {obs_rms[k_best]:.0f} km at {b_km[k_best]:.0f} km, {obs_rms[-1]:.0f} km at "
               f"{b_km[-1]:.0f} km", status,
-              "observer phase-shifted on the target's DRO" + (
-                  "" if rebound < 1.2 else "; not monotonic: past about half an orbit apart the geometry repeats"))
+              "observer phase-shifted on the target's DRO; out-of-plane share of the observer's terminal variance "
+              f"{np.mean(res['obs_z']**2 / obs_rms**2):.0%} (mean over baselines)" + (
+                  "" if rebound < 1.2 else "; the rise at the longest baselines is out-of-plane error, which "
+                  "coplanar range and range rate do not observe"))
 table.add("Structured vs dense speed at test-case-2 size (N = 17)", "not in paper",
           f"MI {r17.ratio_value:.1f}x, MI + gradient {r17.ratio_gradient:.1f}x", "beyond paper",
-          "the square-root recursion (QR per step) costs more per step than the covariance form it replaced, so at "
-          "N = 17 it only matches the dense form; its O(N) against O(N^3) shows at larger N (timing figure)")
+          f"crossover from this run's times: {cross_value} (MI), {cross_gradient} (MI + gradient); for shorter "
+          "windows the QR per step of the square-root recursion can cost more than the dense factorisation; O(N) "
+          "against O(N^3) shows at larger N (timing figure)")
 table.display()
