@@ -350,6 +350,17 @@ class StationKeepingSurface:
         return 100.0 * np.mean(s < self.informed_range_sigma_km[:, None], axis=1)
 
     @property
+    def best(self) -> np.ndarray:
+        """Index of the maneuver with the smallest :math:`J_\\rho` at ``t[-1]`` per arrival time (the *valley* of the
+        slice; first one on ties), (n_t,) of int."""
+        return np.argmin(self.range_sigma_km, axis=1)
+
+    @property
+    def best_range_sigma_km(self) -> np.ndarray:
+        """Smallest :math:`\\sqrt{J_\\rho}` at ``t[-1]`` per arrival time, km, (n_t,)."""
+        return self.range_sigma_km[self._rows(), self.best]
+
+    @property
     def informed_fuel_percentile(self) -> np.ndarray:
         """Percent of maneuvers of the same arrival time that use *more* fuel than :math:`\\mathbf u^*`."""
         return 100.0 * np.mean(self.fuel_m_s > self.informed_fuel_m_s[:, None], axis=1)

@@ -235,3 +235,17 @@ def test_slice_statistics_by_hand(surface):
         assert np.isclose(s.informed_fuel_percentile[j], 100 * np.sum(fuel[j] > fuel[j, i]) / s.theta.size)
     assert np.allclose(s.t_arrival_hours, [-6.0, 0.5, 7.0])
     assert np.allclose(s.phase, s.theta / (2 * np.pi))
+
+
+def test_slice_best_is_the_valley(surface):
+    """The best maneuver of each slice: nothing in its slice is smaller, and its own percentile would be 0."""
+    s = surface
+    for j in range(s.t_arrival.size):
+        row = s.range_sigma_km[j]
+        assert s.best_range_sigma_km[j] == row[s.best[j]]
+        assert np.all(row >= s.best_range_sigma_km[j])
+        assert np.sum(row < row[s.best[j]]) == 0
+    # u* cannot beat the slice best; where u* is the best, its percentile is 0
+    assert np.all(s.informed_range_sigma_km >= s.best_range_sigma_km)
+    same = s.informed == s.best
+    assert np.all(s.informed_percentile[same] == 0) and np.all(s.informed_percentile[~same] > 0)
