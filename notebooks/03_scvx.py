@@ -34,7 +34,6 @@ N_GUESSES = 2 if QUICK else 6
 SIGMA = 1.0  # Sundman exponent (notebook 04); the DRO is benign, so its value matters little here
 
 import matplotlib.pyplot as plt
-import matplotlib.ticker as mticker
 import numpy as np
 
 from cislunar import discretization as D
@@ -121,22 +120,55 @@ print(f"exact-penalty variant: {len(res_pen.history)} iterations, impulse "
 window_thrust = float(np.max(np.linalg.norm(res.u[in_window], axis=1)))
 print(f"largest thrust at the window nodes: {window_thrust:.1e} LU/TU^2")
 
-fig, axes = plt.subplots(1, 3, figsize=(15, 4.2), layout="constrained")
-its = [h["iteration"] for h in res.history]
-axes[0].semilogy(its, [max(h["cost"], 1e-16) for h in res.history], "o-")
-axes[0].set(xlabel="iteration [-]", ylabel=r"nonlinear cost $\mathcal{J}$ [non-dim.]")
-axes[1].semilogy(its, [max(h["max_defect"], 1e-16) for h in res.history], "o-")
-axes[1].set(xlabel="iteration [-]", ylabel="largest defect after the step\n[LU or LU/TU]")
-axes[2].semilogy(its, [h["eta"] for h in res.history], "o-")
-axes[2].set(xlabel="iteration [-]", ylabel=r"trust-region radius $\eta$ [non-dim.]")
+n_acc = sum(h["accepted"] for h in res.history)
+updates = [h["iteration"] for h in res.history if h["multiplier_update"]]
+rhos = [h["rho"] for h in res.history]
+print(f"{n_acc} of {len(res.history)} steps accepted, rho in [{min(rhos):.3f}, {max(rhos):.3f}]; eta "
+      f"{res.history[0]['eta']:g} at the start, {res.history[-1]['eta']:g} (eta_max = {settings.eta_max:g}) at the end; "
+      f"multipliers updated (and weight raised) after iterations {updates}")
+
+fig, axes = plt.subplots(1, 3, figsize=(15, 4.4), layout="constrained")
+# J as a sawtooth: each step runs from J before (at x = it) to J after (at x = it + 1); a multiplier/weight update
+# then redefines J at the same trajectory (vertical jump at x = it + 1)
+for h in res.history:
+    it = h["iteration"]
+    axes[0].semilogy([it, it + 1], [h["cost"], h["new_cost"]], "-", color="C0", marker="o", ms=3)
+for h, nxt in zip(res.history[:-1], res.history[1:]):
+    if h["multiplier_update"]:
+        axes[0].semilogy([h["iteration"] + 1] * 2, [h["new_cost"], nxt["cost"]], ":", color="C1", lw=1.5)
+axes[0].plot([], [], "-o", ms=3, color="C0", label="SCvx step (J decreases)")
+axes[0].plot([], [], ":", lw=1.5, color="C1", label=r"$\lambda$ update, $w$ raised (J redefined)")
+axes[0].set(xlabel="iteration [-]", ylabel=r"augmented-Lagrangian cost $\mathcal{J}$ [non-dim.]",
+            title="cost: every step lowers it")
+impulse_hist = np.array([h["impulse"] for h in res.history]) * em.velocity_unit_km_s * 1e3
+axes[1].plot([h["iteration"] + 1 for h in res.history], impulse_hist, "o-", color="C2")
+axes[1].set(xlabel="iteration [-]", ylabel="total impulse after the step [m/s]",
+            title="impulse rises as the defects close")
+axes[2].semilogy([h["iteration"] + 1 for h in res.history], [max(h["max_defect"], 1e-16) for h in res.history],
+                 "o-", color="C0")
+axes[2].axhline(settings.defect_tol, color="0.4", ls="--", lw=0.8, label="convergence tolerance")
+axes[2].set(xlabel="iteration [-]", ylabel="largest defect after the step\n[LU or LU/TU]", title="defects")
 for ax in axes:
     ax.xaxis.set_major_locator(plt.MaxNLocator(integer=True))
+    for it in updates:  # the updates happen between steps: mark them in every panel
+        ax.axvline(it + 1, color="C1", lw=0.6, alpha=0.35, zorder=0)
+for ax in (axes[0], axes[2]):
     ax.yaxis.set_minor_formatter(plt.NullFormatter())  # decade labels only: no colliding minor tick labels
-axes[2].yaxis.set_minor_locator(mticker.LogLocator(subs=(2.0, 5.0)))  # eta spans about one decade: label 2x, 5x
-axes[2].yaxis.set_minor_formatter(mticker.FormatStrFormatter("%g"))
-axes[2].yaxis.set_major_formatter(mticker.FormatStrFormatter("%g"))
-fig.suptitle("SCvx iterations, minimum-impulse DRO transfer (test case 1 boundary conditions)")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)  # below the axes
+fig.suptitle("SCvx iterations, minimum-impulse DRO transfer (test case 1 boundary conditions); "
+             "faint red lines: multiplier updates")
 _ = plotting.save_figure(fig, "03_iterations", output_dir=out)
+
+# %% [markdown]
+# **Reading the iterations.** The augmented-Lagrangian cost $\mathcal J$ is not one fixed function over the run:
+# each multiplier update moves $\lambda$ and raises $w$, which raises $\mathcal J$ at the *same* trajectory (dotted
+# red jumps in the left panel). Every SCvx step lowers the $\mathcal J$ it was taken on (solid segments), so the
+# rise of $\mathcal J$ over the run is not divergence; it is the price of closing the defects. The ballistic
+# guess misses $x_f$ (printed above), so the cheapest trajectory under a small weight leaves defects open and
+# spends almost nothing; as $w$ grows the defects close (right panel) and the impulse climbs to the converged value
+# (middle panel), which is the quantity the run minimises once the defects vanish. With every step accepted at
+# $\rho$ near 1 (printed above: the convex model is accurate at this scale), the trust region grows to its cap
+# after the first step and stays there, so its history is only printed.
 
 # %% [markdown]
 # ## 3 · Is the converged trajectory real?
@@ -150,19 +182,21 @@ terminal_miss_km = float(np.linalg.norm(x_single[-1, :3] - x_final[:3]) * em.len
 terminal_miss_mm_s = float(np.linalg.norm(x_single[-1, 3:] - x_final[3:]) * em.velocity_unit_km_s * 1e6)
 print(f"single shooting with the converged control misses x_f by {terminal_miss_km:.2e} km and "
       f"{terminal_miss_mm_s:.2e} mm/s")
-fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.2))
-unorm = np.linalg.norm(res.u, axis=1) * em.acceleration_unit_km_s2 * 1e9
-ax1.semilogy(em.tu_to_days(t), np.maximum(unorm, 1e-6), ".-", label="|u| (nodes, FOH in between)")
-ax1.axhline(A_MAX * em.acceleration_unit_km_s2 * 1e9, color="k", lw=0.8, ls="--", label="a_max")
+fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.6), layout="constrained")
+unorm = np.linalg.norm(res.u, axis=1) * em.acceleration_unit_km_s2 * 1e9  # µm/s²
+a_max_um = A_MAX * em.acceleration_unit_km_s2 * 1e9
 ax1.axvspan(em.tu_to_days(t[k_ws]), em.tu_to_days(t[k_we]), color="0.9", label="observation window (no thrust)")
-ax1.set(xlabel="time [days]", ylabel="thrust acceleration [um/s^2]", title="converged control")
-ax1.legend(fontsize=8, loc="center")
-dense_t = np.linspace(0, T, 800)
-ref = propagate(em, dro.x0, dense_t).x
-plotting.plot_rotating(ax2, (x_single - propagate(em, dro.x0, t).x)[None], em, "xy", units="km", marker=".",
-                       label="converged minus initial DRO")
-ax2.set_title("relative motion w.r.t. the initial DRO (rotating frame)")
-ax2.legend(loc="upper right")
+ax1.plot(em.tu_to_days(t), unorm, ".-", label="|u| at the nodes")
+ax1.set(xlabel="time [days]", ylabel="thrust acceleration [µm/s²]", ylim=(0, None),
+        title=f"converged control ($a_{{max}}$ = {a_max_um:.0f} µm/s², off the scale)")
+ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.15), frameon=False)  # below the axes
+rel_km = (x_single - propagate(em, dro.x0, t).x)[:, :2] * em.length_unit_km
+plotting.plot_rotating(ax2, (x_single - propagate(em, dro.x0, t).x)[None], em, "xy", units="km", marker=".")
+ax2.plot(*rel_km[0], "o", color="C2", ms=7, zorder=3, label="start (same state)")
+ax2.plot(*rel_km[-1], "s", color="C3", ms=7, zorder=3, label=r"end: $x_f$ on the neighbouring DRO")
+ax2.set(xlabel=r"$\Delta x$ [km]", ylabel=r"$\Delta y$ [km]",
+        title="converged minus initial DRO, at the nodes (rotating frame)")
+ax2.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=2, frameon=False)
 _ = plotting.save_figure(fig, "03_converged_control", output_dir=out)
 
 # %% [markdown]
