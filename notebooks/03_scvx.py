@@ -124,7 +124,8 @@ n_acc = sum(h["accepted"] for h in res.history)
 updates = [h["iteration"] for h in res.history if h["multiplier_update"]]
 rhos = [h["rho"] for h in res.history]
 print(f"{n_acc} of {len(res.history)} steps accepted, rho in [{min(rhos):.3f}, {max(rhos):.3f}]; eta "
-      f"{res.history[0]['eta']:g} at the start, {res.history[-1]['eta']:g} (eta_max = {settings.eta_max:g}) at the end; "
+      f"{res.history[0]['eta']:g} at the start, {res.history[-1]['eta']:g} (eta_max = {settings.eta_max:g}) "
+      "at the end; "
       f"multipliers updated (and weight raised) after iterations {updates}")
 
 fig, axes = plt.subplots(1, 3, figsize=(15, 4.4), layout="constrained")
