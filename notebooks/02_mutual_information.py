@@ -78,7 +78,8 @@ mc, se = info.monte_carlo_mutual_information([[p]], np.zeros((0, 1, 1)), np.zero
 print(f"closed form 0.5 ln(1 + h^2 p / r)  = {closed:.5f} nats")
 print(f"E_x[KL] over {MC_SAMPLES} samples    = {kl.mean():.5f} +- {kl.std(ddof=1) / np.sqrt(MC_SAMPLES):.5f}")
 print(f"joint Monte Carlo of log ratio       = {mc:.5f} +- {se:.5f}")
-print(f"posterior/prior std ratio: {np.sqrt(1 / (1 / p + h**2 / r)) / np.sqrt(p):.4f} = exp(-I) = {np.exp(-closed):.4f}")
+print(f"posterior/prior std ratio: {np.sqrt(1 / (1 / p + h**2 / r)) / np.sqrt(p):.4f} "
+      f"= exp(-I) = {np.exp(-closed):.4f}")
 
 # %% [markdown]
 # ## 2 · The stacked window (Eqs. 12-23) on a toy problem
@@ -134,12 +135,14 @@ rho_km = np.logspace(0, 5, 200)  # 1 km up: below it the noise exceeds 4 mrad, o
 sig = meas.angular_sigma(rho_km, meas.AMOS_SIGMA_MIN_RAD, meas.AMOS_RESOLUTION_KM)
 fig, ax = plt.subplots(figsize=(5.5, 3.5))
 ax.loglog(rho_km, sig * 1e6, label=r"$\sqrt{\sigma_{min}^2 + D^2/\rho^2}$ (AMOS Eq. 20)")
-ax.axvline(meas.AMOS_RESOLUTION_KM / meas.AMOS_SIGMA_MIN_RAD, color="0.5", ls=":", label=r"$\rho = D/\sigma_{min}$ = 400 km")
+ax.axvline(meas.AMOS_RESOLUTION_KM / meas.AMOS_SIGMA_MIN_RAD, color="0.5", ls=":",
+           label=r"$\rho = D/\sigma_{min}$ = 400 km")
 ax.axvline(215.0, color="C3", ls="--", label="215 km: AMOS mean agent-target range")
 ax.set(xlabel="range [km]", ylabel=r"$\sigma_\theta$ [µrad]", title="Angular noise model")
 ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=1, frameon=False)  # below the axes
 _ = plotting.save_figure(fig, "02_angular_noise_model", output_dir=out)
-print(f"sigma_theta at 215 km: {meas.angular_sigma(215.0, meas.AMOS_SIGMA_MIN_RAD, meas.AMOS_RESOLUTION_KM) * 1e6:.3f} µrad")
+print(f"sigma_theta at 215 km: "
+      f"{meas.angular_sigma(215.0, meas.AMOS_SIGMA_MIN_RAD, meas.AMOS_RESOLUTION_KM) * 1e6:.3f} µrad")
 
 # %% [markdown]
 # ## 4 · Test case 2: the observation window and its CRLB
@@ -175,7 +178,8 @@ lin = cov.linearize_augmented(em, start[0], start[1:], t_win, meas.RANGE_RANGE_R
 print(f"P_ref = {em.tu_to_days(P_ref):.3f} d; window {em.tu_to_days(t_win[0]):.2f}-{em.tu_to_days(t_win[-1]):.2f} d, "
       f"{t_win.size} measurement times, state dim {lin.P0.shape[0]}")
 print(f"q = {q_nd:.4e} LU^2/TU^3; one-day Q_S velocity sigma = "
-      f"{np.sqrt(lin.Q[0, 3, 3]) * em.velocity_unit_km_s * 1e3:.3f} m/s (sqrt(q dt) = {np.sqrt(cov.WOLF_JONES_PSD_KM2_S3 * 86400) * 1e3:.3f} m/s)")
+      f"{np.sqrt(lin.Q[0, 3, 3]) * em.velocity_unit_km_s * 1e3:.3f} m/s "
+      f"(sqrt(q dt) = {np.sqrt(cov.WOLF_JONES_PSD_KM2_S3 * 86400) * 1e3:.3f} m/s)")
 mi_dense = info.window_information(lin, method="dense")
 mi_struct, gains = info.mutual_information(*lin.arrays, return_terms=True)
 print(f"I(X;Y): dense Eq. 18 = {mi_dense:.9f} nats, chain rule = {mi_struct:.9f} nats "
@@ -268,7 +272,8 @@ g_fd = np.array([(8 * (mi_of_observer(start[0] + hfd * e) - mi_of_observer(start
                  for e in np.eye(6)])
 grad_err = np.max(np.abs(g_struct - g_fd)) / np.max(np.abs(g_fd))
 print("gradient [nats/LU, nats/(LU/TU)]\n structured:", g_struct, "\n dense:     ", g_dense, "\n central FD:", g_fd)
-print(f"max |structured - FD| / max |FD| = {grad_err:.1e}; structured vs dense {np.max(np.abs(g_struct - g_dense)) / np.max(np.abs(g_dense)):.1e}")
+print(f"max |structured - FD| / max |FD| = {grad_err:.1e}; structured vs dense "
+      f"{np.max(np.abs(g_struct - g_dense)) / np.max(np.abs(g_dense)):.1e}")
 
 # %% [markdown]
 # **How far does the linearisation of Eq. 44 hold?** Step the observer's initial state along the gradient
@@ -330,7 +335,8 @@ for k, (name, res) in enumerate(study.items()):
     ax2.loglog(b_km, res["obs"], "o-", ms=4, color=f"C{k}", zorder=3)
 rr = study["range + range rate"]
 ax2.loglog(em.lu_to_km(rr["baseline"]), rr["obs_z"], "-", lw=6, color="C1", alpha=0.3, zorder=1)
-ax1.set(xlabel="mean baseline [km]", ylabel=r"$\mathcal{I} - \mathcal{I}_{shortest}$ [nats]", title="MI gain vs baseline")
+ax1.set(xlabel="mean baseline [km]", ylabel=r"$\mathcal{I} - \mathcal{I}_{shortest}$ [nats]",
+        title="MI gain vs baseline")
 ax2.set(xlabel="mean baseline [km]", ylabel="terminal position RMS [km]", title="CRLB vs baseline (colours as left)")
 ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)  # legends below the axes
 roles = [plt.Line2D([], [], marker="o", ms=4, color="0.3", label="observer"),
@@ -381,7 +387,8 @@ fig, ax = plt.subplots(figsize=(5.5, 3.8))
 ax.loglog(TIMING_SIZES, [1e3 * r.dense_value for r in timings], "o-", label="dense Eq. 18")
 ax.loglog(TIMING_SIZES, [1e3 * r.structured_value for r in timings], "s-", label="chain rule")
 ax.loglog(TIMING_SIZES, [1e3 * r.dense_gradient for r in timings], "o--", label="dense Eq. 18 + Eqs. 47-50")
-ax.loglog(TIMING_SIZES, [1e3 * r.structured_gradient for r in timings], "s--", label="chain rule + gradient (square-root forward mode)")
+ax.loglog(TIMING_SIZES, [1e3 * r.structured_gradient for r in timings], "s--",
+          label="chain rule + gradient (square-root forward mode)")
 ax.set(xlabel="measurement times N [-]", ylabel="time per evaluation [ms]", title="Evaluation cost")
 ax.set_xticks(TIMING_SIZES, [str(n) for n in TIMING_SIZES])  # plain labels at the sizes run, no minor labels
 ax.xaxis.set_minor_formatter(plt.NullFormatter())
@@ -422,7 +429,8 @@ table.add("Eq. 11: I = E_X[KL(p(Y|X)||p(Y))] (scalar worked example)", f"{closed
           "reproduced" if abs(mc - closed) < 3 * se else "differs: Monte Carlo outside 3 standard errors")
 table.add("Eq. 18 on test case 2 window (dense)", "formula only", f"{mi_dense:.4f} nats", "derived",
           "no numerical MI values are printed in the paper")
-table.add("Eq. 18 by chain rule (Kalman recursion)", "not in paper", f"rel. diff {abs(mi_dense - mi_struct) / mi_dense:.1e}",
+table.add("Eq. 18 by chain rule (Kalman recursion)", "not in paper",
+          f"rel. diff {abs(mi_dense - mi_struct) / mi_dense:.1e}",
           "beyond paper", "same value at O(N) cost; square-root form (the dense log-determinant loses digits when "
           "the measurements are far more precise than the prior)")
 table.add("Eqs. 44-52 gradient vs central differences", "formula only", f"max rel. err {grad_err:.1e}",
