@@ -65,16 +65,22 @@ A_MAX = 1e-6 / em.acceleration_unit_km_s2  # Wolf & Jones Table 3: 1e-6 km/s^2, 
 
 # %%
 nodes = {(name, s): D.sundman_nodes(em, x0, tf, N_NODES, s)[0] for name, (x0, tf) in ARCS.items() for s in SIGMAS}
-fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
+fig, axes = plt.subplots(1, 2, figsize=(12, 4.6), layout="constrained")
 for ax, name in zip(axes, ARCS):
     for s in SIGMAS:
         t = nodes[name, s]
-        ax.semilogy(em.tu_to_days(0.5 * (t[1:] + t[:-1])), em.tu_to_days(np.diff(t)) * 24, ".-",
-                    label=rf"$\sigma$ = {s:g}")
+        ax.plot(em.tu_to_days(0.5 * (t[1:] + t[:-1])), em.tu_to_days(np.diff(t)) * 24, ".-",
+                label=rf"$\sigma$ = {s:g}")
     ax.set_xlabel("time [days]")
     ax.set_ylabel("node spacing [hours]")
     ax.set_title(name)
-axes[0].legend()
+# the DRO's spacing varies by a factor of about two: a linear axis; the NRHO's by orders of magnitude: a log axis
+# with plain numbers (0.1, 1, 10 hours)
+axes[1].set_yscale("log")
+axes[1].yaxis.set_major_formatter(plt.FormatStrFormatter("%g"))
+axes[1].yaxis.set_minor_formatter(plt.NullFormatter())
+handles, labels = axes[0].get_legend_handles_labels()
+fig.legend(handles, labels, loc="outside lower center", ncol=len(SIGMAS), fontsize=9, frameon=False)
 fig.suptitle(f"Sundman-spaced nodes ({N_NODES} per arc)")
 _ = plotting.save_figure(fig, "04_node_spacing", output_dir=out)
 spread = {(name, s): float(np.diff(nodes[name, s]).max() / np.diff(nodes[name, s]).min()) for name, s in nodes}
@@ -82,10 +88,12 @@ for key, v in spread.items():
     print(f"{key[0]:30s} sigma = {key[1]:3.1f}: longest / shortest interval = {v:8.2f}")
 
 # %%
-fig, axes = plt.subplots(1, 2, figsize=(12, 5))
+fig, axes = plt.subplots(1, 2, figsize=(12, 5.4), layout="constrained")
 for ax, name, plane in zip(axes, ARCS, ("xy", "yz")):
     x0, tf = ARCS[name]
     dense = propagation.propagate(em, x0, np.linspace(0, tf, 1500)).x
+    r_m = np.linalg.norm(dense[:, :3] - em.secondary_position, axis=1) * em.length_unit_km
+    print(f"{name}: distance to the Moon {r_m.min():,.0f} to {r_m.max():,.0f} km (ratio {r_m.max() / r_m.min():.1f})")
     plotting.plot_rotating(ax, dense, em, plane, moon_centred=True, units="km", color="0.6", lw=0.8)
     for s, marker in ((0.0, "o"), (max(SIGMAS), "x")):
         pts = propagation.propagate(em, x0, nodes[name, s]).x
@@ -93,13 +101,14 @@ for ax, name, plane in zip(axes, ARCS, ("xy", "yz")):
                                label=rf"nodes, $\sigma$ = {s:g}")
     plotting.plot_primaries(ax, em, plane, moon_centred=True, units="km", earth=False)
     ax.set_title(name)
-    ax.legend(loc="lower left")
-    ax.locator_params(axis="x", nbins=5)
+    plotting.thousands_km_axes(ax, plane)
+handles, labels = axes[0].get_legend_handles_labels()  # the same entries in both panels: one legend below them
+fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=9, frameon=False)
 _ = plotting.save_figure(fig, "04_nodes_on_orbits", output_dir=out)
 
 # %% [markdown]
-# On the DRO $r_m$ varies only between about 70,000 and 120,000 km, so even $\sigma = 2$ changes the spacing by a
-# factor of about two; on the NRHO, $r_m$ spans 3,200 to 71,000 km and the nodes pile up at perilune.
+# On the DRO $r_m$ varies by less than a factor of two (printed above), so even $\sigma = 2$ changes the spacing
+# by a factor of about two; on the NRHO $r_m$ varies by a factor of about twenty and the nodes pile up at perilune.
 #
 # ## 2 · First-order hold and the discrete affine model (Eqs. 27-33)
 #
