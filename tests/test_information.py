@@ -93,8 +93,9 @@ def test_gaussian_kl():
     assert out.shape == (2,) and out[1] > out[0]
 
 
+@pytest.mark.parametrize("method", ["sqrt", "sqrt-forward"])
 @given(seed=st.integers(0, 2**32 - 1))
-def test_gradient_matches_central_differences_linear_gaussian(seed):
+def test_gradient_matches_central_differences_linear_gaussian(method, seed):
     """Gradient of Eq. 18 for F(xi) = F0 + xi.dF + xi^2 terms, H(xi) likewise, at xi0 != 0."""
     P0, F0, Q, H0, R, dF, dH = random_system(seed, N=5, M=2, n=4, p=3)
     rng = np.random.default_rng(seed + 1)
@@ -108,7 +109,7 @@ def test_gradient_matches_central_differences_linear_gaussian(seed):
     F, H = system(xi0)
     jF = dF + 2 * d2F * xi0
     jH = dH + 2 * d2H * xi0
-    _, g = I.mutual_information_gradient(P0, F, Q, H, R, jF, jH)
+    _, g = I.mutual_information_gradient(P0, F, Q, H, R, jF, jH, method=method)
     fd = np.zeros(3)
     h = 1e-5
     for i, e in enumerate(np.eye(3)):
@@ -185,6 +186,12 @@ def test_bad_input_names_argument(window):
         I.mutual_information_gradient(P0, F, Q, H, R, dF, dH[..., :2, :])
     with pytest.raises(ValueError, match="dF"):
         I.mutual_information_gradient_dense(P0, F, Q, H, R, dF[..., :2], dH)
+    with pytest.raises(ValueError, match="dF"):
+        I.mutual_information_gradient(P0, F, Q, H, R, dF[:-1], dH)
+    with pytest.raises(ValueError, match="dH"):
+        I.mutual_information_gradient(P0, F, Q, H, R, dF, dH[:-1], method="sqrt-forward")
+    with pytest.raises(ValueError, match="Q"):
+        I.mutual_information_gradient(P0, F, -Q, H, R, dF, dH)
     with pytest.raises(ValueError, match="rng"):
         I.monte_carlo_mutual_information(P0, F, Q, H, R, 10, 42)
     with pytest.raises(ValueError, match="n_samples"):
@@ -228,8 +235,8 @@ def _static_ill_conditioned(xi=0.0):
 def test_square_root_value_and_gradient_accurate_when_measurements_dominate():
     """Prior/noise ratios of 1e12: the square-root recursion keeps the value to ~1e-10 relative, where the
     covariance form (EKF innovations) is off by 2e-8 and the dense Eq. 18 by 2e-7 (test case 2's window is worse:
-    1e-5).  Gradients: both methods within 1e-4 of the closed form here (the test-case-2 gradient check in
-    test_wolf_jones separates them)."""
+    1e-5).  Gradients: all three structured methods within 1e-4 of the closed form here (every method is ~1e-5 off
+    at this ratio; the test-case-2 gradient check in test_wolf_jones separates them)."""
     P0, F, Q, H, R, dF, dH, exact, dexact = _static_ill_conditioned(0.3)
     assert I.mutual_information(P0, F, Q, H, R) == pytest.approx(exact, rel=1e-9)
     hist = C.covariance_analysis(P0, F, Q, H, R)
@@ -238,7 +245,117 @@ def test_square_root_value_and_gradient_accurate_when_measurements_dominate():
     val, g = I.mutual_information_gradient(P0, F, Q, H, R, dF, dH)
     assert val == pytest.approx(exact, rel=1e-9)
     assert g[0] == pytest.approx(dexact, rel=1e-4)
-    _, g_adj = I.mutual_information_gradient(P0, F, Q, H, R, dF, dH, method="adjoint")
-    assert g_adj[0] == pytest.approx(dexact, rel=1e-4)
+    for method in ("sqrt-forward", "adjoint"):
+        val_m, g_m = I.mutual_information_gradient(P0, F, Q, H, R, dF, dH, method=method)
+        assert val_m == pytest.approx(val, rel=1e-14) and g_m[0] == pytest.approx(dexact, rel=1e-4)
     with pytest.raises(ValueError, match="method"):
         I.mutual_information_gradient(P0, F, Q, H, R, dF, dH, method="forward")
+
+
+# ------------------------------------------------------------------------ square-root gradient: reverse vs forward mode
+def _rel(a, b):
+    """Relative max-abs difference of two gradients."""
+    return float(np.max(np.abs(a - b)) / max(np.max(np.abs(b)), 1e-300))
+
+
+def _reference_terms(P0, F, Q, H, R):
+    """Per-measurement gains from the reference square-root recursion (the one of 2026-11-22)."""
+    P0, F, Q, H, R, LR = C._check_linear_system(P0, F, Q, H, R, chol_R=True)
+    return I._sqrt_forward(P0, F, Q, np.linalg.solve(LR, H))
+
+
+@given(seed=st.integers(0, 2**32 - 1), N=st.integers(1, 7), M=st.integers(1, 4), n=st.integers(1, 6),
+       logcond=st.floats(-3, 2))
+def test_reverse_mode_equals_forward_mode(seed, N, M, n, logcond):
+    """method="sqrt" (reverse mode) and "sqrt-forward" differentiate the same recursion: equal to round-off on
+    well-conditioned windows (the two drift apart with the condition number, see the test-case-2 window below); the
+    value is bit-for-bit that of mutual_information and of the reference recursion."""
+    P0, F, Q, H, R, dF, dH = random_system(seed, N, M, n, 3, 10.0**logcond)
+    info_r, g_r = I.mutual_information_gradient(P0, F, Q, H, R, dF, dH)
+    info_f, g_f = I.mutual_information_gradient(P0, F, Q, H, R, dF, dH, method="sqrt-forward")
+    assert info_r == I.mutual_information(P0, F, Q, H, R) == float(np.sum(_reference_terms(P0, F, Q, H, R)))
+    assert info_r == pytest.approx(info_f, rel=1e-14)
+    assert _rel(g_r, g_f) <= 1e-10
+
+
+def test_reverse_mode_on_cr3bp_window(window):
+    """The 7-day CR3BP window: reverse and forward mode equal to 1e-10, value bit-for-bit."""
+    lin, _ = window
+    info_r, g_r = I.mutual_information_gradient(*lin.arrays, lin.dF, lin.dH)
+    _, g_f = I.mutual_information_gradient(*lin.arrays, lin.dF, lin.dH, method="sqrt-forward")
+    assert info_r == I.mutual_information(*lin.arrays)
+    assert _rel(g_r, g_f) <= 1e-10
+
+
+@pytest.fixture(scope="module")
+def case2_sized_window():
+    """The benchmark window (benchmarks/bench_information.py): observer and three targets on the Table 4 DROs, 17
+    daily range / range-rate epochs over [P_ref, 2 P_ref], 24 states; posterior condition number ~4e9."""
+    from cislunar.propagation import find_events, propagate
+
+    targets = np.array([[7.78717734e-1, 0, 0, 0, 5.55157488e-1, 0],
+                        [7.79426943e-1, 0, 0, 0, 5.54128887e-1, 0],
+                        [7.81554639e-1, 0, 0, 0, 5.51070308e-1, 0]])
+    period = float(find_events(EARTH_MOON, OBSERVER, 10.0, ("y_crossing",)).t[1])
+    start = propagate(EARTH_MOON, np.vstack([OBSERVER, targets]), np.array([0.0, period])).x[:, -1]
+    t = period + np.arange(0.0, period + 1e-12, DAY)
+    P0 = C.block_diag([C.state_covariance(C.WOLF_JONES_SIGMA_POS_KM, C.WOLF_JONES_SIGMA_VEL_KM_S, EARTH_MOON)] * 4)
+    R = M.range_range_rate_noise(M.WOLF_JONES_RANGE_SIGMA_KM, M.WOLF_JONES_RANGE_RATE_SIGMA_KM_S, EARTH_MOON)
+    q = C.psd_to_nondimensional(C.WOLF_JONES_PSD_KM2_S3, EARTH_MOON)
+    return C.linearize_augmented(EARTH_MOON, start[0], start[1:], t, M.RANGE_RANGE_RATE, R, P0, q=q,
+                                 derivatives=True)
+
+
+def test_reverse_mode_on_case2_sized_window(case2_sized_window):
+    """Test-case-2 size: value bit-for-bit; gradient within the double-precision floor of the forward mode.
+
+    Against a 40-digit evaluation of this window (mpmath; not a test dependency) the forward mode is 1.8e-8 and the
+    reverse mode 2.4e-8 off, and an eps-sized perturbation of the posterior factors alone moves the gradient by
+    ~1e-7: two square-root implementations agree to ~4e-8 here, not to 1e-10.  A wrong sign or factor anywhere in
+    the backward sweep gives O(1e-3..1) differences.  The dense form (5e-4) and the covariance-form adjoint (9e-5)
+    are the least accurate of the four."""
+    lin = case2_sized_window
+    assert lin.H.shape == (17, 6, 24)
+    args = (*lin.arrays, lin.dF, lin.dH)
+    info_r, g_r = I.mutual_information_gradient(*args)
+    _, g_f = I.mutual_information_gradient(*args, method="sqrt-forward")
+    _, g_a = I.mutual_information_gradient(*args, method="adjoint")
+    info_d, g_d = I.mutual_information_gradient_dense(*args)
+    assert info_r == I.mutual_information(*lin.arrays) == float(np.sum(_reference_terms(*lin.arrays)))
+    assert _rel(g_r, g_f) <= 2e-7
+    assert _rel(g_r, g_a) <= 1e-3 and _rel(g_r, g_d) <= 3e-3
+    assert info_d == pytest.approx(info_r, rel=1e-5)
+    assert abs(g_r[2]) < 1e-8 * np.max(np.abs(g_r)) and abs(g_r[5]) < 1e-8 * np.max(np.abs(g_r))  # planar
+
+
+def test_value_bit_for_bit_with_reference_recursion():
+    """mutual_information (lean sweep, no sign fixing, cached noise roots) reproduces the reference recursion bit for
+    bit, including single-component measurements (matrix-vector products) and zero process noise."""
+    cases = [random_system(s, N=N, M=Mm, n=n, cond=c)[:5]
+             for s, (N, Mm, n, c) in enumerate([(6, 1, 4, 1.0), (5, 3, 5, 1e4), (1, 2, 3, 1.0), (7, 4, 6, 1e-2)])]
+    cases.append(_static_ill_conditioned(0.3)[:5])
+    for args in cases:
+        ref = _reference_terms(*args)
+        total, terms = I.mutual_information(*args, return_terms=True)
+        np.testing.assert_array_equal(terms, ref)
+        assert total == float(np.sum(ref))
+
+
+def test_process_noise_roots_cache_follows_values():
+    """The cached square roots of Q are keyed on Q's entries: a changed Q (new array or the same array changed in
+    place) gives the value of an uncached evaluation."""
+    P0, F, Q, H, R, dF, dH = random_system(5, N=5)
+    base = I.mutual_information(P0, F, Q, H, R)
+    Q3 = Q.copy()
+    Q3[1] *= 3.0
+    I._ROOT_CACHE.clear()
+    fresh = I.mutual_information(P0, F, Q3, H, R)
+    assert fresh != base
+    I._ROOT_CACHE.clear()
+    assert I.mutual_information(P0, F, Q, H, R) == base
+    assert I.mutual_information(P0, F, Q3, H, R) == fresh
+    Q[1] *= 3.0  # in place: the cache holds a copy
+    assert I.mutual_information(P0, F, Q, H, R) == fresh
+    assert I.mutual_information_gradient(P0, F, Q, H, R, dF, dH)[0] == fresh
+    assert I.mutual_information(P0, F[:2], Q[:2], H[:3], R[:3]) == pytest.approx(
+        I.mutual_information_dense(P0, F[:2], Q[:2], H[:3], R[:3]), rel=1e-12)  # other shape: no false hit
