@@ -2,10 +2,16 @@
 
 Scenario: observer and three targets on the Table 4 DROs (observer on the ``observer_tf`` DRO, which closes; the
 printed ``observer_t0`` row does not), range and range-rate measurements (100 m, 10 m/s), process-noise PSD
-1e-11 LU^2/TU^3 (the adopted reading of Table 5), initial 100 km / 1 cm/s per axis, one measurement per day over the observation window
-[P_ref, 2 P_ref] (17 measurement times, 24 states, 6 measurements per time: range and range rate of 3 targets).
+1e-11 LU^2/TU^3 (the adopted reading of Table 5), initial 100 km / 1 cm/s per axis, one measurement per day over the
+observation window [P_ref, 2 P_ref] (17 measurement times, 24 states, 6 measurements per time: range and range rate
+of 3 targets), derivatives with respect to the six observer coordinates.
 
-``python -m benchmarks information`` prints the time per evaluation and the ratio; ``main()`` returns them.
+One interleaved best-of-9 run times: the dense value and value + gradient; the structured value; the structured
+value + gradient by reverse mode (``method="sqrt"``, the default), with the process-noise square roots cached as in
+every repeated evaluation of one window (SCvx) and cold (cache cleared before each call); and by forward mode
+(``method="sqrt-forward"``, the 2026-11-22 default).  Then the SCvx planning model of test case 2.
+
+``python -m benchmarks information`` prints the times per evaluation and the ratios; ``main()`` returns them.
 """
 
 from __future__ import annotations
@@ -39,14 +45,36 @@ def build_window(system=EARTH_MOON):
     return lin, period
 
 
+def _rel(a, b) -> float:
+    return float(np.max(np.abs(np.asarray(a) - b)) / np.max(np.abs(b)))
+
+
 def main() -> dict:
     t0 = time.perf_counter()
     lin, period = build_window()
     t_build = time.perf_counter() - t0
-    args = (*lin.arrays, lin.dF, lin.dH)
+    arrays = lin.arrays
+    args = (*arrays, lin.dF, lin.dH)
     info_d, grad_d = I.mutual_information_gradient_dense(*args)
     info_s, grad_s = I.mutual_information_gradient(*args)
-    timing = I.time_evaluations(*args, repeat=9, min_time=0.1)
+    _, grad_f = I.mutual_information_gradient(*args, method="sqrt-forward")
+    _, grad_a = I.mutual_information_gradient(*args, method="adjoint")
+
+    def cold():
+        I._ROOT_CACHE.clear()
+        return I.mutual_information_gradient(*args)
+
+    names = ["dense_value", "structured_value", "dense_value_grad", "sqrt_reverse_value_grad",
+             "sqrt_reverse_cold_value_grad", "sqrt_forward_value_grad"]
+    times = I._interleaved_best([
+        lambda: I.mutual_information_dense(*arrays),
+        lambda: I.mutual_information(*arrays),
+        lambda: I.mutual_information_gradient_dense(*args),
+        lambda: I.mutual_information_gradient(*args),
+        cold,
+        lambda: I.mutual_information_gradient(*args, method="sqrt-forward"),
+    ], 9, 0.1)
+    ms = dict(zip(names, 1e3 * np.array(times)))
     N, M_, n = lin.H.shape
     out = {
         "n_measurement_times": int(N),
@@ -54,24 +82,35 @@ def main() -> dict:
         "measurements_per_time": int(M_),
         "period_days": float(EARTH_MOON.tu_to_days(period)),
         "mutual_information_nats": float(info_s),
+        "value_bit_for_bit_structured": bool(info_s == I.mutual_information(*arrays)),
         "mi_rel_diff_dense_structured": float(abs(info_s - info_d) / abs(info_d)),
-        "grad_rel_diff_dense_structured": float(np.max(np.abs(grad_s - grad_d)) / np.max(np.abs(grad_d))),
+        "grad_rel_diff_dense_structured": _rel(grad_s, grad_d),
+        "grad_rel_diff_sqrt_forward_reverse": _rel(grad_s, grad_f),
+        "grad_rel_diff_adjoint_reverse": _rel(grad_s, grad_a),
         "linearisation_s": t_build,
-        "dense_value_ms": 1e3 * timing.dense_value,
-        "structured_value_ms": 1e3 * timing.structured_value,
-        "dense_value_grad_ms": 1e3 * timing.dense_gradient,
-        "structured_value_grad_ms": 1e3 * timing.structured_gradient,
-        "ratio_value": timing.ratio_value,
-        "ratio_value_grad": timing.ratio_gradient,
+        **{f"{k}_ms": float(v) for k, v in ms.items()},
+        "ratio_value": ms["dense_value"] / ms["structured_value"],
+        "ratio_value_grad": ms["dense_value_grad"] / ms["sqrt_reverse_value_grad"],
+        "ratio_value_grad_cold": ms["dense_value_grad"] / ms["sqrt_reverse_cold_value_grad"],
+        "ratio_forward_over_reverse": ms["sqrt_forward_value_grad"] / ms["sqrt_reverse_value_grad"],
+        "ratio_value_grad_forward": ms["dense_value_grad"] / ms["sqrt_forward_value_grad"],
     }
     print(f"window: {N} measurement times x {M_} measurements, state dim {n}, P_ref = {out['period_days']:.3f} d")
-    print(f"MI = {info_s:.6f} nats; dense vs structured: MI rel diff {out['mi_rel_diff_dense_structured']:.1e}, "
-          f"gradient rel diff {out['grad_rel_diff_dense_structured']:.1e}")
+    print(f"MI = {info_s:.6f} nats (gradient's value bit-for-bit mutual_information: "
+          f"{out['value_bit_for_bit_structured']}); dense vs structured MI rel diff "
+          f"{out['mi_rel_diff_dense_structured']:.1e}")
+    print(f"gradient rel diff (max abs) of the reverse mode from: forward mode "
+          f"{out['grad_rel_diff_sqrt_forward_reverse']:.1e}, dense {out['grad_rel_diff_dense_structured']:.1e}, "
+          f"covariance adjoint {out['grad_rel_diff_adjoint_reverse']:.1e}")
     print(f"linearisation (propagation, STMs/STT, process noise; includes first-call compilation): {t_build:.2f} s")
-    print(f"MI only      : dense {out['dense_value_ms']:.3f} ms, structured {out['structured_value_ms']:.3f} ms, "
+    print(f"MI only      : dense {ms['dense_value']:.3f} ms, structured {ms['structured_value']:.3f} ms, "
           f"ratio {out['ratio_value']:.1f}x")
-    print(f"MI + gradient: dense {out['dense_value_grad_ms']:.3f} ms, structured {out['structured_value_grad_ms']:.3f} ms, "
-          f"ratio {out['ratio_value_grad']:.1f}x")
+    print(f"MI + gradient: dense {ms['dense_value_grad']:.3f} ms, reverse mode {ms['sqrt_reverse_value_grad']:.3f} ms "
+          f"(cold noise roots {ms['sqrt_reverse_cold_value_grad']:.3f} ms), forward mode "
+          f"{ms['sqrt_forward_value_grad']:.3f} ms")
+    print(f"ratios: dense / reverse {out['ratio_value_grad']:.1f}x (cold {out['ratio_value_grad_cold']:.1f}x), "
+          f"forward / reverse {out['ratio_forward_over_reverse']:.1f}x, dense / forward "
+          f"{out['ratio_value_grad_forward']:.1f}x")
     out.update(planning_model())
     return out
 
@@ -79,7 +118,8 @@ def main() -> dict:
 def planning_model() -> dict:
     """The SCvx information model of test case 2 (cislunar.wolf_jones): cost of value, gradient, Hessian.
 
-    Ratio in one run: square-root forward-mode gradient against the covariance-form adjoint.
+    Ratios in one interleaved run: the reverse-mode square-root gradient (default) against the forward mode and the
+    covariance-form adjoint.
     """
     from cislunar import wolf_jones as W
 
@@ -88,19 +128,25 @@ def planning_model() -> dict:
     x = propagate(sc.system, sc.observer_x0, np.array([0.0, sc.window[0]])).x[-1]
     lin = model.linearization(x, derivatives=True)
     args = (*lin.arrays, lin.dF, lin.dH)
-    t_sqrt, t_adj = I._interleaved_best([lambda: I.mutual_information_gradient(*args),
-                                         lambda: I.mutual_information_gradient(*args, method="adjoint")], 5, 0.1)
+    t_rev, t_fwd, t_adj = I._interleaved_best([
+        lambda: I.mutual_information_gradient(*args),
+        lambda: I.mutual_information_gradient(*args, method="sqrt-forward"),
+        lambda: I.mutual_information_gradient(*args, method="adjoint")], 5, 0.1)
     t0 = time.perf_counter()
     model.hessian(x)
     t_hess = time.perf_counter() - t0
     v0 = model(x)
     v1, g = model(x, 1)
-    out = {"tc2_gradient_sqrt_ms": 1e3 * t_sqrt, "tc2_gradient_adjoint_ms": 1e3 * t_adj,
-           "tc2_gradient_ratio_sqrt_over_adjoint": t_sqrt / t_adj,
+    g_fwd = I.mutual_information_gradient(*args, method="sqrt-forward")[1]
+    out = {"tc2_gradient_sqrt_ms": 1e3 * t_rev, "tc2_gradient_sqrt_forward_ms": 1e3 * t_fwd,
+           "tc2_gradient_adjoint_ms": 1e3 * t_adj, "tc2_gradient_ratio_forward_over_sqrt": t_fwd / t_rev,
+           "tc2_gradient_ratio_sqrt_over_adjoint": t_rev / t_adj, "tc2_grad_rel_diff_forward": _rel(g, g_fwd),
            "tc2_hessian_incl_propagation_s": t_hess, "tc2_value_order0_vs_order1_rel": abs(v0 - v1) / abs(v0)}
-    print(f"test case 2 planning model: gradient sqrt {out['tc2_gradient_sqrt_ms']:.2f} ms vs adjoint "
-          f"{out['tc2_gradient_adjoint_ms']:.2f} ms; central-difference Hessian incl. propagation "
-          f"{t_hess:.2f} s; value(order 0) vs value(order 1) rel diff {out['tc2_value_order0_vs_order1_rel']:.1e}")
+    print(f"test case 2 planning model: gradient reverse {out['tc2_gradient_sqrt_ms']:.2f} ms, forward "
+          f"{out['tc2_gradient_sqrt_forward_ms']:.2f} ms, covariance adjoint {out['tc2_gradient_adjoint_ms']:.2f} ms "
+          f"(reverse vs forward gradient rel diff {out['tc2_grad_rel_diff_forward']:.1e}); central-difference Hessian "
+          f"incl. propagation {t_hess:.2f} s; value(order 0) vs value(order 1) rel diff "
+          f"{out['tc2_value_order0_vs_order1_rel']:.1e}")
     return out
 
 
