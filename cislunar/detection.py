@@ -73,6 +73,7 @@ __all__ = [
     "error_rates",
     "DetectionThreshold",
     "ml_threshold",
+    "threshold_bootstrap",
     "decide",
     "DetectionScore",
     "detection_accuracy",
@@ -1087,7 +1088,7 @@ class DetectionThreshold:
         return self.false_positive + self.missed_detection
 
 
-def ml_threshold(z_h0, z_h1, *, bandwidth="scott") -> DetectionThreshold:
+def ml_threshold(z_h0, z_h1, *, bandwidth="scott", n_grid: int = 4001) -> DetectionThreshold:
     """Fit PDFs to the H0 and H1 samples and place :math:`z_{lim}` where they cross (Eqs. 34-35).
 
     The PDFs are Gaussian KDEs (:func:`fit_pdf`).  Crossings are searched between the smallest and largest sample
@@ -1102,6 +1103,8 @@ def ml_threshold(z_h0, z_h1, *, bandwidth="scott") -> DetectionThreshold:
         Test statistic without and with maneuvers.
     bandwidth : str or float
         KDE bandwidth rule (see :func:`fit_pdf`).
+    n_grid : int
+        Grid points bracketing the crossings (:func:`pdf_crossings`); each crossing is then refined to round-off.
     """
     z0 = _checks.as_array(z_h0, "z_h0", ndim=(1,))
     z1 = _checks.as_array(z_h1, "z_h1", ndim=(1,))
@@ -1110,13 +1113,48 @@ def ml_threshold(z_h0, z_h1, *, bandwidth="scott") -> DetectionThreshold:
             raise ValueError(f"{name} must hold at least two distinct values; got {z.size} value(s)")
     k0, k1 = fit_pdf(z0, bandwidth), fit_pdf(z1, bandwidth)
     lo, hi = min(z0.min(), z1.min()), max(z0.max(), z1.max())
-    cross = pdf_crossings(k0, k1, lo, hi)
+    cross = pdf_crossings(k0, k1, lo, hi, n_grid=n_grid)
     if cross.size == 0:
         raise ValueError("the H0 and H1 PDFs do not cross between the samples: no maximum-likelihood threshold")
     errs = np.array([sum(error_rates(c, k0, k1)) for c in cross])
     z_lim = float(cross[np.argmin(errs)])
     fp, md = error_rates(z_lim, k0, k1)
     return DetectionThreshold(z_lim, fp, md, cross, k0, k1)
+
+
+def threshold_bootstrap(z_h0, z_h1, n_resamples: int, rng: np.random.Generator, *, bandwidth="scott",
+                        n_grid: int = 1001) -> np.ndarray:
+    """Bootstrap of the maximum-likelihood threshold and its expected error (Monte Carlo standard errors).
+
+    Each resample draws the H0 and H1 sets with replacement (same sizes) and refits :func:`ml_threshold`.
+
+    Parameters
+    ----------
+    z_h0, z_h1 : array_like, shape (n0,), (n1,)
+        Training samples of the test statistic.
+    n_resamples : int
+    rng : numpy.random.Generator
+    bandwidth : str or float
+        KDE bandwidth rule (:func:`fit_pdf`).
+    n_grid : int
+        Bracketing grid of the crossings (coarser than :func:`ml_threshold`'s default for speed; crossings are
+        refined to round-off either way).
+
+    Returns
+    -------
+    ndarray, shape (n_resamples, 2)
+        Columns: :math:`z_{lim}` (unit of the samples) and the total expected error (false positive + missed
+        detection).  Their standard deviations over the rows are the standard errors.
+    """
+    z0 = _checks.as_array(z_h0, "z_h0", ndim=(1,), min_size=2)
+    z1 = _checks.as_array(z_h1, "z_h1", ndim=(1,), min_size=2)
+    n = _checks.integer(n_resamples, "n_resamples", minimum=2)
+    _checks.rng(rng)
+    out = np.empty((n, 2))
+    for i in range(n):
+        th = ml_threshold(rng.choice(z0, z0.size), rng.choice(z1, z1.size), bandwidth=bandwidth, n_grid=n_grid)
+        out[i] = th.z_lim, th.total_error
+    return out
 
 
 def decide(z, z_lim: float) -> np.ndarray:

@@ -42,6 +42,10 @@ def specs(Spec, lazy):
                dict(burn_offset_hours="real")))
     s.append(S("filter_trials", detection.filter_trials, dict(setup=lazy(_setup), inputs=lazy(_inputs), n_epochs=4),
                dict(setup="instance", inputs="iterable", n_epochs="int2_opt")))
+    s.append(S("threshold_bootstrap", detection.threshold_bootstrap,
+               dict(z_h0=np.array([0.1, 0.3, 0.2, 0.25]), z_h1=np.array([1.0, 1.4, 0.9, 1.2]), n_resamples=2,
+                    rng=lazy(lambda: np.random.default_rng(0)), bandwidth="scott", n_grid=101),
+               dict(z_h0="vec", z_h1="vec", n_resamples="int1", rng="rng", bandwidth="bandwidth", n_grid="int2")))
     s.append(S("control_spike_contrast", detection.control_spike_contrast,
                dict(setup=lazy(_setup), result=lazy(_filtered), half_width_hours=6.0, burn_offset_hours=0.0),
                dict(setup="instance", result="instance", half_width_hours="pos", burn_offset_hours="real")))

@@ -390,3 +390,24 @@ def test_control_spike_contrast_of_a_known_spike(short_setup):
         det.control_spike_contrast(s, res, half_width_hours=1e5)
     with pytest.raises(TypeError, match="result"):
         det.control_spike_contrast(s, object())
+
+
+def test_threshold_bootstrap_matches_the_spread_over_independent_samples():
+    """The bootstrap standard error of z_lim agrees with the spread of z_lim over independent training sets.
+
+    The crossing sits in the tail of the H0 sample, so one data set's bootstrap error scatters by tens of per cent;
+    the average over a few data sets is compared.
+    """
+    m0, s0, m1, s1, n0, n1 = 0.2, 0.05, 1.0, 0.3, 200, 400
+    rng = np.random.default_rng(12)
+    indep = np.array([det.ml_threshold(rng.normal(m0, s0, n0), rng.normal(m1, s1, n1), n_grid=1001).z_lim
+                      for _ in range(60)])
+    boots = [det.threshold_bootstrap(rng.normal(m0, s0, n0), rng.normal(m1, s1, n1), 25, np.random.default_rng(k))
+             for k in range(4)]
+    assert boots[0].shape == (25, 2)
+    se = np.mean([b[:, 0].std(ddof=1) for b in boots])
+    assert 0.6 < se / indep.std(ddof=1) < 1.6
+    assert abs(np.median(boots[0][:, 0]) - _gauss_crossing(m0, s0, m1, s1)) < 4 * indep.std()
+    assert np.all((boots[0][:, 1] > 0) & (boots[0][:, 1] < 1))
+    with pytest.raises(ValueError, match="n_resamples"):
+        det.threshold_bootstrap([0.1, 0.2], [1.0, 2.0], 1, rng)
