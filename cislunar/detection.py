@@ -81,6 +81,7 @@ __all__ = [
     "run_policy_study",
     "filter_trials",
     "control_spike_contrast",
+    "azimuth_contrast",
     "direction_response",
     "HealthLeadStudy",
     "health_lead_study",
@@ -1367,6 +1368,34 @@ def control_spike_contrast(setup: DetectionSetup, result: BatchOCBEResult, *, ha
         norm = np.linalg.norm(u, axis=-1)
         out[:, j] = norm[:, near].mean(axis=-1) / norm[:, ~near].mean(axis=-1)
     return out
+
+
+def azimuth_contrast(sample: MonteCarloSample, *, half_width_deg: float = 30.0,
+                     max_elevation_deg: float = 45.0) -> float:
+    """The paper's Fig. 16 pattern in one number: is :math:`z/|\\Delta v|` larger for burns along :math:`\\pm\\hat j`?
+
+    Mean of :math:`z/|\\Delta v|` over the maneuvering runs whose azimuth is within ``half_width_deg`` of
+    :math:`\\pm 90°`, over its mean for azimuths within ``half_width_deg`` of 0° or 180°, both restricted to
+    elevations below ``max_elevation_deg`` in magnitude.  1 means no preference; NaN when a sector is empty.
+
+    Parameters
+    ----------
+    sample : MonteCarloSample
+        Runs with a maneuver (H1).
+    half_width_deg, max_elevation_deg : float
+        Sector half width and elevation cut, deg.
+    """
+    _checks.instance(sample, "sample", MonteCarloSample, "a cislunar.detection.MonteCarloSample")
+    hw = _checks.in_range(half_width_deg, "half_width_deg", 0.0, 90.0, closed=False)
+    emax = _checks.in_range(max_elevation_deg, "max_elevation_deg", 0.0, 90.0, closed=False)
+    if not np.all(sample.magnitude > 0):
+        raise ValueError("sample must hold maneuvering runs only (positive magnitudes)")
+    r = sample.z / sample.magnitude
+    a, e = np.abs(np.degrees(sample.azimuth)), np.abs(np.degrees(sample.elevation))
+    low = e < emax
+    side = low & (np.abs(a - 90.0) < hw)
+    axial = low & ((a < hw) | (a > 180.0 - hw))
+    return float(r[side].mean() / r[axial].mean()) if side.any() and axial.any() else float("nan")
 
 
 def direction_response(setup: DetectionSetup, directions, magnitude_m_s: float, n_repeats: int, seed, *,

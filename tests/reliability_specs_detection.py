@@ -49,6 +49,12 @@ def specs(Spec, lazy):
     s.append(S("control_spike_contrast", detection.control_spike_contrast,
                dict(setup=lazy(_setup), result=lazy(_filtered), half_width_hours=6.0, burn_offset_hours=0.0),
                dict(setup="instance", result="instance", half_width_hours="pos", burn_offset_hours="real")))
+    n = 4
+    sample = detection.MonteCarloSample(np.ones(n), np.ones(n), np.ones(n), np.radians([90.0, 0.0, -90.0, 180.0]),
+                                        np.zeros(n), *(np.zeros(n),) * 4)
+    s.append(S("azimuth_contrast", detection.azimuth_contrast,
+               dict(sample=sample, half_width_deg=30.0, max_elevation_deg=45.0),
+               dict(sample="instance", half_width_deg="range:0:90", max_elevation_deg="range:0:90")))
     s.append(S("direction_response", detection.direction_response,
                dict(setup=lazy(_setup), directions=np.array([[0.0, 0.0], [1.5, 0.2]]), magnitude_m_s=0.5,
                     n_repeats=1, seed=3, burn_offset_hours=0.0),

@@ -411,3 +411,16 @@ def test_threshold_bootstrap_matches_the_spread_over_independent_samples():
     assert np.all((boots[0][:, 1] > 0) & (boots[0][:, 1] < 1))
     with pytest.raises(ValueError, match="n_resamples"):
         det.threshold_bootstrap([0.1, 0.2], [1.0, 2.0], 1, rng)
+
+
+def test_azimuth_contrast_of_a_known_pattern():
+    az = np.radians([90.0, -90.0, 0.0, 180.0, 45.0, 90.0])
+    el = np.radians([0.0, 10.0, -20.0, 5.0, 0.0, 80.0])
+    mag = np.array([1.0, 2.0, 1.0, 0.5, 1.0, 1.0])
+    ratio = np.array([2.0, 2.0, 1.0, 1.0, 7.0, 9.0])  # z / |dv|: the 45 deg and the high-elevation runs are ignored
+    n = az.size
+    s = det.MonteCarloSample(ratio * mag, ratio * mag, mag, az, el, *(np.zeros(n),) * 4)
+    assert det.azimuth_contrast(s) == pytest.approx(2.0)
+    assert np.isnan(det.azimuth_contrast(s, half_width_deg=5.0, max_elevation_deg=1.0))  # a sector is empty
+    with pytest.raises(ValueError, match="sample"):
+        det.azimuth_contrast(det.MonteCarloSample(*(np.zeros(2),) * 9))
