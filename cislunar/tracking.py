@@ -269,6 +269,10 @@ class TrialSummary:
         ``inconsistent_fraction > DIVERGED_FRACTION`` or the filter failed numerically.
     failure : str
         Exception message when the filter failed, else "".
+    first_inconsistent_epoch : int
+        Index of the first epoch whose NEES exceeds the 99.9% quantile (-1 if none; -1 too when the filter
+        failed numerically).  Where a divergence starts tells its mechanism apart: at epoch 0 the first
+        measurement update (a prior too wide for the linearised measurement), later the time update.
     """
 
     final_sigma_pos_km: float
@@ -280,6 +284,7 @@ class TrialSummary:
     inconsistent_fraction: float
     diverged: bool
     failure: str = ""
+    first_inconsistent_epoch: int = -1
 
 
 def nees(x_est, P, truth) -> np.ndarray:
@@ -307,7 +312,8 @@ def summarize(system: CR3BP, x_est, P, truth) -> TrialSummary:
         raise ValueError(f"P must have shape ({x_est.shape[0]}, 6, 6); got {P.shape}")
     e = x_est - truth
     n = nees(x_est, P, truth)
-    frac = float(np.mean(n > chi2.ppf(NEES_PROBABILITY, 6)))
+    over = n > chi2.ppf(NEES_PROBABILITY, 6)
+    frac = float(np.mean(over))
     L, V = system.length_unit_km, system.velocity_unit_km_s * 1e3
     return TrialSummary(
         final_sigma_pos_km=float(np.sqrt(np.trace(P[-1][:3, :3])) * L),
@@ -318,6 +324,7 @@ def summarize(system: CR3BP, x_est, P, truth) -> TrialSummary:
         nees_mean=float(np.mean(n)),
         inconsistent_fraction=frac,
         diverged=bool(frac > DIVERGED_FRACTION),
+        first_inconsistent_epoch=int(np.argmax(over)) if over.any() else -1,
     )
 
 

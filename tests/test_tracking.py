@@ -86,3 +86,17 @@ def test_nees_of_exact_draws_has_the_chi_square_mean():
     e = rng.multivariate_normal(np.zeros(6), P, size=4000)
     n = tracking.nees(e, np.broadcast_to(P, (4000, 6, 6)), np.zeros((4000, 6)))
     assert abs(n.mean() - 6.0) < 3 * np.sqrt(12.0 / 4000)
+
+
+def test_summary_counts_inconsistent_epochs_and_dates_the_first():
+    """Errors of 1 sigma are consistent; one of 10 sigma (NEES 100 > 22.5) at epochs 3 and 7 only."""
+    N = 10
+    P = np.broadcast_to(np.diag([1e-10] * 3 + [1e-12] * 3), (N, 6, 6)).copy()
+    truth = np.zeros((N, 6))
+    x = np.tile(np.sqrt(np.diag(P[0])) / np.sqrt(6), (N, 1))  # NEES 1 at every epoch
+    x[[3, 7], 0] = 10 * np.sqrt(P[0, 0, 0])
+    s = tracking.summarize(em, x, P, truth)
+    assert s.first_inconsistent_epoch == 3 and s.inconsistent_fraction == pytest.approx(0.2) and s.diverged
+    s0 = tracking.summarize(em, np.tile(x[0], (N, 1)), P, truth)
+    assert s0.first_inconsistent_epoch == -1 and s0.inconsistent_fraction == 0 and not s0.diverged
+    assert s0.nees_mean == pytest.approx(1.0, rel=1e-12)
