@@ -47,6 +47,8 @@ import warnings
 import matplotlib.pyplot as plt
 import matplotlib.ticker as mticker
 import numpy as np
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
 from cislunar import lpv, plotting
 from cislunar.report import ComparisonTable
@@ -355,16 +357,17 @@ table.add("Hinf precision formula", "kappa = sqrt(beta/gamma)", "kappa = sqrt(be
 # %%
 gammas = np.geomspace(3e-4, 3e-2, N_GAMMA)
 sweep = {norm: lpv.gamma_sweep(lmi1[norm], gammas) for norm in lmi1}
-fig, ax = plt.subplots(1, 2, figsize=(10, 3.8))
+fig, ax = plt.subplots(1, 2, figsize=(8.5, 3.8), layout="constrained")
 for norm, label in (("h2", "H2"), ("hinf", r"H$_\infty$")):
     k = np.array([np.nan if d is None else d.kappa[0] for d in sweep[norm]])
     nd = np.array([np.nan if d is None else d.noise_deg[0] for d in sweep[norm]])
     ax[0].loglog(gammas * model.system.length_unit_km, k, "o-", label=label)
     ax[1].loglog(gammas * model.system.length_unit_km, nd, "o-", label=label)
 for a in ax:
-    a.axvline(GAMMA * model.system.length_unit_km, color="k", lw=0.8, ls=":")
+    a.axvline(GAMMA * model.system.length_unit_km, color="k", lw=0.8, ls=":",
+              label=rf"paper's $\gamma$ = {GAMMA} LU ({GAMMA * model.system.length_unit_km:.0f} km)")
     a.set_xlabel(r"$\gamma$ [km]")
-    a.legend()
+fig.legend(*ax[0].get_legend_handles_labels(), loc="outside lower center", ncol=3)
 ax[0].set_ylabel(r"required precision $\kappa_{\sin\theta_1}$ [non-dim.]")
 ax[1].set_ylabel(r"allowable $\theta_1$ noise [deg] (Eq. 24)")
 fig.suptitle("trade curve: precision needed for a position-error bound")
@@ -386,8 +389,8 @@ table.add("trade curve kappa(gamma)", "-", f"slopes H2 {slope['h2']:.2f}, Hinf {
 # $[0.075, 0.085)$ deg, H2 per sample $[0.05, 0.15)$ deg, and H2 more than H-infinity?
 
 # %%
-study = lpv.sensitivity_study(GAMMA, orbits=STUDY_ORBITS or lpv.RESONANT_CANDIDATES, levels=STUDY_LEVELS, pole_radius=R_BW,
-                              n_samples=N_STUDY, progress=True)
+study = lpv.sensitivity_study(GAMMA, orbits=STUDY_ORBITS or lpv.RESONANT_CANDIDATES, levels=STUDY_LEVELS,
+                              pole_radius=R_BW, n_samples=N_STUDY, progress=True)
 h2i, hinf = study.h2_intensity_deg, study.hinf_deg
 n_opt = int(np.sum(study.h2_status == "optimal") + np.sum(study.hinf_status == "optimal"))
 print(f"{2 * study.h2_kappa.size} solves in {study.seconds:.0f} s; {n_opt} ended optimal")
@@ -400,40 +403,6 @@ dteq = 1.0 / (study.h2_kappa * np.sin(np.radians(hinf))) ** 2
 for i, nm in enumerate(names):
     print(f"{nm:14s} {study.r13_max[i]:8.3f} {hinf[i, 0, j]:9.4f} {h2i[i, 0, j]:28.4f} "
           f"{dt01[i, 0, j] * TU_MIN:26.0f} {dteq[i, 0, j] * TU_MIN:25.0f}")
-
-# %%
-fig, ax = plt.subplots(1, 3, figsize=(16, 4.6), layout="constrained")
-order = np.argsort(study.r13_max)
-ax[0].plot(study.r13_max[order], hinf[order, 0, j], "o-", label=r"H$_\infty$, R = 1000/TU")
-rr = np.linspace(study.r13_max.min(), study.r13_max.max(), 100)
-ax[0].plot(rr, np.degrees(np.arcsin(GAMMA / rr)), "k--", lw=0.8, label=r"$\sin^{-1}(\gamma/\max r_{13})$")
-ax[0].axhspan(0.075, 0.085, color="C2", alpha=0.2, lw=0, label="paper 0.08 deg (printed digits)")
-ax[0].set_xlabel(r"largest Earth distance on the orbit, $\max r_{13}$ [LU]")
-ax[0].set_ylabel(r"H$_\infty$ allowable $\theta_1$ noise [deg]")
-ax[0].legend(loc="upper right", fontsize=8)
-xo = np.arange(len(order))
-for s_i, structure in enumerate(study.structures):
-    for l_i, lvl in enumerate(study.levels):
-        ax[1].plot(xo + 0.06 * (l_i - 1.5), h2i[order, s_i, l_i], ["o", "s"][s_i], color=f"C{l_i}", ms=5,
-                   mfc=None if s_i == 0 else "none", label=f"{structure}, level {lvl:g}")
-ax[1].set_xticks(xo, [f"{names[i]}\n{study.r13_max[i]:.2f} LU" for i in order], fontsize=7, rotation=45)
-ax[1].set_ylim(0, 1.45 * float(np.nanmax(h2i)))
-ax[1].set_xlabel(r"orbit, sorted by $\max r_{13}$ [-]")
-ax[1].set_ylabel("H2 allowance read as an angle [deg]")
-ax[1].set_title("H2: intensity (filled: accelerations, open: all states)", fontsize=10)
-ax[1].legend(fontsize=6.5, loc="upper left", ncol=2)
-dts = np.geomspace(1e-3, 1.0, 200)
-for i in order:
-    ps = study.h2_per_sample_deg(dts)[i, 0, j]
-    ax[2].loglog(dts * TU_MIN, ps, lw=1, label=names[i])
-ax[2].axhspan(0.05, 0.15, color="C2", alpha=0.2, lw=0)
-ax[2].axhline(0.1, color="k", lw=0.6, ls=":")
-ax[2].set_xlabel(r"sampling interval $\Delta t$ [min]")
-ax[2].set_ylabel("H2 allowable per-sample noise [deg]")
-ax[2].set_title("H2 per sample (accelerations, level 1e-3)", fontsize=10)
-ax[2].legend(fontsize=7, loc="upper right", ncol=2)
-fig.suptitle(r"Sensitivity of the allowable $\theta_1$ noise at $\gamma$ = 0.0013 LU to the unstated inputs")
-_ = plotting.save_figure(fig, "11_sensitivity", output_dir=out)
 
 # %%
 # Where do both of the paper's numbers hold?  Per orbit, structure and level: the dt window in which the H2
@@ -464,7 +433,91 @@ table.add("where H2 = 0.1 deg", "0.1 deg", f"never as an intensity (max {never:.
 table.add("both numbers and H2 > Hinf together", "yes", f"{len(hits)} of {ok_all.size} cases, e.g. "
           + (f"{hits[0][0]}, dt {hits[0][3]:.0f}-{hits[0][4]:.0f} min" if hits else "none"),
           "derived" if hits else "differs: no tried combination reproduces both",
-          "only with the per-sample reading of H2, on an orbit with max r13 near 0.93 LU, for the dt windows listed")
+          f"only with the per-sample reading of H2, on an orbit with max r13 in [{band[0]:.2f}, {band[1]:.2f}] LU, "
+          "for the dt windows listed")
+
+# %% [markdown]
+# **The study in one figure.** All three rows share the orbit axis, sorted by the largest Earth distance
+# $\max r_{13}$; the shaded column marks the orbits whose H-infinity allowance falls in the paper's band.
+# (a) The H-infinity allowance (accelerations, level $10^{-3}$; the other disturbances change it by the relative
+# amount printed in the table) against its unbounded-gain limit $\sin^{-1}(\gamma/\max r_{13})$. (b) The H2
+# allowance read directly as an angle, for every disturbance structure (marker) and level (colour), side by side
+# within each orbit's slot. (c) The H2 allowance per sample: the sampling intervals at which it equals 0.1 deg
+# (dot) or lies in the paper's printed range (bar), and the interval below which it exceeds the H-infinity one
+# (red dash).
+
+# %%
+order = np.argsort(study.r13_max)
+xo = np.arange(order.size)
+n_s, n_l = len(study.structures), study.levels.size
+fig, ax = plt.subplots(3, 1, figsize=(7.5, 9.0), sharex=True, layout="constrained")
+for a in ax:
+    for x in xo[ok_hinf[order, 0, j]]:
+        a.axvspan(x - 0.45, x + 0.45, color="C7", alpha=0.15, lw=0, zorder=0)
+# (a) H-infinity: optimum against its unbounded-gain limit
+ax[0].axhspan(0.075, 0.085, color="C2", alpha=0.2, lw=0)
+ax[0].plot(xo, hinf[order, 0, j], "o", color="C1", ms=6, zorder=3)
+ax[0].plot(xo, np.degrees(np.arcsin(GAMMA / study.r13_max[order])), "_", color="k", ms=16, mew=1.2, zorder=4)
+ax[0].set_ylabel(r"H$_\infty$ allowable noise [deg]")
+ax[0].set_title(r"(a) H$_\infty$ (energy bound, an angle RMS directly)", fontsize=10, loc="left")
+ax[0].legend(handles=[
+    Line2D([], [], color="C1", marker="o", ls="", label=rf"optimum, R = {R_BW:.0f}/TU"),
+    Line2D([], [], color="k", marker="_", ms=12, mew=1.2, ls="", label=r"limit $\sin^{-1}(\gamma/\max r_{13})$"),
+    Patch(color="C2", alpha=0.2, label="paper's 0.08 deg (printed digits)"),
+    Patch(color="C7", alpha=0.15, label=r"orbit with H$_\infty$ in the paper's band")],
+    loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
+# (b) H2 read directly: every structure and level, side by side within an orbit's slot
+slot = 0.8 / (n_s * n_l)
+colours = plt.cm.viridis(np.linspace(0.0, 0.8, n_l))
+for s_i in range(n_s):
+    for l_i in range(n_l):
+        dx = (s_i * n_l + l_i + 0.5) * slot - 0.4
+        ax[1].plot(xo + dx, h2i[order, s_i, l_i], ["o", "s"][s_i % 2], color=colours[l_i], ms=4.5,
+                   mfc=colours[l_i] if s_i == 0 else "none", mew=1.2, ls="", zorder=3)
+ax[1].axhspan(0.05, 0.15, color="C2", alpha=0.2, lw=0)
+ax[1].set_yscale("log")
+ax[1].set_ylabel("H2 allowance read\nas an angle [deg]")
+ax[1].set_title("(b) H2 read directly (a white-noise intensity, not an angle)", fontsize=10, loc="left")
+key = [Line2D([], [], color="0.3", marker="o", ls="", label="accelerations"),
+       Line2D([], [], color="0.3", marker="s", mfc="none", mew=1.2, ls="", label="all four states")]
+key += [Patch(color=colours[l_i], label=f"level {lvl:g}") for l_i, lvl in enumerate(study.levels)]
+key += [Patch(color="C2", alpha=0.2, label="paper's 0.1 deg (printed digits)")]
+ax[1].legend(handles=key, loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, title="disturbance on",
+             title_fontsize=8)
+# (c) H2 per sample: the sampling intervals that give the paper's number
+k0 = (order, 0, j)
+ax[2].vlines(xo, study.dt_for_h2(0.15)[k0] * TU_MIN, study.dt_for_h2(0.05)[k0] * TU_MIN,
+             color="C0", lw=5, alpha=0.35, zorder=2)
+ax[2].plot(xo, dt01[k0] * TU_MIN, "o", color="C0", ms=6, zorder=3)
+ax[2].plot(xo, dteq[k0] * TU_MIN, "_", color="C1", ms=18, mew=2.0, zorder=2.5)
+ax[2].set_yscale("log")
+ax[2].set_ylabel(r"sampling interval $\Delta t$ [min]")
+ax[2].set_title(f"(c) H2 per sample (accelerations, level {study.levels[j]:g})", fontsize=10, loc="left")
+ax[2].legend(handles=[Line2D([], [], color="C0", lw=5, alpha=0.35, label="per-sample noise 0.05-0.15 deg"),
+                      Line2D([], [], color="C0", marker="o", ls="", label="per-sample noise 0.1 deg"),
+                      Line2D([], [], color="C1", marker="_", ms=14, mew=2.0, ls="",
+                             label=r"H2 > H$_\infty$ for $\Delta t$ below")],
+             loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
+ax[2].set_xticks(xo, [f"{study.orbits[i][0]}:{study.orbits[i][1]}\nrp {study.orbits[i][2]:.2f}\n"
+                      f"{study.r13_max[i]:.2f}" for i in order], fontsize=8)
+ax[2].set_xlim(-0.5, order.size - 0.5)
+ax[2].set_xlabel(r"resonant orbit p:q, perigee radius $r_p$ [LU], $\max r_{13}$ [LU]; "
+                 r"sorted by $\max r_{13}$")
+fig.suptitle(r"Allowable $\theta_1$ noise at $\gamma$ = 0.0013 LU over the inputs the paper leaves unstated",
+             fontsize=11)
+for a in ax[1:]:  # plain numbers at 1-2-5 steps: readable whether the data span one decade or several
+    a.yaxis.set_major_locator(mticker.LogLocator(subs=(1.0, 2.0, 5.0)))
+    a.yaxis.set_major_formatter(mticker.FuncFormatter(lambda v, _: f"{v:g}"))
+    a.yaxis.set_minor_formatter(mticker.NullFormatter())
+_ = plotting.save_figure(fig, "11_sensitivity", output_dir=out)
+
+# %% [markdown]
+# **Reading it.** The H-infinity allowance sits on or just below its limit for every orbit, so it is a statement
+# about the orbit's apogee, and only the orbit(s) in the shaded column give the paper's 0.08 deg. Read directly,
+# the H2 allowance never reaches the paper's 0.1 deg band on any orbit, structure or level, and a larger
+# disturbance only lowers it (most for perturbations of all four states at the largest level). Per sample, 0.1 deg
+# needs sampling intervals of hours; both of the paper's numbers and its ordering hold together only where, in the
+# shaded column, the bar reaches below the red dash: the windows printed above.
 
 # %%
 table.display()
