@@ -252,11 +252,11 @@ for o in outer_band[:: max(1, len(outer_band) // 8)]:
     print(f"{o.perilune_radius_km:14.0f} {o.apolune_radius_km:13.0f} {o.period_days:11.3f} "
           f"{'  '.join(f'{b:+.3f}' for b in np.sort(o.broucke_indices.real))}")
 
-fig, ax = plt.subplots()
+fig, ax = plt.subplots(figsize=(9.5, 4.6))
 ax.semilogy(rp, nu, "-", color="0.3", label="southern L2 halo family")
 ax.semilogy(nrho.perilune_radius_km, nrho.stability_index, "o", color="C0", ms=8, label="9:2 NRHO")
 ax.semilogy(stable.perilune_radius_km, stable.stability_index, "o", color="C1", ms=8,
-            label="stable NRHO, inner band edge (nu = 1)")
+            label=r"stable NRHO, inner band edge ($\nu$ = 1)")
 ax.axvspan(*band_rp, color="C2", alpha=0.15, label="outer stable band (family members)")
 ax.semilogy(outer.perilune_radius_km, outer.stability_index, "D", color="C2", ms=7,
             label="stable NRHO, outer band (most stable)")
@@ -269,7 +269,8 @@ ax.xaxis.set_minor_formatter(plt.matplotlib.ticker.NullFormatter())
 ax.set_xlabel("perilune radius [km]")
 ax.set_ylabel(r"stability index $\nu$ [-]")
 ax.set_title("Stability along the southern L2 halo family")
-ax.legend(loc="upper center", fontsize=8)
+ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)  # beside the axes: the band spans the height
+fig.tight_layout()
 _ = plotting.save_figure(fig, "01_halo_stability_vs_perilune", output_dir=out)
 
 # %% [markdown]
@@ -280,16 +281,17 @@ _ = plotting.save_figure(fig, "01_halo_stability_vs_perilune", output_dir=out)
 # (all within $[-1, 1]$, the member chosen is the one farthest from both edges).
 #
 # **Which stable NRHO do notebooks 09 and 10 use, and why?** Both, side by side in every comparison that involves
-# "the stable NRHO", because the paper does not say which it flew. The evidence of their full-mode runs points to
-# the outer band:
+# "the stable NRHO", because the paper does not say which it flew. The evidence of their full-mode runs (their
+# closing tables hold the numbers) points to the outer band:
 #
 # * notebook 09 (observation strategy, angles + rates from L2): the paper finds its stable NRHO "qualitatively
 #   similar but quantitatively better" than the 9:2 and consistent at every cadence. The outer-band member ends
-#   one period with a final 3-sigma position 0.64-0.79 of the 9:2 NRHO's at every cadence and stays consistent at
-#   6-12 h; the inner-band edge is *worse* determined than the 9:2 at every cadence, and 10-35 % of its runs at
-#   6-12 h lose consistency, with or without rates (its perilune is only about 95 km above the surface);
-# * notebook 10 (maneuver detection): accuracies of all three orbits lie within 97-100 %, which 100 + 100 test
-#   runs cannot separate, and the window-tuned filter is most consistent on the outer-band member.
+#   one period with a smaller final 3-sigma position than the 9:2 NRHO at every cadence and stays consistent at
+#   6-12 h; the inner-band edge is *worse* determined than the 9:2 at every cadence, and many of its runs at
+#   6-12 h lose consistency, with or without rates. Notebook 09's regime map shows where: its failures at the
+#   paper's hand-off start at the perilune passage, only about 95 km above the surface;
+# * notebook 10 (maneuver detection): the detection accuracies of the three orbits are too close for 100 + 100
+#   test runs to separate, and the window-tuned filter is most consistent on the outer-band member.
 #
 # So the outer band's most stable member (`orbits.stable_nrho_outer`) is the reading we favour; the name
 # `orbits.stable_nrho` keeps denoting the inner band's edge, and the closing tables of 09 and 10 carry both rows
