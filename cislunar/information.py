@@ -284,7 +284,7 @@ def _sqrt_sweep(P0, F, LQ, Hw, *, keep: bool = False):
     roots of the process noise.
 
     Returns the per-measurement gains :math:`\\tfrac12\\ln|S_k|` (N,) and, with ``keep``: the time-update pre-arrays
-    ``T`` (N, n, 2n) (:math:`T_k = [F_{k-1}V_{k-1},\\ Q_{k-1}^{1/2}]`, :math:`T_0 = [\\bar L_0,\\ 0]`), the
+    ``T`` (N, n, 2n) (:math:`T_k = [F_{k-1}V_{k-1},\\ Q_{k-1}^{1/2}]`, :math:`T_0 = [\\mathrm{chol}\\,P_0,\\ 0]`), the
     inverse transposed measurement post-arrays ``Bi`` (N, M+n, M+n) (:math:`B_k^{-T}`, upper triangular) and the
     transposed posterior factors ``Vt`` (N, n, n) (:math:`V_k^T`, upper triangular).
     """
@@ -475,6 +475,9 @@ def _tri_solve(L, B):
 def _gradient_sqrt(P0, F, Q, H, R, dF, dH):
     """Forward-mode derivative of the square-root recursion of :func:`_sqrt_forward` (p tangent directions).
 
+    ``method="sqrt-forward"``: the default before 2026-11-24, kept as the reference of the reverse mode
+    (:func:`_gradient_sqrt_reverse`), which computes the same derivative at a cost independent of p.
+
     For a lower-triangular factor :math:`LL^T = M`, :math:`dL = L\\,\\Phi(L^{-1}dML^{-T})` with :math:`\\Phi` the
     lower triangle with halved diagonal.  Time update: :math:`M = GG^T + Q`, :math:`G = F\\hat L`, so
     :math:`L^{-1}dML^{-T} = Y + Y^T`, :math:`Y = (L^{-1}dG)(L^{-1}G)^T`.  Measurement update: with the pre-array
@@ -525,8 +528,9 @@ def _gradient_sqrt_reverse(P0, F, Q, H, R, dF, dH):
 
     Notation (whitened :math:`\\hat H_k = L_{R_k}^{-1}H_k`): prior and posterior factors :math:`U_k, V_k`,
     time-update pre-array :math:`T_k = [F_{k-1}V_{k-1},\\ Q_{k-1}^{1/2}]` (:math:`U_kU_k^T = T_kT_k^T`;
-    :math:`T_0 = U_0 = \\mathrm{chol}\\,P_0`), measurement post-array :math:`B_k = [S_k^{1/2}, 0; \\bar K_k, V_k]`
-    (lower triangular, :math:`B_kB_k^T = A_kA_k^T`, :math:`A_k = [I, \\hat H_kU_k; 0, U_k]`) and
+    :math:`T_0 = [U_0,\\ 0]`, :math:`U_0 = \\mathrm{chol}\\,P_0`), measurement post-array
+    :math:`B_k = [S_k^{1/2}, 0; \\bar K_k, V_k]` (lower triangular, :math:`B_kB_k^T = A_kA_k^T`,
+    :math:`A_k = [I, \\hat H_kU_k; 0, U_k]`) and
     :math:`\\mathcal I = \\sum_k\\sum_{i<M}\\ln|(B_k)_{ii}|` nats.
 
     *Reverse rule of a triangular factor.*  If :math:`BB^T = AA^T` then :math:`dB = B\\,\\Phi(Y + Y^T)`,
