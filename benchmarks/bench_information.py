@@ -9,7 +9,9 @@ of 3 targets), derivatives with respect to the six observer coordinates.
 One interleaved best-of-9 run times: the dense value and value + gradient; the structured value; the structured
 value + gradient by reverse mode (``method="sqrt"``, the default), with the process-noise square roots cached as in
 every repeated evaluation of one window (SCvx) and cold (cache cleared before each call); and by forward mode
-(``method="sqrt-forward"``, the 2026-11-22 default).  Then the SCvx planning model of test case 2.
+(``method="sqrt-forward"``, the 2026-11-22 default); and the covariance-form adjoint (``method="adjoint"``, ~1e-5
+relative error; its 2026-11-21 version, with a covariance-form forward pass, gave the 10x of that day), a reference
+for ratios measured under different machine load.  Then the SCvx planning model of test case 2.
 
 ``python -m benchmarks information`` prints the times per evaluation and the ratios; ``main()`` returns them.
 """
@@ -65,7 +67,7 @@ def main() -> dict:
         return I.mutual_information_gradient(*args)
 
     names = ["dense_value", "structured_value", "dense_value_grad", "sqrt_reverse_value_grad",
-             "sqrt_reverse_cold_value_grad", "sqrt_forward_value_grad"]
+             "sqrt_reverse_cold_value_grad", "sqrt_forward_value_grad", "covariance_adjoint_value_grad"]
     times = I._interleaved_best([
         lambda: I.mutual_information_dense(*arrays),
         lambda: I.mutual_information(*arrays),
@@ -73,6 +75,7 @@ def main() -> dict:
         lambda: I.mutual_information_gradient(*args),
         cold,
         lambda: I.mutual_information_gradient(*args, method="sqrt-forward"),
+        lambda: I.mutual_information_gradient(*args, method="adjoint"),
     ], 9, 0.1)
     ms = dict(zip(names, 1e3 * np.array(times)))
     N, M_, n = lin.H.shape
@@ -94,6 +97,7 @@ def main() -> dict:
         "ratio_value_grad_cold": ms["dense_value_grad"] / ms["sqrt_reverse_cold_value_grad"],
         "ratio_forward_over_reverse": ms["sqrt_forward_value_grad"] / ms["sqrt_reverse_value_grad"],
         "ratio_value_grad_forward": ms["dense_value_grad"] / ms["sqrt_forward_value_grad"],
+        "ratio_value_grad_adjoint": ms["dense_value_grad"] / ms["covariance_adjoint_value_grad"],
     }
     print(f"window: {N} measurement times x {M_} measurements, state dim {n}, P_ref = {out['period_days']:.3f} d")
     print(f"MI = {info_s:.6f} nats (gradient's value bit-for-bit mutual_information: "
@@ -107,10 +111,11 @@ def main() -> dict:
           f"ratio {out['ratio_value']:.1f}x")
     print(f"MI + gradient: dense {ms['dense_value_grad']:.3f} ms, reverse mode {ms['sqrt_reverse_value_grad']:.3f} ms "
           f"(cold noise roots {ms['sqrt_reverse_cold_value_grad']:.3f} ms), forward mode "
-          f"{ms['sqrt_forward_value_grad']:.3f} ms")
+          f"{ms['sqrt_forward_value_grad']:.3f} ms, covariance adjoint {ms['covariance_adjoint_value_grad']:.3f} ms")
     print(f"ratios: dense / reverse {out['ratio_value_grad']:.1f}x (cold {out['ratio_value_grad_cold']:.1f}x), "
           f"forward / reverse {out['ratio_forward_over_reverse']:.1f}x, dense / forward "
-          f"{out['ratio_value_grad_forward']:.1f}x")
+          f"{out['ratio_value_grad_forward']:.1f}x, dense / covariance adjoint "
+          f"{out['ratio_value_grad_adjoint']:.1f}x")
     out.update(planning_model())
     return out
 
