@@ -8,8 +8,8 @@ What is here
   DRO), the observation window (:math:`[3P/4, 3P/2]` or :math:`[P, 2P]`), the measurement model and its noise,
   the prior covariances, the process noise, :math:`a_{max}`, node times and per-node thrust bounds.
 * :class:`WindowInformation`: the mutual information of the window (Eq. 18) as a function of the observer state
-  at the window start, with its gradient (Eqs. 44-52, adjoint form) and a Hessian by central differences of the
-  gradient, in the protocol of :func:`cislunar.scvx.solve_scvx` (``info(x, order)`` and ``info.hessian(x)``).
+  at the window start, with its gradient (Eqs. 44-52, reverse mode of the square-root recursion) and a Hessian by
+  central differences of the gradient, in the protocol of :func:`cislunar.scvx.solve_scvx` (``info(x, order)`` and ``info.hessian(x)``).
   Value and gradient describe **the same function**: the augmented process noise :math:`\tilde P`'s Q blocks are
   computed once along a reference (the ballistic guess) and held fixed, exactly what the paper's gradient assumes
   ("this formulation does not account for the sensitivity of the process noise covariance").
@@ -468,7 +468,7 @@ class WindowInformation:
         return float(value), grad
 
     def hessian(self, x) -> np.ndarray:
-        """Symmetrised finite differences of the (square-root, forward-mode) gradient, (6, 6), nats per unit^2.
+        """Symmetrised finite differences of the (square-root, reverse-mode) gradient, (6, 6), nats per unit^2.
 
         ``hessian_scheme="central"`` (default) uses twelve perturbed observers (error O(h^2)); ``"forward"`` six
         plus the gradient at ``x`` (error O(h), half the cost, but on test case 2 its error made SCvx creep: the

@@ -250,10 +250,12 @@ transient = sig_post[:, 1] > sig_post[:, 0]
 # \tilde P\tilde H^T + \tilde H\tilde P\,\partial_\xi\tilde H^T\big)\Big)\quad\text{(Eqs. 47-48)}.$$
 #
 # As the paper says, $\tilde P$ (the process noise) is held fixed. The structured gradient differentiates the
-# square-root Kalman recursion in forward mode (one tangent per parameter, six here), so it keeps the accuracy of
-# the square-root value; the reverse-mode (adjoint) derivative of the covariance form, whose cost does not grow
-# with the number of parameters, is kept as `method="adjoint"` but loses ~5 digits on ill-conditioned windows
-# (test case 2's optimised windows, notebook 06). Both structured and dense gradients are compared with
+# square-root Kalman recursion itself in reverse mode (one forward sweep that keeps the triangular factors, one
+# backward sweep of adjoints; its cost does not grow with the number of parameters), so it keeps the accuracy of
+# the square-root value. The forward-mode derivative of the same recursion (one tangent per parameter) is kept as
+# `method="sqrt-forward"`, the reference it is tested against; the reverse-mode derivative of the covariance form is
+# kept as `method="adjoint"` but loses ~5 digits on ill-conditioned windows (test case 2's optimised windows,
+# notebook 06). Both structured and dense gradients are compared with
 # fourth-order central differences of the full re-propagated MI.
 
 # %%
@@ -388,7 +390,7 @@ ax.loglog(TIMING_SIZES, [1e3 * r.dense_value for r in timings], "o-", label="den
 ax.loglog(TIMING_SIZES, [1e3 * r.structured_value for r in timings], "s-", label="chain rule")
 ax.loglog(TIMING_SIZES, [1e3 * r.dense_gradient for r in timings], "o--", label="dense Eq. 18 + Eqs. 47-50")
 ax.loglog(TIMING_SIZES, [1e3 * r.structured_gradient for r in timings], "s--",
-          label="chain rule + gradient (square-root forward mode)")
+          label="chain rule + gradient (square-root reverse mode)")
 ax.set(xlabel="measurement times N [-]", ylabel="time per evaluation [ms]", title="Evaluation cost")
 ax.set_xticks(TIMING_SIZES, [str(n) for n in TIMING_SIZES])  # plain labels at the sizes run, no minor labels
 ax.xaxis.set_minor_formatter(plt.NullFormatter())
@@ -435,7 +437,7 @@ table.add("Eq. 18 by chain rule (Kalman recursion)", "not in paper",
           "the measurements are far more precise than the prior)")
 table.add("Eqs. 44-52 gradient vs central differences", "formula only", f"max rel. err {grad_err:.1e}",
           "beyond paper" if grad_err < 1e-5 else "differs: gradient disagrees with finite differences",
-          "P~ held fixed as in the paper; dense Eq. 48 and the square-root forward mode agree")
+          "P~ held fixed as in the paper; dense Eq. 48 and the square-root reverse and forward modes agree")
 table.add("Eq. 44 linearisation error at 10 km / 100 km steps", "not in paper",
           f"{lin_err[1]:.2e} / {lin_err[2]:.2e} nats", "beyond paper", "scale for the SCvx trust region")
 table.add("Process-noise PSD (Table 5)", "1e-11 km/s^3",
