@@ -800,8 +800,9 @@ dep_note = "" if rho_dep > 0.8 else (
 table.add("Fig. 7: departure grows with alpha_h", "generally", f"Spearman(alpha, max departure) = {rho_dep:.2f}; "
           + ", ".join(f"{r['alpha']:g}: {d_ / 1e3:.1f}" for r, d_ in zip(ok, dep_max)) + " (10^3 km)",
           "reproduced" if rho_dep > 0.8 else "differs: departure not monotone in alpha",
-          "largest distance from the reference DRO over the scenario; threshold Spearman 0.8"
-          + dep_note)
+          "largest distance from the reference DRO over the scenario; threshold Spearman 0.8; fragile: which local "
+          "optimum a weight lands in moves with round-off (a gradient differing by ~1e-8 relative gave 0.69 on "
+          "2026-11-24), so the correlation, not any single departure, is the evidence" + dep_note)
 table.add("Fig. 7 z-mirror: the mirror of an optimum is an optimum", "postulated family of symmetric optima",
           f"alpha {row_m['alpha']:g}: mirrored optimum re-solved in {twin.iterations} iterations, cost difference "
           f"{twin_dcost:.0e}, distance to the exact mirror {twin_km:.2f} km", "beyond paper",
