@@ -9,8 +9,11 @@ OCBE filter and smoother, z from the smoothed control.
 * ``fast``: :func:`cislunar.detection.run_detection_monte_carlo` with ``batch_size=8`` as notebook 10 calls it
   (same seeds and trials; the block integrator, several batches per lockstep call).
 
-Both see the same seeds; the largest relative difference of z is printed.  Then the filter alone (no draws) per
-engine and lockstep size on the same inputs, the split between drawing and filtering, and the single-trial OCBE.
+Both see the same seeds; the largest relative difference of z is printed.  Then the fast path at the paper's sizes
+for one policy and orbit (500 runs without and 3000 with a maneuver), to show that its cost per trial does not
+change with the size (trials are independent, so the reference path scales the same way), the filter alone (no
+draws) per engine and lockstep size on the same inputs, the split between drawing and filtering, and the
+single-trial OCBE.
 Ratios come from one run (the machine may be shared); no timed assertion.
 Run with ``OMP_NUM_THREADS=1 python -m benchmarks detection``.
 """
@@ -76,6 +79,17 @@ def main(n_trials: int = 128, batch: int = 8, lockstep=(8, 16, 32, 64, 128), n_s
     print(f"Monte Carlo, {n_trials} trials, batch_size {batch}: reference {t_ref / n_trials * 1e3:.1f} ms/trial, "
           f"fast {t_new / n_trials * 1e3:.1f} ms/trial, speed-up {t_ref / t_new:.2f}x, "
           f"max |dz/z| {result['mc_max_rel_dz']:.1e}")
+
+    # the paper's sizes for one policy and orbit (notebook 10 runs this for every policy and orbit, twice)
+    t0 = time.perf_counter()
+    det.run_detection_monte_carlo(setup, None, 500, seed + 2, batch_size=batch, progress=False)
+    det.run_detection_monte_carlo(setup, pol, 3000, seed + 3, batch_size=batch, progress=False)
+    t_paper = time.perf_counter() - t0
+    result["paper_size_fast_s"] = t_paper
+    result["paper_size_reference_projected_s"] = t_ref / n_trials * 3500
+    print(f"paper's sizes (500 H0 + 3000 H1, one policy and orbit): fast {t_paper:.1f} s ({t_paper / 3500 * 1e3:.1f} "
+          f"ms/trial); the reference path at its {t_ref / n_trials * 1e3:.1f} ms/trial would take "
+          f"{t_ref / n_trials * 3500:.0f} s, {t_ref / n_trials * 3500 / t_paper:.1f}x as long")
 
     # where the time goes: drawing the trials vs filtering them
     t_draw, inputs = _best(lambda: [det.draw_trial(c, setup, pol)

@@ -20,7 +20,7 @@ Pieces, in the order of the paper:
   (:func:`cislunar.ocbe.block_integrator`, about four times cheaper than the full 12x12 variational system, which
   the ``engine="reference"`` path keeps).  Both equal the single-trial filter to round-off
   (``tests/test_detection.py``); :func:`run_detection_monte_carlo` runs several batches per lockstep call.  The
-  Monte Carlo is about four times faster than with the first batched OCBE (``benchmarks/bench_detection.py``).
+  Monte Carlo is about six times faster than with the first batched OCBE (``benchmarks/bench_detection.py``).
   Every Monte Carlo trial also records the NEES of its forward and smoothed estimates against its truth, so each
   training or test set doubles as a consistency check of the tuning (:attr:`MonteCarloSample.inconsistent_runs`).
 * **Hypothesis test** (Eqs. 34-35): Gaussian kernel density estimates of :math:`z` under :math:`\mathcal H_0`
