@@ -583,7 +583,8 @@ print(f"every such cell has a burn (H1): {all(h == 'H1' for _, _, h in bad_cells
 # the mean forward NEES without a burn is 4.7-5.1 (below 6: the hand-off covariance is conservative), the mean
 # smoothed NEES on the inner-band stable NRHO is about 8 (slightly optimistic, without making runs fail). Every
 # failing cell has a burn: the forward filter fails in 12-58 % of the burn runs, more for the quiet policy than
-# for the active one, and the smoothed estimate in 10-19 % on the 9:2 quiet cell and the inner-band stable NRHO.
+# for the active one, and the smoothed estimate in 10-19 % of the quiet burn runs on the 9:2 and the inner-band
+# stable NRHO.
 # The forward failures are expected: at $f = 0.1$ the window admits a tenth of the burn's velocity variance, so
 # until the measurements have pulled the estimate over, the error is several standard deviations. At $f_c$ every
 # cell of all three orbits stays at or below 3.2 % of 3000 runs: the window tuning *can* be consistent, as the
