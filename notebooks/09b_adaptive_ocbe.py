@@ -221,7 +221,8 @@ for d in a_big.detections:
           f"the burn), declared at epoch {d.declared_epoch}; metric {d.metric_before:.1f} -> {d.metric_after:.2f}; "
           f"control weight x {d.factor:.3g}")
 print(f"after the reset: {100 * d_big['nees_f_after']:.0f} % of forward epochs and {100 * d_big['nees_s']:.0f} % of "
-      f"smoothed epochs have NEES above the 99.9 % chi2_6 quantile; final position error {d_big['err_final_km']:.2f} km")
+      f"smoothed epochs have NEES above the 99.9 % chi2_6 quantile; final position error "
+      f"{d_big['err_final_km']:.2f} km")
 p_big = panels_of(a_big, big)
 _ = plotting.save_figure(error_panels(a_big, p_big, "3 m/s"), "09b_fig6_adaptive_3ms_errors", output_dir=out)
 
