@@ -768,8 +768,7 @@ class PanelSeries:
         near = np.abs(self.t_sub_days - t0) <= hw
         if not near.any() or near.all():
             raise ValueError(f"t_days +- half_width_days must cover some but not all of the track; got {t0} +- {hw}")
-        u = self.control_norm_m_s2
-        return np.array([u[j][near].mean() / u[j][~near].mean() for j in range(2)])
+        return ocbe.spike_contrast(self.t_sub_days, self.control_norm_m_s2, t0, hw)
 
 
 def panel_series(system: CR3BP, result, truth, control_weight, y, observer_states, model, meas_cov, *,

@@ -1363,11 +1363,8 @@ def control_spike_contrast(setup: DetectionSetup, result: BatchOCBEResult, *, ha
     near = np.abs(result.t_sub - t_b) <= hw
     if not near.any() or near.all():
         raise ValueError("half_width_hours and burn_offset_hours must select some but not all of the track")
-    out = np.empty((result.z_smooth.size, 2))
-    for j, u in enumerate((result.control_step, result.control_smooth)):
-        norm = np.linalg.norm(u, axis=-1)
-        out[:, j] = norm[:, near].mean(axis=-1) / norm[:, ~near].mean(axis=-1)
-    return out
+    norms = np.stack([np.linalg.norm(u, axis=-1) for u in (result.control_step, result.control_smooth)], axis=1)
+    return ocbe.spike_contrast(result.t_sub, norms, t_b, hw)
 
 
 def azimuth_contrast(sample: MonteCarloSample, *, half_width_deg: float = 30.0,

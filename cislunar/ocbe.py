@@ -39,7 +39,8 @@ from .dynamics import CR3BP
 from .propagation import (DEFAULT_TOL, _check_outcome, _check_tol, _grid_from, _heyoka, _inside_primaries,
                           check_outside_primaries, thread_local_copy)
 
-__all__ = ["OCBETransition", "ocbe_transition", "ocbe_process_noise", "estimated_control", "OCBEResult",
+__all__ = ["OCBETransition", "ocbe_transition", "ocbe_process_noise", "estimated_control", "spike_contrast",
+           "OCBEResult",
            "ocbe_filter_smoother", "variational_system", "block_integrator", "BLOCK_LAYOUT",
            "FilterDivergenceError"]
 
@@ -360,6 +361,45 @@ def estimated_control(control_weight: float, phi_pp, p) -> np.ndarray:
         raise ValueError(f"phi_pp must have shape (..., 6, 6); got {phi_pp.shape}")
     p = _checks.as_array(p, "p", shape=(6,))
     return -q * (phi_pp @ p)[..., 3:6]
+
+
+def spike_contrast(t, control_norm, t_centre: float, half_width: float) -> np.ndarray:
+    """How much an estimated control stands out near ``t_centre``: mean norm within ``half_width`` over the mean
+    farther away (1: no spike; the measure of the paper's Figs. 11 and 13).
+
+    Means, not maxima or medians: the forward (single-step) control is a saw-tooth that restarts every interval and
+    the smoothed one spreads a burn over the raised-uncertainty intervals, so the average level is what
+    distinguishes a spike.
+
+    Parameters
+    ----------
+    t : array_like, shape S
+        Times of the control samples, e.g. the (N-1, n_sub) sub-grid of a run (any unit, the same as
+        ``t_centre`` and ``half_width``).
+    control_norm : array_like, shape (...,) + S
+        Control norms at those times (any unit; leading axes are e.g. trials or forward/smoothed).
+    t_centre, half_width : float
+        Centre and half width of the window that should hold the spike.
+
+    Returns
+    -------
+    ndarray, shape (...)
+    """
+    t = _checks.as_array(t, "t")
+    u = _checks.as_array(control_norm, "control_norm")
+    if t.ndim < 1 or u.shape[u.ndim - t.ndim:] != t.shape or u.ndim < t.ndim:
+        raise ValueError(f"control_norm must have shape (..., {', '.join(map(str, t.shape))}) to match t; "
+                         f"got {u.shape}")
+    if np.any(u < 0):
+        raise ValueError("control_norm must hold norms (>= 0)")
+    t0 = _checks.real(t_centre, "t_centre")
+    hw = _checks.positive(half_width, "half_width")
+    near = np.abs(t - t0) <= hw
+    if not near.any() or near.all():
+        raise ValueError(f"t_centre +- half_width must cover some but not all of t; got {t0} +- {hw}")
+    u = u.reshape(u.shape[:u.ndim - t.ndim] + (-1,))
+    near = near.ravel()
+    return u[..., near].mean(axis=-1) / u[..., ~near].mean(axis=-1)
 
 
 # ----------------------------------------------------------------------------------------------------------

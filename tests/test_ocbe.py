@@ -202,3 +202,21 @@ def test_block_integrator_equals_the_full_variational_system(two_hours_near_peri
         ocbe.block_integrator(0)
     with pytest.raises(ValueError, match="tol"):
         ocbe.block_integrator(2, tol=1.0)
+
+
+def test_spike_contrast_of_a_known_spike():
+    """Norm 5 within +-0.1 of 0.5 on a 2-D sub-grid, 1 elsewhere: contrast 5 per leading row; flat: 1."""
+    t = np.linspace(0.0, 1.0, 20).reshape(4, 5)
+    spike = np.where(np.abs(t - 0.5) <= 0.1, 5.0, 1.0)
+    u = np.stack([spike, np.ones_like(t), 2.0 * spike])
+    got = ocbe.spike_contrast(t, u, 0.5, 0.1)
+    assert np.allclose(got, [5.0, 1.0, 5.0], rtol=0, atol=1e-14)
+    # a mean, not a maximum: one large sample among several near samples counts by its share
+    u1 = np.ones_like(t)
+    near = np.flatnonzero(np.abs(t.ravel() - 0.5) <= 0.1)
+    u1.ravel()[near[0]] = 1.0 + near.size
+    assert abs(ocbe.spike_contrast(t, u1, 0.5, 0.1) - 2.0) < 1e-14
+    with pytest.raises(ValueError, match="control_norm"):
+        ocbe.spike_contrast(t, np.ones((2, 3)), 0.5, 0.1)
+    with pytest.raises(ValueError, match="t_centre"):
+        ocbe.spike_contrast(t, u, 5.0, 0.1)

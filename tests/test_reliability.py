@@ -385,6 +385,9 @@ def _specs():
     s.append(S("estimated_control", ocbe.estimated_control, dict(control_weight=1.0, phi_pp=np.eye(6),
                                                                  p=np.ones(6)),
                dict(control_weight="pos", phi_pp="arr", p="arr")))
+    s.append(S("spike_contrast", ocbe.spike_contrast,
+               dict(t=np.linspace(0.0, 1.0, 11), control_norm=np.ones((2, 11)), t_centre=0.5, half_width=0.1),
+               dict(t="arr", control_norm="arr", t_centre="real", half_width="pos")))
     s.append(S("variational_system", ocbe.variational_system, dict(tol=1e-13), dict(tol="range:1e-16:1e-3")))
     s.append(S("block_integrator", ocbe.block_integrator, dict(batch_size=2, tol=1e-13),
                dict(batch_size="int1", tol="range:1e-16:1e-3")))
