@@ -50,7 +50,8 @@ from cislunar.report import ComparisonTable
 
 plotting.use_style()
 out = OUTPUT_DIR or None
-table = ComparisonTable("01 CR3BP and reference orbits (Greaves & Scheeres 2021 §Dynamics, Wolf & Jones Tables 2 and 4)")
+table = ComparisonTable("01 CR3BP and reference orbits "
+                        "(Greaves & Scheeres 2021 §Dynamics, Wolf & Jones Tables 2 and 4)")
 
 # %% [markdown]
 # ## 1 · The CR3BP in the rotating frame
@@ -157,53 +158,89 @@ print(f"printed observer state: C = {em.jacobi(np.array([obs.x0, 0, 0, 0, obs.vy
 
 dro_x0 = np.linspace(0.95, 0.70, DRO_MEMBERS)
 dros = orbits.dro_family(em, dro_x0)
-fig, (ax1, axz, ax2) = plt.subplots(1, 3, figsize=(15, 5.2), gridspec_kw=dict(width_ratios=[1.25, 0.8, 1]))
-for orb in dros[:: max(1, len(dros) // 12)]:
-    _, xs = orb.sample(400)
-    plotting.plot_rotating(ax1, xs, em, "xy", units="km", moon_centred=True, color="0.75", lw=0.8)
-    plotting.plot_rotating(axz, xs, em, "xy", units="km", moon_centred=True, color="0.75", lw=0.8)
-# Table 2 and Table 4 print the same observer_t0 row: one curve, one colour, both labels.
+# Table 2 and Table 4 print the same observer_t0 row: one orbit, one colour, both labels.
 wj_groups = {}
 for c in checks:
     wj_groups.setdefault((c.x0, c.vy0), []).append(c)
-wj_groups = list(wj_groups.values())
-wj_colours = [plt.cm.tab10(i % 10) for i in (0, 1, 2, 4, 5, 6, 8, 9, 0, 1)[:len(wj_groups)]]  # no red (printed observer)
+wj_groups = sorted(wj_groups.values(), key=lambda g: g[0].x0)  # left to right in the zoom panels
+wj_colours = [plt.cm.tab10(i) for i in (0, 1, 2, 4, 5, 6, 8, 9)[:len(wj_groups)]]  # no red (printed observer)
+x_moon = em.secondary_position[0]
+wj_cross = np.array([(g[0].x0 - x_moon) * em.length_unit_km for g in wj_groups])  # Moon-centred x0, km
+wj_period = np.array([g[0].corrected.period_days for g in wj_groups])
+print(f"W&J DROs: {len(wj_groups)} distinct orbits, x-axis crossings {wj_cross.min():.0f} to {wj_cross.max():.0f} km "
+      f"from the Moon (spread {np.ptp(wj_cross):.0f} km), periods {wj_period.min():.3f}-{wj_period.max():.3f} d; "
+      f"family drawn: periods {min(o.period_days for o in dros):.1f}-{max(o.period_days for o in dros):.1f} d")
+# Members of the family across the zoom window, seeded by a W&J orbit (the coarse family is too sparse there).
+zoom_x0 = np.linspace(wj_cross.max() + 1500.0, wj_cross.min() - 1500.0, 12) / em.length_unit_km + x_moon
+dros_zoom = orbits.dro_family(em, zoom_x0, seed=wj_groups[-1][0].corrected.x0)
+
+fig = plt.figure(figsize=(14, 6.2))
+grid = fig.add_gridspec(1, 3, width_ratios=[0.62, 1, 1])
+ax1, axz, ax2 = (fig.add_subplot(grid[0, k]) for k in range(3))
+for orb in dros[:: max(1, len(dros) // 12)]:
+    _, xs = orb.sample(400)
+    plotting.plot_rotating(ax1, xs, em, "xy", units="km", moon_centred=True, color="0.75", lw=0.8)
+ax1.plot([], [], color="0.75", lw=0.8, label="DRO family")
 for group, col in zip(wj_groups, wj_colours):
     _, xs = group[0].corrected.sample(2000)
     plotting.plot_rotating(ax1, xs, em, "xy", units="km", moon_centred=True, color=col, lw=1.2)
     plotting.plot_rotating(axz, xs, em, "xy", units="km", moon_centred=True, color=col, lw=1.5,
                            label=" = ".join(f"Table {c.table}: {c.label}" for c in group))
-_, bad = (lambda s: (None, propagation.propagate(em, s, np.linspace(0, obs.corrected.period, 400)).x))(
-    np.array([obs.x0, 0, 0, 0, obs.vy0, 0]))
+bad = propagation.propagate(em, np.array([obs.x0, 0, 0, 0, obs.vy0, 0]), np.linspace(0, obs.corrected.period, 400)).x
 plotting.plot_rotating(ax1, bad, em, "xy", units="km", moon_centred=True, color="C1", ls="--",
                        label="observer state as printed (not periodic)")
 plotting.plot_primaries(ax1, em, "xy", moon_centred=True, units="km", earth=False)
-ax1.set_title("DRO family (grey), Wolf & Jones orbits (colour)", fontsize=10)
-# Tick labels in thousands of km so that they cannot collide.
-for ax in (ax1, axz):
-    ax.xaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
-    ax.yaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
-    ax.set_xlabel("x (Moon-centred) [10³ km]")
-    ax.set_ylabel("y [10³ km]")
-ax1.locator_params(axis="both", nbins=5)
-ax1.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), frameon=False, fontsize=8)
-# Zoom on the -x crossing, where the Wolf & Jones orbits (x0 within ~0.01 LU of each other) separate.
-x_wj = np.array([(c.x0 - em.secondary_position[0]) * em.length_unit_km for c in checks])
-axz.set_xlim(x_wj.min() - 1500.0, x_wj.max() + 1500.0)
+ax1.set_aspect("equal", adjustable="box")  # the panel takes the family's shape: no empty side margins
+ax1.set_title("DRO family (grey) and\nWolf & Jones orbits (colour)", fontsize=10)
+plotting.thousands_km_axes(ax1, "xy", nbins=4)
+plotting.thousands_km_axes(axz, "xy")
+# Zoom on the -x crossing, where the Wolf & Jones orbits (x0 within ~0.004 LU of each other) separate.
+axz.set_xlim(wj_cross.min() - 1500.0, wj_cross.max() + 1500.0)
 axz.set_ylim(-15000.0, 15000.0)
 axz.set_aspect("auto")
-axz.locator_params(axis="x", nbins=4)
-axz.set_title("zoom: x-axis crossing of the W&J DROs", fontsize=10)
-axz.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=1, frameon=False, fontsize=8)
-ax2.plot([o.x0[0] for o in dros], [o.period_days for o in dros], "-", color="0.5", label="DRO family")
-for group, col in zip(wj_groups, wj_colours):
-    ax2.plot(group[0].x0, group[0].corrected.period_days, "o", color=col, ms=5)
-ax2.plot([], [], "o", color="0.3", label="Tables 2, 4 (corrected; colours as zoom)")
-ax2.set_xlabel("x-axis crossing x0 (barycentric) [LU]")
+axz.set_title("zoom: where the W&J DROs cross the x axis", fontsize=10)
+# Period against the same crossing coordinate: each marker sits below its orbit's crossing in the zoom panel.
+ax2.plot([(o.x0[0] - x_moon) * em.length_unit_km for o in dros_zoom], [o.period_days for o in dros_zoom], "-",
+         color="0.6", lw=1, zorder=1)
+for x, p, col in zip(wj_cross, wj_period, wj_colours):
+    ax2.plot(x, p, "o", color=col, ms=7, mec="k", mew=0.5, zorder=3)
+ax2.set_xlim(axz.get_xlim())
+ax2.set_ylim(wj_period.min() - 0.25 * np.ptp(wj_period), wj_period.max() + 0.25 * np.ptp(wj_period))
+ax2.xaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v / 1e3:g}"))
+for ax in (axz, ax2):  # one tick per 10³ km in both panels, so that crossings and markers line up by eye
+    ax.xaxis.set_major_locator(plt.MultipleLocator(1000.0))
+ax2.set_xlabel("x-axis crossing (Moon-centred) [10³ km]")
 ax2.set_ylabel("period [days]")
-ax2.legend(loc="lower left")  # the family line runs from upper left to lower right: this corner is empty
-fig.tight_layout()
+ax2.set_title("period of each W&J DRO (same x scale as the zoom)", fontsize=10)
+# Inset: the whole family, with the window of the main panel boxed.
+ins = ax2.inset_axes([0.58, 0.55, 0.39, 0.40])
+ins.plot([(o.x0[0] - x_moon) * em.length_unit_km / 1e3 for o in dros], [o.period_days for o in dros], "-",
+         color="0.4", lw=1)
+ins.add_patch(plt.Rectangle((ax2.get_xlim()[0] / 1e3, wj_period.min() - 0.6), np.ptp(ax2.get_xlim()) / 1e3,
+                            np.ptp(wj_period) + 1.2, fill=False, ec="k", lw=0.8))
+ins.set_xlabel("crossing [10³ km]", fontsize=7, labelpad=1)
+ins.set_ylabel("period [d]", fontsize=7, labelpad=1)
+ins.tick_params(labelsize=7)
+ins.set_title("whole family (box: this panel)", fontsize=7, pad=2)
+ins.grid(False)
+handles, labels = [], []
+for ax in (ax1, axz):
+    for h, lab in zip(*ax.get_legend_handles_labels()):
+        handles.append(h)
+        labels.append(lab)
+fig.legend(handles, labels, loc="lower center", ncol=4, frameon=False, fontsize=8)  # below the panels, off the data
+fig.tight_layout(rect=(0, 0.12, 1, 1))
 _ = plotting.save_figure(fig, "01_dro_family_wolf_jones", output_dir=out)
+
+# %% [markdown]
+# **Reading the figure.** At the scale of the family (left) the Wolf & Jones orbits are indistinguishable; the
+# middle panel zooms on their crossing of the -x axis, where the seven distinct orbits (Tables 2 and 4 print the
+# same observer_t0 row) lie within about 1.4×10³ km of one another (spread printed above). The right panel plots
+# each orbit's period against the same crossing coordinate, so every marker sits below its orbit's crossing in the
+# middle panel (observer_t0 is drawn from its corrected, periodic state): all of them fall on the family curve, and
+# the farther an orbit crosses from the Moon, the longer its period. The inset places this window on the whole
+# family. The dashed red curve (left) is the observer state as printed, propagated for one period: it is far from
+# periodic.
 
 # %% [markdown]
 # ## 4 · The southern L2 halo family and the NRHOs
@@ -335,40 +372,127 @@ dro_obs = sites.dro_observer_orbit(em)
 stations = sites.DEFAULT_STATIONS
 span = np.linspace(0.0, 5 * nrho.period, 5 * SAMPLES // 2)  # five NRHO periods, DRO observer running alongside
 visibility = {}
-for name, o in (("9:2", nrho), ("stable", stable)):
+for name, o in (("9:2", nrho), ("stable (inner)", stable), ("stable (outer)", outer)):
     xt = propagation.propagate(em, o.x0, span).x
     xd = propagation.propagate(em, dro_obs.x0, span).x
     cov = sites.surface_coverage(em, o.sample(SAMPLES)[1], stations)
-    pairs = [cov[[i, j]].any(axis=0).mean() for i in range(3) for j in range(i + 1, 3)]
+    pairs = {(i, j): cov[[i, j]].any(axis=0).mean() for i in range(3) for j in range(i + 1, 3)}
+    best = max(pairs, key=pairs.get)
     visibility[name] = dict(
         l2=sites.line_of_sight_clear(em, l2_state, xt).mean(),
         dro=sites.line_of_sight_clear(em, xd, xt).mean(),
-        single=cov.mean(axis=1), best_pair=max(pairs), all3=cov.any(axis=0).mean(),
+        single=cov.mean(axis=1), best_pair=pairs[best], best_pair_stations=best, all3=cov.any(axis=0).mean(),
     )
     v = visibility[name]
-    print(f"{name:7s} NRHO: L2 line of sight clear {100*v['l2']:.2f}% | DRO observer clear {100*v['dro']:.2f}% | "
-          f"stations alone {np.round(100*v['single'], 1)}% | best pair {100*v['best_pair']:.1f}% | "
-          f"all three {100*v['all3']:.2f}%")
+    print(f"{name:14s} NRHO: L2 line of sight clear {100*v['l2']:.2f}% | DRO observer clear {100*v['dro']:.2f}% | "
+          f"stations alone {np.round(100*v['single'], 1)}% | best pair {100*v['best_pair']:.1f}% "
+          f"({' + '.join(stations[k].name for k in best)}) | all three {100*v['all3']:.2f}%")
 
-fig, axes = plotting.three_plane_axes(figsize=(13, 4.5))
-for o in (nrho, stable):
-    plotting.plot_three_planes(axes, o.sample(1200)[1], em, moon_centred=True, units="km", color="C0", lw=1)
-plotting.plot_three_planes(axes, dro_obs.sample(800)[1], em, moon_centred=True, units="km", color="C1", lw=1.2,
+# %% [markdown]
+# At the scale of the observers (10⁵ km) the Moon and the three stations are a single dot, so the figure below
+# adds two close-ups. **Bottom left:** the Moon seen along the x axis (the y-z plane, viewed from the L2 side).
+# All three stations lie in that plane, and each station's horizon plane contains the x direction, so it appears
+# as a dashed line tangent to the Moon: the station sees what lies beyond its line. **Bottom right:** the six hours
+# either side of the 9:2 NRHO's perilune (half a period after apolune, by the orbit's symmetry), with a bar
+# wherever a station has the spacecraft above its horizon (intervals printed below).
+#
+# The south-pole station sees the long southern apolune arc, nearly the whole period, but loses the spacecraft
+# for about four hours around perilune, when it passes over the northern hemisphere. The station at 45°N 90°E (on
+# the -y side) sees the approach up to perilune, the one at 45°N 90°W the departure. Hence no pair suffices: the
+# south pole with either northern station leaves about two hours of the passage uncovered (after or before
+# perilune), and the two northern stations together see only a few percent of the period. All three together see
+# the whole orbit. For the inner-band stable NRHO, whose perilune is only about 95 km above the surface, even three
+# stations leave a short gap (its "all three" value above is below 100%); the outer-band orbit is fully covered.
+
+# %%
+# Visibility from each station around the 9:2 NRHO's perilune (apolune at t = 0, perilune at T/2 by symmetry).
+HOURS = 6.0  # half-width of the time window drawn, hours
+t_peri = np.linspace(-HOURS, HOURS, 1441)  # 30-s grid, hours from perilune
+# The grid starts at apolune (t = 0, where nrho.x0 holds) and the first point is dropped.
+x_peri = propagation.propagate(em, nrho.x0, np.r_[0.0, nrho.period / 2 + t_peri * 3600.0 / em.time_unit_s]).x[1:]
+cov_peri = sites.surface_coverage(em, x_peri, stations)
+best_pair = visibility["9:2"]["best_pair_stations"]
+rows = [(stations[k].name, cov_peri[k]) for k in range(3)]
+rows += [(f"best pair: {' + '.join(stations[k].name for k in best_pair)}", cov_peri[list(best_pair)].any(axis=0)),
+         ("all three", cov_peri.any(axis=0))]
+
+def visible_intervals(seen):
+    """(start, end) in hours from perilune of each run of True in ``seen`` (sampled on ``t_peri``)."""
+    edges = np.flatnonzero(np.diff(np.r_[0, seen.astype(int), 0]))
+    return [(t_peri[a], t_peri[b - 1]) for a, b in zip(edges[::2], edges[1::2])]
+
+
+print(f"9:2 NRHO above the horizon within +-{HOURS:g} h of perilune (hours from perilune):")
+for label, seen in rows:
+    print(f"  {label:32s} " + ", ".join(f"{a:+.1f} to {b:+.1f}" for a, b in visible_intervals(seen)))
+
+station_colours = ("C3", "C5", "C7")  # orange, teal, gold: distinct from the orbits (blue, red, green, purple)
+orbit_styles = ((nrho, "C0", "9:2 NRHO"), (stable, "C1", "stable NRHO (inner band)"),
+                (outer, "C2", "stable NRHO (outer band)"))
+fig = plt.figure(figsize=(13, 9.4))
+grid = fig.add_gridspec(2, 3, height_ratios=[1, 0.9])
+axes = {plane: fig.add_subplot(grid[0, k]) for k, plane in enumerate(("xy", "xz", "yz"))}
+ax_moon = fig.add_subplot(grid[1, 0])
+ax_time = fig.add_subplot(grid[1, 1:])
+for o, colour, label in orbit_styles:
+    xs = o.sample(1500)[1]
+    plotting.plot_three_planes(axes, xs, em, moon_centred=True, units="km", color=colour, lw=1.1, label=label)
+    plotting.plot_rotating(ax_moon, xs, em, "yz", moon_centred=True, units="km", color=colour, lw=1.3)
+plotting.plot_three_planes(axes, dro_obs.sample(800)[1], em, moon_centred=True, units="km", color="C4", lw=1.2,
                            label="DRO observer")
+p_l2 = (l2_state[:3] - em.secondary_position) * em.length_unit_km
 for plane, ax in axes.items():
     plotting.plot_primaries(ax, em, plane, moon_centred=True, units="km", earth=False)
     i, j = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}[plane]
-    p = (l2_state[:3] - em.secondary_position) * em.length_unit_km
-    ax.plot(p[i], p[j], "*", color="C1", ms=12, label="L2 observer")
-    for s in stations:
-        q = (s.position(em) - em.secondary_position) * em.length_unit_km
-        ax.plot(q[i], q[j], "^", color="C1", ms=6)
-for plane, ax in axes.items():  # tick labels in thousands of km, at most five per axis: no collisions
-    plotting.thousands_km_axes(ax, plane)
-handles, labels = axes["xy"].get_legend_handles_labels()
-fig.legend(handles, labels, loc="lower center", ncol=len(labels), frameon=False)  # below the panels
-fig.suptitle("Observer sites (red) and the NRHOs (blue), Moon-centred; triangles: surface stations")
-fig.tight_layout(rect=(0, 0.07, 1, 1))
+    ax.plot(p_l2[i], p_l2[j], "*", color="k", ms=12, zorder=4, label="L2 observer")
+    plotting.thousands_km_axes(ax, plane)  # tick labels in thousands of km, at most five per axis: no collisions
+axes["yz"].annotate(f"L2 observer (x = +{p_l2[0] / 1e3:.1f}×10³ km)\nprojects onto the Moon here", xy=(0, 0),
+                    xytext=(0.97, 0.97), textcoords="axes fraction", ha="right", va="top", fontsize=8,
+                    arrowprops=dict(arrowstyle="->", color="0.3", lw=0.8))
+axes["xz"].set_title("x-z plane", fontsize=10)
+axes["xy"].set_title("x-y plane (Earth-Moon plane)", fontsize=10)
+axes["yz"].set_title("y-z plane (viewed from +x, the L2 side)", fontsize=10)
+
+# Zoom on the Moon (y-z plane): stations and their horizon lines.
+plotting.plot_primaries(ax_moon, em, "yz", moon_centred=True, units="km", earth=False)
+R = em.secondary_radius_km
+for s, colour in zip(stations, station_colours):
+    q = (s.position(em) - em.secondary_position) * em.length_unit_km
+    up = q[1:] / np.linalg.norm(q[1:])  # local vertical in the y-z plane (stations lie in it: longitude +-90 or pole)
+    along = np.array([-up[1], up[0]])
+    ends = q[1:] + np.outer([-1.0, 1.0], along) * 3 * R
+    ax_moon.plot(ends[:, 0], ends[:, 1], "--", color=colour, lw=1)
+    ax_moon.plot(q[1], q[2], "^", color=colour, ms=9, mec="k", mew=0.6, zorder=5, label=f"station {s.name}")
+ax_moon.plot([], [], "--", color="0.4", lw=1, label="station horizon (the station sees beyond its line)")
+ax_moon.set_xlim(-2.6 * R, 2.6 * R)
+ax_moon.set_ylim(-2.2 * R, 2.9 * R)
+ax_moon.set_aspect("equal", adjustable="box")
+plotting.thousands_km_axes(ax_moon, "yz")
+ax_moon.set_title("zoom on the Moon, y-z plane (viewed from +x)", fontsize=10)
+
+# Timeline: which stations see the 9:2 NRHO around its perilune passage.
+for k, ((label, seen), colour) in enumerate(zip(rows, (*station_colours, "0.45", "k"))):
+    y = len(rows) - 1 - k
+    ax_time.broken_barh([(a, b - a) for a, b in visible_intervals(seen)], (y - 0.2, 0.4), color=colour)
+    ax_time.text(-HOURS + 0.1, y + 0.27, label, fontsize=8, va="bottom")
+ax_time.axvline(0.0, color="0.3", ls=":", lw=1)
+ax_time.text(0.1, -0.6, "perilune", fontsize=8, color="0.3")
+ax_time.set_xlim(-HOURS, HOURS)
+ax_time.set_ylim(-0.7, len(rows) - 0.2)
+ax_time.set_yticks([])
+ax_time.grid(axis="y", visible=False)
+ax_time.set_xlabel("time from the 9:2 NRHO's perilune [h]")
+ax_time.set_title("when each station has the 9:2 NRHO above its horizon (bars)", fontsize=10)
+
+handles, labels = [], []
+for ax in (axes["xy"], ax_moon):
+    for h, lab in zip(*ax.get_legend_handles_labels()):
+        if lab not in labels:
+            handles.append(h)
+            labels.append(lab)
+fig.legend(handles, labels, loc="lower center", ncol=5, frameon=False, fontsize=8)  # below the panels, off the data
+fig.suptitle("Observer sites and the NRHOs (Moon-centred, rotating frame)")
+fig.tight_layout(rect=(0, 0.06, 1, 1))
 _ = plotting.save_figure(fig, "01_observer_sites_fig3", output_dir=out)
 
 # %% [markdown]
@@ -414,7 +538,8 @@ P = obs.corrected.period_days
 table.add("W&J test case 1 observation window [d]", "12 to 23", f"{0.75 * P:.1f} to {1.5 * P:.1f}",
           "differs: the text's 23 d end is not 3P/2",
           f"window [3P/4, 3P/2] with P = {P:.2f} d (corrected observer DRO) ends at {1.5 * P:.1f} d")
-table.add("W&J time unit", "P_synodic / 2 pi", f"{em.time_unit_days:.5f} d (2 pi TU = {2*np.pi*em.time_unit_days:.2f} d)",
+table.add("W&J time unit", "P_synodic / 2 pi",
+          f"{em.time_unit_days:.5f} d (2 pi TU = {2 * np.pi * em.time_unit_days:.2f} d)",
           "differs: naming only", "the primaries' period about the barycentre is the sidereal, not synodic, month")
 table.add("STM vs central differences (9:2 period)", "-", f"{best_stm:.1e}", "beyond paper", "relative, best step")
 table.add("STT vs central differences of the STM", "-", f"{best_stt:.1e}", "beyond paper", "relative, best step")
