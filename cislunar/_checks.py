@@ -238,6 +238,36 @@ def seed_entropy(value, name: str = "seed"):
     return value
 
 
+def int_seed_list(value, name: str = "seed", *, why: str = "an index is appended per set") -> list:
+    """A root seed given as a non-negative int or a flat sequence of them, as a list (``SeedSequence`` refused).
+
+    For callers that derive sub-seeds by appending an index (``base + [k]``); ``why`` says so in the refusal.
+    """
+    seed_entropy(value, name)
+    if isinstance(value, np.random.SeedSequence):
+        raise ArgumentTypeError(f"{name} must be an int or a list of ints here ({why}); got a SeedSequence")
+    return [int(v) for v in np.atleast_1d(value)]
+
+
+def sequence_of(value, name: str, cls, what: str) -> list:
+    """A non-empty sequence whose items are all ``cls`` instances, as a list (``what`` names the class, no article).
+
+    A single instance, a str/bytes/dict or a non-iterable is refused with an ``ArgumentTypeError`` naming ``name``;
+    a wrong item is named by its index (``name[i]``).
+    """
+    if isinstance(value, (cls, str, bytes, dict)):
+        raise ArgumentTypeError(f"{name} must be a sequence of {what}; got a single {_type_name(value)}")
+    try:
+        items = list(value)
+    except TypeError:
+        raise ArgumentTypeError(f"{name} must be a sequence of {what}; got {_type_name(value)}") from None
+    if not items:
+        raise ValueError(f"{name} must hold at least one {what}")
+    for i, item in enumerate(items):
+        instance(item, f"{name}[{i}]", cls, f"a {what}")
+    return items
+
+
 def one_or_many(value, name: str, single, what: str) -> tuple:
     """A non-empty tuple from one item of type ``single`` or an iterable of them.
 

@@ -1252,10 +1252,7 @@ def run_policy_study(setup: DetectionSetup, policy: StationKeepingPolicy, n_h0: 
     """
     _check_setup(setup)
     _check_policy(policy)
-    _checks.seed_entropy(seed, "seed")
-    if isinstance(seed, np.random.SeedSequence):
-        raise _checks.ArgumentTypeError("seed must be an int or a list of ints here (the four sets append an index)")
-    base = [int(v) for v in np.atleast_1d(seed)]
+    base = _checks.int_seed_list(seed, "seed", why="the four sets append an index")
     _checks.integer(n_h0, "n_h0", minimum=2)
     _checks.integer(n_h1, "n_h1", minimum=2)
     n_test = _checks.integer(n_test, "n_test", minimum=0)
@@ -1282,18 +1279,7 @@ def run_policy_study(setup: DetectionSetup, policy: StationKeepingPolicy, n_h0: 
 
 
 def _check_inputs(inputs, name: str = "inputs") -> list:
-    if isinstance(inputs, TrialInputs):
-        raise _checks.ArgumentTypeError(f"{name} must be a sequence of TrialInputs, not a single one")
-    try:
-        items = list(inputs)
-    except TypeError:
-        raise _checks.ArgumentTypeError(f"{name} must be a sequence of cislunar.detection.TrialInputs; got "
-                                        f"{type(inputs).__name__}") from None
-    if not items:
-        raise ValueError(f"{name} must hold at least one trial")
-    for i, item in enumerate(items):
-        _checks.instance(item, f"{name}[{i}]", TrialInputs, "a cislunar.detection.TrialInputs (draw_trial)")
-    return items
+    return _checks.sequence_of(inputs, name, TrialInputs, "cislunar.detection.TrialInputs (draw_trial)")
 
 
 def filter_trials(setup: DetectionSetup, inputs, *, n_epochs: int | None = None) -> BatchOCBEResult:
@@ -1423,10 +1409,7 @@ def direction_response(setup: DetectionSetup, directions, magnitude_m_s: float, 
     dirs = _checks.as_array(directions, "directions", ndim=(2,), last=2, min_size=2)
     mag = _checks.positive(magnitude_m_s, "magnitude_m_s")
     n_rep = _checks.integer(n_repeats, "n_repeats", minimum=1)
-    _checks.seed_entropy(seed, "seed")
-    if isinstance(seed, np.random.SeedSequence):
-        raise _checks.ArgumentTypeError("seed must be an int or a list of ints here (repeats append an index)")
-    base = [int(v) for v in np.atleast_1d(seed)]
+    base = _checks.int_seed_list(seed, "seed", why="repeats append an index")
     off = _checks.real(burn_offset_hours, "burn_offset_hours")
     inputs = [draw_trial(np.random.default_rng(base + [k]), setup, magnitude_m_s=mag, direction=d,
                          burn_offset_hours=off) for k in range(n_rep) for d in dirs]
@@ -1539,10 +1522,7 @@ def health_lead_study(setup: DetectionSetup, magnitudes_m_s, n_h0: int, n_h1: in
         raise ValueError("magnitudes_m_s must be positive")
     n0 = _checks.integer(n_h0, "n_h0", minimum=10)
     n1 = _checks.integer(n_h1, "n_h1", minimum=1)
-    _checks.seed_entropy(seed, "seed")
-    if isinstance(seed, np.random.SeedSequence):
-        raise _checks.ArgumentTypeError("seed must be an int or a list of ints here (the sets append an index)")
-    base = [int(v) for v in np.atleast_1d(seed)]
+    base = _checks.int_seed_list(seed, "seed", why="the sets append an index")
     horizon = _checks.positive(horizon_hours, "horizon_hours")
     p = _checks.in_range(tail_probability, "tail_probability", 0.0, 0.5, closed=False)
     _checks.boolean(progress, "progress")

@@ -775,16 +775,5 @@ def random_choice_trial(rng: np.random.Generator, scenarios) -> FilterTrialResul
     Models an *uninformed* station-keeping choice: the target phase is picked without regard to information.
     """
     _checks.rng(rng)
-    if isinstance(scenarios, (str, bytes, dict)):
-        raise _checks.ArgumentTypeError(f"scenarios must be a sequence of FilterScenario; got "
-                                        f"{type(scenarios).__name__}")
-    try:
-        scenarios = tuple(scenarios)
-    except TypeError:
-        raise _checks.ArgumentTypeError(f"scenarios must be a sequence of FilterScenario; got "
-                                        f"{type(scenarios).__name__}") from None
-    if not scenarios:
-        raise ValueError("scenarios must hold at least one FilterScenario")
-    for k, sc in enumerate(scenarios):
-        _checks.instance(sc, f"scenarios[{k}]", FilterScenario, "a cislunar.station_keeping.FilterScenario")
+    scenarios = _checks.sequence_of(scenarios, "scenarios", FilterScenario, "cislunar.station_keeping.FilterScenario")
     return filter_trial(rng, scenarios[int(rng.integers(len(scenarios)))])

@@ -1313,3 +1313,23 @@ def test_detection_monte_carlo_failure_names_the_batch_trials(monkeypatch):
         detection.run_detection_monte_carlo(setup(), None, 5, 0, batch_size=2, progress=False)
     assert info.value.trial_index == 2 and sorted(info.value.completed) == [0, 1]
     assert isinstance(info.value.failure.error, ocbe.FilterDivergenceError)
+
+
+def test_sequence_and_seed_list_helpers_name_the_argument():
+    from cislunar import _checks
+
+    class Item:
+        pass
+
+    a, b = Item(), Item()
+    assert _checks.sequence_of((a, b), "items", Item, "Item") == [a, b]
+    assert _checks.sequence_of(iter([a]), "items", Item, "Item") == [a]
+    for bad, exc, text in ((a, TypeError, "got a single Item"), ("ab", TypeError, "got a single str"),
+                           ({"k": a}, TypeError, "single dict"), (3, TypeError, "got int"),
+                           ([], ValueError, "at least one Item"), ([a, 3], TypeError, r"items\[1\] must be a Item")):
+        with pytest.raises(exc, match=text):
+            _checks.sequence_of(bad, "items", Item, "Item")
+    assert _checks.int_seed_list(5, "seed") == [5] and _checks.int_seed_list([1, 2], "seed") == [1, 2]
+    for bad, text in ((np.random.SeedSequence(1), "appended"), (None, "None"), (-1, "seed"), ([], "empty")):
+        with pytest.raises((TypeError, ValueError), match=text):
+            _checks.int_seed_list(bad, "seed", why="an index is appended")
