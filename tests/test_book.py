@@ -332,14 +332,18 @@ MATH_STATE = """
 """
 
 
+# Sphinx lists the results one by one and writes its summary ("Search finished, found N pages ...") only at the end:
+# wait for the summary, not for the first hit (which may be another page).
 SEARCH_HITS = """
 (async () => {
-  for (let k = 0; k < 200; k++) {
-    const links = [...document.querySelectorAll('#search-results li a')].map(a => a.getAttribute('href'));
-    if (links.length) { return links; }
+  for (let k = 0; k < 300; k++) {
+    const summary = document.querySelector('#search-results p.search-summary');
+    if (summary && summary.innerText.trim()) {
+      return [...document.querySelectorAll('#search-results li a')].map(a => a.getAttribute('href'));
+    }
     await new Promise(r => setTimeout(r, 100));
   }
-  return [];
+  return ['(search did not finish in 30 s)'];
 })()
 """
 
