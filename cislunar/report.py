@@ -13,13 +13,24 @@ import numpy as np
 
 from . import _checks
 
-__all__ = ["ComparisonTable", "Row", "REPORT_METADATA_KEY", "STATUSES", "fmt"]
+__all__ = ["ComparisonTable", "Row", "REPORT_METADATA_KEY", "STATUSES", "STATUS_MEANINGS", "fmt"]
 
 #: Key placed in the display metadata of a rendered table.
 REPORT_METADATA_KEY = "cislunar_report"
 #: Allowed status words (the guide's rule); "differs" and "not in paper" need a reason.  "consistent (tuned)": agrees
 #: only after a choice made while looking at the paper's number.
 STATUSES = ("reproduced", "consistent (tuned)", "differs", "derived", "not in paper", "beyond paper")
+#: What each status word means; shown under every table for the words it uses.
+STATUS_MEANINGS = {
+    "reproduced": "an independent prediction that agrees with the paper within a tolerance fixed before comparing "
+                  "(stated in the row)",
+    "consistent (tuned)": "agrees only after a choice made while looking at the paper's number",
+    "differs": "does not agree; the reason follows, and where the paper's claim rests on something unstated, the "
+               "search for the regime in which it holds",
+    "derived": "the paper gives no number; computed here from what it does give",
+    "not in paper": "an input or value the paper does not state (our choice, or a missing table)",
+    "beyond paper": "a check or result the paper does not attempt",
+}
 
 
 def fmt(value, digits: int = 6) -> str:
@@ -108,15 +119,23 @@ class ComparisonTable:
             lines.append("| " + " | ".join(str(c).replace("|", "\\|").replace("\n", " ") for c in cells) + " |")
         return "\n".join(lines)
 
+    def legend(self) -> str:
+        """What the status words used in this table mean (Markdown, one line per word, in :data:`STATUSES` order)."""
+        used = {r.status.split(":")[0].strip() for r in self.rows}
+        return "\n".join(f"- **{w}**: {STATUS_MEANINGS[w]}" for w in STATUSES if w in used)
+
     def _repr_markdown_(self):
         return self.to_markdown()
 
     def display(self) -> None:
-        """Show the table in a notebook, tagged for the report gatherer (falls back to printing)."""
+        """Show the table in a notebook, tagged for the report gatherer, then the legend of its status words (not
+        tagged: ``build/report.md`` states the rule once in its header).  Falls back to printing."""
         md = self.to_markdown()
+        legend = "*Status words in this table:*\n\n" + self.legend()
         try:
             from IPython.display import display
         except ImportError:  # pragma: no cover - IPython is a notebook dependency
-            print(md)
+            print(md + "\n\n" + legend)
             return
         display({"text/markdown": md, "text/plain": md}, raw=True, metadata={REPORT_METADATA_KEY: True})
+        display({"text/markdown": legend, "text/plain": legend}, raw=True)

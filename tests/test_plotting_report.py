@@ -256,3 +256,15 @@ def test_axis_label_problems_rejects_non_figures():
         plotting.axis_label_problems("not a figure")
     with pytest.raises(TypeError, match="label"):
         plotting.has_unit(3)
+
+
+def test_the_legend_defines_exactly_the_status_words_a_table_uses():
+    from cislunar.report import STATUS_MEANINGS, STATUSES
+
+    assert set(STATUS_MEANINGS) == set(STATUSES)
+    t = ComparisonTable("t").add("a", 1, 1.0, "reproduced", "within 1 %")
+    t.add("b", 2, 3, "differs: too large", "why").add("c", None, 4, "derived")
+    lines = t.legend().splitlines()
+    assert [ln.split("**")[1] for ln in lines] == ["reproduced", "differs", "derived"]
+    assert "fixed before comparing" in lines[0]
+    assert ComparisonTable("empty").legend() == ""
