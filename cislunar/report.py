@@ -27,7 +27,8 @@ STATUS_MEANINGS = {
     "consistent (tuned)": "agrees only after a choice made while looking at the paper's number",
     "differs": "does not agree; the reason follows, and where the paper's claim rests on something unstated, the "
                "search for the regime in which it holds",
-    "derived": "the paper gives no number; computed here from what it does give",
+    "derived": "no paper number to compare with: computed here from what the paper gives (or an input taken "
+               "from it)",
     "not in paper": "an input or value the paper does not state (our choice, or a missing table)",
     "beyond paper": "a check or result the paper does not attempt",
 }
