@@ -37,7 +37,7 @@ errors (beyond the paper: its stated future work).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -56,6 +56,7 @@ __all__ = [
     "StationKeepingSurface",
     "station_keeping_surface",
     "informed_choice",
+    "first_burn_only_range_sigma_km",
     "FilterScenario",
     "FilterTrialResult",
     "execution_sigma",
@@ -360,6 +361,11 @@ class StationKeepingSurface:
         """Smallest :math:`\\sqrt{J_\\rho}` at ``t[-1]`` per arrival time, km, (n_t,)."""
         return self.range_sigma_km[self._rows(), self.best]
 
+    def reselect(self, criterion: str) -> "StationKeepingSurface":
+        """The same surface with :math:`\\mathbf u^*` chosen by another reading of Eq. 25 (see :func:`informed_choice`)."""
+        align, cand, pick = informed_choice(self.dv1, self.u_y, self.range_sigma_km, criterion)
+        return replace(self, alignment=align, candidates=cand, informed=pick)
+
     @property
     def informed_fuel_percentile(self) -> np.ndarray:
         """Percent of maneuvers of the same arrival time that use *more* fuel than :math:`\\mathbf u^*`."""
@@ -381,8 +387,14 @@ def _torus_states(torus, theta, t):
     return out
 
 
-def informed_choice(dv1, u_y, cost):
+def informed_choice(dv1, u_y, cost, criterion: str = "angle"):
     r"""Eq. 25 selection of the informed maneuver in each row (time-of-arrival slice).
+
+    Eq. 25 as printed divides :math:`\mathbf u_y^T\mathbf u_{sk}` by its own absolute value, so it needs a reading.
+    ``criterion="angle"`` (default) ranks by :math:`\cos\theta_u`, the direction alone: on a finer set of ring
+    angles it can pick ever smaller burns next to the agent's own phase.  ``criterion="projection"`` ranks by the
+    component of the burn along the MMD direction, :math:`\mathbf u_y^T\Delta\mathbf v_1/\|\mathbf u_y\|`
+    ("projecting the guidance policy onto the candidates"), which has a limit as the set is refined.
 
     Parameters
     ----------
@@ -392,14 +404,18 @@ def informed_choice(dv1, u_y, cost):
         MMD directions (any sign, any non-zero length).
     cost : array_like (n_t, n_theta)
         Result of the quick covariance analysis used to choose between the two candidates (smaller is better).
+    criterion : {"angle", "projection"}
+        Reading of Eq. 25 (see above).
 
     Returns
     -------
     alignment : ndarray (n_t, n_theta)
-        :math:`\cos\theta_u = \mathbf u_y^T\Delta\mathbf v_1/(\|\mathbf u_y\|\|\Delta\mathbf v_1\|)` (0 for a
-        zero burn).
+        ``"angle"``: :math:`\cos\theta_u = \mathbf u_y^T\Delta\mathbf v_1/(\|\mathbf u_y\|\|\Delta\mathbf v_1\|)`
+        (0 for a zero burn); ``"projection"``: :math:`\mathbf u_y^T\Delta\mathbf v_1/\|\mathbf u_y\|` (units of
+        ``dv1``).
     candidates : ndarray (n_t, 2) of int
-        Indices with :math:`\theta_u` closest to 0 and closest to :math:`\pi`.
+        Indices with the largest and the smallest ``alignment`` (:math:`\theta_u` closest to 0 and to :math:`\pi`,
+        or the largest burn component along :math:`+\mathbf u_y` and along :math:`-\mathbf u_y`).
     informed : ndarray (n_t,) of int
         The candidate with the smaller ``cost``.
     """
@@ -414,13 +430,17 @@ def informed_choice(dv1, u_y, cost):
     if cost.shape != dv1.shape[:2]:
         raise ValueError(f"cost must have the shape (n_t, n_theta) = {dv1.shape[:2]} of dv1 {dv1.shape}; got "
                          f"{cost.shape}")
+    _checks.choice(criterion, "criterion", ("angle", "projection"))
     un = np.linalg.norm(u_y, axis=-1)
     if np.any(un == 0):
         raise ValueError("u_y must hold non-zero directions")
-    norms = np.linalg.norm(dv1, axis=-1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        align = np.einsum("jik,jk->ji", dv1, u_y / un[:, None]) / norms
-    align = np.where(norms > 0, align, 0.0)
+    along = np.einsum("jik,jk->ji", dv1, u_y / un[:, None])
+    if criterion == "projection":
+        align = along
+    else:
+        norms = np.linalg.norm(dv1, axis=-1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            align = np.where(norms > 0, along / norms, 0.0)
     cand = np.stack([np.argmax(align, axis=1), np.argmin(align, axis=1)], axis=1)
     rows = np.arange(dv1.shape[0])
     pick = np.where(cost[rows, cand[:, 0]] <= cost[rows, cand[:, 1]], cand[:, 0], cand[:, 1])
@@ -557,15 +577,72 @@ def station_keeping_surface(system: CR3BP, torus, theta, t_arrival, t_burn: floa
                                  velocity_unit_km_s=system.velocity_unit_km_s, time_unit_s=system.time_unit_s)
 
 
+def first_burn_only_range_sigma_km(system: CR3BP, surface: StationKeepingSurface, target_apolune_state, *,
+                                   informed=None, P0=None, sigma_min_rad: float = AMOS_SIGMA_MIN_RAD,
+                                   resolution_km: float = AMOS_RESOLUTION_KM) -> np.ndarray:
+    """:math:`\\sqrt{J_\\rho}` at ``surface.t[-1]`` of each slice's chosen maneuver flown with its first burn only.
+
+    The paper attributes a local peak on its :math:`\\mathbf u^*` line to the second burn, "not accounted for in our
+    prediction".  This reruns the covariance analysis of each slice's maneuver without the second burn (the agent
+    coasts off the torus after the first), on the surface's measurement grid, so that the ratio
+    ``surface.informed_range_sigma_km / first_burn_only_range_sigma_km(...)`` isolates the second burn's effect.
+
+    Parameters
+    ----------
+    system : CR3BP
+        The system the surface was computed in.
+    surface : StationKeepingSurface
+    target_apolune_state : array_like (6,)
+        Target state at apoapsis (time 0), rotating frame, LU and LU/TU (``torus.orbit.x0``).
+    informed : array_like (n_t,) of int, optional
+        Ring-angle index of the maneuver of each slice (default ``surface.informed``).
+    P0 : array_like (12, 12), optional
+        Covariance at ``surface.t[0]`` (default :func:`cislunar.ssat.initial_covariance`); must be the one the
+        surface was computed with for the ratio to mean anything.
+    sigma_min_rad, resolution_km : float
+        Eq. 20 noise parameters (as for :func:`station_keeping_surface`).
+
+    Returns
+    -------
+    ndarray (n_t,)
+        Range 1-sigma at ``surface.t[-1]``, km.
+    """
+    _system(system)
+    _checks.instance(surface, "surface", StationKeepingSurface, "a cislunar.station_keeping.StationKeepingSurface")
+    x_tgt = _checks.as_state(target_apolune_state, "target_apolune_state", batch=False)
+    nt, nth = surface.t_arrival.size, surface.theta.size
+    if informed is None:
+        informed = surface.informed
+    else:
+        informed = _checks.as_array(informed, "informed", shape=(nt,))
+        if np.any(informed != np.round(informed)) or np.any(informed < 0) or np.any(informed >= nth):
+            raise ValueError(f"informed must hold ring-angle indices in 0..{nth - 1}, one per slice ({nt})")
+        informed = informed.astype(int)
+    if P0 is not None:
+        _initial_cov(P0)
+    _noise(sigma_min_rad, resolution_km)
+    P0 = initial_covariance(system) if P0 is None else P0
+    rows = np.arange(nt)
+    target = target_trajectory(system, x_tgt, surface.t)
+    agent = propagate_with_impulses(system, np.tile(surface.agent_x0, (nt, 1)), surface.t,
+                                    [(surface.t_burn, surface.dv1[rows, informed])])
+    cov = ssat_covariance(system, agent, target, P0, sigma_min_rad=sigma_min_rad, resolution_km=resolution_km)
+    return cov.final_range_sigma_km
+
+
 # --------------------------------------------------------------------------------------------------------------
 # full-filter Monte Carlo (beyond the paper)
 # --------------------------------------------------------------------------------------------------------------
 def execution_sigma(dv, sigma_abs: float, sigma_rel: float) -> np.ndarray:
-    """1-sigma per-axis execution error of a burn: :math:`\\sqrt{\\sigma_{abs}^2 + (\\sigma_{rel}\\|\\Delta v\\|)^2}` (units of ``dv``)."""
+    """1-sigma per-axis execution error of a burn: :math:`\\sqrt{\\sigma_{abs}^2 + (\\sigma_{rel}\\|\\Delta v\\|)^2}` (units of ``dv``).
+
+    A zero burn is a burn not made: its error is 0, not :math:`\\sigma_{abs}`.
+    """
     dv = _checks.as_array(dv, "dv", last=3, min_size=1)
     a = _checks.positive(sigma_abs, "sigma_abs", allow_zero=True)
     r = _checks.positive(sigma_rel, "sigma_rel", allow_zero=True)
-    return np.sqrt(a**2 + (r * np.linalg.norm(dv, axis=-1)) ** 2)
+    norm = np.linalg.norm(dv, axis=-1)
+    return np.where(norm > 0, np.sqrt(a**2 + (r * norm) ** 2), 0.0)
 
 
 @dataclass(frozen=True)

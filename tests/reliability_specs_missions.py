@@ -248,8 +248,13 @@ def specs(S, lazy):
                     velocity_unit_km_s="pos", time_unit_s="pos")))
     s.append(S("informed_choice", sk.informed_choice,
                dict(dv1=np.array([[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]]), u_y=np.array([[1.0, 0.2, 0.0]]),
-                    cost=np.array([[1.0, 2.0]])),
-               dict(dv1="arr", u_y="arr", cost="arr")))
+                    cost=np.array([[1.0, 2.0]]), criterion="projection"),
+               dict(dv1="arr", u_y="arr", cost="arr", criterion="choice")))
+    s.append(S("first_burn_only_range_sigma_km", sk.first_burn_only_range_sigma_km,
+               dict(system=em, surface=lazy(_surface), target_apolune_state=lazy(lambda: _orbit().x0),
+                    informed=lazy(lambda: _surface().informed), P0=P12, sigma_min_rad=1e-5, resolution_km=4e-3),
+               dict(system="system", surface="instance", target_apolune_state="state", informed="arr_opt",
+                    P0="spd_opt", sigma_min_rad="nonneg", resolution_km="nonneg")))
     s.append(S("execution_sigma", sk.execution_sigma, dict(dv=np.array([3.0, 4.0, 0.0]), sigma_abs=0.1,
                                                             sigma_rel=0.01),
                dict(dv="arr", sigma_abs="nonneg", sigma_rel="nonneg")))

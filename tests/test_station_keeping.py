@@ -132,6 +132,50 @@ def test_informed_choice_brute_force():
         sk.informed_choice(dv1, np.zeros((5, 3)), cost)
 
 
+def test_informed_choice_projection_reading_brute_force():
+    """The projection reading ranks by the burn component along u_y: independent of |u_y|, and unlike the angle
+    reading it prefers the larger of two parallel burns."""
+    rng = np.random.default_rng(5)
+    dv1 = rng.standard_normal((4, 25, 3))
+    u_y = rng.standard_normal((4, 3))
+    cost = rng.random((4, 25))
+    align, cand, pick = sk.informed_choice(dv1, u_y, cost, criterion="projection")
+    for j in range(4):
+        comp = [d @ u_y[j] / np.linalg.norm(u_y[j]) for d in dv1[j]]
+        assert np.allclose(align[j], comp, rtol=1e-14, atol=1e-15)
+        assert cand[j, 0] == int(np.argmax(comp)) and cand[j, 1] == int(np.argmin(comp))
+        assert pick[j] == cand[j, int(np.argmin(cost[j, cand[j]]))]
+    a2, c2, _ = sk.informed_choice(dv1, 3.0 * u_y, cost, criterion="projection")
+    assert np.allclose(a2, align, rtol=1e-14, atol=1e-15) and np.array_equal(c2, cand)
+    # two burns along +u_y, one ten times the other: same angle, the projection picks the larger
+    e = u_y[0] / np.linalg.norm(u_y[0])
+    two = np.stack([0.1 * e, 1.0 * e, -0.5 * e])[None]
+    one_cost = np.ones((1, 3))
+    a_angle, _, _ = sk.informed_choice(two, u_y[:1], one_cost)
+    a_proj, c_proj, _ = sk.informed_choice(two, u_y[:1], one_cost, criterion="projection")
+    assert np.allclose(a_angle[0], [1.0, 1.0, -1.0], rtol=0, atol=1e-15)  # the angle cannot tell 0.1 from 1
+    assert np.allclose(a_proj[0], [0.1, 1.0, -0.5], rtol=1e-15) and c_proj[0, 0] == 1 and c_proj[0, 1] == 2
+    with pytest.raises(ValueError, match="criterion"):
+        sk.informed_choice(dv1, u_y, cost, criterion="dot")
+
+
+def test_reselect_matches_informed_choice(surface):
+    """StationKeepingSurface.reselect re-runs Eq. 25 on the stored burns; 'angle' gives back the surface's own u*."""
+    same = surface.reselect("angle")
+    assert np.array_equal(same.informed, surface.informed) and np.array_equal(same.alignment, surface.alignment)
+    proj = surface.reselect("projection")
+    _, cand, pick = sk.informed_choice(surface.dv1, surface.u_y, surface.range_sigma_km, criterion="projection")
+    assert np.array_equal(proj.informed, pick) and np.array_equal(proj.candidates, cand)
+    assert np.array_equal(proj.range_sigma_km, surface.range_sigma_km)
+    # candidates: the largest component along +u_y and along -u_y; u* is one of them
+    rows = np.arange(surface.t_arrival.size)
+    assert np.all(proj.alignment[rows, proj.candidates[:, 0]] == proj.alignment.max(axis=1))
+    assert np.all(proj.alignment[rows, proj.candidates[:, 1]] == proj.alignment.min(axis=1))
+    assert np.all((proj.informed == proj.candidates[:, 0]) | (proj.informed == proj.candidates[:, 1]))
+    speed = np.linalg.norm(surface.dv1, axis=-1)
+    assert np.allclose(np.abs(proj.alignment) <= speed * (1 + 1e-12), True)
+
+
 def test_zero_maneuver_point_is_natural_motion(torus):
     theta = np.array([0.0, 1.0])
     s = sk.station_keeping_surface(em, torus, theta, np.array([-2 * HR]), -14 * HR, 6 * HR, agent_theta=0.0,
@@ -181,6 +225,9 @@ def test_surface_validation(torus):
 def test_execution_sigma():
     dv = np.array([3.0, 4.0, 0.0])
     assert np.isclose(sk.execution_sigma(dv, 0.1, 0.02), np.sqrt(0.01 + 0.01))
+    # a burn that is not made has no execution error; a tiny one has at least the absolute term
+    both = sk.execution_sigma(np.array([[0.0, 0.0, 0.0], [1e-12, 0.0, 0.0]]), 0.1, 0.02)
+    assert both[0] == 0.0 and abs(both[1] - 0.1) < 1e-15
     with pytest.raises(ValueError, match="sigma_rel"):
         sk.execution_sigma(dv, 0.1, -1)
 
@@ -249,3 +296,27 @@ def test_slice_best_is_the_valley(surface):
     assert np.all(s.informed_range_sigma_km >= s.best_range_sigma_km)
     same = s.informed == s.best
     assert np.all(s.informed_percentile[same] == 0) and np.all(s.informed_percentile[~same] > 0)
+
+
+def test_first_burn_only_identities(torus):
+    """At the agent's own ring angle both burns are zero, so flying the first burn only changes nothing (identity);
+    elsewhere dropping a non-zero second burn changes sqrt(J_rho)."""
+    from dataclasses import replace
+
+    theta = np.array([0.0, 2.0, 4.0])
+    t_arr = np.array([-4.0, 3.0]) * HR
+    s = sk.station_keeping_surface(em, torus, theta, t_arr, -16 * HR, 8 * HR, progress=False)
+    assert np.all(s.fuel_m_s[:, 0] < 1e-9)
+    at_agent = replace(s, informed=np.zeros(2, dtype=int))
+    only = sk.first_burn_only_range_sigma_km(em, at_agent, torus.orbit.x0)
+    assert np.allclose(only, s.range_sigma_km[:, 0], rtol=1e-7, atol=0)  # integration grids differ slightly
+    same = sk.first_burn_only_range_sigma_km(em, s, torus.orbit.x0, informed=np.zeros(2))
+    assert np.array_equal(same, only)
+    moved = sk.first_burn_only_range_sigma_km(em, s, torus.orbit.x0, informed=np.array([1, 2]))
+    full = s.range_sigma_km[[0, 1], [1, 2]]
+    assert np.all(s.dv2_m_s[[0, 1], [1, 2]] > 1e-3)
+    assert np.all(np.abs(moved / full - 1) > 1e-3)
+    with pytest.raises(ValueError, match="informed"):
+        sk.first_burn_only_range_sigma_km(em, s, torus.orbit.x0, informed=np.array([0, 3]))
+    with pytest.raises(TypeError, match="surface"):
+        sk.first_burn_only_range_sigma_km(em, "surface", torus.orbit.x0)
