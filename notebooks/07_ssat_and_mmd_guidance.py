@@ -93,10 +93,10 @@ print("T B_a (control in relative coordinates) =\n", ssat.control_matrix("relati
 #
 # The paper does not give the two orbits used for its MMD guidance (that is its Ref. [8]); we need a close,
 # naturally bounded pair about the Gateway orbit. **Choice:** the target flies the 9:2 southern L2 NRHO, the agent
-# flies the *same* orbit a few minutes behind, with the phase lag chosen so that their range at the target's
-# apolune is 215 km (the scale of the paper's Sec. 4 scenario). The burn happens `LEAD_DAYS` = 1 day before
-# apolune, so every coast of up to 48 h straddles apolune. Measurements (Sec. 3.3, 5): azimuth and elevation of the
-# target seen from the agent every hour, with the RMS angular noise of Eq. 20,
+# flies the *same* orbit about half an hour behind (the phase lag is printed below), chosen so that their range at
+# the target's apolune is 215 km (the scale of the paper's Sec. 4 scenario). The burn happens `LEAD_DAYS` = 1 day
+# before apolune, so every coast of up to 48 h straddles apolune. Measurements (Sec. 3.3, 5): azimuth and elevation
+# of the target seen from the agent every hour, with the RMS angular noise of Eq. 20,
 # $\sigma_\theta = \sqrt{\sigma_{\theta,min}^2 + D^2/\rho^2}$, $\sigma_{\theta,min}$ = 10 micro-rad, $D$ = 4 m;
 # initial 3-sigma of 60 km and 60 cm/s per axis for both vehicles, uncorrelated; no process noise (the paper lists
 # none); the covariance is propagated along the true trajectories.
@@ -139,6 +139,10 @@ print(f"phase lag {lag_h * 60:.2f} min; range at the burn {base.range_km[0, 0]:.
       f"at apolune {base.range_km[0, 24]:.1f} km, after 3 d {base.range_km[0, -1]:.1f} km")
 print(f"sqrt(J_rho): {base.range_sigma_km[0, 0]:.2f} km at t0 (= sqrt(2) x 20 km), "
       f"{base.range_sigma_km[0, 24]:.2f} km after 24 h, {base.range_sigma_km[0, -1]:.2f} km after 72 h")
+drop_1h = 100 * (1 - base.range_sigma_km[0, 1] / base.range_sigma_km[0, 0])
+print(f"first hour of measurements: sqrt(J_rho) {base.range_sigma_km[0, 0]:.2f} -> {base.range_sigma_km[0, 1]:.2f} km "
+      f"(-{drop_1h:.0f} %); smallest {base.range_sigma_km[0].min():.2f} km at "
+      f"{np.argmin(base.range_sigma_km[0]):d} h")
 
 # the same analysis by the reference Joseph-form EKF recursion, in the three coordinate systems
 for coords in ("inertial", "relative", "agent"):
@@ -207,10 +211,11 @@ fig.tight_layout()
 _ = plotting.save_figure(fig, "07_ssat_scenario", output_dir=out)
 
 # %% [markdown]
-# The first hour of measurements removes much of the range uncertainty even without a burn: with velocities known
-# to 20 cm/s, a range error needs a proportional relative-velocity error to stay invisible in the angles, and the
-# prior limits that. After that the range is only weakly observable, and its uncertainty grows with the range
-# itself. Both forms of the covariance analysis (square-root information referred to $t_0$, batched; Joseph-form
+# Even without a burn the first hour of measurements cuts $\sqrt{J_\rho}$ by about a fifth (28.3 to 22.7 km,
+# printed above): with velocities known to 20 cm/s, a range error needs a proportional relative-velocity error to
+# stay invisible in the angles, and the prior limits that. After that the range is only weakly observable: the
+# uncertainty falls slowly to its smallest value near apolune, where the range is smallest, and then grows with the
+# range itself. Both forms of the covariance analysis (square-root information referred to $t_0$, batched; Joseph-form
 # EKF recursion) agree, in all three SSAT coordinate systems.
 #
 # ## 3 · MMD guidance (Eqs. 23-24)
@@ -367,10 +372,16 @@ for dv, r in results.items():
           f"{np.round(90 - r.optimum_perp_angle_deg, 1)} deg")
     print(f"   perpendicular-circle best vs optimum: {np.round(100 * (r.perp_best / r.optimum - 1), 1)} %")
     print(f"   sign choice matters: rejected sign worse by {np.round(100 * (r.mmd_other / r.mmd - 1), 1)} %")
+sign_pct = {dv: 100 * (r.mmd_other / r.mmd - 1) for dv, r in results.items()}
+ang_mo = {dv: r.angle_mmd_optimum_deg for dv, r in results.items()}
+for dv in DV_M_S:
+    print(f"upsilon = {dv} m/s: rejected sign worse by {sign_pct[dv].min():.1f}-{sign_pct[dv].max():.1f} %; "
+          f"MMD axis to true minimiser {ang_mo[dv].min():.1f}-{ang_mo[dv].max():.1f} deg")
 
 # %% [markdown]
-# **Reading.** The sign choice of the quick covariance analysis matters: the two signs of the MMD axis differ by
-# several percent in $\sqrt{J_\rho}$. Only for the shortest coast (1 h) does the best burn lie in the plane
+# **Reading.** The sign choice of the quick covariance analysis matters for the larger burn: at 1 m/s the rejected
+# sign of the MMD axis is worse by up to a few tens of percent in $\sqrt{J_\rho}$, at 0.1 m/s by a few percent at
+# most (ranges printed above). Only for the shortest coast (1 h) does the best burn lie in the plane
 # perpendicular to the line of sight, as Ref. [8] states, with the best direction on that circle equal to the
 # optimum. The optimum leaves the plane quickly: for coasts of a few hours it is tens of degrees out of it, and for
 # the 12-h coast of the map above it points within a few degrees of the line of sight itself (towards the target),
@@ -382,8 +393,54 @@ for dv, r in results.items():
 # MMD is a policy, but with the burn at the first epoch (where $P_0$ applies) it is clearly suboptimal: it captures only part of the achievable range
 # information and a sizeable fraction of random directions beat it (numbers above). The surrogate maximises the
 # size of the measurement change at $\tau_f$ alone, whereas $J_\rho$ integrates all measurements of the coast and
-# projects on the final line of sight; the two agree in direction only roughly. This is the honest form of the
+# projects on the final line of sight. The two do not agree in direction: at both burn sizes the MMD axis is
+# between 68 and 90 deg from the true minimiser (printed above), nearly orthogonal to it. This is the honest form of the
 # paper's "nearly optimal" (stated there for its Ref. [8] scenarios, which are not given).
+
+# %% [markdown]
+# ### Computation time
+#
+# The paper (Sec. 4.1) says the loss of optimality "comes with exponentially faster computation time". It gives no
+# number; we measure the two on this machine for the 12-h coast and the 1 m/s burn, in the same run. MMD proper is
+# Eq. 24 and one 3x3 eigenproblem, given the nominal STM and the final measurement Jacobian (timed as the best of
+# many repetitions, since it takes microseconds); the full MMD policy adds the propagation of the nominal pair with
+# its STM and the two-run covariance analysis that picks the sign. The true minimiser of section 3 is the
+# `N_GRID`-direction sphere (one batched propagation and covariance analysis) followed by Nelder-Mead, one covariance
+# analysis per cost evaluation (`ssat.minimize_range_sigma`).
+
+# %%
+import time
+
+
+def best_time(fn, repeat):
+    """Smallest wall-clock time (s) of ``repeat`` calls of ``fn`` (and the last result)."""
+    best, res = np.inf, None
+    for _ in range(repeat):
+        t_start = time.perf_counter()
+        res = fn()
+        best = min(best, time.perf_counter() - t_start)
+    return best, res
+
+
+t12 = t[:k12 + 1]
+dv12 = dv_map * 1e-3 / V
+t_mmd_core, e_timed = best_time(lambda: ssat.mmd_direction(ssat.mmd_matrix(nom12.stm[0, -1], Ha12)), 200)
+t_mmd_policy, _ = best_time(lambda: ssat.mmd_policy(em, xa0, xt0, t12, dv12, P0), 3)
+t_opt, (d_timed, J_timed) = best_time(lambda: ssat.minimize_range_sigma(em, xa0, xt0, t12, dv12, P0, n_grid=N_GRID),
+                                      1 if not QUICK else 2)
+ratio_core, ratio_policy = t_opt / t_mmd_core, t_opt / t_mmd_policy
+print(f"MMD, Eq. 24 + eigenvector: {t_mmd_core * 1e6:.1f} us (best of 200); full MMD policy with propagation and "
+      f"sign check: {t_mmd_policy * 1e3:.1f} ms (best of 3)")
+print(f"true minimiser ({N_GRID}-direction sphere + Nelder-Mead): {t_opt:.2f} s; its sqrt(J_rho) "
+      f"{np.sqrt(J_timed) * L:.2f} km (section 3: {r12.optimum[i12]:.2f} km)")
+print(f"ratio minimiser / MMD: {ratio_core:.1e} (Eq. 24 + eigenvector), {ratio_policy:.0f} (full MMD policy)")
+
+# %% [markdown]
+# MMD's linear algebra is several thousand times faster than the search, and the full policy, propagation and sign
+# check included, still about a hundred times (ratios printed above; the timings depend on the machine). Both
+# answers are fast here, because the search is one batched covariance analysis of all `N_GRID` directions plus a
+# short Nelder-Mead refinement. "Exponentially" is not something a single problem size can show, and nothing in this
+# problem grows exponentially with its size; the measured claim is the ratio.
 
 # %% [markdown]
 # ### A burn in the middle of a tracking arc
@@ -412,29 +469,82 @@ for i, h in enumerate(res_pre.coast_hours):
 # %% [markdown]
 # **Reading.** With a tracking arc before it, the same burn is worth far more (compare "none" with any burn: the
 # kink, not the geometry, carries the information), and for coasts of up to about half a day MMD is then essentially
-# the optimal direction, as the paper states; for longer coasts its excess grows again. The setting in which
-# "nearly optimal" holds is therefore: a burn during tracking and a short coast.
+# the optimal direction, as the paper states; for longer coasts its excess grows again.
+#
+# The 24-h arc is our choice (the paper does not say how long the agent has tracked before the burn), so we sweep
+# it: for each arc length, the longest coast up to which MMD stays within 5 % of the optimum for every coast, and
+# the worst excess beyond it.
+
+# %%
+PRE_ARC_SWEEP_H = (6, 12, 24, 48)
+pre_sweep = {}
+for h_pre in PRE_ARC_SWEEP_H:
+    if h_pre == PRE_ARC_H:
+        pre_sweep[h_pre] = res_pre
+        continue
+    xa_p = propagate(em, xa0, np.array([0.0, -h_pre * HR])).x[-1]
+    xt_p = propagate(em, xt0, np.array([0.0, -h_pre * HR])).x[-1]
+    t_p = np.arange(0, h_pre + int(max(COAST_HOURS)) + 1) * HR
+    pre_sweep[h_pre] = ssat.compare_burn_policies(em, xa_p, xt_p, t_p, [h_pre + k for k in coast_idx],
+                                                  DV_M_S[-1] * 1e-3 / V, P0, burn_index=h_pre, n_grid=N_GRID,
+                                                  n_perp=N_PERP)
+sweep_ok_h = {}
+for h_pre, r in pre_sweep.items():
+    ok = r.mmd_excess_percent <= 5.0
+    n = ok.size if ok.all() else int(np.argmin(ok))
+    sweep_ok_h[h_pre] = r.coast_hours[n - 1] if n else 0.0
+    beyond = r.mmd_excess_percent[n:]
+    print(f"tracking arc {h_pre:3d} h before the burn: MMD excess {np.round(r.mmd_excess_percent, 0)} %; within 5 % "
+          f"for every coast <= {sweep_ok_h[h_pre]:.0f} h"
+          + (f", worst beyond {beyond.max():.0f} %" if beyond.size else ""))
+
+# %% [markdown]
+# The setting in which "nearly optimal" holds is therefore: a burn during tracking and a short coast (up to about
+# half a day for every arc length swept, printed above).
 #
 # ### Does the verdict depend on the demonstration pair?
 #
 # The pair above is one choice among many. As a second, independent geometry we put the agent on the quasi-periodic
 # torus of notebook 08 (the member about the 9:2 NRHO whose mean range to the target is 215 km, :mod:`cislunar.torus`)
 # at four initial ring angles, burn 1 day before apolune, and repeat the comparison with the 1 m/s burn. The torus
-# relative motion is not along-track: the line of sight sweeps around the target.
+# relative motion is not along-track: the line of sight sweeps around the target. The ring angles are 0, 45, 90 and
+# 135 deg, not spread over the full circle: a ring angle 180 deg away puts the agent at nearly the mirrored relative
+# position, which angles-only tracking sees almost identically (both checked below for 0 vs 180 deg), so antipodal
+# angles would not be independent cases.
 
 # %%
 from cislunar.torus import qpo_for_mean_range
 
 qpo, _ = qpo_for_mean_range(nrho, 215.0)
-pairs = {}
-for ring_angle in (0.0, np.pi / 2, np.pi, 3 * np.pi / 2):
+
+
+def qpo_comparison(ring_angle):
     xa_q = qpo.states([ring_angle], [-t_lead])[0, 0]
-    pairs[ring_angle] = ssat.compare_burn_policies(em, xa_q, xt0, t, coast_idx, DV_M_S[-1] * 1e-3 / V, P0,
-                                                   n_grid=N_GRID, n_perp=N_PERP)
+    return ssat.compare_burn_policies(em, xa_q, xt0, t, coast_idx, DV_M_S[-1] * 1e-3 / V, P0, n_grid=N_GRID,
+                                      n_perp=N_PERP)
+
+
+def pct0(a):
+    """An array printed as whole numbers (no scientific notation)."""
+    return np.array2string(np.round(a), formatter={"float_kind": lambda v: f"{v:.0f}"}, max_line_width=200)
+
+
+RING_ANGLES_DEG = (0.0, 45.0, 90.0, 135.0)
+pairs = {np.radians(a): qpo_comparison(np.radians(a)) for a in RING_ANGLES_DEG}
 print(f"agent on the 215-km QPO, burn {DV_M_S[-1]} m/s, coast times {COAST_HOURS} h")
 for ang, r in pairs.items():
-    print(f"ring angle {np.degrees(ang):5.0f} deg: MMD excess {np.round(r.mmd_excess_percent, 0)} %;"
-          f" directions better than MMD {np.round(r.mmd_percentile, 0)} %")
+    print(f"ring angle {np.degrees(ang):5.0f} deg: MMD excess {pct0(r.mmd_excess_percent)} %;"
+          f" directions better than MMD {pct0(r.mmd_percentile)} %")
+anti = qpo_comparison(np.pi)  # the antipode of ring angle 0
+d_q0, d_q180 = (qpo.states([a_], [-t_lead])[0, 0, :3] - xt0[:3] for a_ in (0.0, np.pi))
+print(f"relative position at the burn, ring angle 0 deg: {np.round(d_q0 * L, 1)} km, 180 deg: "
+      f"{np.round(d_q180 * L, 1)} km (|sum| / |d| = {np.linalg.norm(d_q0 + d_q180) / np.linalg.norm(d_q0):.3f})")
+r_q0 = pairs[0.0]
+anti_opt = np.max(np.abs(anti.optimum / r_q0.optimum - 1)) * 100
+anti_pct = np.max(np.abs(anti.mmd_percentile - r_q0.mmd_percentile))
+anti_mmd = np.max(np.abs(anti.mmd / r_q0.mmd - 1)) * 100
+print(f"antipodal check, ring angle 180 vs 0 deg, over all coasts: sqrt(J_rho) of the optimum differs by at most "
+      f"{anti_opt:.1f} %, of MMD by at most {anti_mmd:.1f} %; MMD percentile by at most {anti_pct:.1f} points")
 pct_all = np.concatenate([r.mmd_percentile for r in pairs.values()])
 exc_all = np.concatenate([r.mmd_excess_percent for r in pairs.values()])
 print(f"over all QPO pairs and coasts: median percentile {np.median(pct_all):.0f} %, median excess "
@@ -442,7 +552,9 @@ print(f"over all QPO pairs and coasts: median percentile {np.median(pct_all):.0f
 
 # %% [markdown]
 # **Reading.** The verdict is geometry- and horizon-dependent: for some torus pairs MMD is essentially optimal for
-# coasts of a few hours, and in every pair its excess over the optimum grows with the coast time, because the
+# coasts of a few hours (within 2 % up to 4 h at ring angle 0 deg), for others it is 9 % off already at 1 h; in every
+# pair its excess over the optimum grows with the coast time, to hundreds of percent or more for coasts beyond a day
+# (at every step of the coast time except 36 to 48 h at 90 deg, printed above), because the
 # surrogate looks at the measurement change at $\tau_f$ only while $J_\rho$ accumulates all measurements of the
 # coast. "Nearly optimal" holds for short coasts in favourable geometries, not in general.
 
@@ -476,9 +588,11 @@ table.add("covariance analysis: SRI batch form vs EKF recursion", "-",
 table.add("sqrt(J_rho) without maneuver after 24 h / 72 h (demonstration pair)", "-",
           f"{base.range_sigma_km[0, 24]:.1f} / {base.range_sigma_km[0, -1]:.1f} km", "not in paper",
           "the paper's MMD scenario (its Ref. [8]) is not given; our pair: same 9:2 NRHO, 215 km at apolune")
-table.add("MMD (Eq. 23 read as the eigenvector) = brute-force maximiser of its surrogate", "analytic eigenvector",
+table.add("MMD (Eq. 23 read as the eigenvector) = brute-force maximiser of its surrogate",
+          "u_y = +/- upsilon max(eig(Q)) (Eq. 23)",
           f"{ang_quad:.2f} deg (u^T Q u) / {ang_dev:.2f} deg (nonlinear angle change)", "derived",
-          f"12-h coast, {N_GRID}-direction sphere (spacing {spacing_deg:.1f} deg); Eq. 23 as printed is the eigenvalue")
+          f"12-h coast, {N_GRID}-direction sphere (spacing {spacing_deg:.1f} deg); Eq. 23 as printed is the eigenvalue "
+          "(a scalar); the text ('solution to an eigen-problem') means the unit eigenvector of that eigenvalue")
 in_plane_h = r1.coast_hours[r1.optimum_perp_angle_deg <= 5.0]
 off_plane_small = np.max(r0.optimum_perp_angle_deg[r0.coast_hours <= perp_ok_h[DV_M_S[0]]])
 table.add("Ref. [8]: perpendicular-to-LOS set contains the optimum for short coasts",
@@ -503,22 +617,54 @@ table.add("MMD near-optimal, burn at the start of tracking (first pair; excess o
           f"{DV_M_S[0]} m/s the 5 % is met but is no test: doing nothing is itself within "
           f"{np.max(100 * (r0.none / r0.optimum - 1)):.0f} % of the optimum and MMD captures only "
           f"{r0.mmd_gain_fraction.min() + 0.0:.2f}-{r0.mmd_gain_fraction.max() + 0.0:.2f} of the possible gain")
-table.add("MMD near-optimal, burn at the start of tracking, agent on the 215-km QPO (4 ring angles, 1 m/s)",
+table.add(f"MMD near-optimal, burn at the start of tracking, agent on the 215-km QPO ({len(pairs)} ring angles "
+          f"{', '.join(f'{a:g}' for a in RING_ANGLES_DEG)} deg, {DV_M_S[-1]} m/s)",
           "'nearly optimal'",
           f"median excess {np.median(exc_all):.0f} %, median percentile {np.median(pct_all):.0f} %",
           "differs: see note" if np.median(exc_all) > 5 else "beyond paper",
           f"MMD in the best 10 % of burn directions in {np.mean(pct_all < 10) * 100:.0f} % of the "
-          f"{pct_all.size} (pair, coast) cases; within 5 % of the optimum (tolerance) in {near.sum()} cases, "
-          f"all with coasts <= {coast_all[near].max() if near.any() else 0:.0f} h")
-table.add(f"MMD near-optimal, burn after {PRE_ARC_H} h of tracking (first pair, {DV_M_S[-1]} m/s)", "'nearly optimal'",
-          f"excess {res_pre.mmd_excess_percent.min():.0f}-{res_pre.mmd_excess_percent.max():.0f} %, percentile "
-          f"{res_pre.mmd_percentile.min():.0f}-{res_pre.mmd_percentile.max():.0f} %",
-          "consistent (tuned)" if ok_coast > 0 else "differs: see note",
-          "tuned: the burn timing (24 h of tracking before it) was chosen after the start-of-tracking reading failed; "
-          f"tolerance: within 5 % of the optimum; met for coasts <= {ok_coast:.0f} h, not beyond; "
-          f"a mid-arc burn cuts sqrt(J_rho) from {res_pre.none[-1]:.1f} km (no burn) to "
-          f"{res_pre.optimum[-1]:.2f} km (best) after {res_pre.coast_hours[-1]:.0f} h")
+          f"{pct_all.size} (pair, coast) cases ({len(pairs)} ring angles x {len(coast_idx)} coasts); within 5 % of "
+          f"the optimum (tolerance) in {near.sum()} cases, all with coasts <= "
+          f"{coast_all[near].max() if near.any() else 0:.0f} h. Antipodal ring angles are not independent cases: "
+          f"180 deg gives the sqrt(J_rho) of 0 deg within {anti_opt:.1f} % (optimum) and {anti_mmd:.1f} % (MMD)")
+# the mid-arc burn: the coasts within the 5 % tolerance (leading run) and the rest, each with its own status
+pre_exc, pre_pct, pre_h = res_pre.mmd_excess_percent, res_pre.mmd_percentile, res_pre.coast_hours
+pre_label = f"MMD near-optimal, burn after {PRE_ARC_H} h of tracking (first pair, {DV_M_S[-1]} m/s)"
+tuned_why = (f"tolerance fixed before comparing: within 5 % of the optimum; nothing in the computation was fitted, "
+             f"but the setting was: the mid-arc burn ({PRE_ARC_H} h of tracking before it) was adopted after the "
+             f"start-of-tracking comparison missed the paper's 'nearly optimal', a choice made while looking at the "
+             f"paper's claim, hence not 'reproduced'")
+if n_ok:
+    table.add(f"{pre_label}, coasts <= {ok_coast:.0f} h", "'nearly optimal'",
+              f"excess {pre_exc[:n_ok].min():.0f}-{pre_exc[:n_ok].max():.0f} %, percentile "
+              f"{pre_pct[:n_ok].min():.1f}-{pre_pct[:n_ok].max():.1f} %", "consistent (tuned)",
+              f"{tuned_why}. Not specific to the 24-h arc: with {', '.join(f'{h:g}' for h in PRE_ARC_SWEEP_H)} h of "
+              f"tracking before the burn the 5 % holds for every coast <= {min(sweep_ok_h.values()):.0f} h. A mid-arc "
+              f"burn cuts sqrt(J_rho) from {res_pre.none[n_ok - 1]:.1f} km (no burn) to "
+              f"{res_pre.optimum[n_ok - 1]:.3f} km (best) after {ok_coast:.0f} h")
+if n_ok < pre_h.size:
+    rest = slice(n_ok, None)
+    bad = pre_exc[rest] > 5.0
+    table.add(f"{pre_label}, coasts {pre_h[rest][0]:.0f}-{pre_h[rest][-1]:.0f} h", "'nearly optimal'",
+              f"excess {pre_exc[rest].min():.0f}-{pre_exc[rest].max():.0f} %, percentile "
+              f"{pre_pct[rest].min():.1f}-{pre_pct[rest].max():.1f} %",
+              (f"differs: excess {pre_exc[rest][bad].min():.0f}-{pre_exc[rest][bad].max():.0f} %" if bad.any()
+               else "consistent (tuned)"),
+              "tolerance 5 % (as above) exceeded at "
+              f"{', '.join(f'{h:g}' for h in pre_h[rest][bad])} h: MMD maximises the measurement change at tau_f "
+              "only, while J_rho accumulates every measurement of the coast; the paper's Ref. [8] scenarios (burn "
+              "timing, coast, geometry) are not given, the sweep here covers coast time, burn timing (start of "
+              "tracking, previous rows; tracking arc before the burn "
+              f"{', '.join(f'{h:g}' for h in PRE_ARC_SWEEP_H)} h: every arc length fails beyond "
+              f"{max(sweep_ok_h.values()):.0f} h, worst excess "
+              f"{min(r.mmd_excess_percent.max() for r in pre_sweep.values()):.0f}-"
+              f"{max(r.mmd_excess_percent.max() for r in pre_sweep.values()):.0f} %) and geometry (QPO row)")
 table.add("+/- sign choice by quick covariance analysis", "needed",
-          f"rejected sign worse by {np.min(100 * (r1.mmd_other / r1.mmd - 1)):.1f}-"
-          f"{np.max(100 * (r1.mmd_other / r1.mmd - 1)):.1f} %", "beyond paper")
+          "; ".join(f"rejected sign worse by {sign_pct[dv].min():.1f}-{sign_pct[dv].max():.1f} % ({dv} m/s)"
+                    for dv in DV_M_S[::-1]), "beyond paper", "first pair, burn at the start of tracking, all coasts")
+table.add("computation time: true minimiser / MMD (Sec. 4.1: 'exponentially faster')", "no number",
+          f"{ratio_core:.1e} (Eq. 24 + eigenvector), {ratio_policy:.0f} (full MMD policy)", "beyond paper",
+          f"12-h coast, {DV_M_S[-1]} m/s, this machine: {t_opt:.2f} s ({N_GRID}-direction sphere + Nelder-Mead) vs "
+          f"{t_mmd_core * 1e6:.0f} us (best of 200) / {t_mmd_policy * 1e3:.1f} ms with propagation and sign check "
+          "(best of 3); a timing ratio, not a test of 'exponentially'")
 table.display()
