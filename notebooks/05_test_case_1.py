@@ -14,9 +14,9 @@
 # **What you will learn.** How a low-thrust observer on a distant retrograde orbit (DRO) trades propellant for
 # tracking accuracy: we plan its trajectory with successive convexification (SCvx) over a grid of homotopy weights
 # $\alpha_h$ between "minimum impulse" and "maximum mutual information", check that every plan really flies, and
-# judge the plans with the Cramér-Rao lower bound (CRLB) of a sequential estimator. Along the way: why the SCvx
-# of the paper creeps with an information reward and what makes it converge, how many local optima the problem has,
-# and which of the paper's printed numbers are slips.
+# judge the plans with the Cramér-Rao lower bound (CRLB) of a sequential estimator. Along the way: how the printed
+# SCvx (L1 exact penalty, linear information model) behaves here with an information reward and what makes our
+# solver converge, how many local optima the problem has, and which of the paper's printed numbers are slips.
 #
 # **Paper sections followed.** Wolf & Jones (arXiv 2408.17435), "Test Case #1" (Tables 2-3, Figs. 1-5) with the
 # objective of Eqs. 42-44 and the SCvx of Eqs. 24-36 (notebook 03); the mutual information and its gradient are
@@ -35,6 +35,8 @@ SIGMA = 1.0  # Sundman exponent (notebook 04)
 ALPHAS = ([0.0, 5e-3, 1e-2] if QUICK else  # quick: the right panels of Figs. 1 and 3 show the grid's top
           [0.0, 1e-3, 2e-3, 3e-3, 5e-3, 7e-3, 1e-2, 1.5e-2, 2e-2])
 PENALTY_ITER = 10 if QUICK else 80  # iterations granted to the paper's exact-penalty SCvx in section 4
+PENALTY_ITER_LONG = 20 if QUICK else 300  # the same at gamma = 1e3 with a larger iteration limit
+PENALTY_GAMMAS = [1e1, 1e3, 1e5] if QUICK else [1e1, 1e2, 1e3, 1e4, 1e5]  # exact-penalty weights swept (unstated)
 BUDGETS_EXTRA_MPS = [5.0] if QUICK else [1.0, 5.0, 20.0]  # impulse budgets above the baseline's (section 8)
 BUDGET_RTOL = 0.02  # a budget counts as met within 2 % (fixed before solving)
 
@@ -69,21 +71,27 @@ MPS = KM_S * 1e3
 # (Table 3); a 10 m/s velocity error alone moves a position by 864 km in a day, the transient of Fig. 4.
 #
 # **The printed observer state is not a DRO.** Its $\dot y_0 = 0.528996986$ does not close (notebook 01): held at
-# the printed $x_0$, the periodic DRO has $\dot y_0 = 0.5559319$, a transcription slip in two digits is the likely
-# cause. What would the printed state give? Flown ballistically it leaves the DRO region and **hits the Moon before
+# the printed $x_0$, the periodic DRO has $\dot y_0 = 0.5559319$; a transcription slip is the likely cause (the
+# two values differ from the second digit on). What would the printed state give? Flown ballistically it leaves the DRO region and **hits the Moon before
 # the two periods are over**; reaching $x_{\mathcal S}(t_f)$ from it with the window constraint costs tens of m/s
 # (computed below: essentially the 27.6 m/s velocity slip), where the corrected state needs well under 1 m/s
 # (section 5). We use the corrected state.
 #
-# **Which digit slipped, $x_0$ or $\dot y_0$?** Both readings give a DRO: hold $x_0$ and correct $\dot y_0$, or hold
-# the printed $\dot y_0$ and correct $x_0$. The paper's own day counts decide: its text puts test case 1's window
-# at "12 and 23 days" ($[3P/4, 3P/2]$) and test case 2's at "roughly 17 and 32 days" ($[P, 2P]$). Below, the
-# windows that each reading implies, judged with a tolerance of 1 day fixed before comparing.
+# **Which number slipped, $x_0$ or $\dot y_0$?** Both readings give a DRO: hold $x_0$ and correct $\dot y_0$, or hold
+# the printed $\dot y_0$ and correct $x_0$. Evidence that does not use the paper's day counts: the paper calls the
+# spacecraft's orbits "adjacent" DROs, and the six other printed rows of Tables 2 and 4 (all periodic as printed)
+# span a narrow range of $x_0$ and period. The reading whose $x_0$ and period fall inside that span is adopted.
+# The day counts of the text ("12 and 23 days" for test case 1's window $[3P/4, 3P/2]$, "roughly 17 and 32 days"
+# for test case 2's $[P, 2P]$) are printed for both readings too, with a tolerance of 1 day; they were looked at
+# when the reading was first chosen, so the window rows built on it are marked "consistent (tuned)", not
+# "reproduced".
 #
 # **Process noise.** Table 3 prints $Q = 10^{-11}$ "km/s³". Notebook 06 (and `cislunar.wolf_jones`) tries the
 # plausible readings against the paper's statement that the CRLB stays bounded over the window and adopts the
 # non-dimensional acceleration PSD $q = 10^{-11}$ LU²/TU³; the literal unit fix $10^{-11}$ km²/s³ would let the
-# observer error grow to tens of thousands of km. Section 7 judges the planned trajectories with both readings.
+# observer error grow to tens of thousands of km. Since the reading was picked by the very property the paper
+# claims (a bounded CRLB), that claim is no independent test of it: its rows are "consistent (tuned)". Section 7
+# judges the planned trajectories with both readings.
 
 # %%
 sc = wolf_jones.test_case_1()
@@ -110,20 +118,30 @@ printed_transfer = scvx.solve_scvx(em, t_tmp, x_tmp, np.zeros((t_tmp.size, 3)), 
                                    x_final=sc.observer_xf)
 print(f"minimum-impulse transfer (alpha_h = 0) from the printed state to x_S(t_f): "
       f"{printed_transfer.impulse * MPS:.2f} m/s")
-# the two readings of the slip and the windows they imply (paper: 12-23 d for case 1, roughly 17-32 d for case 2)
+# the two readings of the slip; independent evidence: the span of the six other (periodic) rows of Tables 2 and 4
 vy0_held = orbits.correct_symmetric(em, sc.observer_x0_printed + [0.02, 0, 0, 0, 0, 0], fix="vy0")
 readings = {"x0 held (vy0 corrected)": (sc.observer_x0, P),
             "vy0 held (x0 corrected)": (vy0_held.x0, vy0_held.period)}
-paper_days = {"case 1": (12.0, 23.0), "case 2": (17.0, 32.0)}
-reading_miss = {}
+other_rows = {f"case {n} {lab}": c for n, s_ in ((1, sc), (2, wolf_jones.test_case_2()))
+              for lab, c in s_.row_checks.items() if lab != "observer_t0"}
+x0_span = (min(c.x0 for c in other_rows.values()), max(c.x0 for c in other_rows.values()))
+p_span = (min(em.tu_to_days(c.corrected.period) for c in other_rows.values()),
+          max(em.tu_to_days(c.corrected.period) for c in other_rows.values()))
+print(f"the {len(other_rows)} other rows of Tables 2 and 4: x0 {x0_span[0]:.5f}-{x0_span[1]:.5f} LU, periods "
+      f"{p_span[0]:.2f}-{p_span[1]:.2f} d, closures <= {max(c.raw_closure for c in other_rows.values()):.1e}")
+reading_adjacent, reading_miss, reading_miss23 = {}, {}, {}
 for name, (x0_r, P_r) in readings.items():
     pd = em.tu_to_days(P_r)
     w1, w2 = (0.75 * pd, 1.5 * pd), (pd, 2.0 * pd)
+    reading_adjacent[name] = x0_span[0] <= x0_r[0] <= x0_span[1] and p_span[0] <= pd <= p_span[1]
     reading_miss[name] = max(abs(w1[0] - 12.0), abs(w2[0] - 17.0), abs(w2[1] - 32.0))
-    print(f"{name:<26}: x0 = {x0_r[0]:.7f}, vy0 = {x0_r[4]:.7f}, P = {pd:.2f} d -> case 1 window "
-          f"{w1[0]:.2f}-{w1[1]:.2f} d, case 2 window {w2[0]:.2f}-{w2[1]:.2f} d")
+    reading_miss23[name] = abs(w1[1] - 23.0)
+    print(f"{name:<26}: x0 = {x0_r[0]:.7f}, vy0 = {x0_r[4]:.7f}, P = {pd:.2f} d (inside the span of the other rows: "
+          f"{reading_adjacent[name]}) -> case 1 window {w1[0]:.2f}-{w1[1]:.2f} d, case 2 window "
+          f"{w2[0]:.2f}-{w2[1]:.2f} d")
 print("largest miss of the paper's 12 (case 1), 17 and 32 days (case 2):",
-      {k: round(v, 2) for k, v in reading_miss.items()}, "(its '23 days' is missed by both readings)")
+      {k: round(float(v), 2) for k, v in reading_miss.items()},
+      "; miss of its '23 days' (case 1 window end):", {k: round(float(v), 2) for k, v in reading_miss23.items()})
 
 # %% [markdown]
 # ## 2 · Nodes, thrust bounds and the information model
@@ -136,7 +154,8 @@ print("largest miss of the paper's 12 (case 1), 17 and 32 days (case 2):",
 # control peaked on day 16, inside it.)
 #
 # The information model gives, for the observer state $x_{k^*}$ at the window-start node, the mutual information
-# $\mathcal I$ of the window (Eq. 18), its gradient (Eqs. 44-52) and a Hessian by finite differences of the
+# $\mathcal I$ of the window (Eq. 18), its gradient (the reverse-mode derivative of Eq. 18 through the
+# square-root recursion, where the paper writes Eqs. 44-52 term by term) and a Hessian by finite differences of the
 # gradient; the process noise is held fixed along the ballistic window arc so that value and gradient describe the
 # same function (the paper also neglects the sensitivity of $\tilde P$).
 
@@ -205,8 +224,11 @@ print(f"impulse and MI non-decreasing in alpha_h: {monotone}; largest up/down co
 #
 # The per-iteration log of $\alpha_h = 5\times10^{-3}$ (cold start from the ballistic DRO): predicted decrease, the
 # two parts of the model error (defects; information), the ratio $\rho$, the trust-region radius $\eta$ and
-# whether the step sat on the trust-region boundary. Then the same problem with the paper's L1 exact penalty
-# ($\gamma = 10^3$) and the same quadratic information model, given a fixed number of iterations.
+# whether the step sat on the trust-region boundary. Then the same problem with the printed method: the L1 exact
+# penalty on the defects (Eq. 43) and the *linear* information model of Eq. 44. The paper gives neither the
+# penalty weight $\gamma$ nor an iteration limit, so both are swept: $\gamma$ over four decades with a fixed number
+# of iterations, and $\gamma = 10^3$ once more with a larger limit. A hybrid (exact penalty with our quadratic
+# information model, $\gamma = 10^3$) separates the effect of the penalty from that of the information model.
 
 # %%
 i5 = ALPHAS.index(5e-3)
@@ -217,24 +239,42 @@ print(f"{'it':>3} {'predicted':>10} {'err defect':>11} {'err MI':>10} {'rho':>8}
 for h in cold.history:
     print(f"{h['iteration']:3d} {h['predicted']:10.2e} {h['model_error_defect']:11.2e} {h['model_error_info']:10.2e} "
           f"{h['rho']:8.3f} {h['eta']:9.2e} {'on' if h['tr_active'] else '':>3} {h['max_defect']:8.1e}")
-try:
-    pen = scvx.solve_scvx(em, t, x_ball, u_ball, u_max, x_final=sc.observer_xf, info=info, info_node=k_ws,
-                          alpha=5e-3, settings=scvx.SCvxSettings(method="penalty", max_iter=PENALTY_ITER))
-    pen_history, pen_outcome = pen.history, f"converged in {pen.iterations} iterations"
-except scvx.SCvxError as exc:
-    pen_history, pen_outcome = exc.history, f"no convergence: {exc.reason}"
-pen_best = min(h["new_cost"] for h in pen_history if h["accepted"])
-print(f"exact penalty: {pen_outcome}; best accepted cost {pen_best:.6f} vs {best[i5].cost:.6f}; last rho "
-      f"{pen_history[-1]['rho']:.2f}, eta {pen_history[-1]['eta']:.1e}")
+
+
+def penalty_run(gamma, max_iter, model):
+    """Exact-penalty SCvx at alpha_h = 5e-3 from the ballistic DRO: outcome, history, best accepted cost."""
+    st = scvx.SCvxSettings(method="penalty", information_model=model, defect_weight=gamma, max_iter=max_iter)
+    try:
+        r = scvx.solve_scvx(em, t, x_ball, u_ball, u_max, x_final=sc.observer_xf, info=info, info_node=k_ws,
+                            alpha=5e-3, settings=st)
+        hist, outcome, ok_ = r.history, f"converged in {r.iterations} iterations (largest defect {r.max_defect:.1e})", True
+    except scvx.SCvxError as exc:
+        hist, outcome, ok_ = exc.history, exc.reason, False
+    acc = [h["new_cost"] for h in hist if h["accepted"]]
+    return dict(gamma=gamma, max_iter=max_iter, model=model, converged=ok_, outcome=outcome, history=hist,
+                best=min(acc) if acc else np.nan, eta=hist[-1]["eta"] if hist else np.nan)
+
+
+t0 = time.perf_counter()
+pen_runs = [penalty_run(g, PENALTY_ITER, "linear") for g in PENALTY_GAMMAS]
+pen_runs.append(penalty_run(1e3, PENALTY_ITER_LONG, "linear"))
+pen_hybrid = penalty_run(1e3, PENALTY_ITER, "quadratic")
+print(f"printed method (L1 exact penalty, linear MI model of Eq. 44), alpha_h = 5e-3, from the ballistic DRO "
+      f"({time.perf_counter() - t0:.0f} s for {len(pen_runs) + 1} runs); best of sweeps: cost {best[i5].cost:.6f}")
+for r in pen_runs + [pen_hybrid]:
+    print(f"  gamma {r['gamma']:7.0e}, {r['model']:>9} MI model, limit {r['max_iter']:3d}: {r['outcome']}; best "
+          f"accepted cost {r['best']:.6f}; last eta {r['eta']:.1e}")
+pen_printed = next(r for r in pen_runs if r["gamma"] == 1e3 and r["max_iter"] == PENALTY_ITER)
+pen_history = pen_printed["history"]
+pen_any = any(r["converged"] for r in pen_runs)
 
 fig, axes = plt.subplots(1, 3, figsize=(14, 3.8))
 ha = cold.history
 its = [h["iteration"] for h in ha]
 axes[0].semilogy(its, [max(abs(h["predicted"]), 1e-16) for h in ha], "o-", ms=3, label="augmented Lagrangian")
 axes[0].semilogy([h["iteration"] for h in pen_history], [max(abs(h["predicted"]), 1e-16) for h in pen_history],
-                 ".-", ms=3, color="C3", label="exact penalty")
+                 ".-", ms=3, color="C3", label=r"printed: L1 penalty, linear MI ($\gamma = 10^3$)")
 axes[0].set(xlabel="iteration [-]", ylabel="|predicted decrease| [-]")
-axes[0].legend(fontsize=8, loc="upper right")
 axes[1].semilogy(its, [h["eta"] for h in ha], "o-", ms=3)
 axes[1].semilogy([h["iteration"] for h in pen_history], [h["eta"] for h in pen_history], ".-", ms=3, color="C3")
 axes[1].set(xlabel="iteration [-]", ylabel=r"trust-region radius $\eta$ [-]")
@@ -243,7 +283,18 @@ axes[2].semilogy([h["iteration"] for h in pen_history], [max(h["max_defect"], 1e
                  ms=3, color="C3")
 axes[2].set(xlabel="iteration [-]", ylabel="largest defect [LU, LU/TU]")
 fig.suptitle(r"SCvx on test case 1, $\alpha_h = 5\times10^{-3}$, from the ballistic DRO")
+fig.legend(*axes[0].get_legend_handles_labels(), loc="lower center", ncol=2, fontsize=8)
+fig.tight_layout(rect=(0, 0.08, 1, 1))
 _ = plotting.save_figure(fig, "05_convergence", output_dir=out)
+
+# %% [markdown]
+# **Reading.** Whether the printed method converges is read from the printed outcomes: none of the exact-penalty
+# runs, at any $\gamma$ of the sweep or with the larger iteration limit, meets the stopping test; the trust region
+# shrinks (last $\eta$ printed) while the cost creeps towards our solver's optimum. The hybrid with our quadratic
+# information model does not converge within its limit either: the quadratic model alone does not make the printed
+# method converge (whether the augmented Lagrangian alone would, with Eq. 44's linear model, is not checked here).
+# The closing table therefore separates the printed method (which does
+# not converge here) from our modified solver (which converges on the whole grid).
 
 # %% [markdown]
 # ## 5 · Does every plan fly, and does it depend on the node grid? (beyond the paper)
@@ -319,7 +370,7 @@ for ax, i in zip(axes, show):
            title=rf"$\alpha_h$ = {ALPHAS[i]:g}: {best[i].impulse * MPS:.1f} m/s, I = {best[i].information:.1f} nats")
 handles, labels = axes[0].get_legend_handles_labels()
 fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, 0.0))
-fig.suptitle("Fig. 1 analogue: observer trajectory, Moon-centred rotating frame")
+fig.suptitle("Fig. 1 analogue: observer trajectory, Moon-centred rotating frame (thrust: |a| above 1 % of a_max)")
 fig.tight_layout(rect=(0, 0.06, 1, 1))
 _ = plotting.save_figure(fig, "05_fig1_trajectories", output_dir=out)
 
@@ -415,6 +466,10 @@ print(f"with q = 1e-11 km^2/s^3 = {q_literal:.3g} LU^2/TU^3 instead of {sc.q:g}:
       f"alpha_h = 0: {lit[0].terminal_rms_km[0]:.0f} / {lit[0].terminal_rms_km[1]:.0f} km, alpha_h = {ALPHAS[-1]:g}: "
       f"{lit[1].terminal_rms_km[0]:.0f} / {lit[1].terminal_rms_km[1]:.0f} km (observer / target); growth over the "
       f"window after the transient: {lit[1].rms_km[0, -1] / lit[1].rms_km[0, 1]:.1f} x")
+lit_growth = [c.rms_km[0, -1] / c.rms_km[0, 1] for c in lit]  # window end over the 2nd measurement (Fig. 4 test)
+print("literal Q, observer RMS at the 2nd measurement -> window end: " + "; ".join(
+    f"alpha_h = {ALPHAS[i]:g}: {c.rms_km[0, 1]:.0f} -> {c.rms_km[0, -1]:.0f} km ({g_:.3f} x)"
+    for i, c, g_ in zip((0, len(ALPHAS) - 1), lit, lit_growth)))
 bounded = bool(np.all(np.array([c.rms_km[:, -1] <= c.rms_km[:, 1] for c in crlb])))
 transient = bool(np.all(np.array([c.rms_km[:, 1] > c.rms_km[:, 0] for c in crlb])))
 
@@ -506,81 +561,115 @@ _ = plotting.save_figure(fig, "05_equal_impulse", output_dir=out)
 # ## 9 · Paper versus reproduction
 #
 # Tolerances fixed before comparing: "reproduced" for a qualitative claim means the stated behaviour holds for
-# every $\alpha_h$ of the grid (criterion in the row); day counts of the text within 1 day; "unbounded" CRLB means a
-# terminal RMS above 10 prior sigmas (1000 km). The paper prints no number for test case 1 beyond its inputs
-# (Tables 2-3), so the quantitative rows are "not in paper" or "beyond paper". Slips in the paper are listed with
-# what we used.
+# every $\alpha_h$ of the grid (criterion in the row); day counts of the text within 1 day; "bounded" CRLB means a
+# window-end RMS no larger than at the 2nd measurement; "correlates well" a Spearman rank correlation below -0.8.
+# Rows resting on a reading chosen with the paper's claim in view (process noise, the slip in Table 2) are at best
+# "consistent (tuned)"; the solver rows separate the printed method from ours. The paper prints no number for test
+# case 1 beyond its inputs (Tables 2-3), so the quantitative rows are "not in paper" or "beyond paper". Slips in
+# the paper are listed with what we used.
 
 # %%
 table.add("observer x_S(t0) (Table 2) is a DRO", "vy0 = 0.528996986",
           f"not periodic (misses itself by {chk.raw_closure:.2f} LU); periodic vy0 = {chk.corrected.x0[4]:.7f}",
           "differs: printed vy0 is a slip", f"as printed it {printed_fate}; corrected state used (notebook 01)")
-x0_wins = reading_miss["x0 held (vy0 corrected)"] <= 1.0 < reading_miss["vy0 held (x0 corrected)"]
-table.add("which digit of x_S(t0) slipped", "case 1 window '12 and 23 days', case 2 'roughly 17 and 32 days'",
-          "; ".join(f"{k}: largest miss of 12/17/32 d {v:.2f} d" for k, v in reading_miss.items()),
-          "derived" if x0_wins else "differs: neither reading fits the day counts",
-          f"tolerance 1 day; vy0 held gives x0 = {vy0_held.x0[0]:.7f}, P = {em.tu_to_days(vy0_held.period):.2f} d")
-w_end = em.tu_to_days(sc.window[1])
-table.add("observation window", "[3P/4, 3P/2]; text: '12 and 23 days'",
-          f"{em.tu_to_days(sc.window[0]):.2f}-{w_end:.2f} d",
-          "reproduced" if abs(w_end - 23.0) <= 1.0 else "differs: text's 23 d is a slip",
-          f"tolerance 1 day; 3P/2 = {w_end:.2f} d for P = {em.tu_to_days(P):.2f} d; the last daily measurement is at "
-          f"{em.tu_to_days(sc.measurement_times[-1]):.2f} d")
-table.add("Fig. 3 alpha_h of the left panel", "text: 5e-2; caption and Fig. 1: 5e-3", "5e-3 shown",
-          "differs: text's 5e-2 is a slip", "5e-2 lies outside the paper's grid (up to 2e-2)")
+for lab, name in (("observer_tf", "observer x_S(t_f)"), ("target1_t0", "target x_T(1)(t0)")):
+    c_ = sc.row_checks[lab]
+    table.add(f"Table 2 {name} is a periodic DRO", "implied (DRO family)",
+              f"closure after one period {c_.raw_closure:.1e}; period {em.tu_to_days(c_.corrected.period):.2f} d",
+              "reproduced" if c_.raw_closure < 1e-6 else "differs: the printed row does not close",
+              "criterion: closure < 1e-6 (nine printed digits allow ~1e-8)")
+adopted, rejected = "x0 held (vy0 corrected)", "vy0 held (x0 corrected)"
+x0_wins = reading_adjacent[adopted] and not reading_adjacent[rejected]
+table.add("which number of x_S(t0) slipped (x0 or vy0)", "orbits called 'adjacent'; six other rows printed",
+          f"x0 held: x0 = {sc.observer_x0[0]:.5f}, P = {em.tu_to_days(P):.2f} d; vy0 held: x0 = "
+          f"{vy0_held.x0[0]:.5f}, P = {em.tu_to_days(vy0_held.period):.2f} d; other rows: x0 {x0_span[0]:.5f}-"
+          f"{x0_span[1]:.5f}, P {p_span[0]:.2f}-{p_span[1]:.2f} d",
+          "derived" if x0_wins else "differs: adjacency does not single out one reading",
+          "criterion: x0 and period inside the span of the other rows; the text's day counts were looked at first "
+          "(largest miss of 12/17/32 d: " + ", ".join(f"{k.split(' (')[0]} {v:.2f} d" for k, v in reading_miss.items())
+          + "; of '23 d': " + ", ".join(f"{k.split(' (')[0]} {v:.2f} d" for k, v in reading_miss23.items()) + ")")
+w_start, w_end = em.tu_to_days(sc.window[0]), em.tu_to_days(sc.window[1])
+table.add("observation window", "[3P/4, 3P/2]; text: '12 and 23 days'", f"{w_start:.2f}-{w_end:.2f} d",
+          "consistent (tuned)" if abs(w_start - 12.0) <= 1.0 and abs(w_end - 23.0) <= 1.0 else
+          f"differs: 3P/2 misses the text's 23 d by {abs(w_end - 23.0):.2f} d",
+          f"tolerance 1 day; P = {em.tu_to_days(P):.2f} d of the adopted reading (chosen with the day counts in view, "
+          f"so at best 'consistent (tuned)'); the rejected reading misses 23 d by {reading_miss23[rejected]:.2f} d; "
+          f"last daily measurement at {em.tu_to_days(sc.measurement_times[-1]):.2f} d")
+table.add("Fig. 3 alpha_h of the left panel", "text: 5e-2; Fig. 3 caption and Fig. 1: 5e-3", "5e-3 shown",
+          "differs: text's 5e-2 is a slip", "the caption of Fig. 3 itself and Fig. 1 give 5e-3")
 table.add("process noise Q (Table 3)", "1e-11 'km/s^3'", f"q = {sc.q:g} LU^2/TU^3 (acceleration PSD)",
-          "derived", "reading chosen by the CRLB-boundedness test of notebook 06 / cislunar.wolf_jones")
-lit_unbounded = lit[0].terminal_rms_km[0] > 10 * wolf_jones.SIGMA_POS_KM
-table.add("CRLB bounded over the window under Q = 1e-11 km^2/s^3 (literal)", "bounded (Fig. 4)",
-          f"alpha_h = 0: terminal observer RMS {lit[0].terminal_rms_km[0]:.0f} km (adopted q: {term_obs[0]:.0f} km); "
-          f"alpha_h = {ALPHAS[-1]:g}: {lit[1].rms_km[0, 1]:.0f} -> {lit[1].rms_km[0, -1]:.0f} km (adopted: "
-          f"{crlb[-1].rms_km[0, 1]:.0f} -> {crlb[-1].rms_km[0, -1]:.1f} km)",
-          "differs: literal reading rejected" if lit_unbounded else "reproduced",
-          "unbounded = terminal RMS above 10 prior sigmas (1000 km), fixed before comparing; why the "
-          "non-dimensional reading is used")
+          "consistent (tuned)", "reading chosen as one that keeps this case's CRLB bounded, which is the paper's "
+          "Fig. 4 claim (notebook 06, section 9); the SI reading 1e-11 m^2/s^3 would pass the same test")
+lit_grows = [g_ > 1.0 for g_ in lit_growth]
+table.add("CRLB under the literal Q = 1e-11 km^2/s^3: bounded after the transient?", "bounded (Fig. 4)",
+          "; ".join(f"alpha_h = {ALPHAS[i]:g}: {c.rms_km[0, 1]:.0f} -> {c.rms_km[0, -1]:.0f} km ({g_:.3f} x)"
+                    for i, c, g_ in zip((0, len(ALPHAS) - 1), lit, lit_growth))
+          + f" (adopted q: {crlb[0].rms_km[0, 1]:.0f} -> {term_obs[0]:.0f} km and {crlb[-1].rms_km[0, 1]:.0f} -> "
+            f"{term_obs[-1]:.1f} km)",
+          "differs: literal reading grows (rejected)" if any(lit_grows) else "consistent (tuned)",
+          "criterion as in the Fig. 4 row: window-end RMS at most the 2nd measurement's, for alpha_h = 0 and the "
+          f"largest; levels too: {lit[0].terminal_rms_km[0]:.0f} km at alpha_h = 0 is "
+          f"{lit[0].terminal_rms_km[0] / wolf_jones.SIGMA_POS_KM:.0f} prior sigmas")
 table.add("zero thrust in the observation window", "a_max = 0 in the window",
-          f"max |u| in the window {max(window_thrust):.0e}", "reproduced" if max(window_thrust) <= 1e-12 else
-          "differs: thrust in the window", "criterion |u| <= 1e-12 at every window node; enforced as u_k = 0 there")
-table.add("SCvx converges for every alpha_h of the grid", "implied (Figs. 2, 5)",
+          f"max |u| in the window {max(window_thrust):.0e}", "derived",
+          "imposed input (u_k = 0 at every window node), not a prediction; checked |u| <= 1e-12: "
+          f"{max(window_thrust) <= 1e-12}")
+pen_summary = "; ".join(f"gamma {r['gamma']:.0e}, {r['max_iter']} it: "
+                        + ("converged" if r["converged"] else
+                           f"not converged, last defect {r['history'][-1]['max_defect']:.0e}, eta {r['eta']:.0e}")
+                        for r in pen_runs)
+table.add("printed SCvx (L1 exact penalty, linear MI of Eq. 44) converges, alpha_h = 5e-3", "implied (Figs. 2, 5)",
+          pen_summary, "reproduced" if pen_any else "differs: the printed formulation does not converge here",
+          "gamma and the iteration limit are unstated: swept (printed in section 4, full reasons there); "
+          f"best accepted cost at gamma 1e3: {pen_printed['best']:.5f} vs {best[i5].cost:.5f} of our solver"
+          + ("" if pen_any else "; what converges: augmented Lagrangian on the defects, convex quadratic MI model, "
+             "round-off-level predicted decrease counted as rho = 1 (row 'modified SCvx')"))
+long_run = pen_runs[-1]
+table.add(f"printed SCvx at gamma 1e3 with {long_run['max_iter']} iterations", "-", long_run["outcome"],
+          "beyond paper", f"best accepted cost {long_run['best']:.5f}; last trust radius {long_run['eta']:.1e}; "
+          f"hybrid (L1 penalty, quadratic MI, {pen_hybrid['max_iter']} it): {pen_hybrid['outcome']}")
+table.add("modified SCvx converges for every alpha_h of the grid", "-",
           f"{sum(a['converged'] for a in sweep.attempts)}/{len(sweep.attempts)} runs, largest defect "
-          f"{max(r.max_defect for r in best):.0e}",
-          "reproduced" if all(a["converged"] for a in sweep.attempts) and max(r.max_defect for r in best) <= 1e-9
-          else "differs: some runs fail", "criterion: every run converges with defects <= 1e-9; augmented "
-          "Lagrangian + quadratic MI model; the printed L1 penalty creeps (next row)")
-table.add("printed SCvx (L1 exact penalty) at alpha_h = 5e-3", "method of Eqs. 42-43", pen_outcome[:60],
-          "beyond paper", f"best accepted cost {pen_best:.5f} vs {best[i5].cost:.5f}; gamma = 1e3")
+          f"{max(r.max_defect for r in best):.0e}", "beyond paper",
+          "augmented Lagrangian + quadratic MI model + changed acceptance (section 3); criterion: every run converges "
+          f"with defects <= 1e-9: {all(a['converged'] for a in sweep.attempts) and max(r.max_defect for r in best) <= 1e-9}")
 table.add("larger alpha_h -> larger departure from the DRO (Fig. 2)", "yes",
           "largest distance from the DRO " + ", ".join(f"{a:g}: {d / 1e3:.1f}" for a, d in zip(ALPHAS, departure_km))
           + " (10^3 km)", "reproduced" if departure_monotone else "differs: departure not monotone",
-          "criterion: non-decreasing over the grid; best of upward and downward sweeps")
+          "criterion: non-decreasing over the grid; best of upward and downward sweeps of the modified solver")
 table.add("impulse and MI grow with alpha_h (Fig. 5)", "yes",
           f"impulse {impulse_mps[0]:.2f} -> {impulse_mps[-1]:.1f} m/s, MI {mi[0]:.1f} -> {mi[-1]:.1f} nats",
           "reproduced" if monotone else "differs: non-monotone front",
           "criterion: both non-decreasing over the grid (1e-6 relative)")
-table.add("CRLB transient at the window start, then bounded (Fig. 4)", "yes",
-          f"transient: {transient}; final <= second-step RMS: {bounded}",
-          "reproduced" if transient and bounded else "differs: see Fig. 4 analogue",
-          "criterion, every alpha_h: RMS grows from the 1st to the 2nd measurement, ends below the 2nd; diagonal "
-          "prior, no correlations (paper's explanation)")
+table.add("CRLB transient at the window start (Fig. 4)", "yes", f"RMS grows from the 1st to the 2nd measurement: "
+          f"{transient} (alpha_h = 0: {crlb[0].rms_km[0, 0]:.0f} -> {crlb[0].rms_km[0, 1]:.0f} km)",
+          "reproduced" if transient else "differs: no transient",
+          "criterion, every alpha_h; diagonal prior, no correlations (paper's explanation); holds for the literal Q too")
+table.add("CRLB bounded after the transient (Fig. 4)", "yes", f"window end <= 2nd-measurement RMS: {bounded}",
+          "consistent (tuned)" if bounded else "differs: see Fig. 4 analogue",
+          "criterion, every alpha_h; the process-noise reading was chosen by this very property, so not independent")
 table.add("more information -> lower terminal RMS (Figs. 4-5)", "observer and target",
           f"observer {term_obs[0]:.1f} -> {term_obs[-1]:.1f} km, target {term_tgt[0]:.1f} -> {term_tgt[-1]:.1f} km",
           "reproduced" if term_obs[-1] < term_obs[0] and term_tgt[-1] < term_tgt[0] else "differs: no gain",
-          f"alpha_h = 0 vs {ALPHAS[-1]:g}")
+          f"alpha_h = 0 vs {ALPHAS[-1]:g}; holds under the literal Q too ({lit[0].terminal_rms_km[0]:.0f} -> "
+          f"{lit[1].terminal_rms_km[0]:.0f} km)")
 table.add("MI correlates with estimator performance", "'correlates well'",
-          f"Spearman(MI, terminal RMS): observer {rho_obs:+.2f}, target {rho_tgt:+.2f}", "beyond paper",
-          f"{len(ALPHAS)} alpha_h values")
+          f"Spearman(MI, terminal RMS): observer {rho_obs:+.2f}, target {rho_tgt:+.2f}",
+          "reproduced" if rho_obs < -0.8 and rho_tgt < -0.8 else "differs: weak rank correlation",
+          f"criterion: Spearman below -0.8 (as in notebook 06), over the {len(ALPHAS)} alpha_h of the grid")
 table.add("single-shooting re-flight of every plan", "-", f"largest terminal miss {max(miss_km):.1e} km",
           "beyond paper", "FOH control alone from x_S(t0), nonlinear CR3BP")
 table.add("node grid (mesh check, alpha_h = 5e-3)", "N not given",
           f"{N_NODES} nodes: {best[i5].impulse * MPS:.2f} m/s, RMS {mesh_rms[0]:.2f} km; {N_NODES_ALT} nodes: "
           f"{mesh.impulse * MPS:.2f} m/s, RMS {mesh_rms[1]:.2f} km", "beyond paper",
-          f"impulse changes by {100 * mesh_dimp:.1f} %: near-impulsive plans (|u|/a_max <= {max(max_ratio):.2f})")
+          f"impulse changes by {100 * mesh_dimp:.1f} %, RMS by {100 * abs(mesh_rms[1] / mesh_rms[0] - 1):.0f} %: "
+          f"near-impulsive plans (|u|/a_max <= {max(max_ratio):.2f})")
 for r in budget_rows:
     table.add(f"baseline vs information plan at {r['budget']:.1f} m/s (solved)", "'substantial improvement'",
               f"alpha_h = {r['alpha']:.2e} spends {r['impulse']:.2f} m/s: observer RMS {r['rms_obs']:.1f} km vs "
               f"{term_obs[0]:.1f} km at {impulse_mps[0]:.2f} m/s ({r['rms_obs'] / term_obs[0]:.2f} x)",
-              "beyond paper", f"budget met within {100 * BUDGET_RTOL:g} %; log-interpolation on the grid said "
-              f"{r['interp']:.1f} km")
+              "beyond paper", f"budget met within {100 * BUDGET_RTOL:g} %; log-interpolation on the grid at the "
+              f"spent impulse said {r['interp']:.1f} km")
 table.add("Pareto values (impulse, terminal RMS)", "plotted only (Fig. 5), no numbers",
           f"{impulse_mps[-1]:.1f} m/s -> target {term_tgt[-1]:.2f} km at alpha_h = {ALPHAS[-1]:g}", "not in paper",
           "the paper's axes are not quantitatively readable; N and sigma of the nodes are not given either")

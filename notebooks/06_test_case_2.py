@@ -15,7 +15,7 @@
 # absolute states of itself and three neighbouring spacecraft from range and range-rate measurements alone; why
 # the optimiser leaves the orbital plane (and in which direction: the z-mirror question the paper leaves open);
 # why the mutual-information reward needs a minimum-range keep-out for range-rate measurements, and how large it
-# must be; how the process-noise units of Tables 3 and 5 are decided by the paper's own figures; and how the
+# must be; which readings of the process-noise units of Tables 3 and 5 the paper's text allows; and how the
 # trade between impulse and estimation accuracy (the Pareto front) looks when the SCvx solver converges for every
 # homotopy weight.
 #
@@ -36,6 +36,7 @@ OUTPUT_DIR = ""
 # Sizes derived from QUICK: quick mode uses fewer SCvx nodes and alphas; the seeds and every study still run.
 N_NODES = 16 if QUICK else 30  # Sundman nodes over the three periods (window ends moved onto nodes)
 MAX_ITER = 100 if QUICK else 150  # SCvx iteration limit per run
+N_NODES_ALT = [14] if QUICK else [24, 27]  # other node grids: the whole sweep again (Fig. 7 robustness, mesh check)
 FREE_ITER = 10 if QUICK else 75  # iterations granted to the run without keep-out (it does not converge)
 SIGMA = 1.0  # Sundman exponent (notebook 04)
 # homotopy grid: 8 values including 0 and the weights of Figs. 6-8 (quick mode: 3; figures asking for an alpha_h
@@ -52,7 +53,7 @@ WORKERS = 2  # processes for the independent upward/downward sweeps and the othe
 import multiprocessing
 import re
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -107,8 +108,10 @@ x_ws_ball = x_ball[k_ws]
 # chain rule in square-root form, notebook 02) is a function of the observer state at the window start alone. The
 # process noise blocks of $\tilde P$ are computed once along the ballistic window arc and held fixed: the value and
 # the gradient then describe the same function (the paper's gradient neglects the sensitivity of $\tilde P$; a value
-# that recomputed Q along each candidate would differ from it by ~0.5 % and confuse the ratio test). The gradient is
-# the forward-mode derivative of the square-root recursion; we check it against fourth-order central differences.
+# that recomputed Q along each candidate differs from it only slightly, at most by the relative amount printed in
+# section 4, but any mismatch between value and gradient would confuse the ratio test). The gradient is the
+# reverse-mode derivative of Eq. 18 computed through the square-root recursion (not the paper's Eqs. 44-52 term by
+# term); we check it against fourth-order central differences.
 
 # %%
 info = sc.information_model()
@@ -145,16 +148,19 @@ print(f"Hessian diagonal (z, vz): {H[2, 2]:.3e}, {H[5, 5]:.3e}; "
 # it grows without bound as the range $\rho$ shrinks, and so does the linear-Gaussian MI. Below we move the
 # observer's window-start state (Newton on the STM) so that it passes target 1 at a chosen distance at the middle
 # measurement of the window and evaluate the MI: nearly flat down to about a hundred metres, the reward then
-# grows without bound (like $\ln(1/\rho)$), so a maximiser that finds this region flies through the target
+# grows without bound (like $\ln(1/\rho)$), so a maximiser that finds this region could fly through the target
 # (section 11: without a keep-out SCvx does not converge, its cost sinks below the constrained optimum's while the
-# defects stay open; smaller keep-outs are tried there too). Well before that singularity the reward stops being
+# defects stay open, and we print how close its iterates come; smaller keep-outs are tried there too). Well before
+# that singularity the reward stops being
 # trustworthy: the MI linearises the measurement about the *true* states, while the prior
 # uncertainty of the relative position is $\sigma_{rel} = \sqrt2\cdot 100$ km = 141 km per axis; the
 # line-of-sight direction that carries the range-rate information is uncertain by about $\sigma_{rel}/\rho$ rad. We
 # require the target to lie outside the prior 3-sigma relative-position sphere,
 # $d_{min} = 3\sqrt2\,\sigma_p$ = 424 km, at every measurement time (`MinimumRange`, linearised through the
 # observer STM: the tangent half-space of the keep-out sphere). The ballistic reference passes no closer than
-# about 1500 km inside the window, so the keep-out only removes the close-approach optima.
+# about 1500 km inside the window, yet the keep-out is not a mere guard against the singularity: at 424 km the scan
+# shows no MI gain from a closer pass (printed below), but the optimiser still presses against the sphere in most
+# plans of the sweep (section 4 counts them), so the keep-out shapes the optima, and section 11 sweeps its radius.
 
 # %%
 k_mid = t_meas.size // 2
@@ -205,6 +211,18 @@ t0 = time.perf_counter()
 sweep = wj.sweep_both_ways(solver, ALPHAS, x_ball, u_ball, executor=executor)
 t_sweep = time.perf_counter() - t0
 failed = [a for a in sweep.attempts if not a["converged"]]
+
+
+def alt_sweep(n_alt):
+    """The same two-way sweep on another Sundman grid (its chains queue in the process pool)."""
+    t_a, k_a, _ = sc.node_times(n_alt, SIGMA)
+    s_a = wj.ScenarioSolver(sc, t_a, k_a, information=info, keep_out=True, settings=solver.settings)
+    return t_a, k_a, wj.sweep_both_ways(s_a, ALPHAS, *sc.ballistic_guess(t_a), executor=executor)
+
+
+# queued behind the seeded runs; collected in section 6 (a thread only waits on the process pool)
+waiter = ThreadPoolExecutor(max_workers=len(N_NODES_ALT))
+alt_jobs = {n_: waiter.submit(alt_sweep, n_) for n_ in N_NODES_ALT}
 print(f"sweeps: {len(sweep.attempts)} runs in {t_sweep:.0f} s, {len(failed)} hit the iteration limit "
       "(" + (", ".join(f"{a['alpha']:g} {a['direction']} {a['start']}" for a in failed) or "none")
       + "; a failed warm start is retried from the ballistic guess)")
@@ -231,6 +249,12 @@ for r in ok:
           f"{np.mean(r['crlb'].terminal_rms_km[1:]):>8.1f} {r['res'].iterations:>4d} {r['res'].max_defect:>8.1e} "
           f"{r['miss_km']:>10.2e} {r['min_range_km']:>10.1f} {r['z_max_km']:>10.0f} {r['u_ratio']:>9.3f}")
 by_alpha = {r["alpha"]: r for r in ok}
+n_bind = sum(r["min_range_km"] <= sc.keep_out_km * (1 + 1e-3) for r in ok if r["alpha"] > 0)
+print(f"424 km keep-out active (closest approach within 0.1 % of it) in {n_bind} of "
+      f"{sum(r['alpha'] > 0 for r in ok)} plans with alpha_h > 0")
+mi_q_rel = max(abs(r["crlb"].mutual_information - r["mi"]) / r["mi"] for r in ok)
+print(f"MI with Q held along the ballistic arc (planning) vs Q recomputed along each plan (CRLB): largest relative "
+      f"difference {mi_q_rel:.1e}")
 
 
 def pick(a):
@@ -244,7 +268,8 @@ def pick(a):
 # %% [markdown]
 # ## 5 · Figure 6: absolute motion for $\alpha_h = 10^{-2}$
 #
-# The converged control flown by single shooting (first-order hold), coloured by thrust (red) and coast (blue),
+# The converged control flown by single shooting (first-order hold), coloured by thrust (red: $|a|$ above 1 % of
+# $a_{max}$, the threshold of notebook 05's Fig. 1) and coast (blue),
 # with the reference DRO (the corrected first row of Table 4) dashed, in the three principal planes. The x-y panel
 # has equal scales; in the two out-of-plane panels the z axis is stretched (by the factor in each panel title),
 # because the excursions of a few thousand km out of the plane would otherwise be a flat line next to an orbit of
@@ -255,7 +280,7 @@ def coast_thrust(ax_dict, res):
     """Single-shooting flight of a converged control, thrust arcs red and coasts blue, in 10^3 km."""
     tf, xf = wj.fly(sc, t, res.u)
     uf = np.linalg.norm(np.stack([np.interp(tf, t, res.u[:, i]) for i in range(3)], axis=1), axis=1)
-    thrust = uf > 1e-3 * sc.a_max
+    thrust = uf > 1e-2 * sc.a_max  # thrust arc: |a| above 1 % of a_max (as in notebook 05's Fig. 1)
     ref = propagate(em, sc.observer_x0, np.linspace(0, sc.period, 400)).x
     k3 = em.length_unit_km / 1e3
     for plane, ax in ax_dict.items():
@@ -275,7 +300,8 @@ a6 = row6["alpha"]
 fig, axd = plotting.three_plane_axes(figsize=(15, 4.6))
 handles, labels = coast_thrust(axd, row6["res"])
 fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=9, bbox_to_anchor=(0.5, -0.02))
-fig.suptitle(rf"Fig. 6 analogue: observer trajectory, $\alpha_h$ = {a6:g} (rotating frame, barycentric)")
+fig.suptitle(rf"Fig. 6 analogue: observer trajectory, $\alpha_h$ = {a6:g} (rotating frame, barycentric; "
+             r"thrust: |a| above 1 % of $a_{max}$)")
 fig.tight_layout(rect=(0, 0.07, 1, 0.95))
 for plane in ("xz", "yz"):  # data units per pixel horizontally / vertically: how much z is stretched
     ax = axd[plane]
@@ -289,15 +315,15 @@ _ = plotting.save_figure(fig, "06_fig6_absolute_trajectory", output_dir=out)
 # ## 6 · Figure 7: motion relative to the reference DRO over the grid
 #
 # The observer's position minus that of the reference DRO at the same time, with the initial (green) and terminal
-# (red) states marked. Drawn for four weights of the grid (all eight curves on top of each other cannot be told
-# apart); the right panel gives, for every $\alpha_h$ of the grid, the largest departure from the reference over the
+# (red) states marked. Drawn for five weights of the grid, among them the paper's pair $5\times10^{-3}$ and
+# $7\times10^{-3}$ (all eight curves on top of each other cannot be told apart); the right panel gives, for every $\alpha_h$ of the grid, the largest departure from the reference over the
 # scenario, which is what "a larger departure" would mean: a longer observer-target baseline and more dynamical
 # differentiation.
 
 # %%
 fig, axs = plt.subplots(1, 4, figsize=(17, 4.6), gridspec_kw={"width_ratios": [1, 1, 1, 0.8]})
 axd = dict(zip(("xy", "xz", "yz"), axs[:3]))
-FIG7_SHOW = (0.0, 5e-4, 5e-3, 2e-2)  # weights drawn (those on the grid)
+FIG7_SHOW = (0.0, 5e-4, 5e-3, 7e-3, 2e-2)  # weights drawn (those on the grid; 5e-3 and 7e-3: the paper's pair)
 dep_max = []
 n_show = 0
 for r in ok:
@@ -308,7 +334,7 @@ for r in ok:
         continue
     for plane, ax in axd.items():
         i, j = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}[plane]
-        ax.plot(rel[:, i] / 1e3, rel[:, j] / 1e3, color=("C0", "C4", "C5", "C3")[n_show % 4], lw=1.1,
+        ax.plot(rel[:, i] / 1e3, rel[:, j] / 1e3, color=("C0", "C4", "C5", "C1", "C3")[n_show % 5], lw=1.1,
                 label=rf"$\alpha_h$ = {r['alpha']:g}" if plane == "xy" else None)
         ax.plot(rel[0, i] / 1e3, rel[0, j] / 1e3, "o", color="green", mec="k", ms=6, zorder=5)
         ax.plot(rel[-1, i] / 1e3, rel[-1, j] / 1e3, "o", color="red", mec="k", ms=6, zorder=5)
@@ -324,7 +350,7 @@ axs[3].set_xticks(xs7, [f"{r['alpha']:g}" for r in ok], rotation=45)
 axs[3].set(xlabel=r"$\alpha_h$ (grid) [-]", ylabel="largest departure [10$^3$ km]", title="every weight of the grid")
 axs[3].set_ylim(0, None)
 axs[3].legend(fontsize=8, loc="lower right")
-fig.legend(*axd["xy"].get_legend_handles_labels(), loc="lower center", ncol=4, fontsize=9,
+fig.legend(*axd["xy"].get_legend_handles_labels(), loc="lower center", ncol=5, fontsize=9,
            bbox_to_anchor=(0.4, -0.04))
 fig.suptitle("Fig. 7 analogue: observer relative to the reference DRO (green: start, red: end)")
 fig.tight_layout(rect=(0, 0.05, 1, 1))
@@ -335,19 +361,48 @@ print("largest departure from the reference [km]:",
 drops = [(ok[n_]["alpha"], ok[n_ + 1]["alpha"]) for n_ in range(len(ok) - 1) if dep_max[n_ + 1] < dep_max[n_]]
 print(f"Spearman rank correlation of alpha_h and the largest departure: {rho_dep:.2f}; departure drops between "
       f"consecutive weights: " + (", ".join(f"{a_:g} -> {b_:g}" for a_, b_ in drops) or "none"))
+# robustness: the same sweep on other node grids (which local optimum a weight lands in can change)
+rho_grids = {N_NODES: float(rho_dep)}
+mesh_rows = []  # node-grid check at the Fig. 6 weight
+for n_alt, job in alt_jobs.items():
+    t_a, k_a, sw_a = job.result()
+    al_a, dep_a = [], []
+    for a, res in zip(ALPHAS, sw_a.best):
+        if res is None:
+            continue
+        tf_a, xf_a = wj.fly(sc, t_a, res.u, refine=4)
+        rel_a = (xf_a - propagate(em, sc.observer_x0, tf_a).x)[:, :3] * em.length_unit_km
+        al_a.append(a)
+        dep_a.append(float(np.max(np.linalg.norm(rel_a, axis=1))))
+        if a == a6:
+            mesh_rows.append((n_alt, dv(res), res.information, wj.evaluate_crlb(sc, res.x[k_a]).terminal_rms_km[0]))
+    rho_grids[n_alt] = float(spearmanr(al_a, dep_a).statistic) if len(al_a) > 2 else np.nan
+    print(f"{n_alt} nodes: {len(al_a)}/{len(ALPHAS)} weights converged; largest departure [km] "
+          + ", ".join(f"{a:g}: {d_:.0f}" for a, d_ in zip(al_a, dep_a)) + f"; Spearman {rho_grids[n_alt]:.2f}")
+waiter.shutdown()
+dep_pass = sum(v > 0.8 for v in rho_grids.values())
+print(f"Spearman(alpha_h, departure) above 0.8 on {dep_pass} of {len(rho_grids)} node grids: "
+      + ", ".join(f"{n_} nodes {v:.2f}" for n_, v in rho_grids.items()))
 
 # %% [markdown]
 # **Reading.** Whether the departure grows with $\alpha_h$ is read from the right panel and the numbers above, not
 # from the curves. It does not grow step by step: neighbouring weights can land in different local optima of this
 # non-convex problem (section 4 keeps the lower cost of two sweeps per weight), and a drop between consecutive
 # weights (printed above) is such a change of optimum, not an effect of the weight. The paper's "generally" is
-# therefore judged by the rank correlation (closing table, threshold 0.8). More weight on information also shows
+# therefore judged by the rank correlation (closing table, threshold 0.8), on this node grid and on the other node
+# grids of the robustness check (whole sweep re-solved there; printed above, so the row does not rest on one grid's
+# choice of local optima). More weight on information also shows
 # in larger out-of-plane excursions and more impulse (table of section 4).
 
 # ## 7 · The z-mirror question of Fig. 7
 #
-# The paper sees near-mirror images across $z = 0$ for $\alpha_h = 5\times10^{-3}$ and $7\times10^{-3}$ and
-# postulates a family of symmetric optima. The CR3BP, the planar DROs of all four spacecraft and range/range-rate
+# The paper sees near-mirror images for $\alpha_h = 5\times10^{-3}$ and $7\times10^{-3}$ ("symmetry across the z
+# axis") and postulates a family of symmetric optima. We read the symmetry as the reflection $z\to-z$ (across the
+# plane $z = 0$, the horizontal axis of the x-z and y-z panels): it is the only reflection of the rotating frame
+# that maps solutions of this problem onto solutions at the same times ($x\to-x$ is no symmetry of the CR3BP, and
+# $y\to-y$ needs time reversal, which the fixed start and end states forbid). First the paper's own comparison:
+# the sweep's optima at the two weights, the sign of their out-of-plane excursion and the distance between one and
+# the mirror image of the other. The CR3BP, the planar DROs of all four spacecraft and range/range-rate
 # measurements are all invariant under $z\to-z$, $\dot z\to-\dot z$; so for every optimum its mirror image is an
 # optimum with exactly the same cost. We start SCvx from $+z$ and $-z$ seeds (a small out-of-plane thrust before
 # the window) at both weights and compare the two answers: equal costs and mirror-image trajectories answer the
@@ -357,6 +412,17 @@ print(f"Spearman rank correlation of alpha_h and the largest departure: {rho_dep
 
 # %%
 mirror = np.diag([1, 1, -1, 1, 1, -1.0])
+pair = [pick(a) for a in (5e-3, 7e-3)]
+if pair[0]["alpha"] != pair[1]["alpha"]:
+    xa, xb = pair[0]["res"].x, pair[1]["res"].x
+    zsign = [float(x_[k_we, 2] * em.length_unit_km) for x_ in (xa, xb)]  # z at the window end, km
+    d_mir = float(np.max(np.linalg.norm((xa - xb @ mirror)[:, :3], axis=1)) * em.length_unit_km)
+    d_same = float(np.max(np.linalg.norm((xa - xb)[:, :3], axis=1)) * em.length_unit_km)
+    print(f"sweep optima: z at the window end: alpha {pair[0]['alpha']:g}: {zsign[0]:+.0f} km, alpha "
+          f"{pair[1]['alpha']:g}: {zsign[1]:+.0f} km; largest distance between the first and the mirror image of the "
+          f"second {d_mir:.0f} km (without mirroring {d_same:.0f} km)")
+else:
+    zsign, d_mir, d_same = None, np.nan, np.nan
 seed_alphas = SEED_ALPHAS  # submitted to the pool in section 4
 seeded = {}
 for key, fut in seed_jobs.items():
@@ -410,7 +476,9 @@ _ = plotting.save_figure(fig, "06_z_mirror", output_dir=out)
 # optimum is an optimum, so Fig. 7's near-mirror pairs need no family of their own. In full mode the $+z$ and $-z$
 # seeds also converge to exact mirror images of each other (equal costs, printed above), but not to the sweep's
 # optimum: at both weights they land in a *different* local optimum with a higher cost (legend and printout), so
-# a pair of mirror images says nothing about which local optimum it belongs to.
+# a pair of mirror images says nothing about which local optimum it belongs to. In full mode the sweep's own optima
+# at the paper's pair of weights are printed first in this section: whether they form a near-mirror pair, as in
+# the paper's Fig. 7, is then a matter of which side round-off sent each one to (closing table).
 
 # %% [markdown]
 # ## 8 · Figure 8: thrust profiles for $\alpha_h = 5\times10^{-3}$ and $2\times10^{-2}$
@@ -501,9 +569,11 @@ for a in fig9_alphas:
 # ballistic observer (where the evidence is sharpest) and the terminal RMS of this case's ballistic and
 # $\alpha_h = 10^{-2}$ trajectories under each reading. The 1e-11 km²/s³ reading lets test case 1's errors grow to
 # tens of thousands of km (a one-day velocity random walk of 0.9 m/s, comparable to test case 1's 0.4 m/s minimum-impulse budget);
-# the three small readings stay bounded and differ little. We adopt the normalised one (`PROCESS_NOISE_PSD_ND`).
-# The paper's evidence cannot decide between it and the SI reading, a factor 2.8 in q: both stay bounded, which is
-# all its text says; their curves below differ in level (terminal values printed), not in kind.
+# the three small readings stay bounded, but not alike: their terminal RMS values differ by the factors printed
+# below the table. We adopt the normalised one (`PROCESS_NOISE_PSD_ND`), choosing it *because* it keeps the
+# CRLB bounded as the paper says, so the "bounded" claims are no independent test of it ("consistent (tuned)" in
+# the closing tables). The paper's text cannot decide among the three small readings (all stay bounded, which is
+# all it says); the choice sets the level of every absolute RMS in notebooks 05 and 06.
 
 # %%
 sc1 = wj.test_case_1()
@@ -525,6 +595,10 @@ _ = plotting.save_figure(fig, "06_process_noise_readings", output_dir=out)
 print(f"{'reading':<48}{'q [km^2/s^3]':>13}{'TC1 end':>10}{'TC1 peak':>10}{'TC2 a=0 end':>12}{'TC2 a=' + format(a6, 'g') + ' end':>15}")
 for label, q_km, e1, p1, e2b, e2i in noise_rows:
     print(f"{label:<48}{q_km:>13.2e}{e1:>10.0f}{p1:>10.0f}{e2b:>12.0f}{e2i:>15.1f}")
+small = [r_ for r_ in noise_rows if r_[1] < 1e-12]  # the three small readings
+q_spread = (max(r_[2] for r_ in small) / min(r_[2] for r_ in small), max(r_[5] for r_ in small) / min(r_[5] for r_ in small))
+print(f"spread of the terminal RMS over the {len(small)} small readings: test case 1 {q_spread[0]:.1f}x, test case 2 "
+      f"(alpha_h = {a6:g}) {q_spread[1]:.1f}x")
 
 # %% [markdown]
 # ## 10 · Figure 10: the Pareto fronts
@@ -541,13 +615,11 @@ rms_tgt = np.array([r["crlb"].terminal_rms_km[1:] for r in ok])
 mis = np.array([r["mi"] for r in ok])
 fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
 axes[0].loglog(np.maximum(dvs, 1e-3), rms_obs, "o-")
-last_lab = -np.inf
-for n_, (r, x_, y_) in enumerate(zip(ok, dvs, rms_obs)):  # label a point only if 20 % in impulse from the last one
-    if np.log10(max(x_, 1e-3)) - last_lab < np.log10(1.2):
-        continue
-    last_lab = np.log10(max(x_, 1e-3))
+for n_, (r, x_, y_) in enumerate(zip(ok, dvs, rms_obs)):  # every point labelled, alternately above and below
+    up = n_ % 2 == 0
     axes[0].annotate(rf"$\alpha_h$ = {r['alpha']:g}" if n_ == 0 else f"{r['alpha']:g}", (x_, y_),
-                     textcoords="offset points", xytext=(6, 4), ha="left", va="bottom", fontsize=7)
+                     textcoords="offset points", xytext=(5, 6) if up else (-5, -8), ha="left" if up else "right",
+                     va="bottom" if up else "top", fontsize=7)
 axes[0].set(xlabel=r"total impulse $\Delta V$ [m/s]", ylabel="terminal position RMS [km]", title="observer")
 for i, (mk, ls) in enumerate((("o", "-"), ("s", "--"), ("^", ":"))):
     axes[1].loglog(np.maximum(dvs, 1e-3), rms_tgt[:, i], marker=mk, ls=ls, ms=8 - 2 * i, label=f"target {i + 1}")
@@ -575,6 +647,14 @@ mono_dv = bool(np.all(np.diff(dvs) >= -1e-9 * np.max(dvs)))
 mono_mi = bool(np.all(np.diff(mis) >= -1e-9 * np.max(mis)))
 print(f"Spearman rank correlation MI vs terminal RMS: observer {rank_obs:.3f}, targets {rank_tgt:.3f}; "
       f"impulse non-decreasing in alpha: {mono_dv}; MI non-decreasing: {mono_mi}")
+dominated = []  # (alpha, index, alpha of a cheaper plan with lower or equal RMS, its index)
+for i_ in range(len(ok)):
+    j_ = next((j_ for j_ in range(len(ok)) if dvs[j_] < dvs[i_] and rms_obs[j_] <= rms_obs[i_]), None)
+    if j_ is not None:
+        dominated.append((ok[i_]["alpha"], i_, ok[j_]["alpha"], j_))
+print("plans worse on both axes than a cheaper plan (observer): " + (", ".join(
+    f"alpha {a:g} ({dvs[i_]:.2f} m/s, {rms_obs[i_]:.1f} km) vs alpha {b:g} ({dvs[j_]:.2f} m/s, {rms_obs[j_]:.1f} km)"
+    for a, i_, b, j_ in dominated) or "none"))
 
 # %% [markdown]
 # ## 11 · Beyond the paper
@@ -595,10 +675,12 @@ print(f"Spearman rank correlation MI vs terminal RMS: observer {rank_obs:.3f}, t
 # optimum follow the keep-out towards the target as it shrinks, and what happens to impulse, information and
 # terminal RMS? The answers are printed below the radius table, one line per radius: a radius well below 424 km
 # whose solve converges, inactive, to the 424 km plan would show that the active keep-out only nudges a local
-# optimum that exists without it; a different impulse means another local optimum; a radius whose solve fails
+# optimum that exists without it; trajectories more than 100 km apart anywhere (compared node by node, a threshold
+# fixed in advance) mean another local optimum; a radius whose solve fails
 # leaves the question open there.
-# Without any keep-out the iterates reach a cost below the constrained optimum's with defects still open: they head
-# for the close-approach singularity. Which local optimum a solve finds is fragile: the planar guess is a saddle
+# Without any keep-out the iterates reach a cost below the constrained optimum's with defects still open; the
+# closest approach to a target of its successive references (recorded along the run, printed below) shows whether
+# they head for the close-approach singularity. Which local optimum a solve finds is fragile: the planar guess is a saddle
 # (section 2) and round-off picks the way out of it, so a change as small as another evaluation order of the MI
 # gradient can move a run of this section, or of the sweep, to a neighbouring optimum. In the figure each radius is
 # a separate solve, so its points are not joined (neighbouring radii can land in different local optima); the dashed
@@ -618,14 +700,12 @@ if base and cheap:
           f"{cheap['crlb'].terminal_rms_km[0]:.0f} km ({base['crlb'].terminal_rms_km[0] / cheap['crlb'].terminal_rms_km[0]:.0f}x "
           f"better); best alpha {best['alpha']:g}: dV {best['dv']:.2f} m/s, RMS {best['crlb'].terminal_rms_km[0]:.1f} km")
 # queue the independent runs (keep-out off, other radii, a_max readings); the budget search runs meanwhile here
-free = wj.ScenarioSolver(sc, t, k_ws, information=info, keep_out=False,
-                         settings=scvx.SCvxSettings(max_iter=FREE_ITER))
 radius_solvers = {d: wj.ScenarioSolver(sc, t, k_ws, information=info, keep_out=True, d_min_km=d,
                                        settings=solver.settings) for d in D_MIN_KM}
 amax_solvers = {label: wj.ScenarioSolver(wj.test_case_2(a_max_km_s2=a_km), t, k_ws, information=info, keep_out=True,
                                          settings=solver.settings)
                 for label, a_km in wj.A_MAX_READINGS_CASE2_KM_S2.items() if a_km != wj.A_MAX_CASE2_KM_S2}
-jobs = {"no keep-out": executor.submit(free, a6, x_ball, u_ball)}
+jobs = {}
 # radii solved from the ballistic guess (quick mode: warm from the adopted solution, cheaper)
 d_guess = (row6["res"].x, row6["res"].u) if QUICK else (x_ball, u_ball)
 jobs.update({("d_min", d): executor.submit(s_, a6, *d_guess) for d, s_ in radius_solvers.items()})
@@ -645,16 +725,42 @@ if base:
             c_hit = wj.evaluate_crlb(sc, hit.result.x[k_ws])
             budget_row = dict(budget=b_mps, alpha=hit.alpha, dv=dv(hit.result), rms=c_hit.terminal_rms_km[0],
                               rms_tgt=float(np.mean(c_hit.terminal_rms_km[1:])), solves=len(hit.solves),
-                              interp=float(np.exp(np.interp(b_mps, [r["dv"] for r in ok],
+                              interp=float(np.exp(np.interp(dv(hit.result), [r["dv"] for r in ok],
                                                             np.log([r["crlb"].terminal_rms_km[0] for r in ok])))))
             print(f"budget {b_mps:.2f} m/s (baseline + {BUDGET_EXTRA_MPS:g}): alpha_h = {hit.alpha:.3e} spends "
                   f"{budget_row['dv']:.2f} m/s ({budget_row['solves']} solves); observer RMS {budget_row['rms']:.1f} km"
                   f" vs {base['crlb'].terminal_rms_km[0]:.0f} km at the baseline's {base['dv']:.2f} m/s "
-                  f"(log-interpolation on the grid said {budget_row['interp']:.1f} km)")
+                  f"(log-interpolation on the grid at the spent impulse said {budget_row['interp']:.1f} km)")
         except (wj.ImpulseBudgetError, scvx.SCvxError) as exc:
             print(f"budget {b_mps:.2f} m/s not reached: {exc}")
 
-extra = {}
+
+
+class RecordingInformation:
+    """The information model, recording the window-start state of every gradient call (= every SCvx reference)."""
+
+    def __init__(self, inner):
+        self.inner, self.refs = inner, []
+
+    def __call__(self, x, order=0):
+        if order >= 1:
+            self.refs.append(np.array(x, dtype=float))
+        return self.inner(x, order)
+
+    def __getattr__(self, name):
+        return getattr(self.inner, name)
+
+
+# the run without keep-out here in the main process, so that its references can be recorded
+rec_info = RecordingInformation(info)
+free = wj.ScenarioSolver(sc, t, k_ws, information=rec_info, keep_out=False,
+                         settings=scvx.SCvxSettings(max_iter=FREE_ITER))
+try:
+    nk = free(a6, x_ball, u_ball)
+except scvx.SCvxError as exc:
+    nk = exc
+nk_ref_range = np.array([ko.ranges(x_).min() for x_ in rec_info.refs]) * em.length_unit_km
+extra = {"no keep-out": nk}
 for key, fut in jobs.items():
     try:
         extra[key] = fut.result()
@@ -668,11 +774,14 @@ if isinstance(nk, scvx.SCvxError):
     nk_cost = min(acc) if acc else np.nan
     print(f"without the keep-out SCvx did not converge: {nk.reason}; best accepted cost {nk_cost:.5f} (defects not "
           f"yet closed) vs {row6['res'].cost:.5f} of the constrained optimum")
+    print(f"closest approach to a target at a measurement over its {nk_ref_range.size} references: last "
+          f"{nk_ref_range[-1]:.1f} km, smallest {nk_ref_range.min():.1f} km (first {nk_ref_range[0]:.0f} km)")
 else:
     nk_range = float(ko.ranges(nk.x[k_ws]).min() * em.length_unit_km)
     print(f"without the keep-out (alpha {a6:g}): closest approach {nk_range:.3f} km at a measurement, MI "
           f"{nk.information:.2f} nats vs {row6['mi']:.2f} with it")
 radius_rows = [dict(d=sc.keep_out_km, src="sweep", dv=row6["dv"], mi=row6["mi"], rms=row6["crlb"].terminal_rms_km[0],
+                    x=row6["res"].x,
                     closest=row6["min_range_km"], z=row6["z_max_km"])]
 for d in D_MIN_KM:
     res = extra[("d_min", d)]
@@ -681,13 +790,15 @@ for d in D_MIN_KM:
         continue
     radius_rows.append(dict(d=d, src="warm" if QUICK else "cold", dv=dv(res), mi=res.information,
                             rms=wj.evaluate_crlb(sc, res.x[k_ws]).terminal_rms_km[0],
-                            closest=float(ko.ranges(res.x[k_ws]).min() * em.length_unit_km),
+                            closest=float(ko.ranges(res.x[k_ws]).min() * em.length_unit_km), x=res.x,
                             z=float(np.max(np.abs(res.x[:, 2])) * em.length_unit_km)))
 radius_rows.sort(key=lambda r: r["d"])
 print(f"alpha_h = {a6:g}: {'keep-out [km]':>13} {'start':>6} {'dV [m/s]':>9} {'MI [nats]':>10} {'RMS obs [km]':>13} "
       f"{'closest [km]':>13} {'binds':>6} {'max|z| [km]':>11}")
+SAME_PLAN_KM = 100.0  # two plans count as the same if their node positions are never farther apart (fixed in advance)
 for r in radius_rows:
     r["binds"] = r["closest"] <= r["d"] * (1 + 1e-3)
+    r["apart"] = float(np.max(np.linalg.norm((r["x"] - row6["res"].x)[:, :3], axis=1)) * em.length_unit_km)
     print(f"{'':>14}{r['d']:>13.0f} {r['src']:>6} {r['dv']:>9.2f} {r['mi']:>10.2f} {r['rms']:>13.1f} "
           f"{r['closest']:>13.1f} {str(r['binds']):>6} {r['z']:>11.0f}")
 for d in D_MIN_KM:
@@ -697,10 +808,13 @@ for d in D_MIN_KM:
     if r is None:
         print(f"keep-out {d:g} km (below the adopted one): solve failed, question open at this radius")
     else:
-        same_plan = abs(r["dv"] - row6["dv"]) <= 0.01 * row6["dv"]
+        same_plan = r["apart"] <= SAME_PLAN_KM
         print(f"keep-out {d:g} km (below the adopted one): {'active' if r['binds'] else 'inactive'} at its optimum, "
-              f"impulse {r['dv']:.2f} vs {row6['dv']:.2f} m/s: "
-              + ("the 424 km plan (within 1 %)" if same_plan else "another local optimum"))
+              f"impulse {r['dv']:.2f} vs {row6['dv']:.2f} m/s, closest approach {r['closest']:.0f} vs "
+              f"{row6['min_range_km']:.0f} km, max|z| {r['z']:.0f} vs {row6['z_max_km']:.0f} km, RMS {r['rms']:.1f} vs "
+              f"{row6['crlb'].terminal_rms_km[0]:.1f} km; the two trajectories lie up to {r['apart']:.0f} km apart: "
+              + (f"the 424 km plan (within {SAME_PLAN_KM:g} km)" if same_plan else
+                 f"a neighbouring local optimum (more than {SAME_PLAN_KM:g} km apart)"))
 fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
 dd = np.array([r["d"] for r in radius_rows])
 i6 = next(n_ for n_, r in enumerate(ok) if r["alpha"] == a6)
@@ -743,6 +857,26 @@ for label, res in extra.items():
     print(f"a_max {label}: dV {dv(res):.2f} m/s, observer RMS {rms:.1f} km, largest |u|/a_max {ratio:.2f}")
 print(f"a_max 5e-7 (adopted): dV {row6['dv']:.2f} m/s, observer RMS "
       f"{row6['crlb'].terminal_rms_km[0]:.1f} km, largest |u|/a_max {row6['u_ratio']:.2f}")
+rank_radii = (float(spearmanr([r["mi"] for r in radius_rows], [r["rms"] for r in radius_rows]).statistic)
+              if len(radius_rows) >= 3 else None)  # fewer than 3 radii: no rank correlation worth the name
+print(f"across keep-out radii at alpha_h = {a6:g}: Spearman(MI, terminal RMS) "
+      + (f"{rank_radii:+.2f}" if rank_radii is not None else f"not computed ({len(radius_rows)} radii)"))
+radii_text = (f"{rank_radii:+.2f} across keep-out radii at alpha {a6:g}" if rank_radii is not None else
+              f"across keep-out radii not computed ({len(radius_rows)} radii)")
+bound_rms = row6["crlb"].terminal_rms_km[0]
+better_resolves = ([f"keep-out {r['d']:.0f} km: {r['rms']:.1f} km at {r['dv']:.2f} m/s" for r in radius_rows
+                    if r["d"] != sc.keep_out_km and r["rms"] < bound_rms]
+                   + [f"a_max {lab}: {r_:.1f} km at {d:.2f} m/s" for lab, d, r_, q_ in amax_rows if r_ < bound_rms])
+dominated_note = "no dominated plan"
+if dominated:
+    dominated_note = ("closest approach at the dominated weights " + ", ".join(
+        f"{a:g}: {by_alpha[a]['min_range_km']:.0f} km" for a, _, _, _ in dominated)
+        + f" (keep-out {sc.keep_out_km:.0f} km, binding if equal)")
+    if a6 in [a for a, _, _, _ in dominated] and better_resolves:
+        dominated_note += (f"; re-solves at alpha {a6:g} reach a lower RMS than the sweep's {bound_rms:.1f} km: "
+                           + "; ".join(better_resolves) + "; the Fig. 6/10 plan there is a keep-out-bound local "
+                           "optimum")
+print("front:", dominated_note)
 executor.shutdown()
 print(f"notebook compute time {time.perf_counter() - t_start:.0f} s")
 
@@ -752,7 +886,10 @@ print(f"notebook compute time {time.perf_counter() - t_start:.0f} s")
 # Tolerances fixed before comparing: the window ends to the paper's "roughly" (±1 day); "out-of-plane motion" means
 # more than 100 km out of plane; "weakly observable at $\alpha_h = 0$" means a terminal observer RMS at least five
 # times that of every $\alpha_h > 0$; "correlates well" means a Spearman rank correlation of MI against terminal RMS
-# below -0.8; the observer "on average" better than the targets means a lower window-mean RMS.
+# below -0.8; the observer "on average" better than the targets means a window-mean RMS at least 10 % lower than
+# the targets' mean; the front is monotone if no plan has both more impulse and a higher RMS than another. Rows
+# resting on a reading chosen with the paper's claim in view (process noise, the Table 2/4 slip) are at best
+# "consistent (tuned)"; imposed inputs (zero thrust in the window) are "derived", not predictions.
 
 # %%
 chk_obs = sc.row_checks["observer_t0"]
@@ -760,11 +897,12 @@ u_bind = max(r["u_ratio"] for r in ok)
 table.add("Table 4 observer x_S(t0) is a periodic DRO", "implied (DRO family)",
           f"closure after one period {chk_obs.raw_closure:.2f} (non-dimensional); vy0 off by "
           f"{chk_obs.vy0_correction:+.4f} LU/TU", "differs: printed vy0 is not periodic",
-          "corrected holding x0 (same row as Table 2); period 16.17 d")
+          f"corrected holding x0 (same row as Table 2; notebook 05 argues this reading from the span of the other "
+          f"rows); period {em.tu_to_days(chk_obs.corrected.period):.2f} d")
 others = [c for lab, c in sc.row_checks.items() if lab != "observer_t0"]
 table.add("Table 4 other rows periodic", "implied", f"closures <= {max(c.raw_closure for c in others):.1e}",
           "reproduced" if max(c.raw_closure for c in others) < 1e-6 else "differs: a row does not close",
-          "nine printed digits allow ~1e-8")
+          "criterion: closure < 1e-6 (nine printed digits allow ~1e-8)")
 table.add("Table 5 title", '"Scenario Parameters for Test Case #1"', "parameters are test case 2's",
           "differs: title slip", "range/range-rate noise and three targets belong to test case 2")
 table.add("Table 5 a_max", '"1x5^-7" km/s^2', f"5e-7 km/s^2; others: " + "; ".join(
@@ -773,36 +911,53 @@ table.add("Table 5 a_max", '"1x5^-7" km/s^2', f"5e-7 km/s^2; others: " + "; ".jo
     + (f"at 5e-7 the bound never binds on the grid (largest |u|/a_max {u_bind:.2f}), so a larger reading changes "
        "nothing but the local optimum found, a smaller one binds" if u_bind < 0.99 else
        f"at 5e-7 the bound binds (largest |u|/a_max {u_bind:.2f})"))
-table.add("Table 3/5 process noise Q", '1e-11 "km/s^3"', "1e-11 LU^2/TU^3 = 2.80e-17 km^2/s^3", "derived",
-          "1e-11 km^2/s^3 makes test case 1's CRLB grow to "
-          f"{noise_rows[0][2]:.0f} km (not bounded); the small readings stay bounded (section 9)")
+table.add("Table 3/5 process noise Q", '1e-11 "km/s^3"', "1e-11 LU^2/TU^3 = 2.80e-17 km^2/s^3", "consistent (tuned)",
+          "chosen as a reading that keeps test case 1's CRLB bounded, the paper's own claim (section 9); 1e-11 "
+          f"km^2/s^3 makes it grow to {noise_rows[0][2]:.0f} km; the three small readings all stay bounded and give "
+          f"terminal RMS values {q_spread[0]:.1f}x (case 1) and {q_spread[1]:.1f}x (case 2) apart")
 table.add("Observation window", "roughly 17-32 days", f"[P, 2P] = {ws_d:.2f}-{we_d:.2f} d",
-          "reproduced" if abs(ws_d - 17) <= 1 and abs(we_d - 32) <= 1 else "differs: window ends",
-          "P_ref of the corrected observer DRO; tolerance +-1 day (the text says 'roughly')")
-table.add("SCvx converges for every alpha_h (best of both sweeps)", "implied (Figs. 7, 10)",
+          "consistent (tuned)" if abs(ws_d - 17) <= 1 and abs(we_d - 32) <= 1 else "differs: window ends",
+          "tolerance +-1 day ('roughly'); P of the corrected observer DRO, whose reading (x0 held) was first chosen "
+          "with these day counts in view; notebook 05 supports it independently (x0 and period inside the span of "
+          f"the other rows) and lists the text's '23 days' of test case 1, missed by "
+          f"{abs(1.5 * em.tu_to_days(sc.period) - 23.0):.2f} d")
+nk_failed = isinstance(nk, scvx.SCvxError)
+small_fail = [d for d in D_MIN_KM if isinstance(extra[("d_min", d)], scvx.SCvxError)]
+table.add("SCvx converges for every alpha_h (printed formulation, no keep-out)", "implied (Figs. 7, 10)",
+          f"alpha_h = {a6:g} without keep-out: " + (nk.reason.split(":")[0] if nk_failed else "converged")
+          + ("; keep-out " + ", ".join(f"{d:g} km" for d in small_fail) + ": no convergence" if small_fail else ""),
+          "differs: the printed formulation does not converge here" if nk_failed else "reproduced",
+          "the paper has no keep-out; our solver also departs from the printed one (augmented Lagrangian, quadratic "
+          "MI model, changed acceptance; notebook 05: the printed L1 penalty does not converge on test case 1)")
+table.add("modified SCvx with a 424 km keep-out converges for every alpha_h", "-",
           f"{len(ok)}/{len(ALPHAS)} alphas; {len(failed)} of {len(sweep.attempts)} runs failed; largest defect "
-          f"{max(r['res'].max_defect for r in ok):.0e}", "reproduced" if len(ok) == len(ALPHAS) else
-          "differs: some alphas did not converge", "keep-out of 424 km at every measurement")
+          f"{max(r['res'].max_defect for r in ok):.0e}", "beyond paper",
+          f"keep-out active in {n_bind} of {sum(r['alpha'] > 0 for r in ok)} plans with alpha_h > 0")
 table.add("Single-shooting re-flight of the converged controls", "not in paper",
           f"largest terminal miss {max(r['miss_km'] for r in ok):.1e} km", "beyond paper",
           "first-order-hold control flown from x_S(t0)")
 z6 = row6["z_max_km"]
 table.add("Fig. 6: out-of-plane motion at alpha_h = 1e-2", "yes", f"max |z| = {z6:.0f} km (alpha {a6:g})",
           "reproduced" if z6 > 100 else "differs: the solution stays (nearly) planar", "threshold 100 km")
-same_free = [r for r in radius_rows if r["d"] < sc.keep_out_km and not r["binds"]
-             and abs(r["dv"] - row6["dv"]) <= 0.01 * row6["dv"]]
-dep_note = "" if rho_dep > 0.8 else (
-    "; the departure plateaus while the 424 km keep-out binds (closest approach "
-    + ", ".join(f"{r['alpha']:g}: {r['min_range_km']:.0f} km" for r in ok if r["alpha"] > 0) + ")"
-    + (f"; yet at alpha {a6:g} a {same_free[0]['d']:.0f} km keep-out, inactive, gives the same plan (closest "
-       f"{same_free[0]['closest']:.0f} km): a local-optimum effect, not made by the keep-out" if same_free else
-       "; see the keep-out sweep"))
+same_free = [r for r in radius_rows if r["d"] < sc.keep_out_km and not r["binds"] and r["apart"] <= SAME_PLAN_KM]
+robust = dep_pass == len(rho_grids)
 table.add("Fig. 7: departure grows with alpha_h", "generally", f"Spearman(alpha, max departure) = {rho_dep:.2f}; "
-          + ", ".join(f"{r['alpha']:g}: {d_ / 1e3:.1f}" for r, d_ in zip(ok, dep_max)) + " (10^3 km)",
-          "reproduced" if rho_dep > 0.8 else "differs: departure not monotone in alpha",
-          "largest distance from the reference DRO over the scenario; threshold Spearman 0.8; fragile: which local "
-          "optimum a weight lands in moves with round-off (a gradient differing by ~1e-8 relative gave 0.69 on "
-          "2026-11-24), so the correlation, not any single departure, is the evidence" + dep_note)
+          + ", ".join(f"{r['alpha']:g}: {d_ / 1e3:.1f}" for r, d_ in zip(ok, dep_max)) + " (10^3 km); other node "
+          "grids: " + ", ".join(f"{n_} nodes {v:.2f}" for n_, v in rho_grids.items() if n_ != N_NODES),
+          ("reproduced" if robust else f"differs: not robust, Spearman above 0.8 on {dep_pass} of "
+           f"{len(rho_grids)} node grids"),
+          "largest distance from the reference DRO over the scenario; threshold Spearman 0.8 on every node grid "
+          "(fixed in advance); which local optimum a weight lands in moves with the grid and with round-off "
+          "(a gradient differing by ~1e-8 relative once gave 0.69)")
+if zsign is not None:
+    table.add("Fig. 7: the 5e-3 and 7e-3 solutions are near-mirror images across z = 0", "yes (Fig. 7)",
+              f"z at the window end {zsign[0]:+.0f} km ({pair[0]['alpha']:g}), {zsign[1]:+.0f} km "
+              f"({pair[1]['alpha']:g}); largest distance to the other's mirror {d_mir:.0f} km, unmirrored "
+              f"{d_same:.0f} km", "reproduced" if d_mir < d_same else
+              "differs: the sweep's two optima lie closer to each other than to each other's mirror",
+              "criterion: one closer to the mirror of the other than to the other itself; which side an optimum "
+              "leaves the plane on is picked by round-off (planar guess is a saddle), so either outcome is an "
+              "accident of the run, and the seeded rows below make the mirror pair on purpose")
 table.add("Fig. 7 z-mirror: the mirror of an optimum is an optimum", "postulated family of symmetric optima",
           f"alpha {row_m['alpha']:g}: mirrored optimum re-solved in {twin.iterations} iterations, cost difference "
           f"{twin_dcost:.0e}, distance to the exact mirror {twin_km:.2f} km", "beyond paper",
@@ -818,10 +973,13 @@ if mirror_rows:
               + ", ".join(f"{m_[5]:.4f} (sweep best {m_[6]:.4f})" for m_ in mirror_rows), "beyond paper",
               "criterion: within 1 km and 1e-6 relative cost; the planar guess is a saddle, the sign is picked by "
               "round-off or the seed")
-table.add("Fig. 8: zero thrust in the window, out-of-plane thrust", "yes",
-          f"max |u| in window {max(r['u_window'] for r in ok):.0e}; a_z used: "
-          f"{any(np.max(np.abs(r['res'].u[:, 2])) > 1e-3 * sc.a_max for r in ok if r['alpha'] > 0)}",
-          "reproduced", "zero thrust is imposed by the node bounds")
+table.add("Fig. 8: zero thrust in the window", "a_max = 0 in the window",
+          f"max |u| in window {max(r['u_window'] for r in ok):.0e}", "derived",
+          "imposed input (zero bound at every window node), not a prediction")
+az_used = [np.max(np.abs(r["res"].u[:, 2])) > 1e-3 * sc.a_max for r in ok if r["alpha"] > 0]
+table.add("Fig. 8: out-of-plane thrust a_z used", "yes", f"a_z above 0.1 % of a_max in {sum(az_used)} of "
+          f"{len(az_used)} plans with alpha_h > 0", "reproduced" if all(az_used) else "differs: some plans stay planar",
+          "criterion: max |a_z| > 1e-3 a_max in every plan with alpha_h > 0")
 if base:
     other = [r["crlb"].terminal_rms_km[0] for r in ok if r["alpha"] > 0]
     weak = base["crlb"].terminal_rms_km[0] >= 5 * max(other)
@@ -829,29 +987,51 @@ if base:
               f"terminal observer RMS {base['crlb'].terminal_rms_km[0]:.0f} km vs <= {max(other):.0f} km",
               "reproduced" if weak else "differs: the baseline is not much worse", "factor 5 fixed in advance")
 if obs_mean:
-    better = all(obs_mean[a] < tgt_mean[a] for a in obs_mean)
+    gap_mean = {a: 1 - obs_mean[a] / tgt_mean[a] for a in obs_mean}
+    gap_end = {a: 1 - common[a][0][0] / np.mean(common[a][0][1:]) for a in obs_mean}
+    better = all(g_ >= 0.10 for g_ in gap_mean.values())
     table.add("Fig. 9: observer RMS below the targets' on average", "yes",
-              "; ".join(f"alpha {a:g}: {obs_mean[a]:.1f} vs {tgt_mean[a]:.1f} km" for a in obs_mean),
-              "reproduced" if better else "differs: observer not better determined",
-              "window-mean RMS; the observer sees all three targets")
-table.add("Fig. 10: MI correlates with estimator performance", "yes (qualitative)",
-          f"Spearman(MI, RMS) = {rank_obs:.2f} observer, {rank_tgt:.2f} targets",
+              "; ".join(f"alpha {a:g}: window mean {obs_mean[a]:.1f} vs {tgt_mean[a]:.1f} km "
+                        f"({100 * gap_mean[a]:.0f} % lower), window end {common[a][0][0]:.1f} vs "
+                        f"{np.mean(common[a][0][1:]):.1f} km ({100 * gap_end[a]:.1f} %)" for a in obs_mean),
+              "reproduced" if better else
+              f"differs: equal within {100 * max(abs(g_) for g_ in gap_mean.values()):.0f} % (window mean)",
+              "criterion fixed in advance: observer's window-mean RMS at least 10 % below the targets' mean; the "
+              "means are dominated by the transient; relative measurements tie the four errors together (section 9)")
+table.add("Fig. 10: MI correlates with estimator performance", "'correlates well'",
+          f"Spearman(MI, RMS) = {rank_obs:.2f} observer, {rank_tgt:.2f} targets over the alpha grid; "
+          + radii_text,
           "reproduced" if rank_obs < -0.8 and rank_tgt < -0.8 else "differs: weak rank correlation",
-          "over the alpha grid, best of both sweeps")
+          "criterion: Spearman below -0.8 over the alpha grid (best of both sweeps), as in notebook 05; across "
+          "keep-out radii at fixed alpha_h (not the paper's front) MI and RMS need not move together: see the "
+          "keep-out row")
 table.add("Fig. 10: impulse and MI grow with alpha_h", "yes",
           f"impulse {dvs[0]:.1f}-{dvs[-1]:.1f} m/s, MI {mis[0]:.1f}-{mis[-1]:.1f} nats, monotone: "
           f"{mono_dv and mono_mi}", "reproduced" if mono_dv and mono_mi else "differs: not monotone",
           "best of the upward and downward sweeps")
+table.add("Fig. 10: front monotone in (impulse, RMS): more impulse, lower RMS", "a trade-off front",
+          "dominated points: " + (", ".join(f"alpha {a:g} ({dvs[i]:.2f} m/s, {rms_obs[i]:.1f} km) by alpha {b:g} "
+                                            f"({dvs[j]:.2f} m/s, {rms_obs[j]:.1f} km)" for a, i, b, j in dominated)
+                                  or "none"),
+          "reproduced" if not dominated else "differs: a plan is worse on both axes than a cheaper one",
+          "criterion: no plan has both more impulse and a higher observer terminal RMS than another; "
+          + dominated_note)
 table.add("Impulse and terminal RMS values (Figs. 8-10)", "plotted, no numbers printed",
           f"alpha 0: {dvs[0]:.2f} m/s, {rms_obs[0]:.0f} km; alpha {ok[-1]['alpha']:g}: {dvs[-1]:.1f} m/s, "
           f"{rms_obs[-1]:.1f} km", "not in paper", "the figures carry no readable values in the text version")
+table.add("node grid (unstated N and sigma), alpha_h = " + f"{a6:g}", "N, sigma not given",
+          f"{N_NODES} nodes: {row6['dv']:.2f} m/s, RMS {row6['crlb'].terminal_rms_km[0]:.1f} km; "
+          + "; ".join(f"{n_} nodes: {d:.2f} m/s, RMS {r_:.1f} km" for n_, d, i_, r_ in mesh_rows),
+          "beyond paper", f"whole sweep re-solved on each grid (sigma = {SIGMA:g}); RMS changes by up to "
+          + (f"{100 * max(abs(r_ / row6['crlb'].terminal_rms_km[0] - 1) for _, _, _, r_ in mesh_rows):.0f} %"
+             if mesh_rows else "n/a (no converged plan at this weight on the other grids)"))
 if base and budget_row:
     table.add(f"Improvement over the minimum-impulse baseline at {budget_row['budget']:.1f} m/s (solved)",
               "substantial", f"alpha_h = {budget_row['alpha']:.2e} spends {budget_row['dv']:.2f} m/s: observer RMS "
               f"{budget_row['rms']:.1f} km vs {base['crlb'].terminal_rms_km[0]:.0f} km for the baseline's "
               f"{base['dv']:.2f} m/s ({base['crlb'].terminal_rms_km[0] / budget_row['rms']:.0f}x lower)",
               "beyond paper", f"budget = baseline + {BUDGET_EXTRA_MPS:g} m/s, met within {100 * BUDGET_RTOL:g} %; "
-              f"log-interpolation on the grid said {budget_row['interp']:.1f} km")
+              f"log-interpolation on the grid at the spent impulse said {budget_row['interp']:.1f} km")
 elif base and cheap:
     table.add("Improvement over the minimum-impulse baseline", "substantial",
               f"alpha {cheap['alpha']:g}: +{cheap['dv'] - base['dv']:.1f} m/s buys "
@@ -860,17 +1040,22 @@ elif base and cheap:
 rms_span = max(r["rms"] for r in radius_rows) / min(r["rms"] for r in radius_rows)
 weak_all = base is not None and all(base["crlb"].terminal_rms_km[0] >= 5 * r["rms"] for r in radius_rows)
 table.add("Keep-out radius (unstated input), swept at the Fig. 6 weight", "not in paper",
-          "; ".join(f"{r['d']:.0f} km: {r['dv']:.1f} m/s, RMS {r['rms']:.0f} km, closest {r['closest']:.0f} km"
-                    + (" (binds)" if r["binds"] else "") for r in radius_rows)
+          "; ".join(f"{r['d']:.0f} km: {r['dv']:.1f} m/s, MI {r['mi']:.2f} nats, RMS {r['rms']:.1f} km, closest "
+                    f"{r['closest']:.0f} km" + (" (binds)" if r["binds"] else "") for r in radius_rows)
           + "; none: " + (f"closest approach {nk_range:.2f} km" if np.isfinite(nk_range) else
-                          f"no convergence ({nk.reason.split(':')[0]})"),
-          "beyond paper", f"terminal RMS varies {rms_span:.1f}x over the radii; the alpha_h = 0 baseline stays >= 5x "
-          f"worse at every radius: {weak_all}; inactive radii: "
-          + (", ".join(f"{r['d']:.0f} km (closest {r['closest']:.0f} km)" for r in radius_rows if not r["binds"])
-             or "none")
+                          f"no convergence ({nk.reason.split(':')[0]}); closest approach of its last reference "
+                          f"{nk_ref_range[-1]:.1f} km"),
+          "beyond paper", (f"across radii more MI goes with a higher RMS (Spearman(MI, RMS) {rank_radii:+.2f}), "
+                           "against 'MI correlates well'" if rank_radii is not None and rank_radii > 0 else
+                           "MI against RMS " + radii_text)
+          + f"; terminal RMS varies {rms_span:.1f}x over the radii; "
+          f"the alpha_h = 0 baseline stays >= 5x worse at every radius: {weak_all}; inactive radii: "
+          + (", ".join(f"{r['d']:.0f} km (closest {r['closest']:.0f} km, up to {r['apart']:.0f} km from the 424 km "
+                       "plan)" for r in radius_rows if not r["binds"]) or "none")
           + (f"; no keep-out: best accepted cost {nk_cost:.4f} (defects open) vs {row6['res'].cost:.4f} constrained"
-             + (" (creeps above it)" if nk_cost > row6["res"].cost else "") if np.isfinite(nk_cost) else "") + "; adopted 424 km = target outside the prior 3-sigma sphere")
-table.add("MI gradient (Eqs. 44-52) vs central differences, case 2 window", "formula only",
+             if np.isfinite(nk_cost) else "") + "; adopted 424 km = target outside the prior 3-sigma sphere")
+table.add("MI gradient (reverse mode of Eq. 18) vs central differences, case 2 window", "Eqs. 44-52 (formula only)",
           f"max rel. difference {grad_err:.1e}", "beyond paper" if grad_err < 1e-5 else
-          "differs: gradient and value disagree", "process noise held fixed in both (same function)")
+          "differs: gradient and value disagree", "differentiates the square-root recursion, not Eqs. 44-52 term "
+          "by term; process noise held fixed in both (same function)")
 table.display()
