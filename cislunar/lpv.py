@@ -546,7 +546,8 @@ def default_disturbance(sigma_acc: float = 1e-3):
     r"""Disturbance channel used in this reproduction: ``disturbance_model("acceleration", sigma_acc)``.
 
     Unmodelled accelerations of size ``sigma_acc`` (LU/TU^2 per unit normalised input; 1e-3 LU/TU^2 is about
-    2.7e-9 km/s^2, the order of the solar tide the CR3BP ignores) on both velocity components:
+    2.7e-9 km/s^2, three to ten times below the solar tide the CR3BP ignores, :math:`2GM_\odot r/d^3 \approx`
+    0.9-3e-8 km/s^2 = 0.003-0.011 LU/TU^2 at r = 0.3-1 LU from the Earth) on both velocity components:
     :math:`B_d = [0; I_2]`, :math:`S_d = \sigma_{acc} I_2`, :math:`D_d = 0`.
 
     Returns
@@ -587,7 +588,8 @@ class ObserverDesign:
         Observer gain :math:`L = X^{-1}Y` of Eq. 3a (sign convention of the paper: the observer is
         :math:`\\dot{\\hat x} = (A + LC)\\hat x - Ly + b + Ld`).
     X : ndarray (4, 4)
-        Lyapunov matrix of the scaled problem, :math:`\\gamma^2 P^{-1}` (dimensionless; see :class:`PrecisionLMI`).
+        Lyapunov matrix of the scaled problem (H2: :math:`\\gamma^2 P^{-1}`; H-infinity: the :math:`X` of Eq. 19,
+        unscaled; see :class:`PrecisionLMI`).
     beta : ndarray (6,)
         :math:`\\beta_i = \\kappa_i^2`.
     kappa : ndarray (6,)
@@ -681,7 +683,8 @@ class PrecisionLMI:
     :math:`Q = Q^T` (2x2).  At every vertex :math:`\rho_v` of the parameter polytope (the LMIs are affine in
     :math:`\rho` because :math:`A, C` are and :math:`X, Y` are constant, so the vertices suffice):
 
-    H2 (Eq. 12-13, derived from the Gramian form :math:`(A+LC)P + P(A+LC)^T + B_{\bar w}B_{\bar w}^T \prec 0`,
+    H2 (Eq. 12-13, derived from the Gramian form :math:`(A+LC)P + P(A+LC)^T + (B_{\bar w}+LD_{\bar w})
+    (B_{\bar w}+LD_{\bar w})^T \prec 0`, the noise entering through :math:`LD_{\bar w}`,
     :math:`\mathrm{tr}(C_z P C_z^T) < \gamma^2`, with :math:`X = P^{-1}, Y = XL`):
 
     .. math:: \begin{bmatrix} \mathrm{sym}(XA_v + YC_v) & (XB_d + YD_d)S_d & Y\\ \star & -I & 0\\
@@ -689,7 +692,8 @@ class PrecisionLMI:
               \begin{bmatrix} -Q & C_z\\ C_z^T & -X\end{bmatrix} \prec 0,\quad \mathrm{tr}\,Q < \gamma^2 .
 
     H-infinity (Eq. 14/19, from the bounded-real lemma
-    :math:`\mathrm{sym}(X(A+LC)) + C_z^TC_z + \gamma^{-2}XB_{\bar w}B_{\bar w}^TX \prec 0`):
+    :math:`\mathrm{sym}(X(A+LC)) + C_z^TC_z + \gamma^{-2}X(B_{\bar w}+LD_{\bar w})(B_{\bar w}+LD_{\bar w})^TX
+    \prec 0`):
 
     .. math:: \begin{bmatrix} \mathrm{sym}(XA_v + YC_v) & (XB_d + YD_d)S_d & C_z^T & Y\\ \star & -\gamma^2 I & 0 & 0\\
               \star & 0 & -I & 0\\ \star & 0 & 0 & -\gamma^2\mathrm{diag}(\beta)\end{bmatrix} \prec 0 ,
@@ -697,10 +701,12 @@ class PrecisionLMI:
     Scaling (three congruences that leave the solution set unchanged).
 
     1. :math:`\gamma`.  With :math:`\gamma = 0.0013` the printed forms mix :math:`\gamma^2 \sim 10^{-6}` and
-       :math:`\beta \sim 10^{6}`.  Both problems are solved in :math:`\tilde X = \gamma^2 X`,
+       :math:`\beta \sim 10^{6}`.  H2 is solved in :math:`\tilde X = \gamma^2 X`,
        :math:`\tilde Y = \gamma^2 Y` (same :math:`L`), :math:`\tilde\beta = \gamma^2\beta`, :math:`\tilde Q =
-       Q/\gamma^2`, in which :math:`\gamma` only scales the disturbance, :math:`S_d \to S_d/\gamma`, and
-       :math:`\mathrm{tr}\,\tilde Q < 1`.  The ratio ``disturbance_scale / gamma`` is one ``cp.Parameter``, so
+       Q/\gamma^2`, with :math:`\mathrm{tr}\,\tilde Q < 1`.  H-infinity is solved after the congruence
+       :math:`\mathrm{diag}(I, I/\gamma, I, I)` of Eq. 19: :math:`X` and :math:`Y` unchanged, the disturbance block
+       :math:`(XB_d+YD_d)S_d/\gamma` against :math:`-I`, and :math:`\tilde\beta = \gamma^2\beta`.  In both,
+       :math:`\gamma` only scales the disturbance, :math:`S_d \to S_d/\gamma`.  The ratio ``disturbance_scale / gamma`` is one ``cp.Parameter``, so
        sweeps over gamma and over the disturbance level re-use the canonicalised problem.
     2. State coordinates (optional).  The error may be written :math:`e = T\hat e` with :math:`T =
        \mathrm{diag}(\mathrm{state\_scale})`; default :math:`T = I`.  :meth:`for_cr3bp` also records the
