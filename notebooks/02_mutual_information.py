@@ -42,7 +42,7 @@ TIMING_MIN_TIME = 0.02 if QUICK else 0.1  # seconds per timing run
 import numpy as np
 import matplotlib.pyplot as plt
 
-from cislunar import covariance as cov, information as info, measurements as meas, plotting
+from cislunar import covariance as cov, information as info, measurements as meas, plotting, scvx
 from cislunar.dynamics import EARTH_MOON as em
 from cislunar.propagation import find_events, propagate
 from cislunar.report import ComparisonTable
@@ -151,12 +151,14 @@ print(f"sigma_theta at 215 km: "
 # per target per day, initial errors 100 km and $10^{-2}$ km/s = 10 m/s per axis (Table 5). **Choice:** the printed
 # observer row ($\dot y_0$ = 0.528996986) does not close as a periodic orbit (notebook 01), and the paper's
 # optimised observer trajectory is not published, so the observer here coasts on the `observer_tf` DRO of Table 4
-# (which closes) — the un-manoeuvred reference, i.e. the paper's minimum-ΔV end of the trade. $P_{ref}$ is the
-# period of that DRO.
+# (which closes): a coasting stand-in, not the $\alpha_h = 0$ solution of the paper (Table 4's $x_{\mathcal S}(t_0)$ and
+# $x_{\mathcal S}(t_f)$ lie on different orbits, so even the minimum-ΔV observer flies a transfer). $P_{ref}$ is the
+# period of that DRO; the window $[P_{ref}, 2P_{ref}]$ therefore starts at half its end time.
 #
 # Process noise: Table 5 prints "$Q$ [km/s³] = $10^{-11}$"; the PSD of an acceleration has units km²/s³. Read as
 # $10^{-11}$ km²/s³ the CRLB of test case 1 grows without bound, against the paper's text, so we adopt the same
-# number in normalised units, $q = 10^{-11}$ LU²/TU³ $= 2.80\times10^{-17}$ km²/s³ (the evidence and the other
+# number in normalised units — a reading chosen by looking at the paper's result, hence "consistent (tuned)" in
+# the table (notebook 06 sweeps the readings) — $q = 10^{-11}$ LU²/TU³ $= 2.80\times10^{-17}$ km²/s³ (the evidence and the other
 # readings are in notebook 06), and discretise it *exactly* along each reference trajectory,
 # $Q_k = \int\Phi(t_{k+1},\tau)GqG^T\Phi(t_{k+1},\tau)^Td\tau$ (time-varying Van Loan; Gauss-Legendre quadrature of
 # heyoka STMs, checked against the Lyapunov ODE in the tests).
@@ -177,6 +179,9 @@ lin = cov.linearize_augmented(em, start[0], start[1:], t_win, meas.RANGE_RANGE_R
                               cov.block_diag([P_obj] * 4), q=q_nd, derivatives=True)
 print(f"P_ref = {em.tu_to_days(P_ref):.3f} d; window {em.tu_to_days(t_win[0]):.2f}-{em.tu_to_days(t_win[-1]):.2f} d, "
       f"{t_win.size} measurement times, state dim {lin.P0.shape[0]}")
+# any [P, 2P] window on these DROs starts at about 16 d: the periods of the three target DROs
+P_targets_d = [float(em.tu_to_days(find_events(em, x, 10.0, ("y_crossing",)).t[1])) for x in targets_x0]
+print("target DRO periods [d]:", np.round(P_targets_d, 2))
 print(f"q = {q_nd:.4e} LU^2/TU^3; one-day Q_S velocity sigma = "
       f"{np.sqrt(lin.Q[0, 3, 3]) * em.velocity_unit_km_s * 1e3:.3f} m/s "
       f"(sqrt(q dt) = {np.sqrt(cov.WOLF_JONES_PSD_KM2_S3 * 86400) * 1e3:.3f} m/s)")
@@ -236,7 +241,13 @@ print("mean position RMS over the window [km]:", dict(zip(names, np.round(sig_po
 print("mean in-plane RMS over the window [km]:", dict(zip(names, np.round(sig_xy.mean(axis=1), 3))))
 print(f"out-of-plane share of the summed position variance at the window end: "
       f"{np.sum(sig_z[:, -1]**2) / np.sum(sig_post[:, -1]**2):.2%}")
-transient = sig_post[:, 1] > sig_post[:, 0]
+# in-plane RMS after the second update above that after the first (the total is the free-flight sigma_z, which
+# grows whatever P0 is, so it cannot show the effect)
+transient = sig_xy[:, 1] > sig_xy[:, 0]
+print("in-plane RMS after the 1st / 2nd update [km]:",
+      {n: (round(float(a), 1), round(float(b), 1)) for n, a, b in zip(names, sig_xy[:, 0], sig_xy[:, 1])},
+      f"; largest in-plane RMS over the window {sig_xy.max():.0f} km")
+
 
 # %% [markdown]
 # ## 5 · The gradient with respect to the observer (Eqs. 44-52)
@@ -249,14 +260,21 @@ transient = sig_post[:, 1] > sig_post[:, 0]
 # $$\frac{\partial\mathcal I}{\partial\xi} = \tfrac12\mathrm{tr}\Big(\tilde S^{-1}\big(\partial_\xi\tilde H\,
 # \tilde P\tilde H^T + \tilde H\tilde P\,\partial_\xi\tilde H^T\big)\Big)\quad\text{(Eqs. 47-48)}.$$
 #
+# **Typos in the printed equations.** Eq. 45 as printed differentiates $\tfrac12(\ln|\tilde H\tilde P\tilde H| -
+# \ln|\tilde R|)$: the transpose and the $+\tilde R$ of Eq. 18 are missing (as printed the matrix is not even square
+# in general). The Kalman gain of "Performance Evaluation", $K = \bar PH^T(H\bar PH + R)^{-1}$, lacks the same
+# transpose. We use Eq. 18 and $K = \bar PH^T(H\bar PH^T+R)^{-1}$.
+#
 # As the paper says, $\tilde P$ (the process noise) is held fixed. The structured gradient differentiates the
 # square-root Kalman recursion itself in reverse mode (one forward sweep that keeps the triangular factors, one
 # backward sweep of adjoints; its cost does not grow with the number of parameters), so it keeps the accuracy of
 # the square-root value. The forward-mode derivative of the same recursion (one tangent per parameter) is kept as
 # `method="sqrt-forward"`, the reference it is tested against; the reverse-mode derivative of the covariance form is
 # kept as `method="adjoint"` but loses ~5 digits on ill-conditioned windows (test case 2's optimised windows,
-# notebook 06). Both structured and dense gradients are compared with
-# fourth-order central differences of the full re-propagated MI.
+# notebook 06). Both structured and dense gradients are compared with fourth-order central differences of the full
+# re-propagated MI, evaluated with the structured (square-root) value: the dense log-determinant carries too few
+# digits for differences at a step of $10^{-6}$ (its gradient itself differs from the structured one at the level
+# printed below).
 
 # %%
 I0, g_struct = info.window_information(lin, gradient=True)
@@ -278,10 +296,14 @@ print(f"max |structured - FD| / max |FD| = {grad_err:.1e}; structured vs dense "
       f"{np.max(np.abs(g_struct - g_dense)) / np.max(np.abs(g_dense)):.1e}")
 
 # %% [markdown]
-# **How far does the linearisation of Eq. 44 hold?** Step the observer's initial state along the gradient
-# direction (position and velocity scaled separately to km and mm/s) and compare the true MI with
-# $\mathcal I + \nabla\mathcal I\cdot\delta x$. SCvx's trust region (Eq. 24f) has to keep steps in the range where
-# the two agree.
+# **How far does the linearisation of Eq. 44 hold?** Step the observer's initial state along the unit gradient
+# direction of the non-dimensional 6-vector, with one scale factor: a step labelled "$s$ km-equivalent" has norm
+# $s$ km converted to LU, shared between position (LU) and velocity (LU/TU) as the gradient is (both parts are
+# printed). Compare the true MI with $\mathcal I + \nabla\mathcal I\cdot\delta x$. A trust region built on Eq. 44
+# alone (the package's `information_model="linear"`) would have to keep steps in the range where the two agree.
+# The package's SCvx does not rely on that by default: its default `information_model="quadratic"` adds a concave
+# curvature term to the information model, and its trust region starts far beyond this range (radii printed below);
+# notebook 05 compares the linear and quadratic models.
 
 # %%
 direction = g_struct / np.linalg.norm(g_struct)
@@ -293,7 +315,14 @@ for s_km in steps_km:
     lin_mi.append(I0 + g_struct @ dx)
 lin_err = np.abs(np.array(true_mi) - np.array(lin_mi))
 for s_km, a, b in zip(steps_km, true_mi, lin_mi):
-    print(f"|dx| = {s_km:7.1f} km-equivalent: true {a:.4f}, Eq. 44 {b:.4f}, error {abs(a - b):.2e} nats")
+    dx = direction * em.km_to_lu(s_km)
+    print(f"|dx| = {s_km:7.1f} km-equivalent (position {np.linalg.norm(dx[:3]) * em.length_unit_km:.1f} km, velocity "
+          f"{np.linalg.norm(dx[3:]) * em.velocity_unit_km_s * 1e6:.3f} mm/s): true {a:.4f}, Eq. 44 {b:.4f}, "
+          f"error {abs(a - b):.2e} nats")
+scvx_defaults = scvx.SCvxSettings()
+print(f"package SCvx defaults: information_model = {scvx_defaults.information_model!r}, trust region eta0 = "
+      f"{scvx_defaults.eta0:g} LU ({em.lu_to_km(scvx_defaults.eta0):,.0f} km), eta_max = {scvx_defaults.eta_max:g} LU "
+      f"({em.lu_to_km(scvx_defaults.eta_max):,.0f} km)")
 
 # %% [markdown]
 # ## 6 · Baseline and information (the Markley / Psiaki argument)
@@ -303,9 +332,11 @@ for s_km, a, b in zip(steps_km, true_mi, lin_mi):
 # baseline, the more the two dynamics differ, and the more observable the pair becomes. Test: a target on the
 # first Table 4 DRO and an observer on the *same* DRO, ahead by a phase $\tau$ (so no new orbit is needed and the
 # baseline grows with $\tau$); one period, daily measurements; relative position (test case 1, 100 m per axis)
-# and range/range-rate (test case 2). We report MI and the terminal CRLB. Expect a difference between the two:
-# relative position measures the full baseline vector, while in-plane range and range rate leave directions
-# unobserved — the paper notes that range needs out-of-plane observer motion (test case 2, Fig. 6).
+# and range/range-rate (test case 2). We report MI and the terminal CRLB, both total and in-plane
+# ($\sqrt{P_{xx}+P_{yy}}$). Expect a difference between the two: relative position measures the full baseline
+# vector, while in-plane range and range rate leave the out-of-plane errors unobserved — the paper notes that
+# range needs out-of-plane observer motion (test case 2, Fig. 6) — so for them only the in-plane CRLB can respond
+# to the baseline.
 
 # %%
 tgt = targets_x0[0]
@@ -316,7 +347,8 @@ t_base = np.arange(0.0, P_tgt + 1e-12, day)
 P0_pair = cov.block_diag([P_obj] * 2)
 models = {"relative position (100 m)": (meas.RELATIVE_POSITION, meas.relative_position_noise(0.1, em)),
           "range + range rate": (meas.RANGE_RANGE_RATE, R_rr)}
-study = {name: {"baseline": [], "mi": [], "obs": [], "tgt": [], "obs_z": []} for name in models}
+study = {name: {"baseline": [], "mi": [], "obs": [], "tgt": [], "obs_z": [], "obs_xy": [], "tgt_xy": []}
+         for name in models}
 for name, (model, noise) in models.items():
     for xo in obs_starts:
         lb = cov.linearize_augmented(em, xo, tgt[None], t_base, model, noise, P0_pair, q=q_nd)
@@ -326,44 +358,59 @@ for name, (model, noise) in models.items():
         study[name]["obs"].append(cov.position_sigma_km(hb.posterior[-1], 0, em))
         study[name]["tgt"].append(cov.position_sigma_km(hb.posterior[-1], 1, em))
         study[name]["obs_z"].append(np.sqrt(hb.posterior[-1, 2, 2]) * em.length_unit_km)  # observer's sigma_z
+        tgt_z = np.sqrt(hb.posterior[-1, 8, 8]) * em.length_unit_km
+        # in-plane terminal RMS sqrt(P_xx + P_yy) = sqrt(total^2 - sigma_z^2)
+        study[name]["obs_xy"].append(np.sqrt(max(study[name]["obs"][-1]**2 - study[name]["obs_z"][-1]**2, 0.0)))
+        study[name]["tgt_xy"].append(np.sqrt(max(study[name]["tgt"][-1]**2 - tgt_z**2, 0.0)))
 study = {k: {kk: np.array(vv) for kk, vv in v.items()} for k, v in study.items()}
 fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.6))
 for k, (name, res) in enumerate(study.items()):
     b_km = em.lu_to_km(res["baseline"])
     ax1.semilogx(b_km, res["mi"] - res["mi"][0], "o-", color=f"C{k}",
                  label=f"{name} (I at shortest = {res['mi'][0]:.1f} nats)")
-    # target first, as large open squares, so the observer's filled dots stay visible where the two coincide
-    ax2.loglog(b_km, res["tgt"], "s", ms=9, mfc="none", mew=1.2, color=f"C{k}")
-    ax2.loglog(b_km, res["obs"], "o-", ms=4, color=f"C{k}", zorder=3)
-rr = study["range + range rate"]
-ax2.loglog(em.lu_to_km(rr["baseline"]), rr["obs_z"], "-", lw=6, color="C1", alpha=0.3, zorder=1)
+    # in-plane RMS: target first, as large open squares, so the observer's filled dots stay visible where they meet
+    ax2.loglog(b_km, res["tgt_xy"], "s", ms=9, mfc="none", mew=1.2, color=f"C{k}")
+    ax2.loglog(b_km, res["obs_xy"], "o-", ms=4, color=f"C{k}", zorder=3)
+    ax2.loglog(b_km, res["obs"], ":", lw=1.2, color=f"C{k}", zorder=2)  # observer's total RMS
 ax1.set(xlabel="mean baseline [km]", ylabel=r"$\mathcal{I} - \mathcal{I}_{shortest}$ [nats]",
         title="MI gain vs baseline")
 ax2.set(xlabel="mean baseline [km]", ylabel="terminal position RMS [km]", title="CRLB vs baseline (colours as left)")
 ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)  # legends below the axes
-roles = [plt.Line2D([], [], marker="o", ms=4, color="0.3", label="observer"),
-         plt.Line2D([], [], marker="s", ms=9, mfc="none", ls="none", color="0.3", label="target"),
-         plt.Line2D([], [], lw=6, color="C1", alpha=0.3,
-                    label=r"observer's out-of-plane $\sigma_z$ (range + range rate)")]
-ax2.legend(handles=roles, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)
+roles = [plt.Line2D([], [], marker="o", ms=4, color="0.3", label="observer, in-plane"),
+         plt.Line2D([], [], marker="s", ms=9, mfc="none", ls="none", color="0.3", label="target, in-plane"),
+         plt.Line2D([], [], ls=":", lw=1.2, color="0.3", label="observer, total (incl. out-of-plane)")]
+ax2.legend(handles=roles, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, frameon=False)
 _ = plotting.save_figure(fig, "02_baseline_study", output_dir=out)
 for name, res in study.items():
     print(name, "\n  baseline [km]:", np.round(em.lu_to_km(res["baseline"])), "\n  MI [nats]:", np.round(res["mi"], 2),
           "\n  observer RMS [km]:", np.round(res["obs"], 3), "\n  target RMS [km]:  ", np.round(res["tgt"], 3),
-          "\n  observer sigma_z [km]:", np.round(res["obs_z"], 3))
+          "\n  observer sigma_z [km]:", np.round(res["obs_z"], 3),
+          "\n  observer in-plane RMS [km]:", np.round(res["obs_xy"], 3),
+          "\n  target in-plane RMS [km]:  ", np.round(res["tgt_xy"], 3))
 gain = {name: float(res["mi"].max() - res["mi"][0]) for name, res in study.items()}
-rms_drop = {name: float(res["obs"][0] / res["obs"].min()) for name, res in study.items()}
+# the status below uses the observer's in-plane terminal RMS: for range + range rate the total is ~all sigma_z
+rms_drop = {name: float(res["obs_xy"][0] / res["obs_xy"].min()) for name, res in study.items()}
 peak = {name: float(em.lu_to_km(res["baseline"][np.argmax(res["mi"])])) for name, res in study.items()}
+same_peak = {name: int(np.argmax(res["mi"])) == int(np.argmin(res["obs_xy"])) for name, res in study.items()}
+for name, res in study.items():
+    print(f"{name}: MI peak at {peak[name]:.0f} km, in-plane CRLB minimum at "
+          f"{em.lu_to_km(res['baseline'][np.argmin(res['obs_xy'])]):.0f} km "
+          f"({'the same baseline' if same_peak[name] else 'different baselines'})")
+obs_above = {name: [f"{b:.0f}" for b, o, g in zip(em.lu_to_km(res["baseline"]), res["obs"], res["tgt"]) if o > 1.05 * g]
+             for name, res in study.items()}
+print("baselines [km] where the observer's total RMS exceeds the target's by > 5%:", obs_above)
 
 # %% [markdown]
-# **Reading the right panel.** For each measurement type the observer's dots sit inside the target's squares, for
-# two different reasons. A relative-position measurement fixes $x_{\mathcal T} - x_{\mathcal S}$ to 100 m, so the
-# absolute error that remains is shared by the two spacecraft and their RMS values agree to a fraction of a
-# kilometre (printed above). With range and range rate on one planar DRO the out-of-plane errors are not observed
-# at all (section 4): both terminal RMS values are the free-flight $\sigma_z$ of the identical prior (the pale band
-# under the observer's curve), and the baseline can only shrink the in-plane part, a small share of the total.
-# The observer's rise at the longest baselines is out-of-plane error too: a spacecraft starting at another point of
-# the DRO ends the period at another phase of its $z$ oscillation.
+# **Reading the right panel.** With relative position the observer's and the target's RMS agree to a fraction of a
+# kilometre (printed above): the measurement fixes $x_{\mathcal T} - x_{\mathcal S}$ to 100 m, so the absolute
+# error that remains is shared. With range and range rate on one planar DRO the out-of-plane errors are not observed
+# at all (section 4): the total terminal RMS (dotted) is the free-flight $\sigma_z$ of the identical prior and hides
+# the effect of the baseline. The observer's total departs from the target's only at the longest baselines (listed
+# above), where a spacecraft starting at another point of the DRO ends the period at another phase of its $z$
+# oscillation. The in-plane RMS, which the measurements do reach, falls steeply with the baseline for both
+# measurement types (range and range rate: by an order of magnitude) and reaches its minimum where the MI peaks
+# (whether the two baselines coincide is printed above; in the full run they do for both types): the MI tracks the
+# observable part of the CRLB, including its rise at the longest, half-period baseline.
 
 # %% [markdown]
 # ## 7 · Cost: dense Eq. 18 versus the chain rule
@@ -372,9 +419,10 @@ peak = {name: float(em.lu_to_km(res["baseline"][np.argmax(res["mi"])])) for name
 # times. The dense form builds $\tilde H$ ($6N\times24N$) and factorises $\tilde S$: $O(N^3)$. The chain rule runs
 # $N$ Kalman steps on $24\times24$ matrices: $O(N)$, in square-root form (two QR factorisations per step, which
 # keep the ~10 digits the covariance form lost on test case 2's windows). A QR costs more than the Cholesky update
-# it replaces, so for short windows the dense form can be the faster one; the cell below finds the window size at
-# which the chain rule overtakes it (the *crossover*, interpolated between the sizes run on log-log axes, for the
-# value alone and for value plus gradient) from this run's own times, and compares with test case 2's
+# it replaces, so for short enough windows the dense form could be the faster one; the cell below looks for the
+# window size at which the chain rule overtakes it (the *crossover*, interpolated between the sizes run on log-log
+# axes, for the value alone and for value plus gradient) from this run's own times — if the chain rule is already
+# faster at the smallest size run, the crossover is only bounded from above — and compares with test case 2's
 # $N$ = 17. Times are best-of-3 wall clock on one BLAS thread (the machine is shared, so absolute numbers vary by
 # tens of percent, and the crossover moves with them).
 
@@ -426,32 +474,51 @@ print(f"chain rule faster than dense from {cross_value} for the MI, from {cross_
 # ## 8 · Paper versus reproduction
 
 # %%
-table.add("Eq. 11: I = E_X[KL(p(Y|X)||p(Y))] (scalar worked example)", f"{closed:.4f} nats (closed form)",
-          f"{mc:.4f} +- {se:.4f} (Monte Carlo)",
-          "reproduced" if abs(mc - closed) < 3 * se else "differs: Monte Carlo outside 3 standard errors")
+table.add("Eq. 11: I = E_X[KL(p(Y|X)||p(Y))] (scalar worked example)", "formula only (Eq. 11)",
+          f"Monte Carlo {mc:.4f} +- {se:.4f} vs closed form {closed:.4f} nats",
+          "beyond paper" if abs(mc - closed) < 3 * se else "differs: Monte Carlo outside 3 standard errors",
+          "our worked example (p = 4, h = r = 1); tolerance: 3 standard errors of the Monte Carlo mean")
 table.add("Eq. 18 on test case 2 window (dense)", "formula only", f"{mi_dense:.4f} nats", "derived",
           "no numerical MI values are printed in the paper")
 table.add("Eq. 18 by chain rule (Kalman recursion)", "not in paper",
           f"rel. diff {abs(mi_dense - mi_struct) / mi_dense:.1e}",
           "beyond paper", "same value at O(N) cost; square-root form (the dense log-determinant loses digits when "
           "the measurements are far more precise than the prior)")
-table.add("Eqs. 44-52 gradient vs central differences", "formula only", f"max rel. err {grad_err:.1e}",
+grad_dense_err = float(np.max(np.abs(g_struct - g_dense)) / np.max(np.abs(g_dense)))
+table.add("Eqs. 44-52 gradient vs central differences", "formula only",
+          f"structured vs FD {grad_err:.1e}; structured vs dense Eq. 48 {grad_dense_err:.1e} (max rel.)",
           "beyond paper" if grad_err < 1e-5 else "differs: gradient disagrees with finite differences",
-          "P~ held fixed as in the paper; dense Eq. 48 and the square-root reverse and forward modes agree")
+          "tolerance 1e-5 on structured vs FD; P~ held fixed as in the paper; FD of the structured value (the dense "
+          "log-determinant has too few digits for differences at step 1e-6), so the dense gradient agrees only to "
+          "the level shown")
 table.add("Eq. 44 linearisation error at 10 km / 100 km steps", "not in paper",
-          f"{lin_err[1]:.2e} / {lin_err[2]:.2e} nats", "beyond paper", "scale for the SCvx trust region")
+          f"{lin_err[1]:.2e} / {lin_err[2]:.2e} nats", "beyond paper",
+          f"the range where Eq. 44 alone holds; the package's SCvx uses a quadratic information model by default and a "
+          f"trust region of {em.lu_to_km(scvx_defaults.eta0):,.0f}-{em.lu_to_km(scvx_defaults.eta_max):,.0f} km "
+          "(notebook 05 compares linear and quadratic)")
 table.add("Process-noise PSD (Table 5)", "1e-11 km/s^3",
-          f"{q_nd:.1e} LU^2/TU^3 = {cov.WOLF_JONES_PSD_KM2_S3:.2e} km^2/s^3", "derived",
-          "normalised reading; 1e-11 km^2/s^3 would let test case 1's CRLB grow without bound (notebook 06)")
-table.add("Reference DRO period / observation window", "window roughly 17-32 days",
-          f"P_ref = {em.tu_to_days(P_ref):.2f} d, window {days[0]:.1f}-{days[-1]:.1f} d", "reproduced",
-          "P_ref from the Table 4 observer_tf DRO")
+          f"{q_nd:.1e} LU^2/TU^3 = {cov.WOLF_JONES_PSD_KM2_S3:.2e} km^2/s^3", "consistent (tuned)",
+          "normalised reading, chosen because 1e-11 km^2/s^3 would let test case 1's CRLB grow without bound, "
+          "against the paper's text; notebook 06 sweeps the readings")
+win_tol_d = 1.0  # tolerance on each end of the window, days
+win_ok = abs(days[0] - 17.0) <= win_tol_d and abs(days[-1] - 32.0) <= win_tol_d
+table.add("Reference DRO period / observation window", "window roughly 17-32 days (Fig. 8 text); [P_ref, 2 P_ref]",
+          f"P_ref = {em.tu_to_days(P_ref):.2f} d, window {days[0]:.2f}-{days[-1]:.2f} d",
+          "reproduced" if win_ok else "differs: window ends more than 1 d from the paper's",
+          f"tolerance +-{win_tol_d:g} d on each end; P_ref from the Table 4 observer_tf DRO. The paper's own definition "
+          f"forces the start to be half the end (~16 d; target DRO periods {', '.join(f'{p:.2f}' for p in P_targets_d)}"
+          f" d), so 'roughly 17' is loose: our start is {17.0 - days[0]:.2f} d earlier")
 table.add("Observer trajectory in the window", "SCvx-optimised (not published)", "coasting on observer_tf DRO",
-          "differs: the optimised trajectory is not given; printed observer_t0 row is not periodic",
-          "corresponds to the un-manoeuvred end of the Pareto trade")
-table.add("RMS growth at the start of the window (Fig. 4 discussion)", "noticeable growth (diagonal P0)",
-          f"grows after first update for {int(transient.sum())} of 4 objects",
-          "reproduced" if transient.any() else "differs: no initial growth in this geometry")
+          "not in paper: our choice; the optimised trajectory is not given and the printed observer_t0 row is not "
+          "periodic", "a coasting stand-in, not the alpha_h = 0 solution (Table 4's x_S(t0) and x_S(tf) are "
+          "different orbits, so alpha_h = 0 still needs a transfer)")
+table.add("In-plane RMS growth after the first update (test case 2 analogue of the Fig. 4 remark)",
+          "noticeable growth at the window start (attributed to a diagonal P0)",
+          f"in-plane RMS grows from the 1st to the 2nd update for {int(transient.sum())} of 4 objects "
+          f"(observer {sig_xy[0, 0]:.0f} -> {sig_xy[0, 1]:.0f} km)",
+          "reproduced" if transient.any() else "differs: no initial growth in this geometry",
+          "criterion: in-plane RMS after the 2nd update above that after the 1st for at least one object; symptom "
+          "only, the cause (diagonal P0) is not tested; the paper's Fig. 4 is test case 1 (notebook 05)")
 obs_better = sig_post[0].mean() < sig_post[1:].mean()
 table.add("Observer RMS below targets on average (Fig. 9)", "yes",
           f"observer {sig_post[0].mean():.2f} km vs targets {sig_post[1:].mean():.2f} km (mean over window)",
@@ -460,25 +527,25 @@ table.add("Observer RMS below targets on average (Fig. 9)", "yes",
           f"for all four; in-plane: observer {sig_xy[0].mean():.1f} km vs targets "
           f"{', '.join(f'{v:.1f}' for v in sig_xy[1:].mean(axis=1))} km")
 for name, res in study.items():
-    b_km, obs_rms, mi = em.lu_to_km(res["baseline"]), res["obs"], res["mi"]
-    k_best = int(np.argmin(obs_rms))
+    b_km, obs_xy, mi = em.lu_to_km(res["baseline"]), res["obs_xy"], res["mi"]
+    k_best = int(np.argmin(obs_xy))
     improves = gain[name] > 0 and rms_drop[name] > 1.5
-    rebound = float(obs_rms[-1] / obs_rms[k_best])  # > 1: the CRLB gets worse again at the longest baselines
+    rebound = float(obs_xy[-1] / obs_xy[k_best])  # > 1: the in-plane CRLB gets worse again at the longest baselines
     mi_drop = float(mi.max() - mi[-1])
     status = ("reproduced" if improves and rebound < 1.2 else
-              f"differs: improves up to about {b_km[k_best]:.0f} km, then the CRLB worsens ({rebound:.1f}x)"
-              if improves else "differs: in-plane range/range-rate gains little from baseline alone")
+              f"differs: improves up to about {b_km[k_best]:.0f} km, then the in-plane CRLB worsens "
+              f"({rebound:.1f}x) and the MI drops" if improves else
+              "differs: the in-plane CRLB gains little from the baseline")
     table.add(f"MI and CRLB improve with baseline ({name})", "yes (Markley/Psiaki argument, qualitative)",
-              f"MI +{gain[name]:.2f} nats up to {peak[name]:.0f} km (then -{mi_drop:.2f}); observer RMS "
-              f"{obs_rms[0]:.0f} -> {obs_rms[k_best]:.0f} km at {b_km[k_best]:.0f} km, {obs_rms[-1]:.0f} km at "
+              f"MI +{gain[name]:.2f} nats up to {peak[name]:.0f} km (then -{mi_drop:.2f}); observer in-plane RMS "
+              f"{obs_xy[0]:.1f} -> {obs_xy[k_best]:.1f} km at {b_km[k_best]:.0f} km, {obs_xy[-1]:.1f} km at "
               f"{b_km[-1]:.0f} km", status,
-              "observer phase-shifted on the target's DRO; out-of-plane share of the observer's terminal variance "
-              f"{np.mean(res['obs_z']**2 / obs_rms**2):.0%} (mean over baselines)" + (
-                  "" if rebound < 1.2 else "; the rise at the longest baselines is out-of-plane error, which "
-                  "coplanar range and range rate do not observe"))
+              "criterion fixed before comparing: MI gain > 0, in-plane RMS drop > 1.5x, rebound at the longest "
+              "baseline < 1.2x; observer phase-shifted on the target's DRO; MI peak and in-plane CRLB minimum at "
+              f"{'the same' if same_peak[name] else 'different'} baselines; out-of-plane share of the observer's "
+              f"terminal variance {np.mean(res['obs_z']**2 / res['obs']**2):.0%} (mean over baselines)")
 table.add("Structured vs dense speed at test-case-2 size (N = 17)", "not in paper",
           f"MI {r17.ratio_value:.1f}x, MI + gradient {r17.ratio_gradient:.1f}x", "beyond paper",
-          f"crossover from this run's times: {cross_value} (MI), {cross_gradient} (MI + gradient); for shorter "
-          "windows the QR per step of the square-root recursion can cost more than the dense factorisation; O(N) "
-          "against O(N^3) shows at larger N (timing figure)")
+          f"crossover from this run's times: {cross_value} (MI), {cross_gradient} (MI + gradient); O(N) against "
+          "O(N^3) shows at larger N (timing figure)")
 table.display()

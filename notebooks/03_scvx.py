@@ -99,6 +99,12 @@ print(f"transfer time {em.tu_to_days(T):.2f} d, {N_NODES} Sundman nodes (sigma =
 #
 # The paper leaves $\rho_{0,1,2}$, $\beta$, $\gamma$ and $\eta_0$ to the user; ours (from Malyuta et al. 2022) are
 # printed below. The convex subproblem is built once with `cvxpy.Parameter`s and re-solved by Clarabel.
+#
+# **Two departures from Table 1** (both in `cislunar.scvx`, listed in the table at the end):
+# (i) *noise rule*: when the predicted decrease is at the subproblem's noise level,
+# $|\mathcal J - \mathcal L| \le 10^{-9}(1+|\mathcal J|)$ (`noise_tol`), the ratio is not formed and $\rho$ is set to
+# 1, so such a step is accepted even when its prediction is slightly negative, which Eq. 36 and Table 1 would
+# reject; (ii) *cap*: the trust region never grows beyond $\eta_{max}$, which Table 1 does not have.
 
 # %%
 settings = scvx.SCvxSettings()
@@ -123,10 +129,21 @@ print(f"largest thrust at the window nodes: {window_thrust:.1e} LU/TU^2")
 n_acc = sum(h["accepted"] for h in res.history)
 updates = [h["iteration"] for h in res.history if h["multiplier_update"]]
 rhos = [h["rho"] for h in res.history]
-print(f"{n_acc} of {len(res.history)} steps accepted, rho in [{min(rhos):.3f}, {max(rhos):.3f}]; eta "
-      f"{res.history[0]['eta']:g} at the start, {res.history[-1]['eta']:g} (eta_max = {settings.eta_max:g}) "
-      "at the end; "
-      f"multipliers updated (and weight raised) after iterations {updates}")
+noise_level = [abs(h["predicted"]) <= settings.noise_tol * (1 + abs(h["cost"])) for h in res.history]
+real = [h for h, nl in zip(res.history, noise_level) if not nl]
+forced = [h["iteration"] for h, nl in zip(res.history, noise_level) if nl]
+rho_real = [h["rho"] for h in real]
+print(f"{n_acc} of {len(res.history)} steps accepted; {len(real)} with a predicted decrease above the noise level, "
+      f"rho in [{min(rho_real):.3f}, {max(rho_real):.3f}]; rho set to 1 by the noise rule at iterations {forced} "
+      f"(predicted {', '.join(format(res.history[i]['predicted'], '.1e') for i in forced)}; "
+      f"{sum(res.history[i]['predicted'] < 0 for i in forced)} negative)")
+print(f"eta {res.history[0]['eta']:g} at the start, {res.history[-1]['eta']:g} (eta_max = {settings.eta_max:g}) "
+      f"at the end; multipliers updated (and weight raised) after iterations {updates}")
+# convergence rate (the paper cites 'global convergence and superlinear convergence rate', Mao et al. 2018):
+# ratio of the largest defect after each step to that after the previous one
+defects = np.array([h["max_defect"] for h in res.history])
+defect_ratio = defects[1:] / defects[:-1]
+print("largest-defect ratio per step:", np.array2string(defect_ratio, precision=2, separator=", "))
 
 fig, axes = plt.subplots(1, 3, figsize=(15, 4.4), layout="constrained")
 # J as a sawtooth: each step runs from J before (at x = it) to J after (at x = it + 1); a multiplier/weight update
@@ -137,10 +154,10 @@ for h in res.history:
 for h, nxt in zip(res.history[:-1], res.history[1:]):
     if h["multiplier_update"]:
         axes[0].semilogy([h["iteration"] + 1] * 2, [h["new_cost"], nxt["cost"]], ":", color="C1", lw=1.5)
-axes[0].plot([], [], "-o", ms=3, color="C0", label="SCvx step (J decreases)")
+axes[0].plot([], [], "-o", ms=3, color="C0", label="SCvx step (J does not rise)")
 axes[0].plot([], [], ":", lw=1.5, color="C1", label=r"$\lambda$ update, $w$ raised (J redefined)")
 axes[0].set(xlabel="iteration [-]", ylabel=r"augmented-Lagrangian cost $\mathcal{J}$ [non-dim.]",
-            title="cost: every step lowers it")
+            title="cost per SCvx step")
 impulse_hist = np.array([h["impulse"] for h in res.history]) * em.velocity_unit_km_s * 1e3
 axes[1].plot([h["iteration"] + 1 for h in res.history], impulse_hist, "o-", color="C2")
 axes[1].set(xlabel="iteration [-]", ylabel="total impulse after the step [m/s]",
@@ -163,13 +180,17 @@ _ = plotting.save_figure(fig, "03_iterations", output_dir=out)
 # %% [markdown]
 # **Reading the iterations.** The augmented-Lagrangian cost $\mathcal J$ is not one fixed function over the run:
 # each multiplier update moves $\lambda$ and raises $w$, which raises $\mathcal J$ at the *same* trajectory (dotted
-# red jumps in the left panel). Every SCvx step lowers the $\mathcal J$ it was taken on (solid segments), so the
-# rise of $\mathcal J$ over the run is not divergence; it is the price of closing the defects. The ballistic
+# red jumps in the left panel). No SCvx step raises the $\mathcal J$ it was taken on (solid segments; steps whose
+# predicted decrease is below the noise level leave it unchanged), so the rise of $\mathcal J$ over the run is not
+# divergence; it is the price of closing the defects. The ballistic
 # guess misses $x_f$ (printed above), so the cheapest trajectory under a small weight leaves defects open and
 # spends almost nothing; as $w$ grows the defects close (right panel) and the impulse climbs to the converged value
-# (middle panel), which is the quantity the run minimises once the defects vanish. With every step accepted at
-# $\rho$ near 1 (printed above: the convex model is accurate at this scale), the trust region grows to its cap
-# after the first step and stays there, so its history is only printed.
+# (middle panel), which is the quantity the run minimises once the defects vanish. Every step is accepted
+# (printed above): the steps with a real predicted decrease have $\rho$ close to 1 (the convex model is accurate at
+# this scale); the others, below the noise level, get $\rho = 1$ from the noise rule, not from the ratio test. The
+# trust region grows to its cap $\eta_{max}$ after the first step and stays there, so its history is only printed.
+# The largest defect does not fall steadily (printed ratios, several near 1): its progress is paced by the multiplier
+# and weight updates, so this run says nothing about the superlinear rate the paper cites from Mao et al. (2018).
 
 # %% [markdown]
 # ## 3 · Is the converged trajectory real?
@@ -231,7 +252,15 @@ print("impulses from random guesses [m/s]:", np.round(np.array(impulses) * em.ve
 # %%
 table.add("SCvx converges with defects driven to zero (Eqs. 30, 42)", "yes (method)",
           f"{len(res.history)} iterations, largest defect {res.max_defect:.0e}",
-          "reproduced" if res.max_defect < 1e-9 else "differs: defects remain")
+          "reproduced" if res.max_defect < 1e-9 else "differs: defects remain",
+          f"tolerance: largest node defect < 1e-9 LU ({em.lu_to_km(1e-9) * 1e3:.2f} m)")
+table.add("global convergence and superlinear rate (Mao et al. 2018, cited)", "stated, not shown",
+          f"largest-defect ratio per step {defect_ratio.min():.1e} to {defect_ratio.max():.1e}",
+          "differs: no superlinear rate seen",
+          "global convergence is consistent with this run (the ballistic guess and the random guesses of section 4 "
+          "all converge), but the largest defect falls irregularly (ratios near 1 for several steps), paced by the "
+          "multiplier and weight updates of our SCvx* variant, not superlinearly; the cited theorem is for Mao's "
+          "penalty SCvx, whose printed form does not converge on test case 1 (notebook 05)")
 table.add("converged FOH control flies the nonlinear dynamics to x_f", "implied",
           f"miss {terminal_miss_km:.1e} km, {terminal_miss_mm_s:.1e} mm/s", "reproduced" if terminal_miss_km < 1.0
           else "differs: single-shooting miss too large",
@@ -253,4 +282,10 @@ table.add("defect handling", "L1 exact penalty, trapezoid over node defects (Eqs
           "differs: documented choice", "the exact penalty creeps with an information reward (notebook 05); without "
           f"one both agree (impulse difference {abs(res_pen.impulse - res.impulse) / res.impulse:.0e}); the penalty "
           "uses one weight dt_k per interval: Eq. 42's trapezoid needs a defect at the last node, where none exists")
+table.add("trust-region update (Table 1)", "rho < rho0 rejects; growth by beta_gr without cap",
+          f"noise rule at iterations {forced}; eta capped at eta_max = {settings.eta_max:g}",
+          "differs: documented choice",
+          f"rho = 1 when |predicted| <= {settings.noise_tol:g} (1 + |J|), which accepted "
+          f"{sum(res.history[i]['predicted'] < 0 for i in forced)} step(s) with a negative prediction that Eq. 36 "
+          f"would reject; steps with a real predicted decrease had rho in [{min(rho_real):.3f}, {max(rho_real):.3f}]")
 table.display()

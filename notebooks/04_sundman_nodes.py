@@ -31,6 +31,7 @@ OUTPUT_DIR = ""
 SIGMAS = [0.0, 1.0, 2.0] if QUICK else [0.0, 0.5, 1.0, 1.5, 2.0]
 N_NODES = 24 if QUICK else 48  # nodes over each reference arc
 N_DRAWS = 2 if QUICK else 8  # random control perturbations per (orbit, sigma)
+N_EXTRA_SEEDS = 1 if QUICK else 3  # further random-draw seeds for the DRO robustness check
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -123,12 +124,15 @@ _ = plotting.save_figure(fig, "04_nodes_on_orbits", output_dir=out)
 # **How good is the affine model between nodes?** SCvx trusts it inside a trust region. About a ballistic
 # reference we apply random smooth control profiles of size $a_{max}$ (Table 3, $10^{-6}$ km/s², about 1 mm/s²),
 # propagate each interval from its reference node with the true nonlinear flow, and compare with the affine
-# prediction: the largest discrepancy over the arc is the linearisation error the convex subproblem cannot see.
-# With a fixed number of nodes, where should they go?
+# prediction: the largest position discrepancy over the arc (median over the random draws) is the linearisation
+# error the convex subproblem cannot see. With a fixed number of nodes, where should they go? We fix in advance the
+# exponent to judge the DRO by, $\sigma = 1$ (the value notebook 03 uses), and the threshold, a 1.1x reduction of
+# the error against uniform nodes, required for every seed of the random control draws; the rest of the sweep is
+# shown, not used for the verdict.
 
 # %%
-def linearisation_error(x0, t_nodes, draws):
-    """Largest one-interval affine-model error (km) for random FOH control perturbations of size a_max.
+def linearisation_error(x0, t_nodes, draws, rng=rng):
+    """Largest one-interval affine-model position error (km) for random FOH control perturbations of size a_max.
 
     Each interval starts from its reference node (multiple shooting, as SCvx linearises); the nonlinear flow with
     the perturbed controls is compared with the affine prediction of Eq. 28.
@@ -140,7 +144,7 @@ def linearisation_error(x0, t_nodes, draws):
         phase = rng.uniform(0, 2 * np.pi, 3)
         du = A_MAX * np.sin(2 * np.pi * t_nodes[:, None] / t_nodes[-1] * rng.integers(1, 4) + phase)
         nonlinear = D.foh_discretize(em, t_nodes, x_ref, du).x_next
-        worst.append(np.max(np.linalg.norm(model.predict(x_ref, du) - nonlinear, axis=1)))
+        worst.append(np.max(np.linalg.norm((model.predict(x_ref, du) - nonlinear)[:, :3], axis=1)))  # position
     return float(np.median(worst) * em.length_unit_km)
 
 
@@ -149,17 +153,26 @@ fig, ax = plt.subplots()
 for name in ARCS:
     ax.semilogy(SIGMAS, [lin_err[name, s] for s in SIGMAS], "o-", label=name)
 ax.set_xlabel(r"Sundman exponent $\sigma$ [-]")
-ax.set_ylabel("largest one-step linearisation error [km]")
+ax.set_ylabel("largest one-step position error [km]")
 ax.set_title(f"FOH affine model vs nonlinear flow ({N_NODES} nodes, controls of size a_max)")
-ax.legend()
+ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=2, frameon=False)  # below the axes
 _ = plotting.save_figure(fig, "04_linearisation_error_vs_sigma", output_dir=out)
 for key, v in lin_err.items():
-    print(f"{key[0]:30s} sigma = {key[1]:3.1f}: {v:.3e} km")
+    print(f"{key[0]:30s} sigma = {key[1]:3.1f}: {v:.3e} km (uniform / this = {lin_err[key[0], 0.0] / v:.2f})")
+# robustness on the DRO: the same comparison with other seeds for the random control draws
+dro_key = list(ARCS)[0]
+extra = {seed: {s: linearisation_error(ARCS[dro_key][0], nodes[dro_key, s], N_DRAWS, np.random.default_rng(seed))
+                for s in SIGMAS} for seed in range(SEED + 1, SEED + 1 + N_EXTRA_SEEDS)}
+for seed, errs in extra.items():
+    print(f"DRO, draw seed {seed}: uniform / sigma error ratio",
+          {f"{s:g}": round(errs[0.0] / errs[s], 2) for s in SIGMAS})
 
 # %% [markdown]
 # The error is not monotonic in $\sigma$: crowding the nodes into perilune leaves long intervals elsewhere, where
-# the affine model then degrades, so an intermediate exponent is best (printed above). On the NRHO the right
-# spacing matters by orders of magnitude; on the quiescent DRO of the paper's test cases it matters little.
+# the affine model then degrades, so an intermediate exponent is best and a large one can be worse than uniform
+# nodes (ratios printed above). On the NRHO the right spacing changes the error by a large factor; on the quiescent
+# DRO of the paper's test cases the gain at $\sigma = 1$ is modest and depends on the random control draws (the
+# other seeds are printed above; the table reports the range and judges it against the 1.1x threshold).
 #
 # ## 3 · Thrust bounds on unequal intervals (Eqs. 40-41)
 #
@@ -192,27 +205,42 @@ print(f"Eq. 40 relative residual of the minimum-norm solution: {residual_40:.1e}
 
 # %%
 dro_name, nrho_name = list(ARCS)
-gain_dro = lin_err[dro_name, 0.0] / min(lin_err[dro_name, s] for s in SIGMAS)
+SIGMA_FIXED = 1.0  # fixed in advance (notebook 03's value), in SIGMAS in both modes
+gain_dro = lin_err[dro_name, 0.0] / lin_err[dro_name, SIGMA_FIXED]
+gain_dro_best = lin_err[dro_name, 0.0] / min(lin_err[dro_name, s] for s in SIGMAS)
+gain_dro_max_sigma = lin_err[dro_name, 0.0] / lin_err[dro_name, max(SIGMAS)]
+gain_dro_seeds = [gain_dro] + [e[0.0] / e[SIGMA_FIXED] for e in extra.values()]
 gain_nrho = lin_err[nrho_name, 0.0] / min(lin_err[nrho_name, s] for s in SIGMAS)
 best_nrho = min(SIGMAS, key=lambda s: lin_err[nrho_name, s])
 table.add("sigma = 0: t and tau coincide (Eq. 37)", "one-to-one equivalence", "uniform nodes, tau = t (tested)",
           "reproduced")
 table.add("positive sigma dilates time near perilune", "yes",
           f"NRHO shortest interval at perilune; spacing ratio {spread[nrho_name, max(SIGMAS)]:.0f} at sigma = "
-          f"{max(SIGMAS):g}", "reproduced" if spread[nrho_name, max(SIGMAS)] > 5 else "differs: little dilation")
+          f"{max(SIGMAS):g}", "reproduced" if spread[nrho_name, max(SIGMAS)] > 5 else "differs: little dilation",
+          "threshold: longest / shortest interval > 5")
 table.add("exponent symbol in Eq. 38", "alpha (Eq. 37: sigma)", "sigma used throughout", "differs: naming only",
           "Eq. 38's r_m^alpha is the Sundman factor of Eq. 37")
 table.add("number of nodes and sigma", "not given", f"N = {N_NODES}; sigma in {SIGMAS}", "not in paper",
           "swept here")
 table.add("Sundman nodes improve linearisation accuracy, DRO arc", "effective (qualitative)",
-          f"best sigma reduces the worst one-step error {gain_dro:.2f}x vs uniform",
-          "reproduced" if gain_dro > 1.1 else "differs: the DRO is too benign for spacing to matter",
-          f"uniform {lin_err[dro_name, 0.0]:.2e} km")
+          f"sigma = {SIGMA_FIXED:g} reduces the worst one-step position error {min(gain_dro_seeds):.2f}-"
+          f"{max(gain_dro_seeds):.2f}x vs uniform ({len(gain_dro_seeds)} draw seeds; {gain_dro:.2f}x for seed {SEED})",
+          "reproduced" if min(gain_dro_seeds) > 1.1 else
+          "differs: the gain at sigma = 1 falls below 1.1x for some draw seeds; the DRO is too benign for the "
+          "spacing to matter reliably",
+          f"criterion: gain > 1.1x at sigma = {SIGMA_FIXED:g} for every draw seed; uniform "
+          f"{lin_err[dro_name, 0.0]:.2e} km; best of the sweep {gain_dro_best:.2f}x; sigma = {max(SIGMAS):g} gives "
+          f"{gain_dro_max_sigma:.2f}x (below 1: worse than uniform)")
 table.add("Sundman nodes improve linearisation accuracy, NRHO arc", "not in paper (motivation)",
           f"{gain_nrho:.1f}x at sigma = {best_nrho:g} vs uniform", "beyond paper",
           f"uniform {lin_err[nrho_name, 0.0]:.2e} km")
 table.add("Eq. 41 minimum-norm node bounds", "QR minimum-norm solution", f"Eq. 40 residual {residual_40:.0e}",
-          "reproduced", "bounds have impulse units as printed; the acceleration reading gives u_max = a_max")
+          "derived", "no paper number: the residual shows only that the least-squares system is solved; bounds "
+          "have impulse units as printed")
+table.add("node bounds used in the SCvx runs (notebooks 03, 05, 06)", "Eq. 41 as printed (impulse units)",
+          "acceleration reading: u_max,k = a_max at every node (zero in the observation window)",
+          "differs: documented choice", "the FOH node controls of Eq. 27 are accelerations; the trapezoid rule on "
+          "accelerations, (u_max,k + u_max,k+1)/2 = a_max, has the minimum-norm solution u_max,k = a_max")
 table.add("FOH matrices (Eqs. 29-31)", "integrated with Phi^-1 (Eq. 32)", "heyoka state/parameter sensitivities",
           "beyond paper", "same matrices without inverting the STM; tests vs STM and finite differences")
 table.display()
