@@ -1,7 +1,7 @@
 r"""Observer sites of the maneuver-detection paper (Greaves & Scheeres 2021, "Measurements" section, Fig. 3).
 
 The paper places optical observers near L2, on a distant retrograde orbit (DRO) and at three lunar-surface
-stations, but its table of observer states is missing from the text.  The sites below are this reproduction's
+stations, and shows them only in its Fig. 3, which is not in the text: no observer state is given.  The sites below are this reproduction's
 documented choices; notebook 01 checks what the paper *says* about them (the L2 observer's line of sight to
 the NRHOs is never blocked; three surface stations are needed to see the whole 9:2 orbit).
 

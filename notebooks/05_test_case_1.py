@@ -52,6 +52,7 @@ from cislunar import discretization as D
 from cislunar import orbits, plotting, scvx, wolf_jones
 from cislunar.dynamics import EARTH_MOON as em
 from cislunar.propagation import ImpactError, propagate
+from cislunar.reference import CLOSURE_TOL
 from cislunar.report import ComparisonTable
 
 plotting.use_style()
@@ -576,8 +577,8 @@ for lab, name in (("observer_tf", "observer x_S(t_f)"), ("target1_t0", "target x
     c_ = sc.row_checks[lab]
     table.add(f"Table 2 {name} is a periodic DRO", "implied (DRO family)",
               f"closure after one period {c_.raw_closure:.1e}; period {em.tu_to_days(c_.corrected.period):.2f} d",
-              "reproduced" if c_.raw_closure < 1e-6 else "differs: the printed row does not close",
-              "criterion: closure < 1e-6 (nine printed digits allow ~1e-8)")
+              "reproduced" if c_.raw_closure < CLOSURE_TOL else "differs: the printed row does not close",
+              f"criterion: closure < {CLOSURE_TOL:g} (nine printed digits allow ~1e-8)")
 adopted, rejected = "x0 held (vy0 corrected)", "vy0 held (x0 corrected)"
 x0_wins = reading_adjacent[adopted] and not reading_adjacent[rejected]
 table.add("which number of x_S(t0) slipped (x0 or vy0)", "orbits called 'adjacent'; six other rows printed",

@@ -63,6 +63,7 @@ from cislunar import covariance as cov
 from cislunar import plotting, scvx
 from cislunar import wolf_jones as wj
 from cislunar.propagation import propagate, propagate_stm
+from cislunar.reference import CLOSURE_TOL
 from cislunar.report import ComparisonTable
 
 plotting.use_style()
@@ -901,8 +902,8 @@ table.add("Table 4 observer x_S(t0) is a periodic DRO", "implied (DRO family)",
           f"rows); period {em.tu_to_days(chk_obs.corrected.period):.2f} d")
 others = [c for lab, c in sc.row_checks.items() if lab != "observer_t0"]
 table.add("Table 4 other rows periodic", "implied", f"closures <= {max(c.raw_closure for c in others):.1e}",
-          "reproduced" if max(c.raw_closure for c in others) < 1e-6 else "differs: a row does not close",
-          "criterion: closure < 1e-6 (nine printed digits allow ~1e-8)")
+          "reproduced" if max(c.raw_closure for c in others) < CLOSURE_TOL else "differs: a row does not close",
+          f"criterion: closure < {CLOSURE_TOL:g} (nine printed digits allow ~1e-8)")
 table.add("Table 5 title", '"Scenario Parameters for Test Case #1"', "parameters are test case 2's",
           "differs: title slip", "range/range-rate noise and three targets belong to test case 2")
 table.add("Table 5 a_max", '"1x5^-7" km/s^2', f"5e-7 km/s^2; others: " + "; ".join(

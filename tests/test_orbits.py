@@ -89,6 +89,20 @@ def test_wolf_jones_table_rows():
         assert 15.5 < c.corrected.period_days < 16.5
 
 
+def test_closure_tolerance_rejects_a_wrong_mass_parameter():
+    """CLOSURE_TOL passes the printed rows with our mass parameter and fails every one of them with mu off by 1e-9
+    (closures 2-2.5e-7), which a loose tolerance such as 1e-6 would pass up to mu off by 4e-9."""
+    from dataclasses import replace
+
+    from cislunar.reference import CLOSURE_TOL
+
+    rows = [r for r in load_wolf_jones_table() if r.label != "observer_t0"]
+    for row in rows:
+        assert verify_table_row(em, row).raw_closure < CLOSURE_TOL / 3
+        off = verify_table_row(replace(em, mu=em.mu + 1e-9), row)
+        assert not off.periodic_as_printed and CLOSURE_TOL < off.raw_closure < 1e-6
+
+
 def test_shooting_failure_raises_with_residual_history():
     with pytest.raises(orbits.ConvergenceError, match="residual history") as info:
         orbits.correct_symmetric(em, [1.1, 0, -0.3, 0, 0.9, 0], 1.0, fix="x0", max_iter=3)
