@@ -84,21 +84,26 @@ for n, d in des.items():
 # allowance is a white-noise intensity; a sensor sampled every $\Delta t$ may have per-sample standard deviation
 # $\sin^{-1}(1/(\kappa\sqrt{\Delta t}))$. Notebook 11 found: read as an angle, H2 allows *less* than H-infinity (the
 # paper's ordering reversed) on every resonant orbit tried; per sample, H2 reaches 0.1 deg only for sampling
-# intervals of hours, and H-infinity 0.08 deg only on orbits whose apogee lies at 0.88-0.99 LU from the Earth (the
-# 2:1 resonance used here). At this notebook's sampling interval:
+# intervals of hours, except with a large disturbance (down to minutes at notebook 11's largest level), and
+# H-infinity 0.08 deg only on orbits whose apogee lies at 0.88-0.99 LU from the Earth (the
+# 2:1 resonance used here); both of the paper's numbers and its ordering hold together on that orbit only for
+# sampling intervals of roughly 100-400 min (notebook 11's windows). At this notebook's sampling interval:
 
 # %%
 h2_ps = float(des["h2"].noise_per_sample_deg(DT)[0])
 hinf_n = float(des["hinf"].noise_deg[0])
+DT_01 = float(1.0 / (des["h2"].kappa[0] * np.sin(np.radians(0.1))) ** 2)  # H2 allows exactly 0.1 deg per sample
 print(f"dt = {DT} TU ({DT * TU_MIN:.1f} min): H2 allows {h2_ps:.3f} deg per sample (intensity reading "
       f"{des['h2'].noise_deg[0]:.4f} deg); Hinf allows {hinf_n:.4f} deg RMS")
 print(f"the simulated {SIGMA_DEG} deg is {SIGMA_DEG / h2_ps:.2f}x the H2 and {SIGMA_DEG / hinf_n:.2f}x the Hinf "
       "allowance")
 table.add("ordering of allowances at the simulated dt", "H2 0.1 > Hinf 0.08 deg", f"H2 {h2_ps:.2f} deg per sample > "
           f"Hinf {hinf_n:.3f} deg" if h2_ps > hinf_n else f"H2 {h2_ps:.3f} < Hinf {hinf_n:.3f} deg",
-          "consistent (tuned)" if h2_ps > hinf_n else "differs: reversed",
-          f"per-sample reading at dt = {DT * TU_MIN:.1f} min (our choice); as an intensity H2 allows "
-          f"{des['h2'].noise_deg[0]:.3f} deg < Hinf (notebook 11)")
+          f"consistent (tuned): ordering only; the H2 value is {h2_ps / 0.1:.1f}x the paper's 0.1 deg"
+          if h2_ps > hinf_n else "differs: reversed",
+          f"per-sample reading at dt = {DT * TU_MIN:.1f} min (our choice), outside notebook 11's window where both "
+          f"numbers hold; H2 = 0.1 deg per sample at dt = {DT_01 * TU_MIN:.0f} min (Section 6 simulates it); as an "
+          f"intensity H2 allows {des['h2'].noise_deg[0]:.3f} deg < Hinf (notebook 11)")
 
 # %% [markdown]
 # ## 3 · Truth, measurements, scheduling parameters
@@ -107,12 +112,13 @@ table.add("ordering of allowances at the simulated dt", "H2 0.1 > Hinf 0.08 deg"
 # $\tilde\theta_i = \theta_i + n_i$, $n_i\sim N(0, (0.1°)^2)$, both angles. The sensor output is continuous and
 # each noise sample is held over `DT` (the white-noise model of intensity $\sigma^2\Delta t$ behind the H2
 # per-sample reading; `observers.simulate_lpv_observer(hold="noise")`). Holding the whole measurement instead would
-# make the observers lag the truth by about $|\dot\theta|\Delta t$, up to 1.5 deg near perigee at 25 min — far
-# more than the noise. The observer $\dot{\hat x} = (A(\rho)+LC(\rho))\hat x - Ly + b(\rho) + Ld(\rho)$ (Eq. 3a) needs
+# make the observers lag the truth by about $|\dot\theta|\Delta t$, largest near perigee (printed below for this
+# `DT`) — far more than the noise. The observer $\dot{\hat x} = (A(\rho)+LC(\rho))\hat x - Ly + b(\rho) + Ld(\rho)$ (Eq. 3a) needs
 # $\rho$; with the Earth-Moon baseline of 1 LU the law of sines gives $r_{13} = \sin\theta_2/\sin\theta_3$,
 # $r_{23}=\sin\theta_1/\sin\theta_3$ and then $x, y$ — singular when $\sin\theta_3\to0$. Where
-# $|\sin\tilde\theta_3|<0.04$ the observer uses $\rho(\hat x)$ (paper). Initial estimate error: 0.02 LU (7700 km)
-# in x and y, 0.01 LU/TU (10 m/s) in each velocity ("large initial errors", unspecified in the paper).
+# $|\sin\tilde\theta_3|<0.04$ the observer uses $\rho(\hat x)$ (paper). Initial estimate error: 0.02 LU (about
+# 7,700 km) in each of x and y, i.e. a position error of about 10,900 km (printed below), and 0.01 LU/TU (10 m/s)
+# in each velocity ("large initial errors", unspecified in the paper; Section 4 sweeps it).
 
 # %%
 t = np.arange(0.0, PERIODS * sc.orbit.period, DT)
@@ -124,7 +130,12 @@ P0 = np.diag([0.03, 0.03, 0.03, 0.03]) ** 2
 exact = {n: simulate_lpv_observer(model, d.gain(), meas, x_hat0, truth, exact_rho=True) for n, d in des.items()}
 runs["ekf"] = simulate_ekf(model, meas, x_hat0, P0, truth, sigma_acc=1e-3)
 frac = runs["h2"].rho_from_estimate.mean()
+e0 = float(runs["h2"].position_error[0])
+th1_rate = np.abs(np.gradient(np.unwrap(model.angles(truth)[0]), t))  # rad/TU
 print(f"{t.size} measurements; rho taken from the estimate on {100 * frac:.1f} % of them (|sin th3| < 0.04)")
+print(f"initial position error {e0 * KM:.0f} km ({abs(x_hat0[0] - truth[0, 0]) * KM:.0f} km per axis)")
+print(f"lag |dtheta1/dt| DT if the whole measurement were held: up to {np.degrees(th1_rate.max() * DT):.2f} deg "
+      f"at DT = {DT * TU_MIN:.1f} min")
 
 # %% [markdown]
 # ## 4 · The accuracy the LMIs guarantee (the criterion for Fig. 3's claim, fixed before looking)
@@ -172,10 +183,45 @@ for n in bound:
 ekf_rms = float(np.sqrt(np.mean(runs["ekf"].position_error[settle] ** 2)))
 
 # %% [markdown]
+# **What sets the convergence time.** The criterion "within 5 % of a period" was fixed before the runs, but whether
+# it can be met depends on an input the paper does not state: the initial error. The error decays no faster than
+# the slowest closed-loop pole of $A(\rho)+LC(\rho)$ along the orbit allows, so falling from the initial error to
+# the guarantee takes about $\ln(e_0/\text{bound})/|\mathrm{Re}\,\lambda|_{\min}$. Below: that prediction, a run
+# with no noise and exact $\rho$ (so neither noise nor triangulation can be blamed), and a sweep of the initial error
+# (the same direction, scaled) on the noisy runs.
+
+# %%
+decay = {}
+for n, d in des.items():
+    Lg = d.gain()
+    ev = np.array([np.linalg.eigvals(model.A(r) + Lg @ model.C(r)).real.max() for r in sc.rho[::10]])
+    decay[n] = float(-ev.max())  # slowest decay rate along the orbit, 1/TU
+t_pred = {n: float(np.log(e0 / bound[n]) / decay[n]) for n in des}
+meas_clean = make_measurements(model, t, truth, 0.0, np.random.default_rng(SEED))
+clean = simulate_lpv_observer(model, des["h2"].gain(), meas_clean, x_hat0, truth, exact_rho=True)
+first_clean = first_and_rms(clean, bound["h2"])[0]
+for n in des:
+    print(f"{n:4s}: slowest closed-loop decay on the orbit {decay[n]:.2f}/TU; predicted time from {e0 * KM:.0f} km "
+          f"to {bound[n] * KM:.0f} km: {t_pred[n]:.2f} TU ({100 * t_pred[n] / span:.1f} % of the period)")
+print(f"h2 , no noise, exact rho: first below the guarantee at {first_clean:.3f} TU "
+      f"({100 * first_clean / span:.1f} % of the period)")
+E0_SCALES = [0.003, 0.01, 0.03, 0.1, 0.3, 1.0]  # times the default initial error
+first_sweep = []
+for f_ in E0_SCALES:
+    x0_f = truth[0] + f_ * (x_hat0 - truth[0])
+    first_sweep.append(first_and_rms(simulate_lpv_observer(model, des["h2"].gain(), meas, x0_f, truth), bound["h2"])[0])
+first_sweep = np.array(first_sweep)
+for f_, tf in zip(E0_SCALES, first_sweep):
+    print(f"h2 , initial error {f_ * e0 * KM:7.0f} km: first below the guarantee at {tf:.3f} TU "
+          f"({100 * tf / span:.1f} % of the period)")
+ok_e0 = [f_ * e0 * KM for f_, tf in zip(E0_SCALES, first_sweep) if tf <= 0.05 * span]
+e0_max_ok = max(ok_e0) if ok_e0 else float("nan")
+
+# %% [markdown]
 # ## 5 · Fig. 3 — trajectories and errors
 #
 # (a), (b): truth (thick grey) and estimate (blue) over the whole orbit; the first 0.3 TU of the estimate (the
-# convergence transient from the 7700 km initial error) is drawn in orange, and the insets magnify its first
+# convergence transient from the 10,900 km initial position error) is drawn in orange, and the insets magnify its first
 # 0.1 TU. (c)-(e): position error of each observer on a common scale, thin at each sample and thick as a running
 # RMS over 0.1 TU, with the design's guaranteed RMS (dashed; the EKF has none), the first sample below it
 # (triangle), $\gamma$ (dotted) and the first 5 % of the period (grey), the window of the convergence criterion.
@@ -251,8 +297,9 @@ _ = plotting.save_figure(fig, "12_fig3_observers", output_dir=out)
 
 # %% [markdown]
 # **Reading the result.** Panels (c) and (d) show the two ways the observers miss the criterion (the numbers are
-# printed in Section 4 and in the table). The H2 error falls slowly from the initial 7700 km and first reaches its
-# guarantee only after about a fifth of the period; afterwards its running RMS stays near the guarantee with bumps
+# printed in Section 4 and in the table). The H2 error falls slowly from the initial 10,900 km and first reaches
+# its guarantee only after about a fifth of the period, as its slowest closed-loop pole predicts (Section 4);
+# afterwards its running RMS stays near the guarantee with bumps
 # well above it. The H-infinity error drops below its own, larger guarantee almost at once, but its running RMS then
 # hovers above that guarantee for most of the orbit. Both LPV observers have a burst of error where the spacecraft
 # crosses the Earth-Moon line ($y = 0$, printed below): there the triangulated $\rho$ is singular and $\rho(\hat x)$
@@ -280,20 +327,60 @@ for n, label in (("h2", "H2"), ("hinf", "Hinf")):
     stay_ok = rms[n] <= bound[n]
     why = "; ".join(w for w, bad in (("not below the guarantee within 5 % of a period", not conv_ok),
                                      ("RMS after convergence above the guarantee", not stay_ok)) if bad)
+    if not conv_ok:
+        why += (f" (set by the initial error {e0 * KM:.0f} km and the slowest pole {decay[n]:.1f}/TU: predicted "
+                f"{t_pred[n]:.2f} TU" + (f"; no noise, exact rho {first_clean:.2f} TU" if n == "h2" else "") + ")")
     table.add(f"{label}: converges rapidly and stays accurate", "yes (Fig. 3)",
               f"first below guarantee at {first[n]:.2f} TU ({100 * first[n] / span:.1f} % of period); RMS after "
               f"{rms[n] * KM:.0f} km vs guaranteed {bound[n] * KM:.0f} km",
               "reproduced" if conv_ok and stay_ok else f"differs: {why}",
               "criterion fixed before: first below the bound within 5 % of a period, RMS after it below the bound; "
               f"the bound assumes exact rho (with true rho: RMS {rms_exact[n] * KM:.0f} km), here rho comes from "
-              "noisy angles")
+              "noisy angles" + (f"; initial error unstated in the paper: sweep {E0_SCALES[0] * e0 * KM:.0f}-"
+                                f"{e0 * KM:.0f} km meets 5 % up to {e0_max_ok:.0f} km" if n == "h2" else ""))
 med = {n: float(np.median(runs[n].position_error[settle])) for n in runs}
+
+# %% [markdown]
+# ## 6 · The same comparison at a sampling interval where the paper's numbers hold
+#
+# At this notebook's `DT` the H2 design allows far more than 0.1 deg per sample (Section 2). Notebook 11's window where both of the
+# paper's numbers and its ordering hold on this orbit is roughly 100-400 min; at $\Delta t_{0.1} =
+# 1/(\kappa_{H2}\sin 0.1°)^2$ (inside it) H2 allows exactly 0.1 deg per sample. Both observers are re-run there with
+# the same 0.1 deg noise, initial error and criterion for "Hinf error larger than H2" (median position error after
+# 10 % of the run, fixed before).
+
+# %%
+t_w = np.arange(0.0, PERIODS * sc.orbit.period, DT_01)
+truth_w = model.planar(propagate(model.system, sc.orbit.x0, t_w).x)
+meas_w = make_measurements(model, t_w, truth_w, SIGMA_DEG, np.random.default_rng(SEED + 1))
+x0_w = truth_w[0] + (x_hat0 - truth[0])
+settle_w = t_w > 0.1 * (t_w[-1] - t_w[0])
+med_w = {}
+for n, d in des.items():
+    r_w = simulate_lpv_observer(model, d.gain(), meas_w, x0_w, truth_w)
+    med_w[n] = float(np.median(r_w.position_error[settle_w]))
+print(f"dt = {DT_01:.4f} TU ({DT_01 * TU_MIN:.0f} min), {t_w.size} samples: H2 allows "
+      f"{des['h2'].noise_per_sample_deg(DT_01)[0]:.3f} deg per sample, Hinf {hinf_n:.4f} deg; median error after 10 % "
+      f"of the run: H2 {med_w['h2'] * KM:.0f} km, Hinf {med_w['hinf'] * KM:.0f} km")
 table.add("Hinf error larger than H2", "yes (Fig. 3c)", f"median {med['hinf'] * KM:.0f} vs {med['h2'] * KM:.0f} km "
-          "after 10 % of the run", "reproduced" if med["hinf"] > med["h2"] else "differs: H2 error not smaller here",
-          f"both runs use {SIGMA_DEG} deg: {SIGMA_DEG / h2_ps:.2f}x the H2 and {SIGMA_DEG / hinf_n:.2f}x the Hinf "
-          "allowance")
-table.add("rho from estimate where |sin th3| < 0.04", "used", f"{100 * frac:.1f} % of samples", "reproduced",
-          "triangulation singular near the Earth-Moon line")
+          f"at dt = {DT * TU_MIN:.1f} min; {med_w['hinf'] * KM:.0f} vs {med_w['h2'] * KM:.0f} km at dt = "
+          f"{DT_01 * TU_MIN:.0f} min",
+          "reproduced" if med["hinf"] > med["h2"] and med_w["hinf"] > med_w["h2"] else
+          "differs: H2 error not smaller at one of the two dt",
+          "criterion fixed before: median position error after 10 % of the run larger for Hinf, at both dt; "
+          f"0.1 deg noise is {SIGMA_DEG / h2_ps:.2f}x (dt {DT * TU_MIN:.1f} min) and "
+          f"{SIGMA_DEG / des['h2'].noise_per_sample_deg(DT_01)[0]:.2f}x (dt {DT_01 * TU_MIN:.0f} min) the H2 and "
+          f"{SIGMA_DEG / hinf_n:.2f}x the Hinf allowance")
+table.add("rho from estimate where |sin th3| < 0.04", "used", f"{100 * frac:.1f} % of samples", "derived",
+          "threshold 0.04 taken from the paper; triangulation singular near the Earth-Moon line")
+ok_no_range = all(not d.used[4:].any() and not np.any(d.gain()[:, 4:]) for d in des.values())
+conv = {n: med[n] < 0.1 * e0 for n in ("h2", "hinf")}
+table.add("observers function without range sensors", "yes (Fig. 3)",
+          f"gain columns of r13^2, r23^2 {'zero' if ok_no_range else 'non-zero'}; median error after 10 % of the run "
+          f"H2 {med['h2'] * KM:.0f}, Hinf {med['hinf'] * KM:.0f} km from {e0 * KM:.0f} km",
+          "reproduced" if ok_no_range and all(conv.values()) else "differs: range channels used or no convergence",
+          "criterion fixed before: no range channel in the gains and the median error after 10 % of the run below "
+          "a tenth of the initial error; only theta1, theta2 measured")
 table.add("EKF on same angles", "-", f"RMS {ekf_rms * KM:.0f} km after 10 % of the run", "beyond paper",
           "continuous-discrete EKF, sigma_acc = 1e-3 LU/TU^2")
 table.add("measurement interval", "not stated", f"{DT} TU ({DT * TU_MIN:.1f} min)", "not in paper",
