@@ -25,7 +25,8 @@ from . import _checks
 from .dynamics import CR3BP
 
 __all__ = ["SurfaceStation", "surface_station_position", "station_elevation", "line_of_sight_clear",
-           "DEFAULT_STATIONS", "l2_observer_state", "dro_observer_orbit", "surface_coverage", "DRO_OBSERVER_X0"]
+           "DEFAULT_STATIONS", "l2_observer_state", "dro_observer_orbit", "surface_coverage", "DRO_OBSERVER_X0",
+           "site_grid", "PairCoverage", "pair_coverage", "OutageStatistics", "occultation_outages"]
 
 
 @dataclass(frozen=True)
@@ -166,3 +167,247 @@ def surface_coverage(system: CR3BP, target_positions, stations=DEFAULT_STATIONS,
         _checks.instance(st, "stations", SurfaceStation, "a sequence of cislunar.sites.SurfaceStation")
     return np.array([station_elevation(system, s.position(system), t) > np.deg2rad(min_elevation_deg)
                      for s in stations])
+
+
+def site_grid(lat_step_deg: float, lon_step_deg: float) -> tuple:
+    """Surface stations on a regular latitude-longitude grid covering the whole Moon.
+
+    Latitudes run from -90 to +90 deg in steps of ``lat_step_deg``; each non-polar latitude carries stations at
+    longitudes -180, -180 + ``lon_step_deg``, ... (< 180); each pole carries a single station (longitude 0).
+
+    Parameters
+    ----------
+    lat_step_deg : float
+        Latitude spacing, degrees; must divide 180 exactly.
+    lon_step_deg : float
+        Longitude spacing, degrees; must divide 360 exactly.
+
+    Returns
+    -------
+    tuple of SurfaceStation
+        Named ``"<lat>,<lon>"`` (degrees), south to north, west to east.
+    """
+    dlat = _checks.positive(lat_step_deg, "lat_step_deg")
+    dlon = _checks.positive(lon_step_deg, "lon_step_deg")
+    for v, total, name in ((dlat, 180.0, "lat_step_deg"), (dlon, 360.0, "lon_step_deg")):
+        k = total / v
+        if k < 1.0 - 1e-9:
+            raise ValueError(f"{name} must be at most {total:g} deg; got {v!r}")
+        if abs(k - round(k)) > 1e-9:
+            raise ValueError(f"{name} must divide {total:g} deg exactly; got {v!r}")
+    lats = np.linspace(-90.0, 90.0, int(round(180.0 / dlat)) + 1)
+    lons = np.linspace(-180.0, 180.0, int(round(360.0 / dlon)) + 1)[:-1]
+    out = []
+    for la in lats:
+        for lo in ((0.0,) if abs(la) == 90.0 else lons):
+            out.append(SurfaceStation(f"{la:+g},{lo:+g}", float(la), float(lo)))
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class PairCoverage:
+    """Coverage of a sampled trajectory by every pair of surface stations (:func:`pair_coverage`).
+
+    Attributes
+    ----------
+    stations : tuple of SurfaceStation
+        The candidate sites, in the order of the matrix indices.
+    fraction : ndarray, shape (n, n)
+        ``fraction[i, j]``: fraction of the target samples above the horizon mask of station i or station j
+        (the diagonal holds single-station coverage).  With samples uniform in time it is a fraction of time.
+    n_samples : int
+        Number of target samples.
+    """
+
+    stations: tuple
+    fraction: np.ndarray
+    n_samples: int
+
+    @property
+    def full(self) -> np.ndarray:
+        """Bool (n, n): the pair sees every sample (exact integer count, not a rounded fraction)."""
+        return np.rint(self.fraction * self.n_samples).astype(np.int64) == self.n_samples
+
+    @property
+    def n_full_pairs(self) -> int:
+        """Number of pairs ``i < j`` of distinct stations that see every sample."""
+        return int(np.triu(self.full, k=1).sum())
+
+    @property
+    def best_pair(self) -> tuple:
+        """Indices ``(i, j)``, ``i < j``, of the pair with the largest coverage (first one in row order on ties)."""
+        f = np.where(np.triu(np.ones(self.fraction.shape, bool), k=1), self.fraction, -1.0)
+        i, j = np.unravel_index(int(np.argmax(f)), f.shape)
+        return int(i), int(j)
+
+    @property
+    def best_fraction(self) -> float:
+        """Coverage of :attr:`best_pair`."""
+        return float(self.fraction[self.best_pair])
+
+
+def pair_coverage(system: CR3BP, target_positions, stations, *, min_elevation_deg: float = 0.0,
+                  chunk: int = 256) -> PairCoverage:
+    """Fraction of target samples seen by each pair of lunar surface stations (all pairs at once).
+
+    A station sees a sample when the sample's elevation above the station's local horizon exceeds
+    ``min_elevation_deg`` (the same rule as :func:`surface_coverage`).  The per-station visibility matrix ``V``
+    (n stations x m samples) is built in Moon-centred coordinates without forming the n x m x 3 difference array:
+    for a station at ``R u`` (unit vertical ``u``) and a target at Moon-centred ``t``,
+    ``sin(el) = (t.u - R) / |t - R u|`` with ``|t - R u|^2 = |t|^2 + R^2 - 2 R t.u``.  The number of samples seen
+    by ``i`` or ``j`` is ``|V_i| + |V_j| - (V V^T)_ij``, one matrix product (exact in float32 for m < 2^24).
+
+    Parameters
+    ----------
+    system : CR3BP
+    target_positions : array_like, shape (m, 3) or (m, 6)
+        Target positions (or states), rotating frame, barycentric origin, LU.
+    stations : sequence of SurfaceStation
+        Candidate sites (e.g. :func:`site_grid`); at least two.
+    min_elevation_deg : float
+        Horizon mask, degrees, in [-90, 90).
+    chunk : int
+        Stations processed per block (memory: about 3 x chunk x m doubles).
+
+    Returns
+    -------
+    PairCoverage
+    """
+    _checks.system(system)
+    t = _checks.as_array(target_positions, "target_positions", ndim=(2,))
+    t = _position_stack(t, "target_positions")
+    if t.shape[0] < 1:
+        raise ValueError("target_positions must hold at least one sample")
+    if t.shape[0] >= 2 ** 24:
+        raise ValueError(f"target_positions: at most 2**24 - 1 samples (float32 counts); got {t.shape[0]}")
+    mask = np.deg2rad(_checks.in_range(min_elevation_deg, "min_elevation_deg", -90.0, 90.0))
+    chunk = _checks.integer(chunk, "chunk", minimum=1)
+    stations = tuple(_checks.sequence_of(stations, "stations", SurfaceStation, "SurfaceStation"))
+    if len(stations) < 2:
+        raise ValueError(f"stations must hold at least two SurfaceStation; got {len(stations)}")
+    R = system.secondary_radius
+    tc = t - system.secondary_position  # Moon-centred, LU
+    if np.any(np.linalg.norm(tc, axis=1) <= R):
+        raise ValueError("target_positions must lie outside the Moon's sphere")
+    up = np.array([(s.position(system) - system.secondary_position) / R for s in stations])  # (n, 3) unit
+    t2 = np.sum(tc * tc, axis=1)
+    vis = np.empty((len(stations), t.shape[0]), dtype=np.float32)
+    sin_mask = np.sin(mask)
+    for a in range(0, len(stations), chunk):
+        tu = up[a:a + chunk] @ tc.T  # (c, m)
+        rng = np.sqrt(np.maximum(t2[None, :] + R * R - 2.0 * R * tu, 0.0))
+        vis[a:a + chunk] = (tu - R) > sin_mask * rng
+    single = vis.sum(axis=1, dtype=np.float64)
+    both = (vis @ vis.T).astype(np.float64)
+    union = single[:, None] + single[None, :] - both
+    return PairCoverage(stations, union / t.shape[0], int(t.shape[0]))
+
+
+@dataclass(frozen=True)
+class OutageStatistics:
+    """Lunar occultations of an observer-target line of sight over a long span (:func:`occultation_outages`).
+
+    Attributes
+    ----------
+    span_days : float
+        Length of the sampled span, days.
+    step_s : float
+        Sampling step, seconds.
+    clear_fraction : float
+        Fraction of samples with a clear line of sight.
+    durations_h : ndarray
+        Duration of each outage (maximal run of blocked samples, counted as samples x step), hours, in time order.
+        A run cut by either end of the span is counted as one (partial) outage.
+    """
+
+    span_days: float
+    step_s: float
+    clear_fraction: float
+    durations_h: np.ndarray
+
+    @property
+    def count(self) -> int:
+        """Number of outages."""
+        return int(self.durations_h.size)
+
+    @property
+    def longest_h(self) -> float:
+        """Longest outage, hours (0 if none)."""
+        return float(self.durations_h.max()) if self.count else 0.0
+
+    @property
+    def mean_interval_days(self) -> float:
+        """Span divided by the number of outages, days (``inf`` if none)."""
+        return self.span_days / self.count if self.count else float("inf")
+
+
+def _periodic_positions(orbit, tq, n_table):
+    """Positions (LU) on a periodic orbit at times ``tq`` (TU) by phase, cubic Hermite on a one-period table."""
+    tt, xs = orbit.sample(n_table + 1)
+    h = tt[1] - tt[0]
+    ph = np.mod(tq, orbit.period)
+    k = np.minimum((ph / h).astype(np.int64), n_table - 1)
+    s = ((ph - tt[k]) / h)[:, None]
+    p0, p1, v0, v1 = xs[k, :3], xs[k + 1, :3], xs[k, 3:] * h, xs[k + 1, 3:] * h
+    h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
+    return h00 * p0 + h10 * v0 + h01 * p1 + h11 * v1
+
+
+def occultation_outages(system: CR3BP, observer, target, span_days: float, step_s: float = 60.0, *,
+                        body: str = "moon", table_points: int = 4000) -> OutageStatistics:
+    """Count and time the occultations of the observer-target line of sight over a long span.
+
+    Each body moves on its periodic orbit indefinitely (its state at time t is the orbit's state at phase
+    ``t mod T``, both starting at their :attr:`x0` at t = 0), so a span of a year or more is sampled without the
+    numerical divergence of propagating an unstable orbit for many periods.  Positions are interpolated from a
+    one-period table of ``table_points`` states by cubic Hermite interpolation in position and velocity.  The line
+    of sight is tested with :func:`line_of_sight_clear` at times ``0, step, 2 step, ...`` up to ``span_days``.
+
+    Parameters
+    ----------
+    system : CR3BP
+    observer, target : cislunar.orbits.PeriodicOrbit or array_like, shape (3,) or (6,)
+        A periodic orbit, or a point fixed in the rotating frame (position or state, LU, barycentric), e.g.
+        :func:`l2_observer_state`.
+    span_days : float
+        Length of the span, days (positive).
+    step_s : float
+        Sampling step, seconds (positive, at most the span).
+    body : {"moon", "earth"}
+        Occulting body.
+    table_points : int
+        Intervals of the one-period interpolation table (>= 16).
+
+    Returns
+    -------
+    OutageStatistics
+    """
+    from .orbits import PeriodicOrbit
+
+    _checks.system(system)
+    span = _checks.positive(span_days, "span_days")
+    step = _checks.positive(step_s, "step_s")
+    if step > span * 86400.0:
+        raise ValueError(f"step_s must not exceed the span ({span * 86400.0:g} s); got {step_s!r}")
+    _checks.choice(body, "body", ("moon", "earth"))
+    n_table = _checks.integer(table_points, "table_points", minimum=16)
+    tq = np.arange(0.0, span * 86400.0 + 0.5 * step, step) / system.time_unit_s  # TU
+    if tq.size > 50_000_000:
+        raise ValueError(f"span_days / step_s gives {tq.size} samples; at most 5e7")
+
+    def positions(value, name):
+        if isinstance(value, PeriodicOrbit):
+            if value.system != system:
+                raise ValueError(f"{name} belongs to a different CR3BP system")
+            return _periodic_positions(value, tq, n_table)
+        a = _checks.as_array(value, name, ndim=(1,))
+        if a.size not in (3, 6):
+            raise ValueError(f"{name} must be a PeriodicOrbit or a fixed position (3,) / state (6,); got shape "
+                             f"{a.shape}")
+        return a[:3]
+
+    clear = line_of_sight_clear(system, positions(observer, "observer"), positions(target, "target"), body=body)
+    clear = np.broadcast_to(clear, tq.shape)
+    edges = np.flatnonzero(np.diff(np.r_[0, (~clear).astype(np.int8), 0]))
+    runs = edges[1::2] - edges[::2]
+    return OutageStatistics(span, step, float(clear.mean()), runs * step / 3600.0)

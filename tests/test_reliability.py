@@ -314,6 +314,19 @@ def _specs():
                     min_elevation_deg=0.0),
                dict(system="system", target_positions="arr", stations="instance",
                     min_elevation_deg="range:-90:90")))
+    s.append(S("site_grid", sites.site_grid, dict(lat_step_deg=30.0, lon_step_deg=60.0),
+               dict(lat_step_deg="pos", lon_step_deg="pos")))
+    s.append(S("pair_coverage", sites.pair_coverage,
+               dict(system=em, target_positions=np.array([[1.0, 0.1, -0.2], [1.1, 0.0, 0.1]]),
+                    stations=sites.DEFAULT_STATIONS, min_elevation_deg=0.0, chunk=2),
+               dict(system="system", target_positions="arr", stations="instance",
+                    min_elevation_deg="range:-90:90", chunk="int1")))
+    s.append(S("occultation_outages", sites.occultation_outages,
+               dict(system=em, observer=lazy(lambda: sites.l2_observer_state(em)),
+                    target=lazy(lambda: orbits.nrho_9_2(em)), span_days=7.0, step_s=3600.0, body="moon",
+                    table_points=64),
+               dict(system="system", observer="instance", target="instance", span_days="pos", step_s="pos",
+                    body="choice", table_points="int1")))
     # measurements
     for name in ("relative_position", "range_range_rate", "azimuth_elevation", "angle_rates", "angles_and_rates"):
         s.append(S(name, getattr(measurements, name), dict(observer=OBS, target=TGT, jacobian=True),
