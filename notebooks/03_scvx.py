@@ -264,7 +264,7 @@ table.add("global convergence and superlinear rate (Mao et al. 2018, cited)", "s
 table.add("converged FOH control flies the nonlinear dynamics to x_f", "implied",
           f"miss {terminal_miss_km:.1e} km, {terminal_miss_mm_s:.1e} mm/s", "reproduced" if terminal_miss_km < 1.0
           else "differs: single-shooting miss too large",
-          "tolerance 1 km (issue 7): node defects below 5e-10 LU (0.2 m) grow over 32 days of free flight")
+          "tolerance 1 km, fixed before the run: node defects below 5e-10 LU (0.2 m) grow over 32 days of free flight")
 table.add("trust-region parameters (Table 1)", "user-defined, not given",
           f"rho = {settings.rho0}/{settings.rho1}/{settings.rho2}, beta = {settings.beta_shrink}/{settings.beta_grow}, "
           f"eta0 = {settings.eta0:g}, eta_max = {settings.eta_max:g}, w0 = {settings.penalty_weight0:g}",

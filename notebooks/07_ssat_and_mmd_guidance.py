@@ -95,7 +95,8 @@ print("T B_a (control in relative coordinates) =\n", ssat.control_matrix("relati
 # naturally bounded pair about the Gateway orbit. **Choice:** the target flies the 9:2 southern L2 NRHO, the agent
 # flies the *same* orbit about half an hour behind (the phase lag is printed below), chosen so that their range at
 # the target's apolune is 215 km (the scale of the paper's Sec. 4 scenario). The burn happens `LEAD_DAYS` = 1 day
-# before apolune, so every coast of up to 48 h straddles apolune. Measurements (Sec. 3.3, 5): azimuth and elevation
+# before apolune, so coasts longer than 24 h straddle apolune (the 48-h coast ends 24 h after it); shorter coasts
+# end before it. Measurements (Sec. 3.3, 5): azimuth and elevation
 # of the target seen from the agent every hour, with the RMS angular noise of Eq. 20,
 # $\sigma_\theta = \sqrt{\sigma_{\theta,min}^2 + D^2/\rho^2}$, $\sigma_{\theta,min}$ = 10 micro-rad, $D$ = 4 m;
 # initial 3-sigma of 60 km and 60 cm/s per axis for both vehicles, uncorrelated; no process noise (the paper lists
@@ -437,7 +438,7 @@ print(f"ratio minimiser / MMD: {ratio_core:.1e} (Eq. 24 + eigenvector), {ratio_p
 
 # %% [markdown]
 # MMD's linear algebra is several thousand times faster than the search, and the full policy, propagation and sign
-# check included, still about a hundred times (ratios printed above; the timings depend on the machine). Both
+# check included, still over a hundred times (ratios printed above; the timings depend on the machine). Both
 # answers are fast here, because the search is one batched covariance analysis of all `N_GRID` directions plus a
 # short Nelder-Mead refinement. "Exponentially" is not something a single problem size can show, and nothing in this
 # problem grows exponentially with its size; the measured claim is the ratio.
@@ -595,7 +596,7 @@ table.add("MMD (Eq. 23 read as the eigenvector) = brute-force maximiser of its s
           "(a scalar); the text ('solution to an eigen-problem') means the unit eigenvector of that eigenvalue")
 in_plane_h = r1.coast_hours[r1.optimum_perp_angle_deg <= 5.0]
 off_plane_small = np.max(r0.optimum_perp_angle_deg[r0.coast_hours <= perp_ok_h[DV_M_S[0]]])
-table.add("Ref. [8]: perpendicular-to-LOS set contains the optimum for short coasts",
+table.add("Ref. [8]: perpendicular-to-LOS set contains the optimum (tested at the shortest coast)",
           "stated", f"best on circle {r1.perp_best[short]:.2f} vs optimum {r1.optimum[short]:.2f} km "
           f"({r1.coast_hours[short]:.0f} h, {DV_M_S[-1]} m/s)",
           "reproduced" if r1.perp_best[short] <= 1.02 * r1.optimum[short] else "differs: see note",

@@ -137,9 +137,9 @@ print(f"KS test of u_z against a uniform sphere: p = {ks_sphere:.1e}; against ar
       f"p = {stats.kstest(uz, stats.arcsine(-1, 2).cdf).pvalue:.2f}")
 table.add("Eq. 5 magnitude stays within mean +- 3 sd (both policies)", "by construction",
           "yes (exact truncnorm draws)", "derived")
-table.add("Eqs. 3-4 pointing", "'random pointing', U[-pi,pi] x U[-pi/2,pi/2]",
-          f"as written; not uniform on the sphere (KS p = {ks_sphere:.0e})", "derived",
-          "uniform elevation over-weights the poles; implemented as the paper writes it")
+_ = table.add("Eqs. 3-4 pointing", "'random pointing', U[-pi,pi] x U[-pi/2,pi/2]",
+              f"as written; not uniform on the sphere (KS p = {ks_sphere:.0e})", "derived",
+              "uniform elevation over-weights the poles; implemented as the paper writes it")
 
 # %% [markdown]
 # ## 2 · Tuning the OCBE: constant versus an apoapsis window

@@ -79,9 +79,9 @@ f_nl = model.f(states)
 err_dyn = np.max(np.abs(model.lpv_rhs(states) - f_nl) / np.maximum(1.0, np.abs(f_nl)))
 print(f"max relative |A(rho)x + b(rho) - f(x)| over {N_CHECK} states: {err_dyn:.2e}")
 EXACT_TOL = 1e-12  # fixed before: "exact" means agreement to rounding, max error below 1e-12
-table.add("LPV form Eqs. 21/23 = CR3BP (Eq. 20)", "exact", f"max rel. error {err_dyn:.1e}",
-          "reproduced" if err_dyn < EXACT_TOL else "differs: LPV form not exact",
-          f"A(rho), b(rho) as printed; checked at random states; tolerance {EXACT_TOL:.0e} fixed before")
+_ = table.add("LPV form Eqs. 21/23 = CR3BP (Eq. 20)", "exact", f"max rel. error {err_dyn:.1e}",
+              "reproduced" if err_dyn < EXACT_TOL else "differs: LPV form not exact",
+              f"A(rho), b(rho) as printed; checked at random states; tolerance {EXACT_TOL:.0e} fixed before")
 
 # %% [markdown]
 # ## 2 · Sensor model (Eq. 22 versus Eq. 23)
@@ -107,8 +107,8 @@ print(f"rho from the two angles (law of sines): max relative error {err_tri:.1e}
 table.add("sensor model Eq. 22 = geometry", "exact", f"max error {err_22:.1e}",
           "reproduced" if err_22 < EXACT_TOL else "differs: sensor model not exact",
           f"rho5 = x, rho6 = y (undefined in paper); tolerance {EXACT_TOL:.0e} fixed before")
-table.add("Eq. 23 d(rho) as printed", "same model as Eq. 22", f"error up to {err_23:.2f}",
-          "differs: Eq. 23's d(rho) is a misprint; Eq. 22 used", "Eq. 23 repeats a C column, drops pi2 factors")
+_ = table.add("Eq. 23 d(rho) as printed", "same model as Eq. 22", f"error up to {err_23:.2f}",
+              "differs: Eq. 23's d(rho) is a misprint; Eq. 22 used", "Eq. 23 repeats a C column, drops pi2 factors")
 
 # %% [markdown]
 # ## 3 · The scheduling polytope from a planar resonant orbit
@@ -119,7 +119,8 @@ table.add("Eq. 23 d(rho) as printed", "same model as Eq. 22", f"error up to {err
 # perigee 0.3 LU on the far side of the Earth (`lpv.resonant_orbit`); the corrected orbit's perigee moves to the
 # smallest $r_{13}$ printed below, on the Moon side. The box $[\min\rho_i, \max\rho_i]$ over one
 # period gives $2^6 = 64$ vertices. The choice matters: Section 6 shows the H-infinity precision is set by the
-# largest Earth distance on the orbit, and Section 9 repeats the whole design over eight planar resonances.
+# largest Earth distance on the orbit, and Section 9 repeats the whole design over eight planar resonant orbits
+# (four resonances, several perigees).
 
 # %%
 sc = lpv.paper_scenario(n_samples=N_ORBIT)
@@ -137,7 +138,7 @@ ax.set_title(f"scheduling box from this orbit: r13 in [{r13.min():.3f}, {r13.max
 _ = plotting.save_figure(fig, "11_resonant_orbit", output_dir=out)
 table.add("resonant orbit (planar)", "not stated", f"2:1, T = {sc.orbit.period:.4f} TU, r13 {r13.min():.3f}-"
           f"{r13.max():.3f} LU", "not in paper", "choice of this reproduction (paper gives no orbit)")
-table.add("polytope vertices", "not stated", f"{V.shape[0]}", "derived", "2^6 box vertices of rho")
+_ = table.add("polytope vertices", "not stated", f"{V.shape[0]}", "derived", "2^6 box vertices of rho")
 
 # %% [markdown]
 # ## 4 · Theorems 1 and 2 as derived (and where the printed text disagrees)
@@ -173,7 +174,7 @@ table.add("polytope vertices", "not stated", f"{V.shape[0]}", "derived", "2^6 bo
 #   (about one e-fold per 6 minutes); Section 5 shows how the precision tends to the unbounded limit as $R$ grows.
 #   H2 needs no bound (its optimum has $\|L\|\approx 21$).
 # * **Disturbance.** The paper never gives $B_d, S_d, D_d$. Default here: $B_d = [0;I_2]$, $S_d = 10^{-3}I$
-#   LU/TU², $D_d=0$: about ten times below the solar tidal acceleration $2GM_\odot r/d_\odot^3$ that the CR3BP
+#   LU/TU², $D_d=0$: three to eleven times below the solar tidal acceleration $2GM_\odot r/d_\odot^3$ that the CR3BP
 #   ignores (both printed below in km/s²); Section 9's level $10^{-2}$ is of the solar-tide order.
 #
 # The LMIs are affine in $\rho$ (constant $X, Y$), so imposing them at the 64 vertices covers the whole box.
@@ -247,9 +248,9 @@ fig.suptitle(r"H$_\infty$ (Theorem 2) at $\gamma$ = 0.0013 LU: precision and gai
 for a in ax:
     a.xaxis.set_minor_formatter(mticker.NullFormatter())
 _ = plotting.save_figure(fig, "11_hinf_bandwidth", output_dir=out)
-table.add("Hinf precision vs bandwidth bound R", "-", f"{dR[R_LIST[0]].noise_deg[0]:.4f} deg (R={R_LIST[0]:.0f}) "
-          f"-> {dR[R_LIST[-1]].noise_deg[0]:.4f} deg (R={R_LIST[-1]:.0f}); limit {limit:.4f} deg",
-          "beyond paper", "the unbounded optimum is an infimum: gain grows like R")
+_ = table.add("Hinf precision vs bandwidth bound R", "-", f"{dR[R_LIST[0]].noise_deg[0]:.4f} deg (R={R_LIST[0]:.0f}) "
+              f"-> {dR[R_LIST[-1]].noise_deg[0]:.4f} deg (R={R_LIST[-1]:.0f}); limit {limit:.4f} deg",
+              "beyond paper", "the unbounded optimum is an infimum: gain grows like R")
 
 # %% [markdown]
 # ## 6 · Fig. 2 — optimal precision per sensor, and verification beyond the solver's word
@@ -354,10 +355,10 @@ table.add("precision sin th1 = cos th1", "identical",
           f"{'equal' if six_equal else 'unequal'}, H2 "
           f"{des_p[('linf', 'h2')].kappa[0]:.1f}, Hinf {des_p[('linf', 'hinf')].kappa[0]:.1f} "
           f"({des_p[('linf', 'hinf')].status})")
-table.add("theta1-only = 6-sensor precision", "-", f"rel. diff. H2 "
-          f"{abs(des['h2'].kappa[0] / des_all['h2'].kappa[0] - 1):.0e}, Hinf "
-          f"{abs(des['hinf'].kappa[0] / des_all['hinf'].kappa[0] - 1):.0e}", "derived",
-          "the comparison rows use the theta1-only problems")
+_ = table.add("theta1-only = 6-sensor precision", "-", f"rel. diff. H2 "
+              f"{abs(des['h2'].kappa[0] / des_all['h2'].kappa[0] - 1):.0e}, Hinf "
+              f"{abs(des['hinf'].kappa[0] / des_all['hinf'].kappa[0] - 1):.0e}", "derived",
+              "the comparison rows use the theta1-only problems")
 
 # %% [markdown]
 # **Reading the H-infinity result.** Its limit equals $\max r_{13}/\gamma$ in precision: the least precision is the
@@ -420,21 +421,22 @@ table.add("Hinf precision formula", "kappa = sqrt(beta/gamma)", "kappa = sqrt(be
           "differs: printed formula does not follow from Eq. 18-19", "verified norm equals gamma with sqrt(beta); "
           f"the printed formula would give {hinf_lit:.4f} deg, not 0.08")
 k_band = 1.0 / np.sin(np.radians([0.085, 0.075]))  # kappa band implied by the printed digits of 0.08 deg
-table.add("kappa implied by Eq. 24 and the paper's 0.1 / 0.08 deg", f"H2 {k_paper['h2']:.0f}, Hinf {k_paper['hinf']:.0f}",
-          f"H2 {k2:.0f}, Hinf {des['hinf'].kappa[0]:.0f}",
-          (f"differs: H2 {k2 / k_paper['h2']:.1f}x the implied value (intensity reading)" if not in_h2(noise["h2"])
-           else "consistent (tuned): H2 within the printed digits") + (
-              "; Hinf inside the band of the printed digits (orbit choice, see above)"
-              if k_band[0] < des["hinf"].kappa[0] <= k_band[1] else "; Hinf outside the band"),
-          f"the paper prints no kappa: 1/sin(0.1 deg), 1/sin(0.08 deg); band for 0.08 deg [0.075, 0.085) is kappa "
-          f"({k_band[0]:.0f}, {k_band[1]:.0f}]")
+_ = table.add("kappa implied by Eq. 24 and the paper's 0.1 / 0.08 deg", f"H2 {k_paper['h2']:.0f}, Hinf {k_paper['hinf']:.0f}",
+              f"H2 {k2:.0f}, Hinf {des['hinf'].kappa[0]:.0f}",
+              (f"differs: H2 {k2 / k_paper['h2']:.1f}x the implied value (intensity reading)" if not in_h2(noise["h2"])
+               else "consistent (tuned): H2 within the printed digits") + (
+                  "; Hinf inside the band of the printed digits (orbit choice, see above)"
+                  if k_band[0] < des["hinf"].kappa[0] <= k_band[1] else "; Hinf outside the band"),
+              f"the paper prints no kappa: 1/sin(0.1 deg), 1/sin(0.08 deg); band for 0.08 deg [0.075, 0.085) is kappa "
+              f"({k_band[0]:.0f}, {k_band[1]:.0f}]")
 
 # %% [markdown]
 # ## 8 · Beyond the paper: required precision against gamma
 #
 # The $\theta_1$-only problems are built once; `gamma` enters only through a `cp.Parameter` ($S_d/\gamma$), so the
 # sweep re-uses the canonicalised problems. Without disturbance $\kappa\gamma$ would be exactly constant (the
-# scaled problem does not depend on $\gamma$); the small $S_d$ bends the H2 curve only at large gamma.
+# scaled problem does not depend on $\gamma$); the small $S_d$ bends the H2 curve only at small gamma, where
+# $S_d/\gamma$ is largest.
 
 # %%
 gammas = np.geomspace(3e-4, 3e-2, N_GAMMA)
@@ -455,9 +457,9 @@ ax[1].set_ylabel(r"Eq. 24 allowance $\sin^{-1}(1/\kappa)$" "\n" r"[H$_\infty$: d
 fig.suptitle("trade curve: precision needed for a position-error bound")
 _ = plotting.save_figure(fig, "11_tradecurve", output_dir=out)
 slope = {n: np.polyfit(np.log(gammas), np.log([d.kappa[0] for d in sweep[n]]), 1)[0] for n in sweep}
-print("log-log slope of kappa against gamma:", {n: round(s, 3) for n, s in slope.items()})
-table.add("trade curve kappa(gamma)", "-", f"slopes H2 {slope['h2']:.2f}, Hinf {slope['hinf']:.2f}",
-          "beyond paper", f"{N_GAMMA} gammas from 115 to 11500 km")
+print("log-log slope of kappa against gamma: " + ", ".join(f"{n} {s:.3f}" for n, s in slope.items()))
+_ = table.add("trade curve kappa(gamma)", "-", f"slopes H2 {slope['h2']:.2f}, Hinf {slope['hinf']:.2f}",
+              "beyond paper", f"{N_GAMMA} gammas from 115 to 11500 km")
 
 # %% [markdown]
 # ## 9 · Where do the paper's numbers come from? A sweep over what the paper leaves unstated
@@ -522,11 +524,11 @@ table.add("where H2 = 0.1 deg", "0.1 deg", f"{'in' if h2_int_ok else 'never in'}
           if not h2_int_ok else "consistent (tuned): as an intensity on some orbits/disturbances",
           "band [0.05, 0.15) fixed before; range over orbits, structures and levels; the per-sample reading needs a "
           "sampling interval, which the paper does not state")
-table.add("both numbers and H2 > Hinf together", "yes", f"{len(hits)} of {ok_all.size} cases, e.g. "
-          + (f"{hits[0][0]}, dt {hits[0][3]:.0f}-{hits[0][4]:.0f} min" if hits else "none"),
-          "consistent (tuned): only in the cases listed" if hits else "differs: no tried combination reproduces both",
-          f"only with the per-sample reading of H2, on an orbit with max r13 in [{band[0]:.2f}, {band[1]:.2f}] LU, "
-          "for the dt windows listed")
+_ = table.add("both numbers and H2 > Hinf together", "yes", f"{len(hits)} of {ok_all.size} cases, e.g. "
+              + (f"{hits[0][0]}, dt {hits[0][3]:.0f}-{hits[0][4]:.0f} min" if hits else "none"),
+              "consistent (tuned): only in the cases listed" if hits else "differs: no tried combination reproduces both",
+              f"only with the per-sample reading of H2, on an orbit with max r13 in [{band[0]:.2f}, {band[1]:.2f}] LU, "
+              "for the dt windows listed")
 
 # %% [markdown]
 # **The study in one figure.** All three rows share the orbit axis, sorted by the largest Earth distance
