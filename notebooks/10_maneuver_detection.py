@@ -133,12 +133,13 @@ ax[0].legend(loc="upper left")
 ax[2].legend(fontsize=8, loc="upper center")
 _ = plotting.save_figure(fig, "10_station_keeping_policy", output_dir=out)
 ks_sphere = stats.kstest(uz, stats.uniform(-1, 2).cdf).pvalue
-print(f"KS test of u_z against a uniform sphere: p = {ks_sphere:.1e}; against arcsine: "
+ks_txt = f"= {ks_sphere:.1e}" if ks_sphere > 0 else "< 1e-300"  # below the smallest double: printed as a bound
+print(f"KS test of u_z against a uniform sphere: p {ks_txt}; against arcsine: "
       f"p = {stats.kstest(uz, stats.arcsine(-1, 2).cdf).pvalue:.2f}")
 table.add("Eq. 5 magnitude stays within mean +- 3 sd (both policies)", "by construction",
           "yes (exact truncnorm draws)", "derived")
 _ = table.add("Eqs. 3-4 pointing", "'random pointing', U[-pi,pi] x U[-pi/2,pi/2]",
-              f"as written; not uniform on the sphere (KS p = {ks_sphere:.0e})", "derived",
+              f"as written; not uniform on the sphere (KS p {ks_txt})", "derived",
               "uniform elevation over-weights the poles; implemented as the paper writes it")
 
 # %% [markdown]
@@ -611,7 +612,7 @@ for (o, p) in studies:
               f"{r['mean'][0]:6.2f} / {r['mean'][1]:5.2f} {100 * r['c'][0]:19.1f} % / {100 * r['c'][1]:4.1f} %")
 bad_cells = {k: v["tune"] for k, v in nees_rows.items() if max(v["tune"]) > 0.10}
 print("cells with more than 10 % inconsistent runs at f = 0.1 (forward / smoothed): "
-      + ("; ".join(f"{o} {p} {h}: {100 * v[0]:.0f} % / {100 * v[1]:.0f} %" for (o, p, h), v in bad_cells.items())
+      + ("; ".join(f"{o} {p} {h}: {100 * v[0]:.1f} % / {100 * v[1]:.1f} %" for (o, p, h), v in bad_cells.items())
          or "none"))
 print(f"every such cell has a burn (H1): {all(h == 'H1' for _, _, h in bad_cells)}; worst cell at f_c: "
       f"{100 * max(max(v['c']) for v in nees_rows.values()):.1f} % of runs")
@@ -757,7 +758,7 @@ _ = plotting.save_figure(fig, "10_pm_j_search", output_dir=out)
 # the factor where the pattern is strongest; right: the random-burn runs of that regime, coloured by
 # $z/|\Delta v|$). At our noise the paired contrast stays between 1.01 and 1.10 whatever $f$ and the burn time:
 # every direction is seen. There $z$ of a 1 m/s burn never falls short of it; it lies above it, the more so the
-# larger $f$ (up to about 1.5 m/s at $f = 1$; the ranges are printed above), because the control also fits noise and
+# larger $f$ (up to about 1.6 m/s at $f = 1$; the ranges are printed above), because the control also fits noise and
 # the integral without a burn grows with the window weight. The burn time within the window moves the contrast by
 # less than a tenth at our noise (up to 0.08, at $f$ = 0.3 and 1) and by a few hundredths where the pattern is
 # strongest (both printed above). The pattern appears only when the angles see the burn poorly: from 300 micro-rad
@@ -915,7 +916,9 @@ for tag, h in lead.items():
     for m, mag in enumerate(h.magnitudes_m_s):
         print(f"   {mag:4.2f} m/s: control first {100 * fr['control first'][m]:3.0f} %, same epoch "
               f"{100 * fr['same epoch'][m]:3.0f} %, residual first {100 * fr['residual first'][m]:3.0f} %, neither "
-              f"{100 * fr['neither'][m]:3.0f} % | median delay control {mc_[m]:4.1f} h, residual {mr_[m]:4.1f} h | "
+              f"{100 * fr['neither'][m]:3.0f} % | median delay control "
+              f"{(f'{mc_[m]:4.1f} h' if np.isfinite(mc_[m]) else 'none (never detected)')}, residual "
+              f"{(f'{mr_[m]:4.1f} h' if np.isfinite(mr_[m]) else 'none (never detected)')} | "
               f"z over the whole track {np.median(h.z_final_m_s[m]):.4f} m/s (median)")
 fig, ax = plt.subplots(1, len(lead), figsize=(5 * len(lead), 3.8), sharey=True)
 for a, (tag, h) in zip(ax, lead.items()):
@@ -1037,7 +1040,7 @@ for o in ORBITS:
     bad = [f"{p} {h}" for p in POLICIES for h in ("H0", "H1") if max(nees_rows[o, p, h]["tune"]) > 0.10]
     table.add(f"Window-tuned OCBE consistent at f = 0.1, {o} (NEES, forward / smoothed)",
               "consistent (Figs. 12-13, single runs)",
-              f"worst cell: {100 * wf:.0f} % / {100 * ws:.0f} % of runs inconsistent"
+              f"worst cell: {100 * wf:.1f} % / {100 * ws:.1f} % of runs inconsistent"
               + (f" ({', '.join(bad)})" if bad else ""),
               "reproduced" if max(wf, ws) <= 0.10 else
               "differs: with a burn the window admits a tenth of its velocity variance",
@@ -1144,7 +1147,7 @@ corr_a = float(np.corrcoef(pm_mc["active"].magnitude, pm_mc["active"].z)[0, 1])
 burn_time_effect = max(abs(pmj[f_pm, sig_pm, o_][1] - pmj[f_pm, sig_pm, 0.0][1]) for o_ in PM_J_OFFSET_H)
 table.add("Conditions for the +-j pattern (f, angle noise, burn time in the window)", "not discussed",
           f"largest paired contrast {best_pmj[1][1]:.2f} at f = {f_pm:g}, {sig_pm:g} micro-rad (burn at apoapsis; "
-          f"the burn time within the window changes it by at most {burn_time_effect:.2f}); there the Fig. 16 "
+          f"a burn 3 h before or after apoapsis moves it by at most {burn_time_effect:.2f}); there the Fig. 16 "
           f"statistic is {ratio_text(pm_a)} (active), but z/|dv| averages {ratio_a:.2f} and corr(z, |dv|) is "
           f"{corr_a:.2f}", "beyond paper",
           f"{PM_J_SEEDS} noise draws per direction; {N_PM_J_MC} random burns per policy in that regime; the pattern "
