@@ -567,15 +567,22 @@ def _check_linear_system(P0, F, Q, H, R, *, chol_R: bool = False):
     return (P0, F, Q, H, R, LR) if chol_R else (P0, F, Q, H, R)
 
 
-def position_sigma_km(P, index: int, system: CR3BP) -> np.ndarray:
-    """RMS position error :math:`\\sqrt{\\mathrm{tr} P_{rr}}` (km) of object ``index`` (0 = observer) in augmented covariances ``(..., n, n)``."""
+def position_sigma_km(P, index: int, system: CR3BP, *, axes=(0, 1, 2)) -> np.ndarray:
+    """RMS position error :math:`\\sqrt{\\sum_a P_{aa}}` (km) of object ``index`` (0 = observer) in augmented
+    covariances ``(..., n, n)``, summed over the rotating-frame position ``axes`` (default all three: the trace of
+    :math:`P_{rr}`; ``(0, 1)`` gives the in-plane RMS, ``(2,)`` the out-of-plane sigma)."""
     P = _checks.psd(P, "P", batch=True)  # a negative covariance would give NaN (round-off negatives pass)
     _check_system(system)
     i = _checks.integer(index, "index", minimum=0)
     if 6 * (i + 1) > P.shape[-1]:
         raise ValueError(f"index must select an object in 0..{P.shape[-1] // 6 - 1}; got {index}")
-    blk = P[..., 6 * i:6 * i + 3, 6 * i:6 * i + 3]
-    return np.sqrt(np.trace(blk, axis1=-2, axis2=-1)) * system.length_unit_km
+    if isinstance(axes, (str, bytes)) or not hasattr(axes, "__iter__"):
+        raise _checks.ArgumentTypeError(f"axes must be a sequence of position axes (0, 1, 2); got {axes!r}")
+    ax = [_checks.integer(a, "axes", minimum=0, maximum=2) for a in axes]
+    if not ax or len(set(ax)) != len(ax):
+        raise ValueError(f"axes must hold distinct position axes among 0, 1, 2; got {axes!r}")
+    idx = [6 * i + a for a in ax]
+    return np.sqrt(np.sum(P[..., idx, idx], axis=-1)) * system.length_unit_km
 
 
 # --------------------------------------------------------------------------------------------------------------

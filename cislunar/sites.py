@@ -1,8 +1,8 @@
 r"""Observer sites of the maneuver-detection paper (Greaves & Scheeres 2021, "Measurements" section, Fig. 3).
 
 The paper places optical observers near L2, on a distant retrograde orbit (DRO) and at three lunar-surface
-stations, and shows them only in its Fig. 3, which is not in the text: no observer state is given.  The sites below are this reproduction's
-documented choices; notebook 01 checks what the paper *says* about them (the L2 observer's line of sight to
+stations, and shows them only in its Fig. 3, which is not in the text: no observer state is given.  The sites
+below are this reproduction's documented choices; notebook 01 checks what the paper *says* about them (the L2 observer's line of sight to
 the NRHOs is never blocked; three surface stations are needed to see the whole 9:2 orbit).
 
 * **L2 observer**: at rest at the L2 libration point (an equilibrium of the rotating frame).
@@ -343,14 +343,10 @@ class OutageStatistics:
 
 def _periodic_positions(orbit, tq, n_table):
     """Positions (LU) on a periodic orbit at times ``tq`` (TU) by phase, cubic Hermite on a one-period table."""
+    from scipy.interpolate import CubicHermiteSpline
+
     tt, xs = orbit.sample(n_table + 1)
-    h = tt[1] - tt[0]
-    ph = np.mod(tq, orbit.period)
-    k = np.minimum((ph / h).astype(np.int64), n_table - 1)
-    s = ((ph - tt[k]) / h)[:, None]
-    p0, p1, v0, v1 = xs[k, :3], xs[k + 1, :3], xs[k, 3:] * h, xs[k + 1, 3:] * h
-    h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
-    return h00 * p0 + h10 * v0 + h01 * p1 + h11 * v1
+    return CubicHermiteSpline(tt, xs[:, :3], xs[:, 3:], axis=0)(np.mod(tq, orbit.period))
 
 
 def occultation_outages(system: CR3BP, observer, target, span_days: float, step_s: float = 60.0, *,

@@ -214,8 +214,8 @@ days = em.tu_to_days(t_win)
 names = ["observer", "target 1", "target 2", "target 3"]
 sig_post = np.array([cov.position_sigma_km(hist.posterior, i, em) for i in range(4)])
 sig_prior = np.array([cov.position_sigma_km(hist.prior, i, em) for i in range(4)])
-sig_z = np.sqrt(hist.posterior[:, 2::6, 2::6].diagonal(axis1=-2, axis2=-1).T) * em.length_unit_km  # (4, N)
-sig_xy = np.sqrt(np.maximum(sig_post**2 - sig_z**2, 0.0))  # in-plane RMS per object
+sig_z = np.array([cov.position_sigma_km(hist.posterior, i, em, axes=(2,)) for i in range(4)])  # out of plane
+sig_xy = np.array([cov.position_sigma_km(hist.posterior, i, em, axes=(0, 1)) for i in range(4)])  # in-plane
 z_cols = np.abs(lin.H[..., [6 * i + j for i in range(4) for j in (2, 5)]]).max()
 print(f"largest |dH/dz|, |dH/dvz| over the window: {z_cols:.1e} (out-of-plane errors unobserved)")
 fig, (ax1, ax2, ax3) = plt.subplots(1, 3, figsize=(14, 4.0), layout="constrained")
@@ -358,11 +358,10 @@ for name, (model, noise) in models.items():
         study[name]["mi"].append(info.mutual_information(*lb.arrays))
         study[name]["obs"].append(cov.position_sigma_km(hb.posterior[-1], 0, em))
         study[name]["tgt"].append(cov.position_sigma_km(hb.posterior[-1], 1, em))
-        study[name]["obs_z"].append(np.sqrt(hb.posterior[-1, 2, 2]) * em.length_unit_km)  # observer's sigma_z
-        tgt_z = np.sqrt(hb.posterior[-1, 8, 8]) * em.length_unit_km
-        # in-plane terminal RMS sqrt(P_xx + P_yy) = sqrt(total^2 - sigma_z^2)
-        study[name]["obs_xy"].append(np.sqrt(max(study[name]["obs"][-1]**2 - study[name]["obs_z"][-1]**2, 0.0)))
-        study[name]["tgt_xy"].append(np.sqrt(max(study[name]["tgt"][-1]**2 - tgt_z**2, 0.0)))
+        study[name]["obs_z"].append(cov.position_sigma_km(hb.posterior[-1], 0, em, axes=(2,)))  # observer's sigma_z
+        # in-plane terminal RMS sqrt(P_xx + P_yy)
+        study[name]["obs_xy"].append(cov.position_sigma_km(hb.posterior[-1], 0, em, axes=(0, 1)))
+        study[name]["tgt_xy"].append(cov.position_sigma_km(hb.posterior[-1], 1, em, axes=(0, 1)))
 study = {k: {kk: np.array(vv) for kk, vv in v.items()} for k, v in study.items()}
 fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.6))
 for k, (name, res) in enumerate(study.items()):

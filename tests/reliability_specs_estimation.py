@@ -178,8 +178,8 @@ def specs(Spec, lazy):
     s.append(S("ekf_update", C.ekf_update, dict(P=SPD3, H=np.ones((2, 3)), R=np.diag([0.5, 0.4])),
                dict(P="spd", H="arr", R="spd")))
     s.append(S("covariance_analysis", C.covariance_analysis, dict(lin), dict(LIN_KINDS)))
-    s.append(S("position_sigma_km", C.position_sigma_km, dict(P=np.eye(12) * 1e-6, index=1, system=em),
-               dict(P="psd", index="int0", system="system")))
+    s.append(S("position_sigma_km", C.position_sigma_km, dict(P=np.eye(12) * 1e-6, index=1, system=em, axes=(0, 1)),
+               dict(P="psd", index="int0", system="system", axes="iterable")))
     s.append(S("propagate_arcs", C.propagate_arcs, dict(system=em, x0=X_DRO, t=T3, q=1e-10, order=1, n_nodes=4),
                dict(system="system", x0="state", t="grid", q="nonneg_opt", order="choice", n_nodes="int2")))
     s.append(S("assemble_augmented", C.assemble_augmented,

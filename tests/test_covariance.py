@@ -339,3 +339,23 @@ def test_assembled_from_cached_targets_equals_one_shot_linearisation(dro_window)
     stm = obs.stm_from_start[0]
     np.testing.assert_allclose(stm[-1], propagate_stm(EARTH_MOON, OBSERVER, [lin.t[0], lin.t[-1]]).stm[-1],
                                rtol=1e-9, atol=1e-9)
+
+
+def test_position_sigma_axes_split_the_trace():
+    """In-plane and out-of-plane parts add up in squares to the full RMS; one axis is its own diagonal entry."""
+    rng = np.random.default_rng(3)
+    A = rng.standard_normal((5, 12, 12))
+    P = A @ np.swapaxes(A, -1, -2) * 1e-8
+    for i in (0, 1):
+        full = C.position_sigma_km(P, i, EARTH_MOON)
+        xy = C.position_sigma_km(P, i, EARTH_MOON, axes=(0, 1))
+        z = C.position_sigma_km(P, i, EARTH_MOON, axes=(2,))
+        assert np.max(np.abs(xy**2 + z**2 - full**2) / full**2) < 1e-14
+        assert np.allclose(z, np.sqrt(P[:, 6 * i + 2, 6 * i + 2]) * EARTH_MOON.length_unit_km, rtol=1e-15)
+    assert np.array_equal(C.position_sigma_km(P, 0, EARTH_MOON, axes=[2, 0]),
+                          C.position_sigma_km(P, 0, EARTH_MOON, axes=(0, 2)))
+    for bad in ((0, 0), (3,), ()):
+        with pytest.raises(ValueError, match="axes"):
+            C.position_sigma_km(P, 0, EARTH_MOON, axes=bad)
+    with pytest.raises(TypeError, match="axes"):
+        C.position_sigma_km(P, 0, EARTH_MOON, axes="xy")
