@@ -1,6 +1,6 @@
 # Two commands on a fresh machine with python3 (3.11) and make:
 #   make reproduce   every notebook at full fidelity -> build/notebooks, build/figures, build/report.md,
-#                    then the static HTML book build/book/index.html (checked by tests/test_book.py)
+#                    then the static HTML book build/book/index.html (checked by tests/publish/test_book.py)
 #   make test        unit tests + every notebook in quick mode + a book built from them, all in a temporary
 #                    directory (build/ only ever holds a full run)
 PYTHON ?= python3
@@ -37,20 +37,20 @@ unit: $(STAMP)
 
 # Quick mode into build-quick/ (never build/).
 notebooks-quick: $(STAMP)
-	$(PY) -m cislunar.notebooks --quick
+	$(PY) -m cislunar.publish.notebooks --quick
 
 reproduce: notebooks book check-book
 
 notebooks: $(STAMP)
-	$(PY) -m cislunar.notebooks
+	$(PY) -m cislunar.publish.notebooks
 
 # Rebuild build/book from the executed notebooks in build/notebooks, without executing anything.
 book: $(STAMP)
-	$(PY) -m cislunar.book
+	$(PY) -m cislunar.publish.book
 
 # The book checks (pages, links, offline, no error output, math typeset in headless Chromium) on build/book.
 check-book: $(STAMP)
-	CISLUNAR_BOOK_BUILD=build $(PY) -m pytest -q -p no:cacheprovider tests/test_book.py
+	CISLUNAR_BOOK_BUILD=build $(PY) -m pytest -q -p no:cacheprovider tests/publish/test_book.py
 
 bench: $(STAMP)
 	$(PY) -m benchmarks

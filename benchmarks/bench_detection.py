@@ -6,7 +6,7 @@ OCBE filter and smoother, z from the smoothed control.
 
 * ``reference``: the Monte Carlo as it ran before (batches of 8 trials: draws, then
   ``ocbe_batch(..., engine="reference")``, the full 12x12 variational system, one batch per call).
-* ``fast``: :func:`cislunar.detection.run_detection_monte_carlo` with ``batch_size=8`` as notebook 10 calls it
+* ``fast``: :func:`cislunar.papers.greaves_scheeres_2021.detection.run_detection_monte_carlo` with ``batch_size=8`` as notebook 10 calls it
   (same seeds and trials; the block integrator, several batches per lockstep call).
 
 Both see the same seeds; the largest relative difference of z is printed.  Then the fast path at the paper's sizes
@@ -22,10 +22,11 @@ import time
 
 import numpy as np
 
-from cislunar import detection as det
-from cislunar import orbits
-from cislunar.dynamics import EARTH_MOON as em
-from cislunar.montecarlo import trial_rng
+from cislunar.cr3bp import orbits
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.estimation import batched_ocbe
+from cislunar.papers.greaves_scheeres_2021 import detection as det
+from cislunar.utils.montecarlo import trial_rng
 
 
 def _best(fn, repeats):
@@ -52,7 +53,7 @@ def main(n_trials: int = 128, batch: int = 8, lockstep=(8, 16, 32, 64, 128), n_s
         z = []
         for k in range(n_batches):
             inputs = [det.draw_trial(c, setup, pol) for c in trial_rng(seed, k).spawn(batch)]
-            res = det.ocbe_batch(*filter_args(inputs), n_sub=setup.n_sub, tol=setup.tol, engine="reference")
+            res = batched_ocbe.ocbe_batch(*filter_args(inputs), n_sub=setup.n_sub, tol=setup.tol, engine="reference")
             z.extend(res.z_smooth * em.velocity_unit_km_s * 1e3)
         return np.array(z[:n_trials])
 
@@ -65,11 +66,11 @@ def main(n_trials: int = 128, batch: int = 8, lockstep=(8, 16, 32, 64, 128), n_s
         for engine in ("reference", "fast"):
             if engine == "reference" and B != batch:
                 continue
-            det.ocbe_batch(*filter_args(warm[:B]), engine=engine)
+            batched_ocbe.ocbe_batch(*filter_args(warm[:B]), engine=engine)
     det.run_detection_monte_carlo(setup, pol, 2 * batch, seed + 1, batch_size=batch, progress=False)
 
     result = {"n_trials": n_trials, "batch_size": batch, "lockstep_trials": det.LOCKSTEP_TRIALS,
-              "heyoka_lanes": det._LANES}
+              "heyoka_lanes": batched_ocbe._LANES}
     t_ref, z_ref = _best(reference_mc, 1)
     t_new, z_new = _best(fast_mc, repeats)
     result["reference_mc_s_per_trial"] = t_ref / n_trials
@@ -96,12 +97,12 @@ def main(n_trials: int = 128, batch: int = 8, lockstep=(8, 16, 32, 64, 128), n_s
                                     for k in range(n_batches) for c in trial_rng(seed, k).spawn(batch)], 1)
     result["draw_s_per_trial"] = t_draw / len(inputs)
     print(f"drawing (truth, measurements, hand-off error): {t_draw / len(inputs) * 1e3:.1f} ms/trial")
-    t_f, _ = _best(lambda: [det.ocbe_batch(*filter_args(inputs[k:k + batch]), engine="reference")
+    t_f, _ = _best(lambda: [batched_ocbe.ocbe_batch(*filter_args(inputs[k:k + batch]), engine="reference")
                             for k in range(0, len(inputs), batch)], 1)
     result[f"filter_reference_B{batch}_s_per_trial"] = t_f / len(inputs)
     print(f"filter, reference engine, lockstep {batch:3d}: {t_f / len(inputs) * 1e3:.1f} ms/trial")
     for B in lockstep:
-        t_b, _ = _best(lambda: [det.ocbe_batch(*filter_args(inputs[k:k + B]))
+        t_b, _ = _best(lambda: [batched_ocbe.ocbe_batch(*filter_args(inputs[k:k + B]))
                                 for k in range(0, len(inputs) - B + 1, B)], repeats)
         per = t_b / (len(inputs) // B * B)
         result[f"filter_fast_B{B}_s_per_trial"] = per
@@ -111,7 +112,7 @@ def main(n_trials: int = 128, batch: int = 8, lockstep=(8, 16, 32, 64, 128), n_s
     det.run_trial_filter(setup, inputs[0])
     t_s, _ = _best(lambda: [det.run_trial_filter(setup, inp) for inp in inputs[:n_single]], 1)
     result["single_trial_s_per_trial"] = t_s / n_single
-    print(f"single-trial OCBE (cislunar.ocbe): {t_s / n_single * 1e3:.1f} ms/trial")
+    print(f"single-trial OCBE (cislunar.estimation.ocbe): {t_s / n_single * 1e3:.1f} ms/trial")
     return result
 
 

@@ -22,11 +22,11 @@ import time
 
 import numpy as np
 
-from cislunar import covariance as C
-from cislunar import information as I
-from cislunar import measurements as M
-from cislunar.dynamics import EARTH_MOON
-from cislunar.propagation import find_events, propagate
+from cislunar.cr3bp.dynamics import EARTH_MOON
+from cislunar.cr3bp.propagation import find_events, propagate
+from cislunar.sensing import covariance as C
+from cislunar.sensing import information as I
+from cislunar.sensing import measurements as M
 
 OBSERVER = np.array([7.80136159e-1, 0, 0, 0, 5.53104815e-1, 0])
 TARGETS = np.array([[7.78717734e-1, 0, 0, 0, 5.55157488e-1, 0],
@@ -121,13 +121,12 @@ def main() -> dict:
 
 
 def planning_model() -> dict:
-    """The SCvx information model of test case 2 (cislunar.wolf_jones): cost of value, gradient, Hessian.
+    """The SCvx information model of test case 2 (cislunar.papers.wolf_jones.scenarios): cost of value, gradient, Hessian.
 
     Ratios in one interleaved run: the reverse-mode square-root gradient (default) against the forward mode and the
     covariance-form adjoint.
     """
-    from cislunar import wolf_jones as W
-
+    from cislunar.papers.wolf_jones import scenarios as W
     sc = W.test_case_2()
     model = sc.information_model()
     x = propagate(sc.system, sc.observer_x0, np.array([0.0, sc.window[0]])).x[-1]

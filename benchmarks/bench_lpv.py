@@ -13,8 +13,7 @@ import warnings
 
 def main(max_k: int = 6, gamma: float = 0.0013) -> dict:
     """Run the benchmark and print a table; returns ``{(solver, n_vertices): {...}}`` as a dict of dicts."""
-    from cislunar import lpv
-
+    from cislunar.estimation import lpv
     sc = lpv.paper_scenario(n_samples=1000)
     order = [0, 2, 4, 5, 1, 3]  # 1/r13^3, 1/r13, x, y, 1/r23^3, 1/r23
     results = {}

@@ -10,7 +10,7 @@ Run with ``python -m benchmarks montecarlo``.
 import time
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
-from cislunar.montecarlo import run_monte_carlo
+from cislunar.utils.montecarlo import run_monte_carlo
 
 
 def _trivial(rng):

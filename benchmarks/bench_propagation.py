@@ -11,9 +11,9 @@ import time
 
 import numpy as np
 
-from cislunar import orbits
-from cislunar.dynamics import EARTH_MOON as em
-from cislunar.propagation import default_threads, propagate_scipy, propagate_stm
+from cislunar.cr3bp import orbits
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.cr3bp.propagation import default_threads, propagate_scipy, propagate_stm
 
 
 def main(n: int = 256, n_scipy: int | None = None, seed: int = 0) -> dict:

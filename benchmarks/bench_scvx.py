@@ -1,11 +1,11 @@
 """SCvx on Wolf & Jones test cases 1 and 2: where an iteration's time goes, re-solve vs rebuild, a full alpha_h
 sweep per case.
 
-Scenario: :func:`cislunar.wolf_jones.test_case_1` (observer and one target on DROs, relative position 100 m, two
+Scenario: :func:`cislunar.papers.wolf_jones.scenarios.test_case_1` (observer and one target on DROs, relative position 100 m, two
 periods, zero thrust in [3P/4, 3P/2]) on 40 Sundman nodes, the information model with fixed process noise.
 
 1. **Per iteration**: the nonlinear evaluation splits into the first-order-hold discretisation
-   (:func:`cislunar.discretization.foh_discretize`), the information model (value, gradient, Hessian) and the
+   (:func:`cislunar.guidance.discretization.foh_discretize`), the information model (value, gradient, Hessian) and the
    convex solve (cvxpy + Clarabel); measured both in isolation at the ballistic reference and averaged over an
    SCvx run at alpha_h = 5e-3 (the Hessian is refreshed only when the window-start state moved, see
    ``SCvxSettings.hessian_refresh``).
@@ -25,9 +25,10 @@ import time
 
 import numpy as np
 
-from cislunar import discretization as D
-from cislunar import scvx, wolf_jones
-from cislunar.dynamics import EARTH_MOON as em
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.guidance import discretization as D
+from cislunar.guidance import scvx
+from cislunar.papers.wolf_jones import scenarios as wolf_jones
 
 N_NODES = 40
 ALPHAS = [0.0, 1e-3, 2e-3, 3e-3, 5e-3, 7e-3, 1e-2, 1.5e-2, 2e-2]

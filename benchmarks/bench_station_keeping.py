@@ -12,10 +12,10 @@ import time
 
 import numpy as np
 
-from cislunar import station_keeping as sk
-from cislunar.dynamics import EARTH_MOON as em
-from cislunar.orbits import nrho_9_2
-from cislunar.torus import qpo_for_mean_range
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.cr3bp.orbits import nrho_9_2
+from cislunar.cr3bp.torus import qpo_for_mean_range
+from cislunar.papers.greaves_scheeres_2023 import station_keeping as sk
 
 
 def main(n: int = 40) -> dict:

@@ -17,10 +17,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from cislunar import torus as tm
-from cislunar.dynamics import EARTH_MOON as em
-from cislunar.orbits import nrho_9_2
-from cislunar.propagation import propagate_stm
+from cislunar.cr3bp import torus as tm
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.cr3bp.orbits import nrho_9_2
+from cislunar.cr3bp.propagation import propagate_stm
 
 
 def _timed(fn, repeat: int = 3):

@@ -1,4 +1,4 @@
-"""Sphinx configuration of the cislunar book (built by ``python -m cislunar.book``; see ``cislunar/book.py``).
+"""Sphinx configuration of the cislunar book (built by ``python -m cislunar.publish.book``; see ``cislunar/book.py``).
 
 The book is assembled from already executed notebooks: nothing is executed here (``nb_execution_mode = "off"``).
 Everything a page needs is served from the build itself, so the book reads offline: MathJax comes from the Python
@@ -18,9 +18,9 @@ extensions = [
     "sphinx.ext.mathjax",
 ]
 
-# Notebooks are executed by cislunar.notebooks (papermill); the book only renders them.
+# Notebooks are executed by cislunar.publish.notebooks (papermill); the book only renders them.
 nb_execution_mode = "off"
-nb_merge_streams = False  # cislunar.book merges consecutive writes itself, keeping the order of outputs
+nb_merge_streams = False  # cislunar.publish.book merges consecutive writes itself, keeping the order of outputs
 nb_output_stderr = "show"  # shown, but styled as plain output (book/_static/cislunar-book.css)
 nb_render_markdown_format = "myst"  # the closing comparison tables are Markdown outputs, with math
 nb_ipywidgets_js = {}  # never load widget renderers from the internet

@@ -1,37 +1,29 @@
 """cislunar: a literate reproduction of four cislunar navigation and tracking papers.
 
-Modules
--------
-dynamics      CR3BP constants, units, vector field, Jacobian, Jacobi constant, libration points
-propagation   heyoka.py propagation of states, STMs and second-order STTs; events; scipy cross-check path
-orbits        symmetric periodic orbits: shooting, continuation, monodromy, stability; reference orbits
-reference     reference-orbit tables transcribed from the papers (``data/``), each row verified
-sites         observer sites: L2, DRO, lunar-surface stations; horizon and occultation geometry
-measurements  relative position, range / range-rate, azimuth / elevation (+ rates), Jacobians, noise models
-covariance    SPD helpers, process-noise discretisation, EKF covariance (CRLB) recursion, augmented states
-information   mutual information of an observation window (dense Eq. 18 and O(N) chain rule) and its gradient
-discretization  Sundman-spaced nodes and first-order-hold discretisation for SCvx
-scvx          successive convexification (SCvx* augmented Lagrangian, quadratic MI model, first-order hold)
-wolf_jones    Wolf & Jones test cases 1 and 2: scenarios, information models, keep-out, CRLB and Pareto helpers
-srif          square-root information filter and smoother (Householder)
-ocbe          optimal-control-based estimator: state/costate transition, Eq. 17 process noise, SRI filter/smoother
-adaptive_ocbe  adaptive OCBE tuning: the OCBE metric and its law, 99 % limit, three-epoch rule, covariance reset
-tracking      optical tracking scenarios (truth with impulses, measurements, hand-off, NEES consistency trials)
-detection     station-keeping policies, batched OCBE Monte Carlo, control-integral hypothesis test
-torus         2-D quasi-periodic invariant tori by the invariant-circle (GMOS) method; the 215-km QPO member
-ssat          spacecraft-to-spacecraft absolute tracking: two-vehicle states, SSAT covariance analysis, MMD guidance
-station_keeping  informed station keeping on a QPO: two-burn transfers, surfaces, informed maneuver, filter trials
-montecarlo    Monte Carlo trials and sweeps through any concurrent.futures-style executor
-lpv           LPV form of the planar CR3BP and H2 / H-infinity sensing-precision LMIs
-observers     LPV observer and EKF simulations on the nonlinear CR3BP
-plotting      packaged matplotlib style, ``save_figure``, rotating-frame plot helpers
-report        paper-vs-reproduction tables gathered into ``build/report.md``
-progress      one progress bar for long loops (widget, plain text when headless, or off)
-notebooks     command-line runner executing ``notebooks/NN_*.py`` with papermill
-book          static HTML book from the executed notebooks (Sphinx + myst-nb, offline)
+The package is built in wings.  Methods, by family, know nothing of the papers or of publishing:
+
+cr3bp        dynamics (constants, units, vector field), propagation (heyoka STMs/STTs, events, impacts), periodic
+             orbits (shooting, continuation, reference orbits), quasi-periodic tori
+sensing      observer sites, measurement models, covariance (CRLB) recursions, mutual information
+estimation   square-root information filter/smoother, the OCBE (single-trial and batched), the adaptive OCBE,
+             filter consistency (NEES), LPV models, H2 / H-infinity observer LMIs and observers
+guidance     first-order-hold discretisation, successive convexification, SSAT and MMD guidance
+
+One package per paper holds its set-ups, studies, claims and figures; papers never import each other:
+
+papers.wolf_jones              Wolf & Jones: MI trajectory planning, test cases 1 and 2
+papers.greaves_scheeres_2021   Greaves & Scheeres (JAS 2021): optical NRHO tracking, OCBE, maneuver detection
+papers.greaves_scheeres_2023   Greaves & Scheeres (AMOS 2023): SSAT, informed station keeping on a QPO
+papers.nychka_bhattacharya     Nychka & Bhattacharya: LPV CR3BP, sensing-precision LMIs, observers
+
+publish      claims and their status rule, comparison tables, the matplotlib style and ``save_figure``, the notebook
+             runner (``python -m cislunar.publish.notebooks``) and the book (``python -m cislunar.publish.book``)
+utils        argument validation, Monte Carlo through any executor, progress output, repository paths
+
+``tests/architecture/test_import_rules.py`` holds these rules against the source.
 """
 
-from .dynamics import CR3BP, EARTH_MOON
+from cislunar.cr3bp.dynamics import CR3BP, EARTH_MOON
 
 __all__ = ["CR3BP", "EARTH_MOON"]
 __version__ = "0.1.0"

@@ -47,12 +47,16 @@ OUTAGE_STEP_S = 300.0 if QUICK else 60.0  # line-of-sight sampling step for thos
 
 import dataclasses
 
-import numpy as np
 import matplotlib.pyplot as plt
+import numpy as np
 
-from cislunar import orbits, plotting, propagation, reference, sites
-from cislunar.dynamics import EARTH_MOON as em, SYNODIC_MONTH_DAYS
-from cislunar.report import ComparisonTable
+from cislunar.cr3bp import orbits, propagation
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.cr3bp.dynamics import SYNODIC_MONTH_DAYS
+from cislunar.papers.wolf_jones import reference
+from cislunar.publish import plotting
+from cislunar.publish.report import ComparisonTable
+from cislunar.sensing import sites
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -71,7 +75,7 @@ table = ComparisonTable("01 CR3BP and reference orbits "
 #
 # where $r_1, r_2$ are the distances to the Earth at $(-\mu,0,0)$ and the Moon at $(1-\mu,0,0)$. This is the
 # *velocity* form (Greaves & Scheeres' Eq. 2 in dimensional form; Wolf & Jones' dynamics section). The Jacobi
-# constant $C = 2U - v^2$ is conserved. The constants, with their sources, are in `cislunar.dynamics`:
+# constant $C = 2U - v^2$ is conserved. The constants, with their sources, are in `cislunar.cr3bp.dynamics`:
 
 # %%
 print(f"mu = {em.mu}")
@@ -394,7 +398,7 @@ _ = plotting.save_figure(fig, "01_nrho_family_fig2", output_dir=out)
 #
 # The paper gives no observer state in its text: the observers are only shown in its Fig. 3 ("All observer
 # locations and the NRHOs are displayed ... in Fig. 3"), which is not in the text. The sites are therefore
-# documented choices in `cislunar.sites`: an observer at rest at L2, one on a DRO, and three lunar-surface
+# documented choices in `cislunar.sensing.sites`: an observer at rest at L2, one on a DRO, and three lunar-surface
 # stations, fixed in the rotating frame because the Moon is tidally locked. We then check the three statements the
 # paper makes about them: the L2 observer's line of sight is never interrupted; the DRO observer suffers limited,
 # infrequent and short lunar occultations; and three surface stations are needed to see the whole 9:2 orbit.
@@ -586,56 +590,56 @@ _ = plotting.save_figure(fig, "01_observer_sites_fig3", output_dir=out)
 # the paper. The period is imposed (the shooting constraint) and the stable NRHO is selected by its stability
 # index, so those rows are "derived"; the perilune and apolune radii are compared, in the note, with the public
 # values collected in `shared/reference-notes.md`, not with the paper. Every Wolf & Jones row is verified against
-# the closure criterion `cislunar.reference.CLOSURE_TOL`.
+# the closure criterion `cislunar.papers.wolf_jones.reference.CLOSURE_TOL`.
 
 # %%
 TOL = reference.CLOSURE_TOL
 NO_TABLE1 = "not stated (Table 1 missing; 'approximate 9:2')"
 T92 = 2 / 9 * SYNODIC_MONTH_DAYS
-table.add("9:2 NRHO period [d]", NO_TABLE1, nrho.period_days,
+table.add_typed("9:2 NRHO period [d]", NO_TABLE1, nrho.period_days,
           "derived" if abs(nrho.period_days - T92) / T92 < 1e-8 else "differs: period constraint not met",
           f"imposed: half period held at (2/9 synodic month)/2, 2/9 x {SYNODIC_MONTH_DAYS} d = {T92:.6f} d "
           "(the resonance defines it)")
 rp_ok = 3200 <= nrho.perilune_radius_km <= 3300
 ra_ok = abs(nrho.apolune_radius_km - 71000) < 1000
-table.add("9:2 NRHO perilune radius [km]", NO_TABLE1, nrho.perilune_radius_km, "not in paper",
+table.add_typed("9:2 NRHO perilune radius [km]", NO_TABLE1, nrho.perilune_radius_km, "not in paper",
           ("agrees with" if rp_ok else "outside") + " the public 3200-3300 km (reference notes)")
-table.add("9:2 NRHO apolune radius [km]", NO_TABLE1, nrho.apolune_radius_km, "not in paper",
+table.add_typed("9:2 NRHO apolune radius [km]", NO_TABLE1, nrho.apolune_radius_km, "not in paper",
           ("agrees with" if ra_ok else "outside") + " the public ~71000 km, +-1000 km (reference notes)")
-table.add("9:2 NRHO apolune state [x0, z0, vy0]", NO_TABLE1,
+table.add_typed("9:2 NRHO apolune state [x0, z0, vy0]", NO_TABLE1,
           f"[{nrho.x0[0]:.5f}, {nrho.x0[2]:.5f}, {nrho.x0[4]:.5f}]", "derived",
           "by shooting with the period imposed; the reference notes' [1.0219, -0.182, -0.1030] only seeds Newton "
           f"(differs by {abs(nrho.x0[0] - 1.0219):.5f} in x0, {abs(nrho.x0[4] + 0.1030):.5f} in vy0)")
-table.add("9:2 NRHO stability index", "Table 1 missing", nrho.stability_index, "not in paper",
+table.add_typed("9:2 NRHO stability index", "Table 1 missing", nrho.stability_index, "not in paper",
           "Table 1 absent from the text; computed here")
-table.add("stable NRHO stability index", "Table 1 missing", stable.stability_index,
+table.add_typed("stable NRHO stability index", "Table 1 missing", stable.stability_index,
           "derived: selected by nu = 1" if abs(stable.stability_index - 1) < 1e-3 else "differs: root finding failed",
           "member at the period-doubling boundary nearest the 9:2 NRHO, found by root finding until nu = 1 "
           "(|nu - 1| < 1e-3 checked)")
-table.add("stable NRHO perilune radius [km] / period [d]", "Table 1 missing",
+table.add_typed("stable NRHO perilune radius [km] / period [d]", "Table 1 missing",
           f"{stable.perilune_radius_km:.1f} / {stable.period_days:.4f}", "not in paper",
           "Table 1 absent; any member of the stable band has index 1, we take its boundary")
-table.add("outer stable band of the L2 halo family: perilune radius [km]", "not discussed",
+table.add_typed("outer stable band of the L2 halo family: perilune radius [km]", "not discussed",
           f"{band_rp[0]:.0f}-{band_rp[1]:.0f} ({len(outer_band)} family members)", "beyond paper",
           f"members with every Broucke index in [-1, 1]; family step {HALO_STEP} (band edges to that resolution)")
-table.add("stable NRHO, outer band: perilune [km] / period [d] / stability index", "Table 1 missing",
+table.add_typed("stable NRHO, outer band: perilune [km] / period [d] / stability index", "Table 1 missing",
           f"{outer.perilune_radius_km:.0f} / {outer.period_days:.3f} / {outer.stability_index:.6f}", "not in paper",
           "most stable member of the outer band (orbits.stable_nrho_outer); notebooks 09, 09b and 10 carry both "
           "candidates")
 # mu is pinned if the printed rows close at the adopted value and fail for every trial |d mu| >= 0.9e-9.
 mu_pinned = mu_closure[em.mu] < TOL and all(cl >= TOL for m, cl in mu_closure.items() if abs(m - em.mu) >= 0.9e-9)
-table.add("Earth-Moon mass ratio mu", "not stated", f"{em.mu} (max closure {mu_closure[em.mu]:.1e})",
+table.add_typed("Earth-Moon mass ratio mu", "not stated", f"{em.mu} (max closure {mu_closure[em.mu]:.1e})",
           "derived" if mu_pinned else "differs: the printed rows do not pin mu to 1e-9",
           f"not in either paper; value of JPL's three-body database; the six periodic W&J rows close within "
           f"CLOSURE_TOL = {TOL:.0e} only for |d mu| < 1e-9 (largest closure per trial d mu: "
           + ", ".join(f"{m - em.mu:+.1e} -> {mu_closure[m]:.1e}" for m in MU_TRIALS[1:]) + "); CLOSURE_TOL was "
           "set to 1e-7 with these closures in view: at 1e-6 the rows would pin mu only to about 4e-9")
-table.add("length unit [km]", "not stated", em.length_unit_km, "not in paper", "our choice: mean Earth-Moon distance")
-table.add("time unit [s]", "not stated", f"{em.time_unit_s} ({em.time_unit_days:.4f} d)", "not in paper",
+table.add_typed("length unit [km]", "not stated", em.length_unit_km, "not in paper", "our choice: mean Earth-Moon distance")
+table.add_typed("time unit [s]", "not stated", f"{em.time_unit_s} ({em.time_unit_days:.4f} d)", "not in paper",
           "our choice: sqrt(L^3 / G(M_E + M_M)); W&J define it only in words (row below)")
 for c in checks:
     ok = c.periodic_as_printed
-    table.add(f"W&J {wj_label(c)}: closure of printed state", "periodic DRO", f"{c.raw_closure:.1e}",
+    table.add_typed(f"W&J {wj_label(c)}: closure of printed state", "periodic DRO", f"{c.raw_closure:.1e}",
               "reproduced" if ok else "differs: printed vy0 is not periodic",
               f"criterion: closure after one period < CLOSURE_TOL = {TOL:.0e}; "
               f"T = {c.corrected.period_days:.4f} d, C = {c.corrected.jacobi:.8f}" +
@@ -659,7 +663,7 @@ miss_start, miss_end = abs(w1[0] - W1_PAPER[0]), abs(w1[1] - W1_PAPER[1])
 # periods for which [3P/4, 3P/2] meets both printed ends within the tolerance
 P_fit = (max((W1_PAPER[0] - WIN_TOL_D) * 4 / 3, (W1_PAPER[1] - WIN_TOL_D) * 2 / 3),
          min((W1_PAPER[0] + WIN_TOL_D) * 4 / 3, (W1_PAPER[1] + WIN_TOL_D) * 2 / 3))
-table.add("W&J test case 1 observation window [d]", "12 to 23", f"{w1[0]:.1f} to {w1[1]:.1f}",
+table.add_typed("W&J test case 1 observation window [d]", "12 to 23", f"{w1[0]:.1f} to {w1[1]:.1f}",
           ("reproduced" if max(miss_start, miss_end) < WIN_TOL_D else
            f"differs: the window end misses by {max(miss_start, miss_end):.1f} d (> {WIN_TOL_D:g} d)"),
           f"window [3P/4, 3P/2], P = {P_tu:.3f} TU = {P_tu * em.time_unit_days:.2f} d (corrected observer DRO); "
@@ -667,7 +671,7 @@ table.add("W&J test case 1 observation window [d]", "12 to 23", f"{w1[0]:.1f} to
           f"[3P/4, 3P/2] fits 12 and 23 d within {WIN_TOL_D:g} d only for P between {P_fit[0]:.1f} and "
           f"{P_fit[1]:.1f} d, shorter than this DRO's {P_tu * em.time_unit_days:.2f} d (23/12 = {ratio_paper:.2f} "
           "against 2: no P fits both exactly)")
-table.add("W&J time unit", "P_synodic / 2 pi",
+table.add_typed("W&J time unit", "P_synodic / 2 pi",
           f"{em.time_unit_days:.4f} d (literal reading {TU_LITERAL_DAYS:.4f} d)",
           "derived" if win["standard"][2] < win["P_synodic/2pi"][2] else "differs: the literal reading fits better",
           f"largest miss of the windows' day counts (12-23 d, 17-32 d): standard unit {win['standard'][2]:.1f} d "
@@ -675,10 +679,10 @@ table.add("W&J time unit", "P_synodic / 2 pi",
           f"{win['P_synodic/2pi'][2]:.1f} d (case 1 {win['P_synodic/2pi'][0][0]:.1f}-"
           f"{win['P_synodic/2pi'][0][1]:.1f}, case 2 {win['P_synodic/2pi'][1][0]:.1f}-"
           f"{win['P_synodic/2pi'][1][1]:.1f}); the standard unit is used")
-table.add("STM vs central differences (9:2 period)", "-", f"{best_stm:.1e}", "beyond paper", "relative, best step")
-table.add("STT vs central differences of the STM", "-", f"{best_stt:.1e}", "beyond paper", "relative, best step")
+table.add_typed("STM vs central differences (9:2 period)", "-", f"{best_stm:.1e}", "beyond paper", "relative, best step")
+table.add_typed("STT vs central differences of the STM", "-", f"{best_stt:.1e}", "beyond paper", "relative, best step")
 v = visibility["9:2"]
-table.add("L2 observer line of sight to the 9:2 NRHO", "never interrupted",
+table.add_typed("L2 observer line of sight to the 9:2 NRHO", "never interrupted",
           f"{100 * v['l2'].clear_fraction:.2f}% clear, {v['l2'].count} outages",
           "reproduced" if v["l2"].count == 0 else "differs: occultations found",
           f"criterion: no occulted sample among {n_los} over {OUTAGE_SPAN_DAYS} d ({OUTAGE_STEP_S:g}-s steps); "
@@ -687,7 +691,7 @@ for name, v in visibility.items():
     st = v["dro"]
     crit = {"limited": 1 - st.clear_fraction < 0.05, "infrequent": st.mean_interval_days > v["period_days"],
             "short": st.longest_h < 6.0}
-    table.add(f"DRO observer outages ({name} NRHO)", "limited, infrequent and short",
+    table.add_typed(f"DRO observer outages ({name} NRHO)", "limited, infrequent and short",
               f"{st.count} outages in {OUTAGE_SPAN_DAYS} d, {100 * (1 - st.clear_fraction):.2f}% of time, longest "
               f"{st.longest_h:.2f} h, one per {st.mean_interval_days:.1f} d",
               "consistent (tuned)" if all(crit.values()) else
@@ -698,7 +702,7 @@ for name, v in visibility.items():
               "through x0 = 0.778 LU (choice)")
 v = visibility["9:2"]
 three_needed = v["all3"] == 1 and sweep.n_full_pairs == 0 and fine.n_full_pairs == 0
-table.add("surface stations needed for the full 9:2 orbit", 3,
+table.add_typed("surface stations needed for the full 9:2 orbit", 3,
           f"3: default three cover {100 * v['all3']:.1f}%; "
           f"best of {n_pairs} grid pairs {100 * sweep.best_fraction:.2f}%",
           "reproduced" if three_needed else "differs: coverage incomplete or a grid pair suffices",

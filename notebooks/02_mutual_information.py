@@ -25,7 +25,7 @@
 # and test case 2 (Tables 4 and 5). Measurement models also follow Greaves & Scheeres 2021 (Eqs. 6-13) and
 # their AMOS 2023 paper (Eqs. 15-20).
 #
-# All computation lives in `cislunar.measurements`, `cislunar.covariance` and `cislunar.information`.
+# All computation lives in `cislunar.sensing.measurements`, `cislunar.sensing.covariance` and `cislunar.sensing.information`.
 
 # %% tags=["parameters"]
 QUICK = False
@@ -39,13 +39,17 @@ N_BASELINES = 5 if QUICK else 10  # observer phase offsets in the baseline study
 TIMING_SIZES = [5, 9, 17] if QUICK else [5, 9, 17, 33, 65]  # measurement times per window in the timing study
 TIMING_MIN_TIME = 0.02 if QUICK else 0.1  # seconds per timing run
 
-import numpy as np
 import matplotlib.pyplot as plt
+import numpy as np
 
-from cislunar import covariance as cov, information as info, measurements as meas, plotting, scvx
-from cislunar.dynamics import EARTH_MOON as em
-from cislunar.propagation import find_events, propagate
-from cislunar.report import ComparisonTable
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.cr3bp.propagation import find_events, propagate
+from cislunar.guidance import scvx
+from cislunar.publish import plotting
+from cislunar.publish.report import ComparisonTable
+from cislunar.sensing import covariance as cov
+from cislunar.sensing import information as info
+from cislunar.sensing import measurements as meas
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -474,45 +478,45 @@ print(f"chain rule faster than dense from {cross_value} for the MI, from {cross_
 # ## 8 · Paper versus reproduction
 
 # %%
-table.add("Eq. 11: I = E_X[KL(p(Y|X)||p(Y))] (scalar worked example)", "formula only (Eq. 11)",
+table.add_typed("Eq. 11: I = E_X[KL(p(Y|X)||p(Y))] (scalar worked example)", "formula only (Eq. 11)",
           f"Monte Carlo {mc:.4f} +- {se:.4f} vs closed form {closed:.4f} nats",
           "beyond paper" if abs(mc - closed) < 3 * se else "differs: Monte Carlo outside 3 standard errors",
           "our worked example (p = 4, h = r = 1); tolerance: 3 standard errors of the Monte Carlo mean")
-table.add("Eq. 18 on test case 2 window (dense)", "formula only", f"{mi_dense:.4f} nats", "derived",
+table.add_typed("Eq. 18 on test case 2 window (dense)", "formula only", f"{mi_dense:.4f} nats", "derived",
           "no numerical MI values are printed in the paper")
-table.add("Eq. 18 by chain rule (Kalman recursion)", "not in paper",
+table.add_typed("Eq. 18 by chain rule (Kalman recursion)", "not in paper",
           f"rel. diff {abs(mi_dense - mi_struct) / mi_dense:.1e}",
           "beyond paper", "same value at O(N) cost; square-root form (the dense log-determinant loses digits when "
           "the measurements are far more precise than the prior)")
 grad_dense_err = float(np.max(np.abs(g_struct - g_dense)) / np.max(np.abs(g_dense)))
-table.add("Eqs. 44-52 gradient vs central differences", "formula only",
+table.add_typed("Eqs. 44-52 gradient vs central differences", "formula only",
           f"structured vs FD {grad_err:.1e}; structured vs dense Eq. 48 {grad_dense_err:.1e} (max rel.)",
           "beyond paper" if grad_err < 1e-5 else "differs: gradient disagrees with finite differences",
           "tolerance 1e-5 on structured vs FD; P~ held fixed as in the paper; FD of the structured value (the dense "
           "log-determinant has too few digits for differences at step 1e-6), so the dense gradient agrees only to "
           "the level shown")
-table.add("Eq. 44 linearisation error at 10 km / 100 km steps", "not in paper",
+table.add_typed("Eq. 44 linearisation error at 10 km / 100 km steps", "not in paper",
           f"{lin_err[1]:.2e} / {lin_err[2]:.2e} nats", "beyond paper",
           f"the range where Eq. 44 alone holds; the package's SCvx uses a quadratic information model by default and a "
           f"trust region of {em.lu_to_km(scvx_defaults.eta0):,.0f}-{em.lu_to_km(scvx_defaults.eta_max):,.0f} km "
           "(notebook 05 compares linear and quadratic)")
-table.add("Process-noise PSD (Table 5)", "1e-11 km/s^3",
+table.add_typed("Process-noise PSD (Table 5)", "1e-11 km/s^3",
           f"{q_nd:.1e} LU^2/TU^3 = {cov.WOLF_JONES_PSD_KM2_S3:.2e} km^2/s^3", "consistent (tuned)",
           "normalised reading, chosen because 1e-11 km^2/s^3 would let test case 1's CRLB grow without bound, "
           "against the paper's text; notebook 06 sweeps the readings")
 win_tol_d = 1.0  # tolerance on each end of the window, days
 win_ok = abs(days[0] - 17.0) <= win_tol_d and abs(days[-1] - 32.0) <= win_tol_d
-table.add("Reference DRO period / observation window", "window roughly 17-32 days (Fig. 8 text); [P_ref, 2 P_ref]",
+table.add_typed("Reference DRO period / observation window", "window roughly 17-32 days (Fig. 8 text); [P_ref, 2 P_ref]",
           f"P_ref = {em.tu_to_days(P_ref):.2f} d, window {days[0]:.2f}-{days[-1]:.2f} d",
           "reproduced" if win_ok else "differs: window ends more than 1 d from the paper's",
           f"tolerance +-{win_tol_d:g} d on each end; P_ref from the Table 4 observer_tf DRO. The paper's own definition "
           f"forces the start to be half the end (~16 d; target DRO periods {', '.join(f'{p:.2f}' for p in P_targets_d)}"
           f" d), so 'roughly 17' is loose: our start is {17.0 - days[0]:.2f} d earlier")
-table.add("Observer trajectory in the window", "SCvx-optimised (not published)", "coasting on observer_tf DRO",
+table.add_typed("Observer trajectory in the window", "SCvx-optimised (not published)", "coasting on observer_tf DRO",
           "not in paper: our choice; the optimised trajectory is not given and the printed observer_t0 row is not "
           "periodic", "a coasting stand-in, not the alpha_h = 0 solution (Table 4's x_S(t0) and x_S(tf) are "
           "different orbits, so alpha_h = 0 still needs a transfer)")
-table.add("In-plane RMS growth after the first update (test case 2 analogue of the Fig. 4 remark)",
+table.add_typed("In-plane RMS growth after the first update (test case 2 analogue of the Fig. 4 remark)",
           "noticeable growth at the window start (attributed to a diagonal P0)",
           f"in-plane RMS grows from the 1st to the 2nd update for {int(transient.sum())} of 4 objects "
           f"(observer {sig_xy[0, 0]:.0f} -> {sig_xy[0, 1]:.0f} km)",
@@ -520,7 +524,7 @@ table.add("In-plane RMS growth after the first update (test case 2 analogue of t
           "criterion: in-plane RMS after the 2nd update above that after the 1st for at least one object; symptom "
           "only, the cause (diagonal P0) is not tested; the paper's Fig. 4 is test case 1 (notebook 05)")
 obs_better = sig_post[0].mean() < sig_post[1:].mean()
-table.add("Observer RMS below targets on average (Fig. 9)", "yes",
+table.add_typed("Observer RMS below targets on average (Fig. 9)", "yes",
           f"observer {sig_post[0].mean():.2f} km vs targets {sig_post[1:].mean():.2f} km (mean over window)",
           "reproduced" if obs_better else "differs: observer is not better determined than the targets here",
           "un-manoeuvred observer, so only qualitative; the total is the unobserved out-of-plane error, the same "
@@ -536,7 +540,7 @@ for name, res in study.items():
               f"differs: improves up to about {b_km[k_best]:.0f} km, then the in-plane CRLB worsens "
               f"({rebound:.1f}x) and the MI drops" if improves else
               "differs: the in-plane CRLB gains little from the baseline")
-    table.add(f"MI and CRLB improve with baseline ({name})", "yes (Markley/Psiaki argument, qualitative)",
+    table.add_typed(f"MI and CRLB improve with baseline ({name})", "yes (Markley/Psiaki argument, qualitative)",
               f"MI +{gain[name]:.2f} nats up to {peak[name]:.0f} km (then -{mi_drop:.2f}); observer in-plane RMS "
               f"{obs_xy[0]:.1f} -> {obs_xy[k_best]:.1f} km at {b_km[k_best]:.0f} km, {obs_xy[-1]:.1f} km at "
               f"{b_km[-1]:.0f} km, rebound {obs_xy[-1] / obs_xy[k_best]:.3f}x (threshold 1.2x)", status,
@@ -544,7 +548,7 @@ for name, res in study.items():
               "baseline < 1.2x; observer phase-shifted on the target's DRO; MI peak and in-plane CRLB minimum at "
               f"{'the same' if same_peak[name] else 'different'} baselines; out-of-plane share of the observer's "
               f"terminal variance {np.mean(res['obs_z']**2 / res['obs']**2):.0%} (mean over baselines)")
-table.add("Structured vs dense speed at test-case-2 size (N = 17)", "not in paper",
+table.add_typed("Structured vs dense speed at test-case-2 size (N = 17)", "not in paper",
           f"MI {r17.ratio_value:.1f}x, MI + gradient {r17.ratio_gradient:.1f}x", "beyond paper",
           f"crossover from this run's times: {cross_value} (MI), {cross_gradient} (MI + gradient); O(N) against "
           "O(N^3) shows at larger N (timing figure)")

@@ -36,10 +36,12 @@ N_EXTRA_SEEDS = 1 if QUICK else 3  # further random-draw seeds for the DRO robus
 import matplotlib.pyplot as plt
 import numpy as np
 
-from cislunar import discretization as D
-from cislunar import orbits, plotting, propagation, reference
-from cislunar.dynamics import EARTH_MOON as em
-from cislunar.report import ComparisonTable
+from cislunar.cr3bp import orbits, propagation
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.guidance import discretization as D
+from cislunar.papers.wolf_jones import reference
+from cislunar.publish import plotting
+from cislunar.publish.report import ComparisonTable
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -61,7 +63,7 @@ A_MAX = 1e-6 / em.acceleration_unit_km_s2  # Wolf & Jones Table 3: 1e-6 km/s^2, 
 # small. The paper integrates $dz/d\tau = r_m^{\sigma}[f;\,1]$ with $z = [x;\,t]$ (Eq. 38; the exponent is printed
 # there as $\alpha$, the same $\sigma$ as in Eq. 37). We integrate the equivalent $d\tau/dt = r_m^{-\sigma}$
 # alongside the reference in time and find the node times by root finding on the dense output;
-# `tests/test_discretization.py` checks that $\sigma = 0$ returns uniform nodes and that $\tau$ equals the
+# `tests/guidance/test_discretization.py` checks that $\sigma = 0$ returns uniform nodes and that $\tau$ equals the
 # quadrature of $r_m^{-\sigma}$.
 
 # %%
@@ -212,18 +214,18 @@ gain_dro_max_sigma = lin_err[dro_name, 0.0] / lin_err[dro_name, max(SIGMAS)]
 gain_dro_seeds = [gain_dro] + [e[0.0] / e[SIGMA_FIXED] for e in extra.values()]
 gain_nrho = lin_err[nrho_name, 0.0] / min(lin_err[nrho_name, s] for s in SIGMAS)
 best_nrho = min(SIGMAS, key=lambda s: lin_err[nrho_name, s])
-table.add("sigma = 0: t and tau coincide (Eq. 37)", "one-to-one equivalence", "uniform nodes, tau = t (tested)",
+table.add_typed("sigma = 0: t and tau coincide (Eq. 37)", "one-to-one equivalence", "uniform nodes, tau = t (tested)",
           "derived", "an identity of Eq. 37 at sigma = 0 (dt = d tau), checked to atol 1e-12 in "
-          "tests/test_discretization.py")
-table.add("positive sigma dilates time near perilune", "yes",
+          "tests/guidance/test_discretization.py")
+table.add_typed("positive sigma dilates time near perilune", "yes",
           f"NRHO shortest interval at perilune; spacing ratio {spread[nrho_name, max(SIGMAS)]:.0f} at sigma = "
           f"{max(SIGMAS):g}", "reproduced" if spread[nrho_name, max(SIGMAS)] > 5 else "differs: little dilation",
           "threshold: longest / shortest interval > 5")
-table.add("exponent symbol in Eq. 38", "alpha (Eq. 37: sigma)", "sigma used throughout", "differs: naming only",
+table.add_typed("exponent symbol in Eq. 38", "alpha (Eq. 37: sigma)", "sigma used throughout", "differs: naming only",
           "Eq. 38's r_m^alpha is the Sundman factor of Eq. 37")
-table.add("number of nodes and sigma", "not given", f"N = {N_NODES}; sigma in {SIGMAS}", "not in paper",
+table.add_typed("number of nodes and sigma", "not given", f"N = {N_NODES}; sigma in {SIGMAS}", "not in paper",
           "swept here")
-table.add("Sundman nodes improve linearisation accuracy, DRO arc", "effective (qualitative)",
+table.add_typed("Sundman nodes improve linearisation accuracy, DRO arc", "effective (qualitative)",
           f"sigma = {SIGMA_FIXED:g} reduces the worst one-step position error {min(gain_dro_seeds):.2f}-"
           f"{max(gain_dro_seeds):.2f}x vs uniform ({len(gain_dro_seeds)} draw seeds; {gain_dro:.2f}x for seed {SEED})",
           "reproduced" if min(gain_dro_seeds) > 1.1 else
@@ -232,16 +234,16 @@ table.add("Sundman nodes improve linearisation accuracy, DRO arc", "effective (q
           f"criterion: gain > 1.1x at sigma = {SIGMA_FIXED:g} for every draw seed; uniform "
           f"{lin_err[dro_name, 0.0]:.2e} km; best of the sweep {gain_dro_best:.2f}x; sigma = {max(SIGMAS):g} gives "
           f"{gain_dro_max_sigma:.2f}x (below 1: worse than uniform)")
-table.add("Sundman nodes improve linearisation accuracy, NRHO arc", "not in paper (motivation)",
+table.add_typed("Sundman nodes improve linearisation accuracy, NRHO arc", "not in paper (motivation)",
           f"{gain_nrho:.1f}x at sigma = {best_nrho:g} vs uniform", "beyond paper",
           f"uniform {lin_err[nrho_name, 0.0]:.2e} km")
-table.add("Eq. 41 minimum-norm node bounds", "QR minimum-norm solution", f"Eq. 40 residual {residual_40:.0e}",
+table.add_typed("Eq. 41 minimum-norm node bounds", "QR minimum-norm solution", f"Eq. 40 residual {residual_40:.0e}",
           "derived", "no paper number: the residual shows only that the least-squares system is solved; bounds "
           "have impulse units as printed")
-table.add("node bounds used in the SCvx runs (notebooks 03, 05, 06)", "Eq. 41 as printed (impulse units)",
+table.add_typed("node bounds used in the SCvx runs (notebooks 03, 05, 06)", "Eq. 41 as printed (impulse units)",
           "acceleration reading: u_max,k = a_max at every node (zero in the observation window)",
           "differs: documented choice", "the FOH node controls of Eq. 27 are accelerations; the trapezoid rule on "
           "accelerations, (u_max,k + u_max,k+1)/2 = a_max, has the minimum-norm solution u_max,k = a_max")
-table.add("FOH matrices (Eqs. 29-31)", "integrated with Phi^-1 (Eq. 32)", "heyoka state/parameter sensitivities",
+table.add_typed("FOH matrices (Eqs. 29-31)", "integrated with Phi^-1 (Eq. 32)", "heyoka state/parameter sensitivities",
           "beyond paper", "same matrices without inverting the STM; tests vs STM and finite differences")
 table.display()

@@ -24,8 +24,8 @@
 # SCvx (Eqs. 24-43) and the CRLB of "Performance Evaluation". Test case 1 is notebook 05, the solver notebook 03,
 # the mutual information notebook 02.
 #
-# All computation lives in `cislunar.wolf_jones` (scenario, information model, keep-out, CRLB, sweeps) and
-# `cislunar.scvx` (the solver).
+# All computation lives in `cislunar.papers.wolf_jones.scenarios` (scenario, information model, keep-out, CRLB, sweeps) and
+# `cislunar.guidance.scvx` (the solver).
 
 # %% tags=["parameters"]
 QUICK = False
@@ -59,12 +59,13 @@ import matplotlib.pyplot as plt
 import numpy as np
 from scipy.stats import spearmanr
 
-from cislunar import covariance as cov
-from cislunar import plotting, scvx
-from cislunar import wolf_jones as wj
-from cislunar.propagation import propagate, propagate_stm
-from cislunar.reference import CLOSURE_TOL
-from cislunar.report import ComparisonTable
+from cislunar.cr3bp.propagation import propagate, propagate_stm
+from cislunar.guidance import scvx
+from cislunar.papers.wolf_jones import scenarios as wj
+from cislunar.papers.wolf_jones.reference import CLOSURE_TOL
+from cislunar.publish import plotting
+from cislunar.publish.report import ComparisonTable
+from cislunar.sensing import covariance as cov
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -196,7 +197,7 @@ for d_show in (1000.0, 424.0, 1.0, 0.1, 1e-3, 1e-6):
 # %% [markdown]
 # ## 4 · SCvx over the homotopy grid, swept both ways
 #
-# For each $\alpha_h$ the solver (`cislunar.scvx`: SCvx* augmented Lagrangian on the defects, the convex
+# For each $\alpha_h$ the solver (`cislunar.guidance.scvx`: SCvx* augmented Lagrangian on the defects, the convex
 # quadratic MI model from the concave part of the Hessian, the keep-out as a linearised constraint) starts from a
 # warm start. The problem has several local optima, so we sweep the grid upward (from the ballistic guess at
 # $\alpha_h = 0$) and downward (from the ballistic guess at the largest $\alpha_h$) and keep the lower cost per
@@ -895,28 +896,28 @@ print(f"notebook compute time {time.perf_counter() - t_start:.0f} s")
 # %%
 chk_obs = sc.row_checks["observer_t0"]
 u_bind = max(r["u_ratio"] for r in ok)
-table.add("Table 4 observer x_S(t0) is a periodic DRO", "implied (DRO family)",
+table.add_typed("Table 4 observer x_S(t0) is a periodic DRO", "implied (DRO family)",
           f"closure after one period {chk_obs.raw_closure:.2f} (non-dimensional); vy0 off by "
           f"{chk_obs.vy0_correction:+.4f} LU/TU", "differs: printed vy0 is not periodic",
           f"corrected holding x0 (same row as Table 2; notebook 05 argues this reading from the span of the other "
           f"rows); period {em.tu_to_days(chk_obs.corrected.period):.2f} d")
 others = [c for lab, c in sc.row_checks.items() if lab != "observer_t0"]
-table.add("Table 4 other rows periodic", "implied", f"closures <= {max(c.raw_closure for c in others):.1e}",
+table.add_typed("Table 4 other rows periodic", "implied", f"closures <= {max(c.raw_closure for c in others):.1e}",
           "reproduced" if max(c.raw_closure for c in others) < CLOSURE_TOL else "differs: a row does not close",
           f"criterion: closure < {CLOSURE_TOL:g} (nine printed digits allow ~1e-8)")
-table.add("Table 5 title", '"Scenario Parameters for Test Case #1"', "parameters are test case 2's",
+table.add_typed("Table 5 title", '"Scenario Parameters for Test Case #1"', "parameters are test case 2's",
           "differs: title slip", "range/range-rate noise and three targets belong to test case 2")
-table.add("Table 5 a_max", '"1x5^-7" km/s^2', f"5e-7 km/s^2; others: " + "; ".join(
+table.add_typed("Table 5 a_max", '"1x5^-7" km/s^2', f"5e-7 km/s^2; others: " + "; ".join(
     f"{lab}: dV {d:.1f} m/s, RMS {r_:.1f} km, |u|/a_max {q_:.2f}" for lab, d, r_, q_ in amax_rows),
     "derived", "read as 5x10^-7 (half of test case 1's; the literal 5^-7 = 1.28e-5 km/s^2 is 13x case 1's); "
     + (f"at 5e-7 the bound never binds on the grid (largest |u|/a_max {u_bind:.2f}), so a larger reading changes "
        "nothing but the local optimum found, a smaller one binds" if u_bind < 0.99 else
        f"at 5e-7 the bound binds (largest |u|/a_max {u_bind:.2f})"))
-table.add("Table 3/5 process noise Q", '1e-11 "km/s^3"', "1e-11 LU^2/TU^3 = 2.80e-17 km^2/s^3", "consistent (tuned)",
+table.add_typed("Table 3/5 process noise Q", '1e-11 "km/s^3"', "1e-11 LU^2/TU^3 = 2.80e-17 km^2/s^3", "consistent (tuned)",
           "chosen as a reading that keeps test case 1's CRLB bounded, the paper's own claim (section 9); 1e-11 "
           f"km^2/s^3 makes it grow to {noise_rows[0][2]:.0f} km; the three small readings all stay bounded and give "
           f"terminal RMS values {q_spread[0]:.1f}x (case 1) and {q_spread[1]:.1f}x (case 2) apart")
-table.add("Observation window", "roughly 17-32 days", f"[P, 2P] = {ws_d:.2f}-{we_d:.2f} d",
+table.add_typed("Observation window", "roughly 17-32 days", f"[P, 2P] = {ws_d:.2f}-{we_d:.2f} d",
           "consistent (tuned)" if abs(ws_d - 17) <= 1 and abs(we_d - 32) <= 1 else "differs: window ends",
           "tolerance +-1 day ('roughly'); P of the corrected observer DRO, whose reading (x0 held) was first chosen "
           "with these day counts in view; notebook 05 supports it independently (x0 and period inside the span of "
@@ -924,7 +925,7 @@ table.add("Observation window", "roughly 17-32 days", f"[P, 2P] = {ws_d:.2f}-{we
           f"{abs(1.5 * em.tu_to_days(sc.period) - 23.0):.2f} d")
 nk_failed = isinstance(nk, scvx.SCvxError)
 small_fail = [d for d in D_MIN_KM if isinstance(extra[("d_min", d)], scvx.SCvxError)]
-table.add("SCvx converges for every alpha_h without a keep-out (our modified solver)", "implied (Figs. 7, 10)",
+table.add_typed("SCvx converges for every alpha_h without a keep-out (our modified solver)", "implied (Figs. 7, 10)",
           f"alpha_h = {a6:g} without keep-out: " + (nk.reason.split(":")[0] if nk_failed else "converged")
           + ("; keep-out " + ", ".join(f"{d:g} km" for d in small_fail) + ": no convergence" if small_fail else ""),
           "differs: without a keep-out even our modified solver does not converge (convex subproblem fails)"
@@ -932,19 +933,19 @@ table.add("SCvx converges for every alpha_h without a keep-out (our modified sol
           "the paper has no keep-out; our solver departs from the printed one (augmented Lagrangian, quadratic MI "
           "model, changed acceptance); the printed formulation was not run on this case (notebook 05: the printed "
           "L1 penalty does not converge on test case 1)")
-table.add("modified SCvx with a 424 km keep-out converges for every alpha_h", "-",
+table.add_typed("modified SCvx with a 424 km keep-out converges for every alpha_h", "-",
           f"{len(ok)}/{len(ALPHAS)} alphas; {len(failed)} of {len(sweep.attempts)} runs failed; largest defect "
           f"{max(r['res'].max_defect for r in ok):.0e}", "beyond paper",
           f"keep-out active in {n_bind} of {sum(r['alpha'] > 0 for r in ok)} plans with alpha_h > 0")
-table.add("Single-shooting re-flight of the converged controls", "not in paper",
+table.add_typed("Single-shooting re-flight of the converged controls", "not in paper",
           f"largest terminal miss {max(r['miss_km'] for r in ok):.1e} km", "beyond paper",
           "first-order-hold control flown from x_S(t0)")
 z6 = row6["z_max_km"]
-table.add("Fig. 6: out-of-plane motion at alpha_h = 1e-2", "yes", f"max |z| = {z6:.0f} km (alpha {a6:g})",
+table.add_typed("Fig. 6: out-of-plane motion at alpha_h = 1e-2", "yes", f"max |z| = {z6:.0f} km (alpha {a6:g})",
           "reproduced" if z6 > 100 else "differs: the solution stays (nearly) planar", "threshold 100 km")
 same_free = [r for r in radius_rows if r["d"] < sc.keep_out_km and not r["binds"] and r["apart"] <= SAME_PLAN_KM]
 robust = dep_pass == len(rho_grids)
-table.add("Fig. 7: departure grows with alpha_h", "generally", f"Spearman(alpha, max departure) = {rho_dep:.2f}; "
+table.add_typed("Fig. 7: departure grows with alpha_h", "generally", f"Spearman(alpha, max departure) = {rho_dep:.2f}; "
           + ", ".join(f"{r['alpha']:g}: {d_ / 1e3:.1f}" for r, d_ in zip(ok, dep_max)) + " (10^3 km); other node "
           "grids: " + ", ".join(f"{n_} nodes {v:.2f}" for n_, v in rho_grids.items() if n_ != N_NODES),
           ("reproduced" if robust else f"differs: not robust, Spearman above 0.8 on {dep_pass} of "
@@ -954,7 +955,7 @@ table.add("Fig. 7: departure grows with alpha_h", "generally", f"Spearman(alpha,
           "(fixed in advance); which local optimum a weight lands in moves with the grid and with round-off (an "
           "earlier run with a gradient differing by ~1e-8 relative gave 0.69), so one grid's value alone is fragile")
 if zsign is not None:
-    table.add("Fig. 7: the 5e-3 and 7e-3 solutions are near-mirror images across z = 0", "yes (Fig. 7)",
+    table.add_typed("Fig. 7: the 5e-3 and 7e-3 solutions are near-mirror images across z = 0", "yes (Fig. 7)",
               f"z at the window end {zsign[0]:+.0f} km ({pair[0]['alpha']:g}), {zsign[1]:+.0f} km "
               f"({pair[1]['alpha']:g}); largest distance to the other's mirror {d_mir:.0f} km, unmirrored "
               f"{d_same:.0f} km", "reproduced" if d_mir < d_same else
@@ -962,7 +963,7 @@ if zsign is not None:
               "criterion: one closer to the mirror of the other than to the other itself; which side an optimum "
               "leaves the plane on is picked by round-off (planar guess is a saddle), so either outcome is an "
               "accident of the run, and the seeded rows below make the mirror pair on purpose")
-table.add("Fig. 7 z-mirror: the mirror of an optimum is an optimum", "postulated family of symmetric optima",
+table.add_typed("Fig. 7 z-mirror: the mirror of an optimum is an optimum", "postulated family of symmetric optima",
           f"alpha {row_m['alpha']:g}: mirrored optimum re-solved in {twin.iterations} iterations, cost difference "
           f"{twin_dcost:.0e}, distance to the exact mirror {twin_km:.2f} km", "beyond paper",
           "exact z-symmetry of CR3BP, planar DROs and range/range-rate; criterion: cost within 1e-6 relative and "
@@ -971,30 +972,30 @@ if mirror_rows:
     worst_mis = max(m_[4] for m_ in mirror_rows)
     worst_dc = max(m_[3] for m_ in mirror_rows)
     same = worst_mis <= 1.0 and worst_dc <= 1e-6
-    table.add("Fig. 7: +z and -z seeds at alpha_h = 5e-3 and 7e-3", "near-mirror solutions (Fig. 7)",
+    table.add_typed("Fig. 7: +z and -z seeds at alpha_h = 5e-3 and 7e-3", "near-mirror solutions (Fig. 7)",
               ("seeds converge to mirror images" if same else "seeds converge to different local optima")
               + f": cost difference {worst_dc:.0e}, distance to mirror {worst_mis:.2f} km; seeded costs "
               + ", ".join(f"{m_[5]:.4f} (sweep best {m_[6]:.4f})" for m_ in mirror_rows), "beyond paper",
               "criterion: within 1 km and 1e-6 relative cost; the planar guess is a saddle, the sign is picked by "
               "round-off or the seed")
-table.add("Fig. 8: zero thrust in the window", "a_max = 0 in the window",
+table.add_typed("Fig. 8: zero thrust in the window", "a_max = 0 in the window",
           f"max |u| in window {max(r['u_window'] for r in ok):.0e}", "derived",
           "imposed input (zero bound at every window node), not a prediction")
 az_used = [np.max(np.abs(r["res"].u[:, 2])) > 1e-3 * sc.a_max for r in ok if r["alpha"] > 0]
-table.add("Fig. 8: out-of-plane thrust a_z used", "yes", f"a_z above 0.1 % of a_max in {sum(az_used)} of "
+table.add_typed("Fig. 8: out-of-plane thrust a_z used", "yes", f"a_z above 0.1 % of a_max in {sum(az_used)} of "
           f"{len(az_used)} plans with alpha_h > 0", "reproduced" if all(az_used) else "differs: some plans stay planar",
           "criterion: max |a_z| > 1e-3 a_max in every plan with alpha_h > 0")
 if base:
     other = [r["crlb"].terminal_rms_km[0] for r in ok if r["alpha"] > 0]
     weak = base["crlb"].terminal_rms_km[0] >= 5 * max(other)
-    table.add("Fig. 9: alpha_h = 0 weakly observable (grey)", "yes",
+    table.add_typed("Fig. 9: alpha_h = 0 weakly observable (grey)", "yes",
               f"terminal observer RMS {base['crlb'].terminal_rms_km[0]:.0f} km vs <= {max(other):.0f} km",
               "reproduced" if weak else "differs: the baseline is not much worse", "factor 5 fixed in advance")
 if obs_mean:
     gap_mean = {a: 1 - obs_mean[a] / tgt_mean[a] for a in obs_mean}
     gap_end = {a: 1 - common[a][0][0] / np.mean(common[a][0][1:]) for a in obs_mean}
     better = all(g_ >= 0.10 for g_ in gap_mean.values())
-    table.add("Fig. 9: observer RMS below the targets' on average", "yes",
+    table.add_typed("Fig. 9: observer RMS below the targets' on average", "yes",
               "; ".join(f"alpha {a:g}: window mean {obs_mean[a]:.1f} vs {tgt_mean[a]:.1f} km "
                         f"({100 * gap_mean[a]:.0f} % lower), window end {common[a][0][0]:.1f} vs "
                         f"{np.mean(common[a][0][1:]):.1f} km ({100 * gap_end[a]:.1f} %)" for a in obs_mean),
@@ -1002,48 +1003,48 @@ if obs_mean:
               f"differs: observer at most {100 * max(gap_mean.values()):.0f} % lower (window mean), threshold 10 %",
               "criterion fixed in advance: observer's window-mean RMS at least 10 % below the targets' mean; the "
               "means are dominated by the transient; relative measurements tie the four errors together (section 9)")
-table.add("Fig. 10: MI correlates with estimator performance", "'correlates well'",
+table.add_typed("Fig. 10: MI correlates with estimator performance", "'correlates well'",
           f"Spearman(MI, RMS) = {rank_obs:.2f} observer, {rank_tgt:.2f} targets over the alpha grid; "
           + radii_text,
           "reproduced" if rank_obs < -0.8 and rank_tgt < -0.8 else "differs: weak rank correlation",
           "criterion: Spearman below -0.8 over the alpha grid (best of both sweeps), as in notebook 05; across "
           "keep-out radii at fixed alpha_h (not the paper's front) MI and RMS need not move together: see the "
           "keep-out row")
-table.add("Fig. 10: impulse and MI grow with alpha_h", "yes",
+table.add_typed("Fig. 10: impulse and MI grow with alpha_h", "yes",
           f"impulse {dvs[0]:.1f}-{dvs[-1]:.1f} m/s, MI {mis[0]:.1f}-{mis[-1]:.1f} nats, monotone: "
           f"{mono_dv and mono_mi}", "reproduced" if mono_dv and mono_mi else "differs: not monotone",
           "best of the upward and downward sweeps")
-table.add("Fig. 10: front monotone in (impulse, RMS): more impulse, lower RMS", "a trade-off front",
+table.add_typed("Fig. 10: front monotone in (impulse, RMS): more impulse, lower RMS", "a trade-off front",
           "dominated points: " + (", ".join(f"alpha {a:g} ({dvs[i]:.2f} m/s, {rms_obs[i]:.1f} km) by alpha {b:g} "
                                             f"({dvs[j]:.2f} m/s, {rms_obs[j]:.1f} km)" for a, i, b, j in dominated)
                                   or "none"),
           "reproduced" if not dominated else "differs: a plan is worse on both axes than a cheaper one",
           "criterion: no plan has both more impulse and a higher observer terminal RMS than another; "
           + dominated_note)
-table.add("Impulse and terminal RMS values (Figs. 8-10)", "plotted, no numbers printed",
+table.add_typed("Impulse and terminal RMS values (Figs. 8-10)", "plotted, no numbers printed",
           f"alpha 0: {dvs[0]:.2f} m/s, {rms_obs[0]:.0f} km; alpha {ok[-1]['alpha']:g}: {dvs[-1]:.1f} m/s, "
           f"{rms_obs[-1]:.1f} km", "not in paper", "the figures carry no readable values in the text version")
-table.add("node grid (unstated N and sigma), alpha_h = " + f"{a6:g}", "N, sigma not given",
+table.add_typed("node grid (unstated N and sigma), alpha_h = " + f"{a6:g}", "N, sigma not given",
           f"{N_NODES} nodes: {row6['dv']:.2f} m/s, RMS {row6['crlb'].terminal_rms_km[0]:.1f} km; "
           + "; ".join(f"{n_} nodes: {d:.2f} m/s, RMS {r_:.1f} km" for n_, d, i_, r_ in mesh_rows),
           "beyond paper", f"whole sweep re-solved on each grid (sigma = {SIGMA:g}); RMS changes by up to "
           + (f"{100 * max(abs(r_ / row6['crlb'].terminal_rms_km[0] - 1) for _, _, _, r_ in mesh_rows):.0f} %"
              if mesh_rows else "n/a (no converged plan at this weight on the other grids)"))
 if base and budget_row:
-    table.add(f"Improvement over the minimum-impulse baseline at {budget_row['budget']:.1f} m/s (solved)",
+    table.add_typed(f"Improvement over the minimum-impulse baseline at {budget_row['budget']:.1f} m/s (solved)",
               "substantial", f"alpha_h = {budget_row['alpha']:.2e} spends {budget_row['dv']:.2f} m/s: observer RMS "
               f"{budget_row['rms']:.1f} km vs {base['crlb'].terminal_rms_km[0]:.0f} km for the baseline's "
               f"{base['dv']:.2f} m/s ({base['crlb'].terminal_rms_km[0] / budget_row['rms']:.0f}x lower)",
               "beyond paper", f"budget = baseline + {BUDGET_EXTRA_MPS:g} m/s, met within {100 * BUDGET_RTOL:g} %; "
               f"log-interpolation on the grid at the spent impulse said {budget_row['interp']:.1f} km")
 elif base and cheap:
-    table.add("Improvement over the minimum-impulse baseline", "substantial",
+    table.add_typed("Improvement over the minimum-impulse baseline", "substantial",
               f"alpha {cheap['alpha']:g}: +{cheap['dv'] - base['dv']:.1f} m/s buys "
               f"{base['crlb'].terminal_rms_km[0] / cheap['crlb'].terminal_rms_km[0]:.0f}x lower observer RMS",
               "beyond paper", "cheapest information trajectory against the alpha_h = 0 transfer (budget solve failed)")
 rms_span = max(r["rms"] for r in radius_rows) / min(r["rms"] for r in radius_rows)
 weak_all = base is not None and all(base["crlb"].terminal_rms_km[0] >= 5 * r["rms"] for r in radius_rows)
-table.add("Keep-out radius (unstated input), swept at the Fig. 6 weight", "not in paper",
+table.add_typed("Keep-out radius (unstated input), swept at the Fig. 6 weight", "not in paper",
           "; ".join(f"{r['d']:.0f} km: {r['dv']:.1f} m/s, MI {r['mi']:.2f} nats, RMS {r['rms']:.1f} km, closest "
                     f"{r['closest']:.0f} km" + (" (binds)" if r["binds"] else "") for r in radius_rows)
           + "; none: " + (f"closest approach {nk_range:.2f} km" if np.isfinite(nk_range) else
@@ -1058,7 +1059,7 @@ table.add("Keep-out radius (unstated input), swept at the Fig. 6 weight", "not i
                        "plan)" for r in radius_rows if not r["binds"]) or "none")
           + (f"; no keep-out: best accepted cost {nk_cost:.4f} (defects open) vs {row6['res'].cost:.4f} constrained"
              if np.isfinite(nk_cost) else "") + "; adopted 424 km = target outside the prior 3-sigma sphere")
-table.add("MI gradient (reverse mode of Eq. 18) vs central differences, case 2 window", "Eqs. 44-52 (formula only)",
+table.add_typed("MI gradient (reverse mode of Eq. 18) vs central differences, case 2 window", "Eqs. 44-52 (formula only)",
           f"max rel. difference {grad_err:.1e}", "beyond paper" if grad_err < 1e-5 else
           "differs: gradient and value disagree", "differentiates the square-root recursion, not Eqs. 44-52 term "
           "by term; process noise held fixed in both (same function)")

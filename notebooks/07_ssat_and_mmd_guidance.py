@@ -42,11 +42,12 @@ import matplotlib.pyplot as plt
 import numpy as np
 from scipy.optimize import brentq
 
-from cislunar import plotting, ssat
-from cislunar.dynamics import EARTH_MOON as em
-from cislunar.orbits import nrho_9_2
-from cislunar.propagation import propagate
-from cislunar.report import ComparisonTable
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.cr3bp.orbits import nrho_9_2
+from cislunar.cr3bp.propagation import propagate
+from cislunar.guidance import ssat
+from cislunar.publish import plotting
+from cislunar.publish.report import ComparisonTable
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -163,7 +164,7 @@ for coords in ("inertial", "relative", "agent"):
 # tests do the same on random states).
 
 # %%
-from cislunar.measurements import AZIMUTH_ELEVATION
+from cislunar.sensing.measurements import AZIMUTH_ELEVATION
 
 w_z = np.array([0.0, 0.0, 1.0])
 r_, v_ = xa0[:3], xa0[3:]
@@ -506,7 +507,7 @@ for h_pre, r in pre_sweep.items():
 # ### Does the verdict depend on the demonstration pair?
 #
 # The pair above is one choice among many. As a second, independent geometry we put the agent on the quasi-periodic
-# torus of notebook 08 (the member about the 9:2 NRHO whose mean range to the target is 215 km, :mod:`cislunar.torus`)
+# torus of notebook 08 (the member about the 9:2 NRHO whose mean range to the target is 215 km, :mod:`cislunar.cr3bp.torus`)
 # at four initial ring angles, burn 1 day before apolune, and repeat the comparison with the 1 m/s burn. The torus
 # relative motion is not along-track: the line of sight sweeps around the target. The ring angles are 0, 45, 90 and
 # 135 deg, not spread over the full circle: a ring angle 180 deg away puts the agent at nearly the mirrored relative
@@ -514,7 +515,7 @@ for h_pre, r in pre_sweep.items():
 # angles would not be independent cases.
 
 # %%
-from cislunar.torus import qpo_for_mean_range
+from cislunar.cr3bp.torus import qpo_for_mean_range
 
 qpo, _ = qpo_for_mean_range(nrho, 215.0)
 
@@ -577,26 +578,26 @@ def leading_hours(r, ok):
 
 
 perp_ok_h = {dv: leading_hours(r, r.perp_best <= 1.02 * r.optimum) for dv, r in results.items()}
-table.add("Eq. 7: T P T^T and its inverse (identity)", "exact", f"{err_cov:.1e} rel. error", "derived")
-table.add("agent-based absolute state equivalent (same relative block, same J_rho)", "stated, not shown",
+table.add_typed("Eq. 7: T P T^T and its inverse (identity)", "exact", f"{err_cov:.1e} rel. error", "derived")
+table.add_typed("agent-based absolute state equivalent (same relative block, same J_rho)", "stated, not shown",
           f"{same_rel_block:.1e} / {np.ptp(J3) / np.mean(J3):.1e}", "derived",
           "angles depend on s_rho only: Jacobian [0 H_rho] in both relative systems (tested)")
-table.add("initial 1-sigma range uncertainty from 3-sigma 60 km per axis, both vehicles", "-",
+table.add_typed("initial 1-sigma range uncertainty from 3-sigma 60 km per axis, both vehicles", "-",
           f"{base.range_sigma_km[0, 0]:.2f} km", "derived", "sqrt(2) x 20 km")
-table.add("covariance analysis: SRI batch form vs EKF recursion", "-",
+table.add_typed("covariance analysis: SRI batch form vs EKF recursion", "-",
           f"{np.max(np.abs(ssat.ssat_covariance_ekf(em, agt, tgt, P0)[1] / base.J_rho[0] - 1)):.1e} rel.",
           "beyond paper", "two independent implementations agree")
-table.add("sqrt(J_rho) without maneuver after 24 h / 72 h (demonstration pair)", "-",
+table.add_typed("sqrt(J_rho) without maneuver after 24 h / 72 h (demonstration pair)", "-",
           f"{base.range_sigma_km[0, 24]:.1f} / {base.range_sigma_km[0, -1]:.1f} km", "not in paper",
           "the paper's MMD scenario (its Ref. [8]) is not given; our pair: same 9:2 NRHO, 215 km at apolune")
-table.add("MMD (Eq. 23 read as the eigenvector) = brute-force maximiser of its surrogate",
+table.add_typed("MMD (Eq. 23 read as the eigenvector) = brute-force maximiser of its surrogate",
           "u_y = +/- upsilon max(eig(Q)) (Eq. 23)",
           f"{ang_quad:.2f} deg (u^T Q u) / {ang_dev:.2f} deg (nonlinear angle change)", "derived",
           f"12-h coast, {N_GRID}-direction sphere (spacing {spacing_deg:.1f} deg); Eq. 23 as printed is the eigenvalue "
           "(a scalar); the text ('solution to an eigen-problem') means the unit eigenvector of that eigenvalue")
 in_plane_h = r1.coast_hours[r1.optimum_perp_angle_deg <= 5.0]
 off_plane_small = np.max(r0.optimum_perp_angle_deg[r0.coast_hours <= perp_ok_h[DV_M_S[0]]])
-table.add("Ref. [8]: perpendicular-to-LOS set contains the optimum (tested at the shortest coast)",
+table.add_typed("Ref. [8]: perpendicular-to-LOS set contains the optimum (tested at the shortest coast)",
           "stated", f"best on circle {r1.perp_best[short]:.2f} vs optimum {r1.optimum[short]:.2f} km "
           f"({r1.coast_hours[short]:.0f} h, {DV_M_S[-1]} m/s)",
           "reproduced" if r1.perp_best[short] <= 1.02 * r1.optimum[short] else "differs: see note",
@@ -607,7 +608,7 @@ table.add("Ref. [8]: perpendicular-to-LOS set contains the optimum (tested at th
           f"sight ({'towards' if towards12 else 'away from'} the target). At {DV_M_S[0]} m/s the 2 % is met up to "
           f"{perp_ok_h[DV_M_S[0]]:.0f} h with the optimum up to {off_plane_small:.0f} "
           "deg out of the plane: the cost hardly depends on a burn that small")
-table.add("MMD near-optimal, burn at the start of tracking (first pair; excess over the true minimiser)",
+table.add_typed("MMD near-optimal, burn at the start of tracking (first pair; excess over the true minimiser)",
           "'nearly optimal'",
           f"{r1.mmd_excess_percent.min():.0f}-{r1.mmd_excess_percent.max():.0f} % ({DV_M_S[-1]} m/s); "
           f"{r0.mmd_excess_percent.min():.0f}-{r0.mmd_excess_percent.max():.0f} % ({DV_M_S[0]} m/s)",
@@ -618,7 +619,7 @@ table.add("MMD near-optimal, burn at the start of tracking (first pair; excess o
           f"{DV_M_S[0]} m/s the 5 % is met but is no test: doing nothing is itself within "
           f"{np.max(100 * (r0.none / r0.optimum - 1)):.0f} % of the optimum and MMD captures only "
           f"{r0.mmd_gain_fraction.min() + 0.0:.2f}-{r0.mmd_gain_fraction.max() + 0.0:.2f} of the possible gain")
-table.add(f"MMD near-optimal, burn at the start of tracking, agent on the 215-km QPO ({len(pairs)} ring angles "
+table.add_typed(f"MMD near-optimal, burn at the start of tracking, agent on the 215-km QPO ({len(pairs)} ring angles "
           f"{', '.join(f'{a:g}' for a in RING_ANGLES_DEG)} deg, {DV_M_S[-1]} m/s)",
           "'nearly optimal'",
           f"median excess {np.median(exc_all):.0f} %, median percentile {np.median(pct_all):.0f} %",
@@ -636,7 +637,7 @@ tuned_why = (f"tolerance fixed before comparing: within 5 % of the optimum; noth
              f"start-of-tracking comparison missed the paper's 'nearly optimal', a choice made while looking at the "
              f"paper's claim, hence not 'reproduced'")
 if n_ok:
-    table.add(f"{pre_label}, coasts <= {ok_coast:.0f} h", "'nearly optimal'",
+    table.add_typed(f"{pre_label}, coasts <= {ok_coast:.0f} h", "'nearly optimal'",
               f"excess {pre_exc[:n_ok].min():.0f}-{pre_exc[:n_ok].max():.0f} %, percentile "
               f"{pre_pct[:n_ok].min():.1f}-{pre_pct[:n_ok].max():.1f} %", "consistent (tuned)",
               f"{tuned_why}. Not specific to the 24-h arc: with {', '.join(f'{h:g}' for h in PRE_ARC_SWEEP_H)} h of "
@@ -646,7 +647,7 @@ if n_ok:
 if n_ok < pre_h.size:
     rest = slice(n_ok, None)
     bad = pre_exc[rest] > 5.0
-    table.add(f"{pre_label}, coasts {pre_h[rest][0]:.0f}-{pre_h[rest][-1]:.0f} h", "'nearly optimal'",
+    table.add_typed(f"{pre_label}, coasts {pre_h[rest][0]:.0f}-{pre_h[rest][-1]:.0f} h", "'nearly optimal'",
               f"excess {pre_exc[rest].min():.0f}-{pre_exc[rest].max():.0f} %, percentile "
               f"{pre_pct[rest].min():.1f}-{pre_pct[rest].max():.1f} %",
               (f"differs: excess {pre_exc[rest][bad].min():.0f}-{pre_exc[rest][bad].max():.0f} %" if bad.any()
@@ -660,10 +661,10 @@ if n_ok < pre_h.size:
               f"{max(sweep_ok_h.values()):.0f} h, worst excess "
               f"{min(r.mmd_excess_percent.max() for r in pre_sweep.values()):.0f}-"
               f"{max(r.mmd_excess_percent.max() for r in pre_sweep.values()):.0f} %) and geometry (QPO row)")
-table.add("+/- sign choice by quick covariance analysis", "needed",
+table.add_typed("+/- sign choice by quick covariance analysis", "needed",
           "; ".join(f"rejected sign worse by {sign_pct[dv].min():.1f}-{sign_pct[dv].max():.1f} % ({dv} m/s)"
                     for dv in DV_M_S[::-1]), "beyond paper", "first pair, burn at the start of tracking, all coasts")
-table.add("computation time: true minimiser / MMD (Sec. 4.1: 'exponentially faster')", "no number",
+table.add_typed("computation time: true minimiser / MMD (Sec. 4.1: 'exponentially faster')", "no number",
           f"{ratio_core:.1e} (Eq. 24 + eigenvector), {ratio_policy:.0f} (full MMD policy)", "beyond paper",
           f"12-h coast, {DV_M_S[-1]} m/s, this machine: {t_opt:.2f} s ({N_GRID}-direction sphere + Nelder-Mead) vs "
           f"{t_mmd_core * 1e6:.0f} us (best of 200) / {t_mmd_policy * 1e3:.1f} ms with propagation and sign check "

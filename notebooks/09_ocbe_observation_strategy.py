@@ -50,10 +50,14 @@ import matplotlib.pyplot as plt
 import numpy as np
 from scipy import stats
 
-from cislunar import measurements, ocbe, orbits, plotting, tracking
-from cislunar.dynamics import EARTH_MOON as em
-from cislunar.montecarlo import run_monte_carlo
-from cislunar.report import ComparisonTable
+from cislunar.cr3bp import orbits
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.estimation import consistency, ocbe
+from cislunar.papers.greaves_scheeres_2021 import tracking
+from cislunar.publish import plotting
+from cislunar.publish.report import ComparisonTable
+from cislunar.sensing import measurements
+from cislunar.utils.montecarlo import run_monte_carlo
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -93,7 +97,7 @@ for name, o in ORBITS.items():
 # 57(4), 2020. The 2021 paper says its noise matches "previous studies ... aimed at autonomous optical
 # navigation"; its reference list is not in our copy of the text, so we cannot confirm it is the same study. We
 # use 10 µrad for the angles and, by Eq. 13, 14.1 µrad/s for the rates; Section 4 also varies it.
-# The Jacobians are analytic (`cislunar.measurements`, tested against finite differences).
+# The Jacobians are analytic (`cislunar.sensing.measurements`, tested against finite differences).
 
 # %%
 R_rates = tracking.angles_rates_covariance(em)
@@ -161,7 +165,7 @@ print(f"largest |rate| {rate_uas.max():.1f} urad/s at day {days[k_peri]:.2f} = {
 # $\begin{bmatrix} S_q & 0 & 0\\ -S_x\Phi_{xx}^{-1} & S_x\Phi_{xx}^{-1} & 0\end{bmatrix}$, the measurement update
 # (Eqs. 24-28) triangularises $\begin{bmatrix}S_x & b_x\\ S_y^{-1}H & S_y^{-1}\delta y\end{bmatrix}$, and a
 # single-step smoother (Eqs. 29-30) gives the costate $\mathbf p_{n|n+1} = -P_{n|n}^{-1}(\mathbf x_{n|n+1}-
-# \mathbf x_{n|n})$ (Eq. 31) and the control estimate (Eq. 32). `cislunar.ocbe.ocbe_filter_smoother` implements
+# \mathbf x_{n|n})$ (Eq. 31) and the control estimate (Eq. 32). `cislunar.estimation.ocbe.ocbe_filter_smoother` implements
 # exactly this; its tests show that it equals a covariance-form EKF whose $Q$ is computed independently (Lyapunov
 # equation), that the full SRI smoother equals the Rauch-Tung-Striebel smoother, and that
 # $Q = -\Phi_{xp}\Phi_{xx}^\top$ equals the exact discretisation of white-noise acceleration of density
@@ -623,8 +627,8 @@ def show_divergence(cell, name, what):
     fig, axes = plt.subplots(3, 1, figsize=(8, 7.5), sharex=True)
     error_panels(axes[0], axes[1], scn.t, run_.x_filt, run_.P_filt, truth_, "forward filter")
     axes[1].set_xlabel("")
-    axes[2].semilogy(em.tu_to_days(scn.t), tracking.nees(run_.x_filt, run_.P_filt, truth_), color="C0", label="NEES")
-    axes[2].axhline(stats.chi2.ppf(tracking.NEES_PROBABILITY, 6), color="C1", ls="--",
+    axes[2].semilogy(em.tu_to_days(scn.t), consistency.nees(run_.x_filt, run_.P_filt, truth_), color="C0", label="NEES")
+    axes[2].axhline(stats.chi2.ppf(consistency.NEES_PROBABILITY, 6), color="C1", ls="--",
                     label=r"99.9 % quantile of $\chi^2_6$")
     axes[2].set(ylabel="NEES [-]", xlabel="time since apoapsis [d]")
     for ax in axes:
@@ -740,17 +744,17 @@ status = ("reproduced" if len(cells) == n_cells else
           "differs: in no (orbit, cadence) cell did most angles-only runs diverge" if not cells else
           "differs: most runs diverged only in some angles-only cells")
 span = f"{cadence_label(min(CADENCES_H))}-{cadence_label(max(CADENCES_H))} cadence"
-table.add(f"angles only, L2, {span}", "diverges at every cadence, both orbits",
+table.add_typed(f"angles only, L2, {span}", "diverges at every cadence, both orbits",
           f"most runs diverged in {len(cells)} of {n_cells} cells; cells above 10% inconsistent runs: "
           + ("; ".join(f"{n} {c:g} h: {100 * d:.0f}%" for n, c, d in flagged_angles) or "none"), status,
           "same 10% flag as the angles + rates row; 10 urad angles (Table 3 missing); other noise levels, cadences "
           "and hand-offs in Section 4 and the regime map (Section 5b)")
 for sig, row in noisier.items():
-    table.add(f"angles only, 9:2 NRHO, 12 h, {sig * 1e6:g} urad", "diverges at every cadence (at its unstated noise)",
+    table.add_typed(f"angles only, 9:2 NRHO, 12 h, {sig * 1e6:g} urad", "diverges at every cadence (at its unstated noise)",
               f"{100 * row[2]:.0f}% diverged",
               "reproduced" if row[2] > 0.5 else "differs: consistent in our runs",
               "noise level varied (Table 3 missing)")
-table.add("angles only, five observers hourly, noise and hand-off / 10 (Fig. 4)", "diverges",
+table.add_typed("angles only, five observers hourly, noise and hand-off / 10 (Fig. 4)", "diverges",
           f"{100 * row_five[2]:.0f}% diverged, NEES {row_five[3]:.1f}",
           "reproduced" if row_five[2] > 0.5 else "differs: consistent in our runs", "1 urad, hand-off 3 sigma 1 km")
 flagged_rates = flagged_cells(rows_rates)
@@ -758,7 +762,7 @@ n_runs_rates = sum(len(v) for v in with_rates.values())
 frac_rates = np.mean([r.diverged for v in with_rates.values() for r in v])
 flagged_orbits_rates = sorted({n for n, _, _ in flagged_rates})
 clean_orbits = [n for n in ORBITS if n not in flagged_orbits_rates]
-table.add(f"angles and rates, L2, {span}", "consistent at every cadence, both orbits",
+table.add_typed(f"angles and rates, L2, {span}", "consistent at every cadence, both orbits",
           f"{100 * frac_rates:.1f}% of {n_runs_rates} runs inconsistent",
           "reproduced" if not flagged_rates else
           ("differs: many inconsistent runs only on the inner-band stable NRHO, the candidate judged unlike the "
@@ -768,18 +772,18 @@ table.add(f"angles and rates, L2, {span}", "consistent at every cadence, both or
            "differs: some cadences have many inconsistent runs on " + ", ".join(flagged_orbits_rates)),
           "cells above 10% inconsistent runs: "
           + ("; ".join(f"{n} {c:g} h: {100 * d:.0f}%" for n, c, d in flagged_rates) or "none"))
-table.add("typical 2-hour run (Fig. 5)", "errors within 3 sigma, forward and smoothed",
+table.add_typed("typical 2-hour run (Fig. 5)", "errors within 3 sigma, forward and smoothed",
           f"mean NEES forward {typical.nees_mean:.1f}, smoothed {typical_s.nees_mean:.1f}; epochs over 99.9 %: "
           f"{100 * typical.inconsistent_fraction:.1f} % / {100 * typical_s.inconsistent_fraction:.1f} %",
           "reproduced" if not (typical.diverged or typical_s.diverged) else "differs: the typical run is inconsistent",
           "one run; criterion: at most 5 % of epochs above the NEES 99.9 % quantile in both passes (Section 3)")
 for cad in sorted(r92):
-    table.add(f"Table 4: final 3-sigma position / velocity, {cadence_label(cad)}", "Table 4 missing",
+    table.add_typed(f"Table 4: final 3-sigma position / velocity, {cadence_label(cad)}", "Table 4 missing",
               f"9:2 {r92[cad][4]:.3g} km / {r92[cad][5]:.3g} m/s; stable inner band {rst[cad][4]:.3g} km / "
               f"{rst[cad][5]:.3g} m/s; stable outer band {rso[cad][4]:.3g} km / {rso[cad][5]:.3g} m/s",
               "not in paper", "median over runs; angles + rates from L2")
 n_contrast = {m: len(v) for m, v in contrast.items()}
-table.add("Regime where angles only diverge but angles + rates stay consistent", "every cadence at its stated set-up",
+table.add_typed("Regime where angles only diverge but angles + rates stay consistent", "every cadence at its stated set-up",
           "; ".join(f"{m}: {n} of {len(map_cells)} cells" for m, n in n_contrast.items()),
           ("differs: no cell shows the contrast, with the paper's 1-s rates"
            + (" or with informative (dt = 1 TU) rates" if len(model_names) > 2 else "")
@@ -794,7 +798,7 @@ table.add("Regime where angles only diverge but angles + rates stay consistent",
 for o in ORBITS:
     ons = [v for (o_, c, sg), v in onset.items() if o_ == o and v is not None]
     at_paper = [regime[o, c, sg, "angles", paper_h] for c in CADENCE_MAP for sg in SIGMA_MAP]
-    table.add(f"{o}: hand-off at which most angles-only runs diverge", "10 km (the stated hand-off)",
+    table.add_typed(f"{o}: hand-off at which most angles-only runs diverge", "10 km (the stated hand-off)",
               (f"from {min(ons):g} km" if ons else f"none up to {10 * max(HANDOFF_MAP):g} km")
               + f"; at 10 km {pct_span(at_paper)} of runs diverge",
               "reproduced" if min(at_paper) > 0.5 else
@@ -802,7 +806,7 @@ for o in ORBITS:
               "differs: at 10 km most runs diverge only in some (noise, cadence) cells",
               f"smallest hand-off over noise {'/'.join(f'{sg * 1e6:g}' for sg in SIGMA_MAP)} urad and cadence "
               f"{'/'.join(f'{c:g}' for c in CADENCE_MAP)} h; criterion: most runs diverged (> 50 %)")
-table.add("stable NRHO (outer stable band) better determined than the 9:2",
+table.add_typed("stable NRHO (outer stable band) better determined than the 9:2",
           "qualitatively similar, quantitatively better",
           f"smaller final sigma at {100 * better_outer:.0f}% of cadences (ratio {min(ratio_outer):.2f}-"
           f"{max(ratio_outer):.2f}; perilune {outer.perilune_radius_km:.0f} km)",
@@ -811,14 +815,14 @@ table.add("stable NRHO (outer stable band) better determined than the 9:2",
           "this remark, so agreement is not an independent prediction")
 for name, key in (("inner band edge", "stable NRHO (inner band)"), ("outer band", "stable NRHO (outer band)")):
     ok = incons[key] <= 0.10
-    table.add(f"stable NRHO ({name}): angles + rates consistent at {'-'.join(f'{c:g}' for c in long_gap)} h",
+    table.add_typed(f"stable NRHO ({name}): angles + rates consistent at {'-'.join(f'{c:g}' for c in long_gap)} h",
               "consistent at every cadence", f"{100 * incons[key]:.0f} % of runs inconsistent (9:2 NRHO: "
               f"{100 * incons['9:2 NRHO']:.0f} %)",
               ("consistent (tuned)" if "outer" in name else "reproduced") if ok else
               "differs: many inconsistent runs at the long cadences",
               "criterion fixed in advance: at most 10 % inconsistent runs (notebook 09's flag)"
               + ("; the outer band was singled out because it fits this remark" if "outer" in name else ""))
-table.add("stable NRHO (inner band edge) better determined than the 9:2",
+table.add_typed("stable NRHO (inner band edge) better determined than the 9:2",
           "qualitatively similar, quantitatively better",
           f"smaller final sigma at {100 * better:.0f}% of cadences",
           "reproduced" if better >= 0.5 else "differs: the 9:2 NRHO is better determined here",

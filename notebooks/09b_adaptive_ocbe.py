@@ -23,9 +23,9 @@
 # **Paper sections followed.** J. A. Greaves, D. J. Scheeres, *Observation and Maneuver Detection for Cislunar
 # Vehicles*, JAS 68 (2021), "Filter Tuning Strategy: Adaptive OCBE Tuning" (Figs. 6-9), with the metric of D. P.
 # Lubey, D. J. Scheeres, JGCD 37(5), 2014 and Lubey's thesis (2015). The OCBE itself (Eqs. 14-32) is
-# `cislunar.ocbe` (notebook 09); the adaptive logic is `cislunar.adaptive_ocbe`; the scenario (L2 observer,
+# `cislunar.estimation.ocbe` (notebook 09); the adaptive logic is `cislunar.estimation.adaptive_ocbe`; the scenario (L2 observer,
 # angles and angle rates every 2 hours, Earth-radar hand-off at periapsis, burn at apoapsis) is
-# `cislunar.tracking` / `cislunar.detection` (notebook 10).
+# `cislunar.papers.greaves_scheeres_2021.tracking` / `cislunar.papers.greaves_scheeres_2021.detection` (notebook 10).
 
 # %% tags=["parameters"]
 QUICK = False
@@ -48,11 +48,15 @@ import matplotlib.pyplot as plt
 import numpy as np
 from scipy import stats
 
-from cislunar import adaptive_ocbe as ad
-from cislunar import detection as det
-from cislunar import ocbe, orbits, plotting, tracking
-from cislunar.dynamics import EARTH_MOON as em
-from cislunar.report import ComparisonTable
+from cislunar.cr3bp import orbits
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.estimation import adaptive_ocbe as ad
+from cislunar.estimation import consistency, ocbe
+from cislunar.papers.greaves_scheeres_2021 import detection as det
+from cislunar.papers.greaves_scheeres_2021 import panels as ocbe_panels
+from cislunar.papers.greaves_scheeres_2021 import tracking
+from cislunar.publish import plotting
+from cislunar.publish.report import ComparisonTable
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -96,7 +100,7 @@ print(f"9:2 NRHO, period {nrho.period_days:.3f} d; {sc.t.size} epochs every {sc.
 # and 9 is $M/13.28$ and its mean line sits at 0.30. Three consecutive exceedances have probability $10^{-6}$ per
 # epoch: over the 79 epochs of one period a false reset has probability below $10^{-4}$.
 #
-# `tests/test_adaptive_ocbe.py` checks the three-term identity and the $\chi^2_m$ law exactly on linear systems
+# `tests/estimation/test_adaptive_ocbe.py` checks the three-term identity and the $\chi^2_m$ law exactly on linear systems
 # (Kolmogorov-Smirnov, with power against $\chi^2_{m\pm1}$). Here we check it on the nonlinear NRHO scenario
 # without a maneuver (batched OCBE, ballistic tuning).
 
@@ -110,7 +114,7 @@ law = ad.metric_law(4)
 ks_p = stats.kstest(pooled, law.cdf).pvalue
 exceed = np.mean(pooled > ad.metric_limit(4))
 n_resets_null = sum(len(d) for d in dets0)
-nees0 = np.array([tracking.nees(res0.x_filt[b], res0.P_filt[b], draws[b].truth) for b in range(N_NULL)])
+nees0 = np.array([consistency.nees(res0.x_filt[b], res0.P_filt[b], draws[b].truth) for b in range(N_NULL)])
 fig, ax = plt.subplots(1, 2, figsize=(11, 3.8))
 xx = np.linspace(0, 20, 300)
 ax[0].hist(pooled, bins=40, range=(0, 20), density=True, alpha=0.6, histtype="stepfilled",
@@ -128,10 +132,10 @@ _ = plotting.save_figure(fig, "09b_metric_law", output_dir=out)
 print(f"pooled metric: mean {pooled.mean():.2f} (law 4, s.e. {np.sqrt(8 / pooled.size):.2f}), "
       f"exceeds the 99 % limit at {100 * exceed:.1f} % of epochs, KS p = {ks_p:.2f}; resets: {n_resets_null}; "
       f"mean NEES {nees0.mean():.2f} (6 if consistent)")
-table.add("OCBE metric law without mismodelling", "statistical metric, limit 99 % (law not stated)",
+table.add_typed("OCBE metric law without mismodelling", "statistical metric, limit 99 % (law not stated)",
           f"chi2_4: mean {pooled.mean():.2f}, KS p = {ks_p:.2f}, {100 * exceed:.1f} % above the limit", "derived",
           "least-squares minimum = whitened SRI innovation; exact on linear systems (tests)")
-_ = table.add("Adaptive filter without a maneuver", "not stated (implied by the 99 % limit and three strikes)",
+_ = table.add_typed("Adaptive filter without a maneuver", "not stated (implied by the 99 % limit and three strikes)",
           f"{n_resets_null} resets in {N_NULL} runs", "derived" if n_resets_null == 0 else "differs: false resets",
           "derived false-reset probability < 1e-4 per track")
 
@@ -166,7 +170,7 @@ print("rate noise / state-driven spread: az-rate 10^%.1f, el-rate 10^%.1f" % tup
 # whitened noise alone exceeds the mean 4 (for two $\chi^2_1$ components, probability $e^{-2} = 13.5$ %), no
 # reasonable $\alpha$ brings $M_k$ to 4 and the rule drives $\alpha$ up by many orders of magnitude (a velocity
 # uncertainty of km/s), after which the linearised filter diverges through a chain of further resets.
-# `cislunar.adaptive_ocbe` therefore also offers `reset="likelihood"`: the $\alpha$ that maximises the Gaussian
+# `cislunar.estimation.adaptive_ocbe` therefore also offers `reset="likelihood"`: the $\alpha$ that maximises the Gaussian
 # likelihood of the innovation (covariance matching), which inflates only as far as the explainable part of the
 # innovation asks. Figs. 6-9 use the paper's rule; Section 4 compares the two.
 
@@ -177,14 +181,14 @@ def run_adaptive(inputs, reset="mean", smooth=True):
 
 
 def panels_of(a, inputs):
-    """The Figs. 6-9 panel series of an adaptive run (cislunar.adaptive_ocbe.panel_series)."""
-    return ad.panel_series(em, a.result, inputs.truth, a.control_weight, inputs.y, setup.observer_states, sc.model,
+    """The Figs. 6-9 panel series of an adaptive run (cislunar.papers.greaves_scheeres_2021.panels.panel_series)."""
+    return ocbe_panels.panel_series(em, a.result, inputs.truth, a.control_weight, inputs.y, setup.observer_states, sc.model,
                            sc.meas_cov)
 
 
 def error_panels(a, panels, title):
     """Fig. 6/8 layout: position (top) and velocity (bottom) error norms and 3-sigma, forward (left), smoothed."""
-    return ad.figure_errors(panels, title, burn_days=setup.t_maneuver / DAY,
+    return ocbe_panels.figure_errors(panels, title, burn_days=setup.t_maneuver / DAY,
                             detection_days=[d.time / DAY for d in a.detections])
 
 
@@ -192,7 +196,7 @@ def control_metric_panels(a, panels, title):
     """Fig. 7/9 layout: control norm (top) and normalised metric (bottom), forward (left) and smoothed (right);
     crosses: what the online filter saw before the first reset (its three strikes)."""
     first = a.detections[0].declared_epoch if a.detections else None
-    return ad.figure_control_metric(panels, title, burn_days=setup.t_maneuver / DAY,
+    return ocbe_panels.figure_control_metric(panels, title, burn_days=setup.t_maneuver / DAY,
                                     detection_days=[d.time / DAY for d in a.detections],
                                     first_pass_metric=a.metric_first_pass if a.detections else None,
                                     first_pass_until=first)
@@ -200,9 +204,9 @@ def control_metric_panels(a, panels, title):
 
 def describe(a, inputs):
     r = a.result
-    nf = tracking.nees(r.x_filt, r.P_filt, inputs.truth)
-    ns = tracking.nees(r.x_smooth, r.P_smooth, inputs.truth)
-    lim = stats.chi2.ppf(tracking.NEES_PROBABILITY, 6)
+    nf = consistency.nees(r.x_filt, r.P_filt, inputs.truth)
+    ns = consistency.nees(r.x_smooth, r.P_smooth, inputs.truth)
+    lim = stats.chi2.ppf(consistency.NEES_PROBABILITY, 6)
     return dict(nees_f_after=float(np.mean(nf[k_burn:] > lim)), nees_s=float(np.mean(ns > lim)),
                 err_final_km=float(np.linalg.norm(r.x_filt[-1, :3] - inputs.truth[-1, :3]) * L_KM))
 
@@ -273,8 +277,8 @@ _ = plotting.save_figure(control_metric_panels(a_small, p_small, "50 mm/s"), "09
 # %%
 a_small_ml = run_adaptive(small, reset="likelihood")
 d_small_ml = describe(a_small_ml, small)
-lim_nees = stats.chi2.ppf(tracking.NEES_PROBABILITY, 6)
-final_nees = {rule: float(tracking.nees(a_.result.x_filt[-1], a_.result.P_filt[-1], small.truth[-1]))
+lim_nees = stats.chi2.ppf(consistency.NEES_PROBABILITY, 6)
+final_nees = {rule: float(consistency.nees(a_.result.x_filt[-1], a_.result.P_filt[-1], small.truth[-1]))
               for rule, a_ in (("mean", a_small), ("likelihood", a_small_ml))}
 for rule, a_ in (("mean", a_small), ("likelihood", a_small_ml)):
     print(f"{rule:10s} rule: resets at epochs {[d.epoch for d in a_.detections]}, factors "
@@ -427,7 +431,7 @@ _ = plotting.save_figure(fig, "09b_adaptive_delay_vs_burn", output_dir=out)
 
 # %%
 rows = []
-lim_nees = stats.chi2.ppf(tracking.NEES_PROBABILITY, 6)
+lim_nees = stats.chi2.ppf(consistency.NEES_PROBABILITY, 6)
 t_mc = time.perf_counter()
 for mag in MAGNITUDES_M_S:
     for i in range(N_PER_MAGNITUDE):
@@ -438,7 +442,7 @@ for mag in MAGNITUDES_M_S:
             except (ad.ResetError, ocbe.FilterDivergenceError):
                 rows.append((mag, rule, True, 1.0, True, MAX_RESETS + 1, False))
                 continue
-            nf = tracking.nees(a.result.x_filt, a.result.P_filt, inputs.truth)
+            nf = consistency.nees(a.result.x_filt, a.result.P_filt, inputs.truth)
             frac = float(np.mean(nf[k_burn:] > lim_nees))
             rows.append((mag, rule, bool(a.detections), frac, frac > tracking.DIVERGED_FRACTION, len(a.detections),
                          bool(nf[-1] < lim_nees)))
@@ -526,11 +530,11 @@ print(f"{'/'.join(f'{m:g}' for m in large)} m/s, paper's rule: {len(bad_large)} 
 # Criteria below were fixed before the comparison: "prompt" and "nearly periapsis" as defined in Section 5, the
 # 10 % flag of notebook 09 for consistency, and "most runs" for the paper's single-run statements.
 o_small = by_size[MAGNITUDES_M_S[0]]
-table.add("3 m/s burn (Fig. 6 run): detected promptly (within two epochs of the burn)", "detected, uncertainty raised at the burn (Fig. 6)",
+table.add_typed("3 m/s burn (Fig. 6 run): detected promptly (within two epochs of the burn)", "detected, uncertainty raised at the burn (Fig. 6)",
           f"epoch +{first.epoch - k_burn}" if first else "not detected",
           "reproduced" if first is not None and first.epoch - k_burn <= 2 else "differs: late or no detection",
           "criterion: dated within two epochs of the first epoch that sees the burn")
-table.add("3 m/s burn (Fig. 6 run): forward filter consistent after the reset", "consistent (Fig. 6)",
+table.add_typed("3 m/s burn (Fig. 6 run): forward filter consistent after the reset", "consistent (Fig. 6)",
           f"{100 * d_big['nees_f_after']:.0f} % of epochs above NEES 99.9 %",
           "reproduced" if d_big["nees_f_after"] <= tracking.DIVERGED_FRACTION else "differs: inconsistent",
           "criterion: at most 5 % of epochs above the quantile (notebook 09's divergence test)")
@@ -538,7 +542,7 @@ o_large = [by_size[m] for m in large]
 n_large = sum(o["n"] for o in o_large)
 prompt_large = sum(o["prompt"] * o["n"] for o in o_large) / n_large
 sizes = "/".join(f"{m:g}" for m in large)
-table.add(f"Burns of {sizes} m/s detected at once", "'near optimal' above 1 m/s",
+table.add_typed(f"Burns of {sizes} m/s detected at once", "'near optimal' above 1 m/s",
           f"prompt in {100 * prompt_large:.1f} % of {n_large} runs ("
           + ", ".join(f"{m:g} m/s {100 * o['prompt']:.1f} %" for m, o in zip(large, o_large)) + ")",
           "reproduced" if prompt_large >= 0.95 else "differs: some large burns are detected late",
@@ -547,7 +551,7 @@ s_large = {rule: [summary(m, rule) for m in large] for rule in ad.RESET_RULES}
 incons_large = {rule: sum(x["inconsistent"] * x["n"] for x in v) / sum(x["n"] for x in v)
                 for rule, v in s_large.items()}
 n_rules_large = sum(x["n"] for x in s_large["mean"])
-table.add(f"Burns of {sizes} m/s: filter consistent after the reset", "'near optimal' above 1 m/s",
+table.add_typed(f"Burns of {sizes} m/s: filter consistent after the reset", "'near optimal' above 1 m/s",
           f"{100 * incons_large['mean']:.0f} % of {n_rules_large} runs inconsistent after the burn ("
           + ", ".join(f"{m:g} m/s {100 * x['inconsistent']:.0f} %" for m, x in zip(large, s_large["mean"]))
           + f"); likelihood rule {100 * incons_large['likelihood']:.0f} %",
@@ -558,25 +562,25 @@ table.add(f"Burns of {sizes} m/s: filter consistent after the reset", "'near opt
           f"weight on one interval; of the {len(bad_large)} inconsistent runs {chained_large} went through a chain of "
           "resets (measured); for the others a likely cause, not measured: a reset sized on a first innovation that "
           "barely shows the burn")
-table.add("50 mm/s burn: detection late (Figs. 8-9)", "late",
+table.add_typed("50 mm/s burn: detection late (Figs. 8-9)", "late",
           f"prompt in {100 * o_small['prompt']:.0f} % of {o_small['n']} runs; median delay of the detected "
           f"{o_small['median_h']:.0f} h; {100 * o_small['undetected']:.0f} % not detected in the period",
           "reproduced" if o_small["prompt"] < 0.5 else "differs: most runs detected promptly",
           "criterion: most runs not prompt; 10 urad angles")
-table.add("50 mm/s burn: detected 'nearly periapsis' (Fig. 8 caption)", "nearly periapsis (one run)",
+table.add_typed("50 mm/s burn: detected 'nearly periapsis' (Fig. 8 caption)", "nearly periapsis (one run)",
           f"{100 * o_small['near']:.0f} % of runs at 10 urad; at most {100 * by_noise[best_noise]['near']:.0f} % over "
           f"{min(NOISE_SWEEP_URAD):g}-{max(NOISE_SWEEP_URAD):g} urad (at {best_noise:g} urad)",
           "reproduced" if o_small["near"] > 0.5 else
           "differs: a possible but not the typical outcome at any angle noise",
           "criterion: most runs detected in the last quarter of the coast (within T/8 of periapsis); more noise "
           "turns late detections into misses")
-table.add("50 mm/s: filter re-converges after the late detection (Fig. 8)", "re-converges",
+table.add_typed("50 mm/s: filter re-converges after the late detection (Fig. 8)", "re-converges",
           f"final NEES consistent in {100 * s_small['final_ok']:.0f} % of {s_small['n_detected']} detected runs "
           f"(likelihood rule {100 * s_small_ml['final_ok']:.0f} %)",
           "reproduced" if s_small["final_ok"] >= 0.9 else
           "differs: after a late detection the filter often stays inconsistent",
           "criterion: at least 90 % of detected runs end with NEES below its 99.9 % quantile (paper's rule)")
-table.add("Filter inconsistent while a small burn is undetected", "implied (reason to move to windowed tuning)",
+table.add_typed("Filter inconsistent while a small burn is undetected", "implied (reason to move to windowed tuning)",
           "runs inconsistent after the burn: "
           + "; ".join(f"{m * 1e3:g} mm/s {100 * summary(m, 'mean')['inconsistent']:.0f} %"
                       for m in MAGNITUDES_M_S if m < 1.0), "derived", "NEES criterion of notebook 09")
@@ -585,11 +589,11 @@ chain = {rule: (sum(summary(m, rule)["chains"] for m in MAGNITUDES_M_S),
 print("detected runs needing more than one reset (a divergence chain): "
       + ", ".join(f"{r} rule {c[0]}/{c[1]} ({100 * c[0] / max(c[1], 1):.0f} %)" for r, c in chain.items())
       + f"; Section 2's mechanism predicts about {100 * np.exp(-2):.1f} % for the paper's (mean) rule")
-table.add("Reset rule 'metric equal to its mean' breaks when rate noise exceeds it", "not discussed",
+table.add_typed("Reset rule 'metric equal to its mean' breaks when rate noise exceeds it", "not discussed",
           "detected runs with a chain of resets: " + ", ".join(f"{r} rule {c[0]}/{c[1]}" for r, c in chain.items()),
           "beyond paper", "angle rates carry no state information here, so their noise exceeds the mean with "
           "probability e^-2 per detection (derived, Section 2); chains counted, their cause not isolated run by run")
-table.add("Base (ballistic) control weight", "not given", f"{Q_BASE_KM2_S3:g} km^2/s^3", "not in paper",
+table.add_typed("Base (ballistic) control weight", "not given", f"{Q_BASE_KM2_S3:g} km^2/s^3", "not in paper",
           "our choice: notebook 10's q outside the apoapsis window; the law of the metric does not depend on it")
 print(f"notebook wall time: {(time.perf_counter() - T_START) / 60:.1f} min")
 table.display()

@@ -23,13 +23,13 @@
 # **Paper sections followed.** J. A. Greaves, D. J. Scheeres, *Observation and Maneuver Detection for Cislunar
 # Vehicles*, JAS 68 (2021): "Modeling Definitions" (Eqs. 3-5, Table 2), "Filter Tuning Strategy" (Figs. 10-13),
 # "Maneuver Detection" (Eqs. 33-35, Figs. 14-21, Tables 5-8) and "Control as a Health Metric" (Fig. 22). The OCBE
-# itself (Eqs. 14-32) is `cislunar.ocbe`; the tracking scenario (L2 observer, angles and angle rates every 2 hours,
-# Earth-radar hand-off at periapsis) is `cislunar.tracking`; everything specific to detection is
-# `cislunar.detection`.
+# itself (Eqs. 14-32) is `cislunar.estimation.ocbe`; the tracking scenario (L2 observer, angles and angle rates every 2 hours,
+# Earth-radar hand-off at periapsis) is `cislunar.papers.greaves_scheeres_2021.tracking`; everything specific to detection is
+# `cislunar.papers.greaves_scheeres_2021.detection`.
 #
 # **What the paper does not give.** Tables 1-8 are missing from its text: in particular the measurement noise
 # (Table 3) and the OCBE tuning values. We use 10 micro-rad angles (1 sigma) with Eq. 13 rates from 1 s
-# differencing (see `cislunar.tracking`). The tuning is the one input every number of this notebook depends on, so
+# differencing (see `cislunar.papers.greaves_scheeres_2021.tracking`). The tuning is the one input every number of this notebook depends on, so
 # Section 2 maps it (window weight, angle noise, window length, base weight) and reads it in two ways: from the
 # paper's *consistency* claim (an independent prediction of everything else) and from the paper's *thresholds*
 # (a tuned reading). Both are carried through and the closing table says which rows rest on which.
@@ -61,17 +61,23 @@ N_BOOT = 4 if QUICK else 40  # bootstrap resamples for the standard errors of z_
 BATCH = 8  # trials that the batched OCBE filters together, epoch by epoch
 WORKERS = 1 if QUICK else 2  # processes for the Monte Carlo
 
-import time
 import multiprocessing as mp
+import time
 from concurrent.futures import ProcessPoolExecutor
 
-import numpy as np
 import matplotlib.pyplot as plt
+import numpy as np
 from scipy import stats
 
-from cislunar import adaptive_ocbe as ad, detection as det, orbits, plotting, tracking
-from cislunar.dynamics import EARTH_MOON as em
-from cislunar.report import ComparisonTable
+from cislunar.cr3bp import orbits
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.estimation import adaptive_ocbe as ad
+from cislunar.estimation import consistency
+from cislunar.papers.greaves_scheeres_2021 import detection as det
+from cislunar.papers.greaves_scheeres_2021 import panels as ocbe_panels
+from cislunar.papers.greaves_scheeres_2021 import tracking
+from cislunar.publish import plotting
+from cislunar.publish.report import ComparisonTable
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -136,9 +142,9 @@ ks_sphere = stats.kstest(uz, stats.uniform(-1, 2).cdf).pvalue
 ks_txt = f"= {ks_sphere:.1e}" if ks_sphere > 0 else "< 1e-300"  # below the smallest double: printed as a bound
 print(f"KS test of u_z against a uniform sphere: p {ks_txt}; against arcsine: "
       f"p = {stats.kstest(uz, stats.arcsine(-1, 2).cdf).pvalue:.2f}")
-table.add("Eq. 5 magnitude stays within mean +- 3 sd (both policies)", "by construction",
+table.add_typed("Eq. 5 magnitude stays within mean +- 3 sd (both policies)", "by construction",
           "yes (exact truncnorm draws)", "derived")
-_ = table.add("Eqs. 3-4 pointing", "'random pointing', U[-pi,pi] x U[-pi/2,pi/2]",
+_ = table.add_typed("Eqs. 3-4 pointing", "'random pointing', U[-pi,pi] x U[-pi/2,pi/2]",
               f"as written; not uniform on the sphere (KS p {ks_txt})", "derived",
               "uniform elevation over-weights the poles; implemented as the paper writes it")
 
@@ -329,7 +335,7 @@ _ = plotting.save_figure(fig, "10_tuning_map", output_dir=out)
 # apoapsis, start at the periapsis hand-off) is filtered twice at $f = 0.1$: with $q_w$ held constant over the
 # whole period (the paper's "increased control uncertainty", Figs. 10-11) and with $q_w$ only in the 8-hour
 # apoapsis window and $q_b$ elsewhere (the paper's proposed tuning, Figs. 12-13). For each we draw the paper's two
-# panel sets with `cislunar.adaptive_ocbe` (the layout of notebook 09b's Figs. 6-9): position and velocity error
+# panel sets with `cislunar.estimation.adaptive_ocbe` (the layout of notebook 09b's Figs. 6-9): position and velocity error
 # norms with their 3-sigma bounds, forward (left) and smoothed (right); then the control norm (top) and the
 # normalised OCBE metric (bottom; notebook 09b: $\chi^2_4$ under a correct model, limit $\chi^2_{4,0.99} = 13.28$,
 # mean line at $4/13.28 = 0.30$; the smoothed metric's epoch average is 4). The paper does not give its burn
@@ -346,10 +352,10 @@ sc_q = s_q.scenario
 demo = det.draw_trial(np.random.default_rng([SEED, 7]), s_q, magnitude_m_s=0.05, direction=(np.pi / 2, 0.0))
 q_tunings = {"constant": s_q.control_weight.max(), "apoapsis window": s_q.control_weight}
 runs = {name: det.run_trial_filter(s_q, demo, control_weight=q) for name, q in q_tunings.items()}
-panels = {name: ad.panel_series(em, r, demo.truth, q_tunings[name], demo.y, s_q.observer_states, sc_q.model,
+panels = {name: ocbe_panels.panel_series(em, r, demo.truth, q_tunings[name], demo.y, s_q.observer_states, sc_q.model,
                                 sc_q.meas_cov) for name, r in runs.items()}
 burn_days = s_q.t_maneuver * em.time_unit_days
-nees_q = stats.chi2.ppf(tracking.NEES_PROBABILITY, 6)
+nees_q = stats.chi2.ppf(consistency.NEES_PROBABILITY, 6)
 fig_summary = {}
 for name, r in runs.items():
     pn = panels[name]
@@ -366,7 +372,7 @@ for name, r in runs.items():
           f"{fig_summary[name]['sig_final'][0]:.2f} km, {fig_summary[name]['sig_final'][1]:.1f} mm/s | control spike "
           f"contrast at the burn: forward {fig_summary[name]['contrast'][0]:.3g}, smoothed "
           f"{fig_summary[name]['contrast'][1]:.3g}")
-_ = plotting.save_figure(ad.figure_errors(panels["constant"], "Fig. 10 analogue, constant q_w", burn_days=burn_days,
+_ = plotting.save_figure(ocbe_panels.figure_errors(panels["constant"], "Fig. 10 analogue, constant q_w", burn_days=burn_days,
                                           velocity_unit="mm/s"), "10_fig10_constant_tuning_errors", output_dir=out)
 
 # %% [markdown]
@@ -374,7 +380,7 @@ _ = plotting.save_figure(ad.figure_errors(panels["constant"], "Fig. 10 analogue,
 # solutions"). Compare the errors (blue) with their 3-sigma bounds (red) and the NEES fractions printed above.
 
 # %%
-_ = plotting.save_figure(ad.figure_control_metric(panels["constant"], "Fig. 11 analogue, constant q_w",
+_ = plotting.save_figure(ocbe_panels.figure_control_metric(panels["constant"], "Fig. 11 analogue, constant q_w",
                                                   burn_days=burn_days),
                          "10_fig11_constant_tuning_control_metric", output_dir=out)
 
@@ -383,7 +389,7 @@ _ = plotting.save_figure(ad.figure_control_metric(panels["constant"], "Fig. 11 a
 # system"). Top: the forward (single-step, Eq. 32) and smoothed control norms; bottom: the normalised metrics.
 
 # %%
-_ = plotting.save_figure(ad.figure_errors(panels["apoapsis window"], "Fig. 12 analogue, 8-h apoapsis window",
+_ = plotting.save_figure(ocbe_panels.figure_errors(panels["apoapsis window"], "Fig. 12 analogue, 8-h apoapsis window",
                                           burn_days=burn_days, velocity_unit="mm/s"),
                          "10_fig12_window_tuning_errors", output_dir=out)
 pw = panels["apoapsis window"]
@@ -424,7 +430,7 @@ print(f"forward 3-sigma position: {pw.position_3sigma_km[0, k_b12]:.2f} km just 
 # 99.9 % quantile only at the first epochs after the burn (printed).
 
 # %%
-_ = plotting.save_figure(ad.figure_control_metric(panels["apoapsis window"], "Fig. 13 analogue, 8-h apoapsis window",
+_ = plotting.save_figure(ocbe_panels.figure_control_metric(panels["apoapsis window"], "Fig. 13 analogue, 8-h apoapsis window",
                                                   burn_days=burn_days),
                          "10_fig13_window_tuning_control_metric", output_dir=out)
 fs_c, fs_w = fig_summary["constant"], fig_summary["apoapsis window"]
@@ -461,8 +467,8 @@ spike = {}
 for tuning, s_ in (("constant", s_const), ("apoapsis window", s_q)):
     for h, inputs in spike_in.items():
         r = det.filter_trials(s_, inputs)
-        nf = np.array([tracking.nees(r.x_filt[b], r.P_filt[b], c.truth) for b, c in enumerate(inputs)])
-        ns = np.array([tracking.nees(r.x_smooth[b], r.P_smooth[b], c.truth) for b, c in enumerate(inputs)])
+        nf = np.array([consistency.nees(r.x_filt[b], r.P_filt[b], c.truth) for b, c in enumerate(inputs)])
+        ns = np.array([consistency.nees(r.x_smooth[b], r.P_smooth[b], c.truth) for b, c in enumerate(inputs)])
         frac = lambda n: float(np.mean(np.mean(n > nees_q, axis=1) > tracking.DIVERGED_FRACTION))  # noqa: E731
         k_b = int(np.searchsorted(sc_q.t, s_q.t_maneuver, side="right"))
         exc = nf > nees_q
@@ -500,9 +506,9 @@ fig11_h0 = float(np.mean(c0[:, 1] < 2))
 # For each orbit and policy: $N_{H0}$ runs without a maneuver and $N_{H1}$ runs with one drawn from the policy
 # (500 and 3000 in the paper), each a full OCBE filter and smoother over one period from the periapsis hand-off,
 # giving $z = \int_{t_0}^{t_f}\|\hat{\mathbf u}(t)\|dt$ of the smoothed control (Eq. 33, trapezoid rule on 9 points
-# per 2-hour interval). Runs go through `cislunar.montecarlo.run_monte_carlo`; the batched OCBE filters 8 runs at a
+# per 2-hour interval). Runs go through `cislunar.utils.montecarlo.run_monte_carlo`; the batched OCBE filters 8 runs at a
 # time, advancing all of them through the same epochs together, and equals the single-run filter to $10^{-10}$
-# (`tests/test_detection.py`).
+# (`tests/papers/greaves_scheeres_2021/test_detection.py`).
 # Every run also records the NEES of its forward and smoothed estimates, so the same runs measure the consistency
 # of the tuning (Section 3b).
 #
@@ -829,7 +835,7 @@ health = det.draw_trial(np.random.default_rng([SEED, 8]), s_q, magnitude_m_s=0.5
 rh = det.run_trial_filter(s_q, health)
 ref = studies["9:2 NRHO", "quiet"]
 z_h = rh.z_smooth * em.velocity_unit_km_s * 1e3
-nees_h = tracking.nees(rh.x_smooth, rh.P_smooth, health.truth)
+nees_h = consistency.nees(rh.x_smooth, rh.P_smooth, health.truth)
 fig, ax = plt.subplots(1, 3, figsize=(15, 3.8))
 hours = sc_q.t * em.time_unit_s / 3600
 err = np.linalg.norm(rh.x_smooth[:, :3] - health.truth[:, :3], axis=1) * em.length_unit_km
@@ -977,16 +983,16 @@ def binom_tol(paper, n):
     return max(0.02, 2 * np.sqrt(paper * (1 - paper) / n) + 1 / (2 * n))
 
 
-table.add("Measurement noise (Table 3)", "missing from the text", "10 micro-rad angles; rates sqrt(2)*10 micro-rad/s",
+table.add_typed("Measurement noise (Table 3)", "missing from the text", "10 micro-rad angles; rates sqrt(2)*10 micro-rad/s",
           "not in paper", "our choice: the value the same authors use in J. Greaves, D. Scheeres, 'Autonomous "
           "Information Gathering Guidance for Spacecraft-to-Spacecraft Tracking with Optical Sensors', AMOS "
-          "Conference 2023, Sec. 3.3 (cislunar.tracking; notebook 09, Section 1); Section 2 maps 2-20 micro-rad")
-table.add("OCBE tuning (8-h apoapsis window)", "values missing",
+          "Conference 2023, Sec. 3.3 (cislunar.papers.greaves_scheeres_2021.tracking; notebook 09, Section 1); Section 2 maps 2-20 micro-rad")
+table.add_typed("OCBE tuning (8-h apoapsis window)", "values missing",
           f"q_w = f E[u^2]/(3T), base 1e-18 km^2/s^3; f_c = {F_C:g} (consistency reading), f = {F_TUNE:g} (threshold "
           f"reading): quiet q_w {setups_c['9:2 NRHO', 'quiet'].q_window_km2_s3:.2e} / "
           f"{setups['9:2 NRHO', 'quiet'].q_window_km2_s3:.2e} km^2/s^3", "not in paper",
           "f_c by a rule fixed before the map (Section 2); f = 0.1 chosen earlier with the paper's thresholds in view")
-table.add("Monte Carlo sizes (H0 / H1 / tests per hypothesis)", "500 / 3000 / 100", f"{N_H0} / {N_H1} / {N_TEST}",
+table.add_typed("Monte Carlo sizes (H0 / H1 / tests per hypothesis)", "500 / 3000 / 100", f"{N_H0} / {N_H1} / {N_TEST}",
           "derived: an input taken from the paper, not a result" if not QUICK else "differs: quick mode",
           ("input, as in the paper: per policy on the 9:2 and the inner-band stable NRHO, at both tunings; the "
            "outer-band stable NRHO (our added candidate) runs reduced sizes, "
@@ -998,14 +1004,14 @@ fig10_why = [f"{h} {w} {100 * x:.1f} % inconsistent" for h in ("H0", "H1")
              for w, x in zip(("forward", "smoothed"), spike["constant", h]["inc"]) if x > 0.10]
 if spike["constant", "H1"]["sig_km"] <= spike["apoapsis window", "H1"]["sig_km"]:
     fig10_why.append("bound not larger than the window tuning's")
-table.add("Fig. 10: constant tuning consistent but less certain", "consistent, less certain (one run)",
+table.add_typed("Fig. 10: constant tuning consistent but less certain", "consistent, less certain (one run)",
           f"inconsistent runs H0 fwd/smo {c_inc[0]:.1f}/{c_inc[1]:.1f} %, H1 {c_inc[2]:.1f}/{c_inc[3]:.1f} %; mean "
           f"forward 3-sigma {spike['constant', 'H1']['sig_km']:.2f} km vs "
           f"{spike['apoapsis window', 'H1']['sig_km']:.2f} km (window)",
           "reproduced" if fig10_ok else "differs: " + "; ".join(fig10_why) + " (criterion 10 %)",
           f"{N_SPIKE} + {N_SPIKE} quiet runs at f = 0.1; criterion fixed before running: at most 10 % inconsistent "
           "runs in every cell and a larger bound than the window tuning")
-table.add("Fig. 11: constant tuning, control spike at the burn in the smoothed control only",
+table.add_typed("Fig. 11: constant tuning, control spike at the burn in the smoothed control only",
           "spike only in the smoothed system",
           f"H1 runs with smoothed contrast >= 2 and above the forward one: {100 * fig11_h1:.0f} %; H0 runs without a "
           f"smoothed spike: {100 * fig11_h0:.0f} %", "reproduced" if fig11_h1 >= 0.9 and fig11_h0 >= 0.9 else
@@ -1016,7 +1022,7 @@ table.add("Fig. 11: constant tuning, control spike at the burn in the smoothed c
           "running: at least 90 % of the runs of each hypothesis")
 zr = studies["9:2 NRHO", "quiet"].h1.z / studies["9:2 NRHO", "quiet"].h1.z_step
 zr_c = studies_c["9:2 NRHO", "quiet"].h1.z / studies_c["9:2 NRHO", "quiet"].h1.z_step
-table.add("Fig. 13: window tuning, smoothed control spike at the burn",
+table.add_typed("Fig. 13: window tuning, smoothed control spike at the burn",
           "'a smoothed control spike around apoapsis that is indicative of a maneuver'",
           f"quiet H1 runs with smoothed z above twice the forward z: {100 * np.mean(zr > 2):.1f} % (f = 0.1), "
           f"{100 * np.mean(zr_c > 2):.1f} % (f_c); median ratio {np.median(zr):.0f} / {np.median(zr_c):.0f}",
@@ -1028,7 +1034,7 @@ table.add("Fig. 13: window tuning, smoothed control spike at the burn",
 # --- consistency of the window tuning
 edge = {v: next((f for f in (F_GRID if v == BASE_VARIANT else F_SIDE)
                   if all(worst("9:2 NRHO", p, f, v) <= 0.10 for p in POLICIES)), None) for v in VARIANTS}
-table.add("Window-tuned OCBE consistent (Figs. 12-13): where it holds", "consistent (single runs)",
+table.add_typed("Window-tuned OCBE consistent (Figs. 12-13): where it holds", "consistent (single runs)",
           f"every orbit, policy and hypothesis at most 10 % inconsistent runs for f >= {F_C:g} (map); at f_c the "
           f"paper-size runs' worst cell is {100 * max(max(v['c']) for v in nees_rows.values()):.1f} %", TUNED,
           "holds only in part of the unstated tuning range, so agreement rests on choosing f (by this very claim); "
@@ -1038,7 +1044,7 @@ for o in ORBITS:
     wf = max(nees_rows[o, p, h]["tune"][0] for p in POLICIES for h in ("H0", "H1"))
     ws = max(nees_rows[o, p, h]["tune"][1] for p in POLICIES for h in ("H0", "H1"))
     bad = [f"{p} {h}" for p in POLICIES for h in ("H0", "H1") if max(nees_rows[o, p, h]["tune"]) > 0.10]
-    table.add(f"Window-tuned OCBE consistent at f = 0.1, {o} (NEES, forward / smoothed)",
+    table.add_typed(f"Window-tuned OCBE consistent at f = 0.1, {o} (NEES, forward / smoothed)",
               "consistent (Figs. 12-13, single runs)",
               f"worst cell: {100 * wf:.1f} % / {100 * ws:.1f} % of runs inconsistent"
               + (f" ({', '.join(bad)})" if bad else ""),
@@ -1050,12 +1056,12 @@ for o in ORBITS:
 for p in POLICIES:
     paper = PAPER_ZLIM[p]
     zl = studies["9:2 NRHO", p].threshold.z_lim
-    table.add(f"z_lim, 9:2 NRHO, {p}, f = 0.1 (Eq. 35)", f"{paper * 1e3:.2f} mm/s", f"{zl * 1e3:.2f} mm/s",
+    table.add_typed(f"z_lim, 9:2 NRHO, {p}, f = 0.1 (Eq. 35)", f"{paper * 1e3:.2f} mm/s", f"{zl * 1e3:.2f} mm/s",
               TUNED if abs(zl / paper - 1) <= 0.25 else f"differs: {100 * (zl / paper - 1):+.0f} %",
               f"{100 * (zl / paper - 1):+.0f} %; within 25 % counts as agreement; f = 0.1 chosen with this number in "
               f"view; the map's z_lim equals the paper's at f = {F_MATCH[p]:.2f}")
     zc, sc_ = studies_c["9:2 NRHO", p].threshold.z_lim, se(("9:2 NRHO", p), "f_c", 0)
-    table.add(f"z_lim, 9:2 NRHO, {p}, f_c = {F_C:g} (prediction)", f"{paper * 1e3:.2f} mm/s",
+    table.add_typed(f"z_lim, 9:2 NRHO, {p}, f_c = {F_C:g} (prediction)", f"{paper * 1e3:.2f} mm/s",
               f"{zc * 1e3:.2f} +- {sc_ * 1e3:.2f} mm/s",
               "reproduced" if abs(zc - paper) <= 2 * sc_ else
               f"differs: {100 * (zc / paper - 1):+.0f} %",
@@ -1065,19 +1071,19 @@ for p in POLICIES:
                  "inside the consistent range"))
 for o in STABLE:
     for p in POLICIES:
-        table.add(f"z_lim, {o}, {p}", "not given",
+        table.add_typed(f"z_lim, {o}, {p}", "not given",
                   f"{studies[o, p].threshold.z_lim * 1e3:.2f} mm/s (f = 0.1), "
                   f"{studies_c[o, p].threshold.z_lim * 1e3:.2f} mm/s (f_c)", "not in paper",
                   "the paper omits the stable-NRHO plots and values"
                   + ("; outer-band candidate (notebook 09), reduced Monte Carlo" if o == OUTER else ""))
 for (o, p), st in studies_c.items():
-    table.add(f"Expected FP / MD, {o}, {p}, f_c (Tables 5-6)", "tables missing",
+    table.add_typed(f"Expected FP / MD, {o}, {p}, f_c (Tables 5-6)", "tables missing",
               f"{st.threshold.false_positive:.4f} / {st.threshold.missed_detection:.4f} (f = 0.1: "
               f"{studies[o, p].threshold.false_positive:.4f} / {studies[o, p].threshold.missed_detection:.4f})",
               "not in paper", f"{st.threshold.crossings.size} PDF crossing(s); FP + MD standard error "
               f"{se((o, p), 'f_c', 1):.4f} (bootstrap)")
 n_cross = [st.threshold.crossings.size for g in (studies, studies_c) for st in g.values()]
-table.add("H0 and H1 PDFs cross once", "yes (Figs. 15, 19)", f"crossings per case (both tunings): {n_cross}",
+table.add_typed("H0 and H1 PDFs cross once", "yes (Figs. 15, 19)", f"crossings per case (both tunings): {n_cross}",
           "reproduced" if all(c == 1 for c in n_cross) else "differs: KDE tails of the finite sample add crossings",
           "criterion fixed in advance: exactly one crossing in every case; z_lim is the crossing of least total error")
 # --- detection accuracy
@@ -1092,11 +1098,11 @@ for p, paper in (("active", 1.00), ("quiet", 0.97)):
     def edge(x):
         return "; our value lies exactly on the tolerance" if np.isclose(abs(x - paper), tol) else ""
 
-    table.add(f"Detection accuracy, 9:2 NRHO, {p}, f = 0.1 (Table 7)", f"{100 * paper:.0f} %", f"{100 * a:.1f} %",
+    table.add_typed(f"Detection accuracy, 9:2 NRHO, {p}, f = 0.1 (Table 7)", f"{100 * paper:.0f} %", f"{100 * a:.1f} %",
               TUNED if abs(a - paper) <= tol + 1e-9 else "differs: see FP/MD",
               f"{n} test runs; tolerance {100 * tol:.1f} points (2 binomial standard errors, at least 2){floor}"
               f"{edge(a)}; f = 0.1 chosen with the paper's thresholds in view")
-    table.add(f"Detection accuracy, 9:2 NRHO, {p}, f_c = {F_C:g} (Table 7, prediction)", f"{100 * paper:.0f} %",
+    table.add_typed(f"Detection accuracy, 9:2 NRHO, {p}, f_c = {F_C:g} (Table 7, prediction)", f"{100 * paper:.0f} %",
               f"{100 * a_c:.1f} %", "reproduced" if abs(a_c - paper) <= tol + 1e-9 else
               f"differs: {100 * (a_c - paper):+.1f} points, beyond the tolerance",
               f"{n} test runs; tolerance {100 * tol:.1f} points, fixed in advance (2 binomial standard errors at the "
@@ -1111,7 +1117,7 @@ for o in STABLE:
             tol = binom_tol(1.0, studies_c[o, p].score.n)
             extra = (f"; accuracy vs the paper's 200/200: {100 * a_s:.1f} % ("
                      f"{'within' if 1.0 - a_s <= tol + 1e-9 else 'outside'} {100 * tol:.1f} points)")
-        table.add(f"Stable NRHO marginally better than the 9:2, {o}, {p}, f_c (Table 8)",
+        table.add_typed(f"Stable NRHO marginally better than the 9:2, {o}, {p}, f_c (Table 8)",
                   "marginally better" + (" (quiet: 200/200)" if p == "quiet" else ""),
                   f"expected FP + MD {e_s:.4f} vs 9:2 {e_n:.4f} (difference {e_s - e_n:+.4f} +- {se_d:.4f}); test "
                   f"accuracy {100 * a_s:.1f} % of {studies_c[o, p].score.n}",
@@ -1124,18 +1130,18 @@ for o in STABLE:
 for p in POLICIES:
     sl, cr, _, _ = lin["9:2 NRHO", p, "f_c"]
     sl1, cr1, _, _ = lin["9:2 NRHO", p, "f = 0.1"]
-    table.add(f"z nearly linear in the magnitude, {p} (Figs. 17, 21)", "apparently linear",
+    table.add_typed(f"z nearly linear in the magnitude, {p} (Figs. 17, 21)", "apparently linear",
               f"f_c: slope {sl:.2f}, corr {cr:.3f} (f = 0.1: {sl1:.2f}, {cr1:.3f})",
               "reproduced" if cr > 0.8 else "differs: weak correlation",
               "criterion fixed in advance: correlation above 0.8 at the prediction tuning f_c")
-table.add("H1 z approximately Gaussian, active (Fig. 15)", "approximately Gaussian",
+table.add_typed("H1 z approximately Gaussian, active (Fig. 15)", "approximately Gaussian",
           f"skewness {lin['9:2 NRHO', 'active', 'f_c'][3]:.2f} "
           f"(f = 0.1: {lin['9:2 NRHO', 'active', 'f = 0.1'][3]:.2f})",
           "reproduced" if abs(lin["9:2 NRHO", "active", "f_c"][3]) < 0.5 else "differs: skewed",
           "criterion fixed in advance: |skewness| below 0.5")
 ctr = {(p, t): lin["9:2 NRHO", p, t][2] for p in POLICIES for t in ("f = 0.1", "f_c")}
 c10 = [c for (f_, s_, o_), (z, c) in pmj.items() if s_ == 10.0]
-table.add("Largest z for burns at azimuth +-90 deg, active (Fig. 16)", "bimodal, peaks at +-j",
+table.add_typed("Largest z for burns at azimuth +-90 deg, active (Fig. 16)", "bimodal, peaks at +-j",
           f"z/|dv| at +-90 deg over 0/180 deg: {ratio_text(ctr['active', 'f_c'])} (f_c), "
           f"{ratio_text(ctr['active', 'f = 0.1'])} (f = 0.1)",
           "reproduced" if ctr["active", "f_c"] > 1.1 else
@@ -1145,7 +1151,7 @@ pm_a, pm_q = det.azimuth_contrast(pm_mc["active"]), det.azimuth_contrast(pm_mc["
 ratio_a, ratio_q = (float(np.mean(pm_mc[p].z / pm_mc[p].magnitude)) for p in ("active", "quiet"))
 corr_a = float(np.corrcoef(pm_mc["active"].magnitude, pm_mc["active"].z)[0, 1])
 burn_time_effect = max(abs(pmj[f_pm, sig_pm, o_][1] - pmj[f_pm, sig_pm, 0.0][1]) for o_ in PM_J_OFFSET_H)
-table.add("Conditions for the +-j pattern (f, angle noise, burn time in the window)", "not discussed",
+table.add_typed("Conditions for the +-j pattern (f, angle noise, burn time in the window)", "not discussed",
           f"largest paired contrast {best_pmj[1][1]:.2f} at f = {f_pm:g}, {sig_pm:g} micro-rad (burn at apoapsis; "
           f"a burn 3 h before or after apoapsis moves it by at most {burn_time_effect:.2f}); there the Fig. 16 "
           f"statistic is {ratio_text(pm_a)} (active), but z/|dv| averages {ratio_a:.2f} and corr(z, |dv|) is "
@@ -1153,7 +1159,7 @@ table.add("Conditions for the +-j pattern (f, angle noise, burn time in the wind
           f"{PM_J_SEEDS} noise draws per direction; {N_PM_J_MC} random burns per policy in that regime; the pattern "
           "needs burns that the angles see poorly (noise far above ours): then z falls short of the burn, least "
           "along +-j, perpendicular to the line of sight")
-table.add("Quiet policy: pattern less bimodal (Fig. 20)", "more uniform",
+table.add_typed("Quiet policy: pattern less bimodal (Fig. 20)", "more uniform",
           f"where the pattern appears ({sig_pm:g} micro-rad, f = {f_pm:g}): quiet {ratio_text(pm_q)} vs active "
           f"{ratio_text(pm_a)}; at our noise {ratio_text(ctr['quiet', 'f_c'])} vs {ratio_text(ctr['active', 'f_c'])}",
           TUNED if pm_a > 1.1 and pm_q < pm_a and ratio_q > 0.5 else
@@ -1167,14 +1173,14 @@ table.add("Quiet policy: pattern less bimodal (Fig. 20)", "more uniform",
 for tag, f_ in (("f = 0.1", F_TUNE), ("f_c", F_C)):
     m, s1 = z05[f_].mean(), z05[f_].std(ddof=1)
     ok = abs(0.4761 - m) <= 2 * s1
-    table.add(f"Health metric: z for a 0.5 m/s burn, quiet tuning, {tag}", "0.4761 m/s (one run)",
+    table.add_typed(f"Health metric: z for a 0.5 m/s burn, quiet tuning, {tag}", "0.4761 m/s (one run)",
               f"{m:.4f} +- {s1:.4f} m/s (mean +- single-run sd, {N_Z05} runs)",
               ("reproduced" if tag == "f_c" else TUNED) if ok else
               f"differs: {(0.4761 - m) / s1:+.1f} single-run sd from our mean",
               "tolerance fixed in advance: 2 single-run standard deviations (the paper's digits are finer); z depends "
               f"on f: {z05[F_GRID[0]].mean():.3f} m/s at f = {F_GRID[0]:g} to {z05[F_GRID[-1]].mean():.3f} at "
               f"f = {F_GRID[-1]:g}")
-    table.add(f"Health metric: sigma level in the quiet H1 distribution, {tag}", "about 30 sigma",
+    table.add_typed(f"Health metric: sigma level in the quiet H1 distribution, {tag}", "about 30 sigma",
               f"{sig_level[tag]:.1f} sigma",
               ("reproduced" if tag == "f_c" else TUNED) if 25 <= sig_level[tag] < 35 else "differs: outside [25, 35)",
               "tolerance from the printed digit, fixed in advance: [25, 35); mean z of the 0.5 m/s burns against the "
@@ -1184,7 +1190,7 @@ for tag, h in lead.items():
     i5 = int(np.argmin(np.abs(h.magnitudes_m_s - 0.5)))
     ok = fr["control first"][i5] > 0.5
     holds = [f"{m:g}" for m, c in zip(h.magnitudes_m_s, fr["control first"]) if c > 0.5]
-    table.add(f"Control test reacts before a residual test (Fig. 22), {tag}", "yes (deviations before the residuals)",
+    table.add_typed(f"Control test reacts before a residual test (Fig. 22), {tag}", "yes (deviations before the residuals)",
               "0.5 m/s: control first {:.0f} %, same epoch {:.0f} %, residual first {:.0f} %; control first at "
               "{}".format(100 * fr["control first"][i5], 100 * fr["same epoch"][i5], 100 * fr["residual first"][i5],
                           ", ".join(f"{m:g} m/s {100 * c:.0f} %" for m, c in zip(h.magnitudes_m_s,
@@ -1200,7 +1206,7 @@ for tag, h in lead.items():
               + ("; noise ten times ours: a regime searched for the claim" if "100" in tag else ""))
 l100 = lead["f = 0.1, 100 urad"]
 i5 = int(np.argmin(np.abs(l100.magnitudes_m_s - 0.5)))
-table.add("Health metric: residuals benign while the estimate diverges (Fig. 22)", "yes",
+table.add_typed("Health metric: residuals benign while the estimate diverges (Fig. 22)", "yes",
           f"one run at 10 micro-rad: smoothed NEES mean {nees_h.mean():.0f}, residual median "
           f"{np.median(rh.residual_norms):.2f}; at 100 micro-rad the residual test stays silent for 24 h in "
           f"{100 * (l100.residual_epoch[i5] < 0).mean():.0f} % of 0.5 m/s runs, the control test too in "

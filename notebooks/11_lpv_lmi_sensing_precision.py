@@ -23,7 +23,7 @@
 # (Eqs. 20-23), §IV-B (Fig. 2, Eq. 24 and the 0.1 deg / 0.08 deg result at gamma = 0.0013). Beyond the paper: the
 # independent verification and the trade curve of required precision against gamma.
 #
-# All computation lives in `cislunar.lpv`; cells call it and plot.
+# All computation lives in `cislunar.estimation.lpv`; cells call it and plot.
 
 # %% tags=["parameters"]
 QUICK = False
@@ -50,8 +50,9 @@ import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from cislunar import lpv, plotting
-from cislunar.report import ComparisonTable
+from cislunar.estimation import lpv
+from cislunar.publish import plotting
+from cislunar.publish.report import ComparisonTable
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -79,7 +80,7 @@ f_nl = model.f(states)
 err_dyn = np.max(np.abs(model.lpv_rhs(states) - f_nl) / np.maximum(1.0, np.abs(f_nl)))
 print(f"max relative |A(rho)x + b(rho) - f(x)| over {N_CHECK} states: {err_dyn:.2e}")
 EXACT_TOL = 1e-12  # fixed before: "exact" means agreement to rounding, max error below 1e-12
-_ = table.add("LPV form Eqs. 21/23 = CR3BP (Eq. 20)", "exact", f"max rel. error {err_dyn:.1e}",
+_ = table.add_typed("LPV form Eqs. 21/23 = CR3BP (Eq. 20)", "exact", f"max rel. error {err_dyn:.1e}",
               "reproduced" if err_dyn < EXACT_TOL else "differs: LPV form not exact",
               f"A(rho), b(rho) as printed; checked at random states; tolerance {EXACT_TOL:.0e} fixed before")
 
@@ -104,10 +105,10 @@ err_23 = np.max(np.abs(y_23 - y_nl))
 err_tri = np.max(np.abs(model.rho_from_angles(*model.angles(states)) - rho_s) / np.abs(rho_s).clip(1e-3))
 print(f"Eq. 22: max |C x + d - y| = {err_22:.2e};  Eq. 23 as printed: {err_23:.3f}")
 print(f"rho from the two angles (law of sines): max relative error {err_tri:.1e}")
-table.add("sensor model Eq. 22 = geometry", "exact", f"max error {err_22:.1e}",
+table.add_typed("sensor model Eq. 22 = geometry", "exact", f"max error {err_22:.1e}",
           "reproduced" if err_22 < EXACT_TOL else "differs: sensor model not exact",
           f"rho5 = x, rho6 = y (undefined in paper); tolerance {EXACT_TOL:.0e} fixed before")
-_ = table.add("Eq. 23 d(rho) as printed", "same model as Eq. 22", f"error up to {err_23:.2f}",
+_ = table.add_typed("Eq. 23 d(rho) as printed", "same model as Eq. 22", f"error up to {err_23:.2f}",
               "differs: Eq. 23's d(rho) is a misprint; Eq. 22 used", "Eq. 23 repeats a C column, drops pi2 factors")
 
 # %% [markdown]
@@ -136,9 +137,9 @@ plotting.plot_primaries(ax, model.system)
 ax.legend(loc="upper right")
 ax.set_title(f"scheduling box from this orbit: r13 in [{r13.min():.3f}, {r13.max():.3f}] LU")
 _ = plotting.save_figure(fig, "11_resonant_orbit", output_dir=out)
-table.add("resonant orbit (planar)", "not stated", f"2:1, T = {sc.orbit.period:.4f} TU, r13 {r13.min():.3f}-"
+table.add_typed("resonant orbit (planar)", "not stated", f"2:1, T = {sc.orbit.period:.4f} TU, r13 {r13.min():.3f}-"
           f"{r13.max():.3f} LU", "not in paper", "choice of this reproduction (paper gives no orbit)")
-_ = table.add("polytope vertices", "not stated", f"{V.shape[0]}", "derived", "2^6 box vertices of rho")
+_ = table.add_typed("polytope vertices", "not stated", f"{V.shape[0]}", "derived", "2^6 box vertices of rho")
 
 # %% [markdown]
 # ## 4 · Theorems 1 and 2 as derived (and where the printed text disagrees)
@@ -200,7 +201,7 @@ for norm in des:
               f"{np.array2string(d.kappa[:2], precision=2)}, Eq. 24 noise {d.noise_deg[0]:.5f} deg; sensors used: "
               f"{[n for n, u in zip(lpv.SENSOR_NAMES, d.used) if u]}")
 for norm in des:
-    table.add(f"{norm} LMI at gamma = 0.0013: solver status", "-", f"{des_all[norm].status} (6 sensors), "
+    table.add_typed(f"{norm} LMI at gamma = 0.0013: solver status", "-", f"{des_all[norm].status} (6 sensors), "
               f"{des[norm].status} (theta1); |L| = {des[norm].gain_norm:.0f}", "beyond paper",
               "Clarabel; Hinf with bandwidth bound R = 1000/TU" if norm == "hinf" else "Clarabel, no gain bound needed")
 
@@ -210,7 +211,7 @@ for norm in des:
 # Two checks. (a) The $\theta_1$-only problems re-solved with a tighter tolerance (1e-9 instead of Clarabel's 1e-8),
 # a tenfold smaller strictness margin and another variable scaling must return the same precision (the tests fix
 # 1e-4 relative; SCS agrees to 2e-6 on the H2 problem but needs over two minutes, so it runs in
-# `tests/test_lpv.py` on request, `CISLUNAR_SCS_TEST=1`). (b) The H-infinity precision against the bandwidth
+# `tests/estimation/test_lpv.py` on request, `CISLUNAR_SCS_TEST=1`). (b) The H-infinity precision against the bandwidth
 # bound $R$: it rises towards the unbounded-gain limit $\sin^{-1}(\gamma/\max r_{13})$ while the gain grows
 # like $R$ — the limit is the infimum of Theorem 2 as printed, and is never attained. (The curve stops at 5000/TU:
 # beyond it the strictness margin of the scaled problem starts to act as a gain bound and the optimum stops growing.)
@@ -225,7 +226,7 @@ for norm, kw in (("h2", {}), ("hinf", {"pole_radius": R_BW})):
     checks[norm] = (dev, [a.status for a in alt])
     print(f"{norm:4s}: tol 1e-9 / eps 1e-9 / scale 3: statuses {checks[norm][1]}, max relative change of kappa "
           f"{dev:.1e}")
-    table.add(f"{norm} precision independent of solver settings", "-", f"max rel. change {dev:.0e} "
+    table.add_typed(f"{norm} precision independent of solver settings", "-", f"max rel. change {dev:.0e} "
               f"({', '.join(checks[norm][1])})", "beyond paper" if dev < 1e-4 else "differs: solver-dependent",
               "tolerance 1e-9, margin 1e-9, variable scale 3 (criterion 1e-4 fixed before)")
 
@@ -248,7 +249,7 @@ fig.suptitle(r"H$_\infty$ (Theorem 2) at $\gamma$ = 0.0013 LU: precision and gai
 for a in ax:
     a.xaxis.set_minor_formatter(mticker.NullFormatter())
 _ = plotting.save_figure(fig, "11_hinf_bandwidth", output_dir=out)
-_ = table.add("Hinf precision vs bandwidth bound R", "-", f"{dR[R_LIST[0]].noise_deg[0]:.4f} deg (R={R_LIST[0]:.0f}) "
+_ = table.add_typed("Hinf precision vs bandwidth bound R", "-", f"{dR[R_LIST[0]].noise_deg[0]:.4f} deg (R={R_LIST[0]:.0f}) "
               f"-> {dR[R_LIST[-1]].noise_deg[0]:.4f} deg (R={R_LIST[-1]:.0f}); limit {limit:.4f} deg",
               "beyond paper", "the unbounded optimum is an infimum: gain grows like R")
 
@@ -261,7 +262,7 @@ _ = table.add("Hinf precision vs bandwidth bound R", "-", f"{dR[R_LIST[0]].noise
 # Unused sensors are drawn as "unused", not as bars.
 #
 # Then, for each gain: eigenvalues of $A(\rho)+LC(\rho)$ and the frozen-parameter H2 norm (Lyapunov equation) and
-# H-infinity norm (Hamiltonian level-set iteration; both checked against python-control in `tests/test_lpv.py`) of
+# H-infinity norm (Hamiltonian level-set iteration; both checked against python-control in `tests/estimation/test_lpv.py`) of
 # the error system with noise $1/\kappa_i$, at the 64 vertices and at `N_VERIFY` uniform random points in the box.
 
 # %%
@@ -294,7 +295,7 @@ for key, d in (("h2", des["h2"]), ("hinf", des["hinf"]), ("h2 (6 sensors)", des_
           f"worst H2 = {v.worst_h2:.4e}, worst Hinf = {v.worst_hinf:.4e} (gamma {GAMMA}); passed: {v.passed}")
 for norm in ("h2", "hinf"):
     v, v6 = ver[norm], ver[f"{norm} (6 sensors)"]
-    table.add(f"{norm} design verified (Hurwitz, norm < gamma)", "guaranteed by LMI",
+    table.add_typed(f"{norm} design verified (Hurwitz, norm < gamma)", "guaranteed by LMI",
               f"max Re eig {max(v.max_real_eig, v6.max_real_eig):.2f}, worst {norm} norm "
               f"{max(v.worst, v6.worst):.4e}", "beyond paper" if v.passed and v6.passed else
               "differs: verification failed", f"theta1-only and 6-sensor gains; {v.n_vertices} vertices + "
@@ -332,18 +333,18 @@ for (obj, n), d in des_p.items():
     k_txt = np.array2string(d.kappa, formatter={"float_kind": lambda v: f"{v:.1f}"})
     print(f"p = {obj[1:]:3s} {n:4s}: {d.status:18s} kappa {k_txt}; used: "
           f"{used_names(d)}; kappa sin/cos th1 - 1 = {d.kappa[0] / d.kappa[1] - 1:+.1e}")
-table.add("objective norm p in min ||beta||_p", "not stated (Remark: p = 1 gives sparse solutions)", "p = 1",
+table.add_typed("objective norm p in min ||beta||_p", "not stated (Remark: p = 1 gives sparse solutions)", "p = 1",
           "not in paper", "chosen for the sparse pattern of Fig. 2; p = 2 and p = inf solved for comparison")
 only_th1 = all((des_all[n].used[:2].all() and not des_all[n].used[2:].any()) for n in des_all)
 other_p = "; ".join(f"p = {o[1:]}: {'all six' if all(des_p[(o, n)].used.all() for n in des_all) else 'other'} "
                     "sensors used" for o in ("l2", "linf"))
-table.add("sensors needed", "sin th1, cos th1 only", ", ".join(
+table.add_typed("sensors needed", "sin th1, cos th1 only", ", ".join(
     n for n, u in zip(lpv.SENSOR_NAMES, des_all["h2"].used & des_all["hinf"].used) if u),
     "consistent (tuned): only with p = 1" if only_th1 else "differs: other sensors selected with p = 1",
     f"both theorems; used = beta_i > {SPARSE_TOL:.0e} max beta (fixed before); {other_p}")
 same_p = {o: all(same_th1(des_p[(o, n)]) for n in des_all) for o in ("l1", "l2", "linf")}
 six_equal = all(np.ptp(des_p[("linf", n)].kappa) < SAME_TOL * des_p[("linf", n)].kappa.max() for n in des_all)
-table.add("precision sin th1 = cos th1", "identical",
+table.add_typed("precision sin th1 = cos th1", "identical",
           f"H2 {des_all['h2'].kappa[0]:.1f}/{des_all['h2'].kappa[1]:.1f}, "
           f"Hinf {des_all['hinf'].kappa[0]:.1f}/{des_all['hinf'].kappa[1]:.1f} (p = 1)",
           "consistent (tuned): only with p = 1 or p = inf" if same_p["l1"] and not same_p["l2"] else
@@ -355,7 +356,7 @@ table.add("precision sin th1 = cos th1", "identical",
           f"{'equal' if six_equal else 'unequal'}, H2 "
           f"{des_p[('linf', 'h2')].kappa[0]:.1f}, Hinf {des_p[('linf', 'hinf')].kappa[0]:.1f} "
           f"({des_p[('linf', 'hinf')].status})")
-_ = table.add("theta1-only = 6-sensor precision", "-", f"rel. diff. H2 "
+_ = table.add_typed("theta1-only = 6-sensor precision", "-", f"rel. diff. H2 "
               f"{abs(des['h2'].kappa[0] / des_all['h2'].kappa[0] - 1):.0e}, Hinf "
               f"{abs(des['hinf'].kappa[0] / des_all['hinf'].kappa[0] - 1):.0e}", "derived",
               "the comparison rows use the theta1-only problems")
@@ -403,25 +404,25 @@ print(f"kappa implied by Eq. 24 and the paper's 0.1 / 0.08 deg: H2 {k_paper['h2'
       f"here H2 {k2:.0f}, Hinf {des['hinf'].kappa[0]:.0f}")
 in_h2 = lambda v: 0.05 <= v < 0.15  # noqa: E731
 in_hinf = lambda v: 0.075 <= v < 0.085  # noqa: E731
-table.add("allowable theta1 noise, H2, intensity read as an angle", "0.1 deg", f"{noise['h2']:.4f} deg",
+table.add_typed("allowable theta1 noise, H2, intensity read as an angle", "0.1 deg", f"{noise['h2']:.4f} deg",
           "reproduced" if in_h2(noise["h2"]) else "differs: a white-noise intensity, not a per-sample angle",
           f"2:1 orbit; criterion [0.05, 0.15) deg fixed before; Section 9 tries other orbits and disturbances; Eq. 8b "
           f"read literally (trace < gamma) gives {h2_lit:.3f} deg, also outside")
-table.add("allowable theta1 noise, H2, per sample", "0.1 deg", f"0.1 deg at dt = {dt_01 * TU_MIN:.0f} min",
+table.add_typed("allowable theta1 noise, H2, per sample", "0.1 deg", f"0.1 deg at dt = {dt_01 * TU_MIN:.0f} min",
           "consistent (tuned)", "sampling interval chosen to match the paper's number (paper states none)")
-table.add("allowable theta1 noise, Hinf, gamma = 0.0013", "0.08 deg", f"{noise['hinf']:.4f} deg (R = {R_BW:.0f}/TU; "
+table.add_typed("allowable theta1 noise, Hinf, gamma = 0.0013", "0.08 deg", f"{noise['hinf']:.4f} deg (R = {R_BW:.0f}/TU; "
           f"limit {limit:.4f})", "consistent (tuned)" if in_hinf(noise["hinf"]) else "differs: depends on max r13",
           f"= asin(gamma / max r13) in the limit; max r13 = {r13max:.3f} LU on the 2:1 orbit, an orbit choice not "
           "independent of the paper's number (Section 9 counts the resonances that fall in [0.075, 0.085))")
-table.add("ordering H2 > Hinf", "H2 0.1 > Hinf 0.08 deg",
+table.add_typed("ordering H2 > Hinf", "H2 0.1 > Hinf 0.08 deg",
           f"intensity reading: H2 {noise['h2']:.3f} < Hinf {noise['hinf']:.3f}; per sample: H2 > Hinf iff dt < "
           f"{dt_eq * TU_MIN:.0f} min", "differs: reversed unless the H2 number is read per sample",
           "the paper compares an intensity with an energy bound without a sampling interval")
-table.add("Hinf precision formula", "kappa = sqrt(beta/gamma)", "kappa = sqrt(beta)",
+table.add_typed("Hinf precision formula", "kappa = sqrt(beta/gamma)", "kappa = sqrt(beta)",
           "differs: printed formula does not follow from Eq. 18-19", "verified norm equals gamma with sqrt(beta); "
           f"the printed formula would give {hinf_lit:.4f} deg, not 0.08")
 k_band = 1.0 / np.sin(np.radians([0.085, 0.075]))  # kappa band implied by the printed digits of 0.08 deg
-_ = table.add("kappa implied by Eq. 24 and the paper's 0.1 / 0.08 deg", f"H2 {k_paper['h2']:.0f}, Hinf {k_paper['hinf']:.0f}",
+_ = table.add_typed("kappa implied by Eq. 24 and the paper's 0.1 / 0.08 deg", f"H2 {k_paper['h2']:.0f}, Hinf {k_paper['hinf']:.0f}",
               f"H2 {k2:.0f}, Hinf {des['hinf'].kappa[0]:.0f}",
               (f"differs: H2 {k2 / k_paper['h2']:.1f}x the implied value (intensity reading)" if not in_h2(noise["h2"])
                else "consistent (tuned): H2 within the printed digits") + (
@@ -458,7 +459,7 @@ fig.suptitle("trade curve: precision needed for a position-error bound")
 _ = plotting.save_figure(fig, "11_tradecurve", output_dir=out)
 slope = {n: np.polyfit(np.log(gammas), np.log([d.kappa[0] for d in sweep[n]]), 1)[0] for n in sweep}
 print("log-log slope of kappa against gamma: " + ", ".join(f"{n} {s:.3f}" for n, s in slope.items()))
-_ = table.add("trade curve kappa(gamma)", "-", f"slopes H2 {slope['h2']:.2f}, Hinf {slope['hinf']:.2f}",
+_ = table.add_typed("trade curve kappa(gamma)", "-", f"slopes H2 {slope['h2']:.2f}, Hinf {slope['hinf']:.2f}",
               "beyond paper", f"{N_GAMMA} gammas from 115 to 11500 km")
 
 # %% [markdown]
@@ -506,25 +507,25 @@ never = float(np.nanmax(h2i))
 for l_i, lvl in enumerate(study.levels):
     print(f"dt for H2 = 0.1 deg per sample at level {lvl:g}: {np.nanmin(dt01[:, :, l_i]) * TU_MIN:.0f}-"
           f"{np.nanmax(dt01[:, :, l_i]) * TU_MIN:.0f} min over orbits and structures")
-table.add("sensitivity study (orbit, disturbance, dt)", "not stated", f"{len(names)} orbits x "
+table.add_typed("sensitivity study (orbit, disturbance, dt)", "not stated", f"{len(names)} orbits x "
           f"{len(study.structures)} structures x {len(study.levels)} levels, {study.seconds:.0f} s, "
           f"{n_opt}/{2 * study.h2_kappa.size} optimal", "beyond paper", "theta1-only LMIs, Clarabel")
 band = (GAMMA / np.sin(np.radians(0.085)), GAMMA / np.sin(np.radians(0.075)))
 spread = float(np.nanmax(np.abs(hinf / hinf[:, :1, :1] - 1)))
 n_hinf_ok = int(ok_hinf[:, 0, 0].sum())
-table.add("where Hinf = 0.08 deg", "0.08 deg", f"{n_hinf_ok} of {len(names)} orbits: "
+table.add_typed("where Hinf = 0.08 deg", "0.08 deg", f"{n_hinf_ok} of {len(names)} orbits: "
           f"{', '.join(names[i] for i in np.nonzero(ok_hinf[:, 0, 0])[0]) or 'none'}",
           "consistent (tuned): only on the orbits listed" if n_hinf_ok else "differs: on no orbit tried",
           f"band [0.075, 0.085) fixed before; needs max r13 in [{band[0]:.3f}, {band[1]:.3f}] LU (unbounded-gain "
           f"limit); disturbance structure and level change it by at most {spread:.0e} (relative)")
 h2_int_ok = bool(np.any((h2i >= 0.05) & (h2i < 0.15)))
-table.add("where H2 = 0.1 deg", "0.1 deg", f"{'in' if h2_int_ok else 'never in'} [0.05, 0.15) deg as an intensity "
+table.add_typed("where H2 = 0.1 deg", "0.1 deg", f"{'in' if h2_int_ok else 'never in'} [0.05, 0.15) deg as an intensity "
           f"(max {never:.3f} deg); per sample at dt = {np.nanmin(dt01) * TU_MIN:.0f}-{np.nanmax(dt01) * TU_MIN:.0f} min",
           "differs: never as an intensity; matches only per sample at a chosen dt (consistent (tuned) there)"
           if not h2_int_ok else "consistent (tuned): as an intensity on some orbits/disturbances",
           "band [0.05, 0.15) fixed before; range over orbits, structures and levels; the per-sample reading needs a "
           "sampling interval, which the paper does not state")
-_ = table.add("both numbers and H2 > Hinf together", "yes", f"{len(hits)} of {ok_all.size} cases, e.g. "
+_ = table.add_typed("both numbers and H2 > Hinf together", "yes", f"{len(hits)} of {ok_all.size} cases, e.g. "
               + (f"{hits[0][0]}, dt {hits[0][3]:.0f}-{hits[0][4]:.0f} min" if hits else "none"),
               "consistent (tuned): only in the cases listed" if hits else "differs: no tried combination reproduces both",
               f"only with the per-sample reading of H2, on an orbit with max r13 in [{band[0]:.2f}, {band[1]:.2f}] LU, "

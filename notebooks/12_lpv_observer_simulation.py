@@ -19,7 +19,7 @@
 # compares (beyond the paper).
 #
 # **Paper sections followed.** Nychka & Bhattacharya (arXiv 2410.02013) §IV-B, Fig. 3 (a-c) and the text around
-# it; observer Eq. 3a. All computation lives in `cislunar.lpv` and `cislunar.observers`.
+# it; observer Eq. 3a. All computation lives in `cislunar.estimation.lpv` and `cislunar.estimation.observers`.
 
 # %% tags=["parameters"]
 QUICK = False
@@ -38,10 +38,15 @@ import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from cislunar import lpv, plotting
-from cislunar.observers import make_measurements, simulate_ekf, simulate_lpv_observer
-from cislunar.propagation import propagate
-from cislunar.report import ComparisonTable
+from cislunar.cr3bp.propagation import propagate
+from cislunar.estimation import lpv
+from cislunar.estimation.observers import (
+    make_measurements,
+    simulate_ekf,
+    simulate_lpv_observer,
+)
+from cislunar.publish import plotting
+from cislunar.publish.report import ComparisonTable
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -73,7 +78,7 @@ for n, d in des.items():
     print(f"{n:4s}: {d.status}; kappa {d.kappa[:2].round(1)}, Eq. 24 noise {d.noise_deg[0]:.4f} deg, "
           f"|L| = {d.gain_norm:.1f}; verified: max Re eig {v.max_real_eig:.2f}, worst {n} {v.worst:.3e} < {GAMMA}: "
           f"{v.passed}")
-    table.add(f"{n} gain: solve status and verification", "-", f"{d.status}, |L| = {d.gain_norm:.0f}, worst {n} "
+    table.add_typed(f"{n} gain: solve status and verification", "-", f"{d.status}, |L| = {d.gain_norm:.0f}, worst {n} "
               f"norm {v.worst:.2e}", "beyond paper" if v.passed and d.optimal else "differs: verification failed",
               "Hinf with bandwidth bound R = 1000/TU" if n == "hinf" else "no gain bound")
 
@@ -98,7 +103,7 @@ print(f"dt = {DT} TU ({DT * TU_MIN:.1f} min): H2 allows {h2_ps:.3f} deg per samp
       f"{des['h2'].noise_deg[0]:.4f} deg); Hinf allows {hinf_n:.4f} deg RMS")
 print(f"the simulated {SIGMA_DEG} deg is {SIGMA_DEG / h2_ps:.2f}x the H2 and {SIGMA_DEG / hinf_n:.2f}x the Hinf "
       "allowance")
-_ = table.add("ordering of allowances at the simulated dt", "H2 0.1 > Hinf 0.08 deg", f"H2 {h2_ps:.2f} deg per sample > "
+_ = table.add_typed("ordering of allowances at the simulated dt", "H2 0.1 > Hinf 0.08 deg", f"H2 {h2_ps:.2f} deg per sample > "
               f"Hinf {hinf_n:.3f} deg" if h2_ps > hinf_n else f"H2 {h2_ps:.3f} < Hinf {hinf_n:.3f} deg",
               f"differs: only the ordering agrees; H2 allows {h2_ps:.2f} deg per sample, {h2_ps / 0.1:.1f}x the paper's "
               "0.1 deg" if h2_ps > hinf_n else "differs: reversed",
@@ -332,7 +337,7 @@ for n, label in (("h2", "H2"), ("hinf", "Hinf")):
     if not conv_ok:
         why += (f" (set by the initial error {e0 * KM:.0f} km and the slowest pole {decay[n]:.1f}/TU: predicted "
                 f"{t_pred[n]:.2f} TU" + (f"; no noise, exact rho {first_clean:.2f} TU" if n == "h2" else "") + ")")
-    table.add(f"{label}: converges rapidly and stays accurate", "yes (Fig. 3)",
+    table.add_typed(f"{label}: converges rapidly and stays accurate", "yes (Fig. 3)",
               f"first below guarantee at {first[n]:.2f} TU ({100 * first[n] / span:.1f} % of period); RMS after "
               f"{rms[n] * KM:.0f} km vs guaranteed {bound[n] * KM:.0f} km",
               "reproduced" if conv_ok and stay_ok else f"differs: {why}",
@@ -365,7 +370,7 @@ for n, d in des.items():
 print(f"dt = {DT_01:.4f} TU ({DT_01 * TU_MIN:.0f} min), {t_w.size} samples: H2 allows "
       f"{des['h2'].noise_per_sample_deg(DT_01)[0]:.3f} deg per sample, Hinf {hinf_n:.4f} deg; median error after 10 % "
       f"of the run: H2 {med_w['h2'] * KM:.0f} km, Hinf {med_w['hinf'] * KM:.0f} km")
-table.add("Hinf error larger than H2", "yes (Fig. 3c)", f"median {med['hinf'] * KM:.0f} vs {med['h2'] * KM:.0f} km "
+table.add_typed("Hinf error larger than H2", "yes (Fig. 3c)", f"median {med['hinf'] * KM:.0f} vs {med['h2'] * KM:.0f} km "
           f"at dt = {DT * TU_MIN:.1f} min; {med_w['hinf'] * KM:.0f} vs {med_w['h2'] * KM:.0f} km at dt = "
           f"{DT_01 * TU_MIN:.0f} min",
           "reproduced" if med["hinf"] > med["h2"] and med_w["hinf"] > med_w["h2"] else
@@ -374,19 +379,19 @@ table.add("Hinf error larger than H2", "yes (Fig. 3c)", f"median {med['hinf'] * 
           f"0.1 deg noise is {SIGMA_DEG / h2_ps:.2f}x (dt {DT * TU_MIN:.1f} min) and "
           f"{SIGMA_DEG / des['h2'].noise_per_sample_deg(DT_01)[0]:.2f}x (dt {DT_01 * TU_MIN:.0f} min) the H2 and "
           f"{SIGMA_DEG / hinf_n:.2f}x the Hinf allowance")
-table.add("rho from estimate where |sin th3| < 0.04", "used", f"{100 * frac:.1f} % of samples", "derived",
+table.add_typed("rho from estimate where |sin th3| < 0.04", "used", f"{100 * frac:.1f} % of samples", "derived",
           "threshold 0.04 taken from the paper; triangulation singular near the Earth-Moon line")
 ok_no_range = all(not d.used[4:].any() and not np.any(d.gain()[:, 4:]) for d in des.values())
 conv = {n: med[n] < 0.1 * e0 for n in ("h2", "hinf")}
-table.add("observers function without range sensors", "yes (Fig. 3)",
+table.add_typed("observers function without range sensors", "yes (Fig. 3)",
           f"gain columns of r13^2, r23^2 {'zero' if ok_no_range else 'non-zero'}; median error after 10 % of the run "
           f"H2 {med['h2'] * KM:.0f}, Hinf {med['hinf'] * KM:.0f} km from {e0 * KM:.0f} km",
           "reproduced" if ok_no_range and all(conv.values()) else "differs: range channels used or no convergence",
           "criterion fixed before: no range channel in the gains and the median error after 10 % of the run below "
           "a tenth of the initial error; only theta1, theta2 measured")
-table.add("EKF on same angles", "-", f"RMS {ekf_rms * KM:.0f} km after 10 % of the run", "beyond paper",
+table.add_typed("EKF on same angles", "-", f"RMS {ekf_rms * KM:.0f} km after 10 % of the run", "beyond paper",
           "continuous-discrete EKF, sigma_acc = 1e-3 LU/TU^2")
-_ = table.add("measurement interval", "not stated", f"{DT} TU ({DT * TU_MIN:.1f} min)", "not in paper",
+_ = table.add_typed("measurement interval", "not stated", f"{DT} TU ({DT * TU_MIN:.1f} min)", "not in paper",
               "choice of this reproduction; continuous sensor, noise held over each interval")
 
 # %%

@@ -24,8 +24,7 @@ def selected_notebooks():
     ``CISLUNAR_TEST_NOTEBOOKS=01,04 pytest tests/test_book.py`` builds and checks a book of two notebooks only (for
     working on the book); ``make test`` leaves it unset and covers every notebook.
     """
-    from cislunar import notebooks
-
+    from cislunar.publish import notebooks
     names = [n.strip() for n in os.environ.get("CISLUNAR_TEST_NOTEBOOKS", "").split(",") if n.strip()]
     return notebooks.discover(names or None)
 
@@ -46,8 +45,7 @@ class QuickRuns:
         self.state.mkdir(parents=True, exist_ok=True)
 
     def _run(self, source: Path) -> dict:
-        from cislunar import notebooks
-
+        from cislunar.publish import notebooks
         try:
             res = notebooks.run_notebook(source, quick=True, seed=0, output_dir=self.build)
         except Exception as exc:  # recorded here, reported by the notebook's own test

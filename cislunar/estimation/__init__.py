@@ -1,0 +1,1 @@
+"""Estimation: SRIF, the OCBE (single and batched), adaptive OCBE, NEES consistency, LPV models and observers."""

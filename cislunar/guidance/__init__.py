@@ -1,0 +1,1 @@
+"""Guidance: first-order-hold discretisation, successive convexification, SSAT and MMD guidance."""

@@ -1,0 +1,1 @@
+"""Sensing: observer sites, measurement models, covariance recursions and mutual information."""
