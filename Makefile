@@ -1,8 +1,9 @@
 # Two commands on a fresh machine with python3 (3.11) and make:
 #   make reproduce   every notebook at full fidelity -> build/notebooks, build/figures, build/report.md,
-#                    then the static HTML book build/book/index.html (checked by tests/publish/test_book.py)
+#                    then the static HTML book build/book/index.html (checked by tests/publish/test_book.py).
+#                    The run is staged and replaces build/ only when every notebook succeeded; Ctrl-C ends it.
 #   make test        unit tests + every notebook in quick mode + a book built from them, all in a temporary
-#                    directory (build/ only ever holds a full run)
+#                    directory; it fails if it left anything in the repository outside .venv/ (its scratch)
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
@@ -15,7 +16,11 @@ export MKL_NUM_THREADS ?= 1
 export PYTHONHASHSEED := 0
 export JUPYTER_PREFER_ENV_PATH := 1
 
-.PHONY: all test unit notebooks-quick reproduce notebooks book check-book bench clean distclean venv
+.PHONY: all test unit notebooks-quick reproduce notebooks notebook book check-book bench clean distclean venv
+# pytest's cache (the quick notebooks' last run times) lives in the venv, the one scratch folder of `make test`
+PYTEST := $(PY) -m pytest -o cache_dir=$(VENV)/pytest-cache
+# What `make test` may leave behind: nothing but .venv/ (compared before and after)
+REPO_STATE = git status --porcelain --ignored 2>/dev/null | grep -v '^!! \.venv/$$' || true
 
 all: test
 
@@ -30,10 +35,15 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 test: $(STAMP)
-	$(PY) -m pytest -n 2 --dist loadgroup tests
+	@$(REPO_STATE) > $(VENV)/repo-state-before
+	@$(PYTEST) -n 2 --dist loadgroup tests; status=$$?; \
+	$(REPO_STATE) > $(VENV)/repo-state-after; \
+	if ! cmp -s $(VENV)/repo-state-before $(VENV)/repo-state-after; then \
+	    echo "make test changed the repository outside .venv/:"; diff $(VENV)/repo-state-before $(VENV)/repo-state-after; \
+	    exit 1; fi; exit $$status
 
 unit: $(STAMP)
-	$(PY) -m pytest -n 2 -m "not notebook" tests
+	$(PYTEST) -n 2 -m "not notebook" tests
 
 # Quick mode into build-quick/ (never build/).
 notebooks-quick: $(STAMP)
@@ -43,6 +53,11 @@ reproduce: notebooks book check-book
 
 notebooks: $(STAMP)
 	$(PY) -m cislunar.publish.notebooks
+
+# One notebook (or several), full fidelity into build/ unless ARGS says --quick:
+#   make notebook NB=05 ARGS="-p N_NODES=24"      make notebook NB="01 04" ARGS=--quick
+notebook: $(STAMP)
+	$(PY) -m cislunar.publish.notebooks $(NB) $(ARGS)
 
 # Rebuild build/book from the executed notebooks in build/notebooks, without executing anything.
 book: $(STAMP)
@@ -56,7 +71,8 @@ bench: $(STAMP)
 	$(PY) -m benchmarks
 
 clean:
-	rm -rf build build-quick .pytest_cache .hypothesis
+	rm -rf build build-quick build-scratch build-incomplete build-quick-incomplete build.staging-* \
+	    build-quick.staging-* .build*.old-* .pytest_cache .hypothesis
 
 distclean: clean
 	rm -rf $(VENV) *.egg-info

@@ -16,7 +16,13 @@ release = os.environ.get("CISLUNAR_BOOK_RELEASE", "")
 extensions = [
     "myst_nb",
     "sphinx.ext.mathjax",
+    "sphinx.ext.autodoc",  # the API reference pages (api/), from the package's docstrings
+    "sphinx.ext.napoleon",  # which are numpydoc
 ]
+napoleon_google_docstring = False
+napoleon_numpy_docstring = True
+autodoc_member_order = "bysource"
+autodoc_typehints = "none"  # the docstrings state types with units
 
 # Notebooks are executed by cislunar.publish.notebooks (papermill); the book only renders them.
 nb_execution_mode = "off"

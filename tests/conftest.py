@@ -1,3 +1,4 @@
+import dataclasses
 import fcntl
 import json
 import os
@@ -12,7 +13,7 @@ os.environ.setdefault("JUPYTER_PREFER_ENV_PATH", "1")
 try:
     from hypothesis import settings
 
-    settings.register_profile("ci", deadline=None, max_examples=40, derandomize=True)
+    settings.register_profile("ci", deadline=None, max_examples=40, derandomize=True, database=None)
     settings.load_profile("ci")
 except ImportError:  # pragma: no cover
     pass
@@ -44,10 +45,23 @@ class QuickRuns:
         self.state = root / "state"
         self.state.mkdir(parents=True, exist_ok=True)
 
+    def run(self):
+        """The session's one run (shared by both xdist workers), so its quick build is a build of one run."""
+        from cislunar.publish import provenance
+        from cislunar.utils import paths
+
+        path = self.state / "run.json"
+        with open(self.state / "run.lock", "a+") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            if not path.is_file():
+                run = provenance.new_run(quick=True, seed=0, root=paths.repo_root())
+                path.write_text(json.dumps(dataclasses.asdict(run)))
+        return provenance.RunInfo(**json.loads(path.read_text()))
+
     def _run(self, source: Path) -> dict:
         from cislunar.publish import notebooks
         try:
-            res = notebooks.run_notebook(source, quick=True, seed=0, output_dir=self.build)
+            res = notebooks.run_notebook(source, quick=True, seed=0, output_dir=self.build, run=self.run())
         except Exception as exc:  # recorded here, reported by the notebook's own test
             return {"ok": False, "error": f"{type(exc).__name__}: {exc}"}
         return {"ok": True, "report": res.report_markdown, "seconds": res.seconds}

@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import copy
 import json
+import pkgutil
 import re
 import shutil
 import subprocess
@@ -32,12 +33,16 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import cislunar
 from cislunar.publish import notebooks as runner
+from cislunar.publish import provenance
+from cislunar.publish.claims import STATUSES
+from cislunar.publish.report import REPORT_METADATA_KEY
 from cislunar.utils import paths
 
 __all__ = ["BookError", "NotebookEntry", "read_entries", "stage", "build_book", "main"]
 
-_STATUS_WORDS = ("reproduced", "consistent (tuned)", "differs", "derived", "not in paper", "beyond paper")
+_STATUS_WORDS = STATUSES
 
 
 class BookError(RuntimeError):
@@ -230,13 +235,21 @@ def clean_notebook(nb: dict, build: Path, *, source_name: str) -> dict:
             cell["source"] = src
         if cell.get("outputs"):
             cell["outputs"] = _terminal_streams(cell["outputs"])
+        if cell["cell_type"] == "code" and any(o.get("metadata", {}).get(REPORT_METADATA_KEY)
+                                               for o in cell.get("outputs", [])):
+            meta = cell.setdefault("metadata", {})
+            meta["tags"] = sorted(set(meta.get("tags", [])) | {"hide-input"})  # the table shows; its code folds
     mode, seconds = _notebook_mode(nb)
     how = {"full": " at full fidelity", "quick": " in **quick mode**"}.get(mode, "")
     took = f" in {seconds:.0f} s" if seconds is not None else ""
     caveat = (" Quick mode shrinks sample sizes and grids but runs the same science; `make reproduce` gives the "
               "paper-scale numbers." if mode == "quick" else "")
+    run = nb.get("metadata", {}).get(provenance.METADATA_KEY, {})
+    origin = (f" Run {run['run_id']}, commit {run.get('commit', 'unknown')}, started {run.get('started', '?')}."
+              if run.get("run_id") else "")
     note = (f"```{{note}}\nExecuted headless{how}{took} by `python -m cislunar.publish.notebooks` from "
-            f"`notebooks/{source_name}.py`; the book shows that run without executing anything again.{caveat}\n```")
+            f"`notebooks/{source_name}.py`; the book shows that run without executing anything again.{origin}"
+            f"{caveat}\n```")
     banner = {"cell_type": "markdown", "id": "cislunar-book-run-note", "metadata": {}, "source": note}
     first_md = next((i for i, c in enumerate(nb["cells"]) if c["cell_type"] == "markdown"), -1)
     nb["cells"].insert(first_md + 1, banner)
@@ -282,7 +295,7 @@ def _index_markdown(entries: list[NotebookEntry], build: Path) -> str:
     lines += ["```{toctree}", ":hidden:", ":caption: Notebooks", ""]
     lines += [f"notebooks/{e.name}" for e in entries if e.executed]
     lines += ["```", "", "```{toctree}", ":hidden:", ":caption: Results and references", "", "report", "papers",
-              "```", ""]
+              "api/index", "```", ""]
     return "\n".join(lines)
 
 
@@ -299,7 +312,30 @@ def _report_markdown(build: Path, titles: dict) -> str:
             return f"## [{titles[name]}](notebooks/{name}.ipynb){m.group(2)}"
         return m.group(0)
 
-    return re.sub(r"^## (\d\d_\w+)(.*)$", link, text, flags=re.MULTILINE)
+    body = re.sub(r"^## (\d\d[a-z]?_\w+)(.*)$", link, text, flags=re.MULTILINE)
+    return _insert_summary(body, build, titles)
+
+
+def _insert_summary(report: str, build: Path, titles: dict) -> str:
+    """A table of status counts per notebook (and in total) placed before the first section of the report."""
+    rows, total = [], {}
+    for path in sorted((build / "report").glob("*.md")):
+        counts = _statuses(path.read_text())
+        for k, v in counts.items():
+            total[k] = total.get(k, 0) + v
+        title = titles.get(path.stem, path.stem)
+        rows.append([f"[{title}](notebooks/{path.stem}.ipynb)" if path.stem in titles else title]
+                    + [str(counts.get(w, 0)) for w in _STATUS_WORDS])
+    if not rows:
+        return report
+    head = "| notebook | " + " | ".join(_STATUS_WORDS) + " |"
+    lines = ["## Summary", "", "Rows of each closing table by status word.", "", head,
+             "|---|" + "---:|" * len(_STATUS_WORDS)]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    lines.append("| **total** | " + " | ".join(f"**{total.get(w, 0)}**" for w in _STATUS_WORDS) + " |")
+    summary = "\n".join(lines) + "\n\n"
+    m = re.search(r"^## ", report, flags=re.MULTILINE)
+    return report[:m.start()] + summary + report[m.start():] if m else report + "\n" + summary
 
 
 def _papers_markdown() -> str:
@@ -362,7 +398,39 @@ def stage(build: Path) -> Path:
     (src / "index.md").write_text(_index_markdown(entries, build))
     (src / "report.md").write_text(_report_markdown(build, {e.name: e.title for e in entries if e.executed}))
     (src / "papers.md").write_text(_papers_markdown())
+    _write_api_pages(src / "api")
     return src
+
+
+def _api_modules() -> dict:
+    """``{wing: [module names]}`` of the package, found on disk (wings in the order a reader meets them)."""
+    order = ["cr3bp", "sensing", "estimation", "guidance", "papers", "publish", "utils"]
+    found: dict = {w: [] for w in order}
+    for info in pkgutil.walk_packages(cislunar.__path__, "cislunar."):
+        parts = info.name.split(".")
+        if info.ispkg or parts[-1].startswith("_") or len(parts) < 3:
+            continue
+        found.setdefault(parts[1], []).append(info.name)
+    return {w: sorted(m) for w, m in found.items() if m}
+
+
+def _write_api_pages(folder: Path) -> None:
+    """One page per module, rendered by autodoc from its numpydoc docstrings (napoleon), under ``api/``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    wings = _api_modules()
+    index = ["# API reference", "",
+             "Every module of the package, from its docstrings (numpydoc: parameters with units and frames). "
+             "Methods come first, by family; then one package per paper, publishing and utilities.", ""]
+    toc = ["```{toctree}", ":maxdepth: 1", ""]
+    for wing, modules in wings.items():
+        index += [f"## {wing}", ""]
+        for mod in modules:
+            index.append(f"- [{mod}]({mod}.md)")
+            toc.append(mod)
+            (folder / f"{mod}.md").write_text(f"# {mod}\n\n```{{eval-rst}}\n.. automodule:: {mod}\n   :members:\n"
+                                              f"   :show-inheritance:\n```\n")
+        index.append("")
+    (folder / "index.md").write_text("\n".join(index + ["", *toc, "```", ""]))
 
 
 def _work_dir(build: Path) -> Path:
@@ -385,7 +453,7 @@ def _mathjax_dir() -> Path:
     raise BookError("sphinx-mathjax-offline is installed but holds no mathjax/tex-chtml.js")
 
 
-def build_book(build_dir=None, *, out_dir=None, quiet: bool = True) -> Path:
+def build_book(build_dir=None, *, out_dir=None, quiet: bool = True, expected=None) -> Path:
     """Stage and render the book; returns ``<out>/index.html``.
 
     Parameters
@@ -396,13 +464,22 @@ def build_book(build_dir=None, *, out_dir=None, quiet: bool = True) -> Path:
         Where the HTML goes (default ``<build>/book``).
     quiet : bool
         Pass ``-q`` to Sphinx (warnings are still printed).
+    expected : iterable of str, optional
+        Notebooks the build must hold (default: every notebook source).
 
     Raises
     ------
+    cislunar.publish.provenance.IncompleteBuildError
+        When the build is partial, holds a failed notebook or mixes runs (:func:`provenance.audit_build`); the
+        message names every problem.
     BookError
         When there is nothing to build, a tool is missing, or Sphinx fails (its output is in the message).
     """
     build = paths.build_dir(build_dir)
+    names = [s.stem for s in runner.discover()] if expected is None else list(expected)
+    problems = provenance.audit_build(build, names)
+    if problems:
+        raise provenance.IncompleteBuildError(build, problems)
     out = Path(out_dir) if out_dir is not None else build / "book"
     mathjax = _mathjax_dir()
     src = stage(build)
@@ -452,7 +529,7 @@ def main(argv=None) -> int:
     start = time.perf_counter()
     try:
         index = build_book(args.build_dir, out_dir=args.out_dir, quiet=not args.verbose)
-    except BookError as exc:
+    except (BookError, provenance.IncompleteBuildError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
     print(f"book: {index} ({time.perf_counter() - start:.1f} s)", flush=True)

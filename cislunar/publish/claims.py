@@ -156,8 +156,10 @@ class Within(Criterion):
 
     def probes(self, standard_error: float = 0.0):
         h = self.half_width(standard_error)
-        eps = max(h * 1e-3, 1e-9 * max(abs(self.target), 1.0))
-        return (self.target + h - eps if h > 0 else self.target), self.target + h + eps
+        if h > 0:  # a thousandth of the half width, never below the float spacing at the edge
+            eps = max(h * 1e-3, 8 * float(np.spacing(abs(self.target) + h)))
+            return self.target + h - eps, self.target + h + eps
+        return self.target, self.target + max(abs(self.target) * 1e-6, 1e-300)
 
 
 @dataclass(frozen=True)

@@ -48,7 +48,8 @@ def save_figure(fig, name: str, *, output_dir=None, formats=("png",)) -> list[Pa
     name : str
         File stem, e.g. ``"01_dro_family"``; letters, digits, ``_`` and ``-`` only.
     output_dir : path-like, optional
-        Build directory (default ``build/`` under the repository root).
+        Build directory (the runner passes its build); default: the scratch folder of hand runs
+        (``build-scratch/`` in a checkout, :func:`cislunar.utils.paths.scratch_dir`), never ``build/``.
     formats : sequence of str
         File formats among ``png``, ``pdf`` and ``svg``.
 

@@ -27,7 +27,7 @@ from urllib.parse import unquote, urlsplit
 import pytest
 from conftest import selected_notebooks
 
-from cislunar.publish import book, notebooks
+from cislunar.publish import book, notebooks, provenance
 from cislunar.utils import paths
 
 SOURCES = selected_notebooks()
@@ -485,13 +485,51 @@ def built(quick_runs):
         if not marker.is_file():
             notebooks.assemble_report(build)
             start = time.perf_counter()
-            book.build_book(build)
+            book.build_book(build, expected=[s.stem for s in SOURCES])
             marker.write_text(json.dumps({"seconds": time.perf_counter() - start}))
     seconds = json.loads(marker.read_text())["seconds"]
     print(f"\nbook built from {len(results)} quick notebooks in {seconds:.1f} s")
     ok = sorted(name for name, r in results.items() if r["ok"])
     return build, build / "book", ok, seconds
 
+
+
+@pytest.mark.notebook
+@pytest.mark.xdist_group("book")
+def test_the_build_is_complete_and_of_one_run(built):
+    """What the book was made from: every notebook ran, all in one run, each page and section saying which."""
+    build, out, ok, _ = built
+    assert provenance.audit_build(build, [s.stem for s in SOURCES]) == []
+    run = {r["run_id"] for r in provenance.read_records(build).values()}
+    assert len(run) == 1
+    (run_id,) = run
+    for name in ok:
+        assert run_id in (out / "notebooks" / f"{name}.html").read_text(), name
+    assert run_id in (out / "report.html").read_text()
+
+
+def test_the_book_refuses_a_partial_or_mixed_build(tmp_path):
+    from cislunar.publish.claims import Claim
+
+    run_a = provenance.new_run(quick=True, seed=0, root=paths.repo_root())
+    run_b = provenance.new_run(quick=True, seed=0, root=paths.repo_root())
+    build = tmp_path / "b"
+    for name, run in (("01_a", run_a), ("02_b", run_b)):
+        (build / "notebooks").mkdir(parents=True, exist_ok=True)
+        (build / "report").mkdir(exist_ok=True)
+        (build / "notebooks" / f"{name}.ipynb").write_text(json.dumps(
+            {"cells": [], "metadata": {"cislunar": {"run_id": run.run_id}}, "nbformat": 4, "nbformat_minor": 5}))
+        row = Claim("x", kind="derived").judge(1.0)
+        (build / "report" / f"{name}.md").write_text(f"## {name}\n\n{provenance.provenance_line(run, 1)}\n\n{row}\n")
+        provenance.write_record(build, name, run, status="ok", seconds=1)
+    with pytest.raises(provenance.IncompleteBuildError, match="mixed build"):
+        book.build_book(build, expected=["01_a", "02_b"])
+    with pytest.raises(provenance.IncompleteBuildError, match="03_c: missing"):
+        book.build_book(build, expected=["01_a", "03_c"])
+    provenance.write_record(build, "01_a", run_a, status="interrupted", seconds=1)
+    err = pytest.raises(provenance.IncompleteBuildError, book.build_book, build, expected=["01_a"])
+    assert "01_a: interrupted" in str(err.value)
+    assert book.main(["--build-dir", str(build)]) == 1
 
 
 @pytest.mark.notebook

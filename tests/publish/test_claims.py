@@ -16,7 +16,8 @@ from cislunar.publish.report import ComparisonTable
 
 
 @pytest.mark.parametrize("criterion", [
-    C.Within(1.2, 0.05), C.Within(1.2, 0.05, relative=True), C.Within(-3.0, 0.0), C.Within(10.0, 0.1, n_sigma=2),
+    C.Within(1.2, 0.05), C.Within(1.2, 0.05, relative=True), C.Within(-3.0, 0.0), C.Within(1e-11, 5e-12),
+    C.Within(1e-20, 0.0), C.Within(6.5e5, 1e-9), C.Within(10.0, 0.1, n_sigma=2),
     C.AtMost(0.1), C.AtMost(-2.0, n_sigma=1), C.AtLeast(0.9), C.AtLeast(0.0), C.Between(0.2, 0.4),
     C.Holds("the bound is met"), C.Holds("diverges", expected=False), C.Equals(3), C.Equals("reading B"),
 ])

@@ -75,17 +75,24 @@ def test_quick_runs_never_write_into_build(tmp_path):
     assert notebooks.main(["--quick", "--output-dir", str(full), "01"]) == 2
 
 
-def test_report_says_which_mode_made_it(tmp_path):
+def test_report_says_which_mode_and_run_made_it(tmp_path):
+    from cislunar.publish import provenance
+
+    full = provenance.new_run(quick=False, seed=0, root=paths.repo_root())
+    quick = provenance.new_run(quick=True, seed=0, root=paths.repo_root())
     rep = tmp_path / "report"
     rep.mkdir()
-    (rep / "01_a.md").write_text("## 01_a (full mode, 3 s)\n\n| quantity | paper | reproduced | status |\n")
+    table = "| quantity | paper | reproduced | status |\n"
+    (rep / "01_a.md").write_text(f"## 01_a\n\n{provenance.provenance_line(full, 3)}\n\n{table}")
     text = notebooks.assemble_report(tmp_path).read_text()
-    assert "**Mode: full.**" in text
-    (rep / "02_b.md").write_text("## 02_b (quick mode, 1 s)\n\n| quantity | paper | reproduced | status |\n")
+    assert "**Mode: full.**" in text and f"Run {full.run_id}, commit {full.commit}" in text
+    assert "Incomplete" not in text and "Mixed" not in text
+    (rep / "02_b.md").write_text(f"## 02_b\n\n{provenance.provenance_line(quick, 1)}\n\n{table}")
     text = notebooks.assemble_report(tmp_path).read_text()
-    assert "**Mode: mixed.**" in text and "01_a (full mode" in text and "02_b (quick mode" in text
+    assert "**Mode: mixed.**" in text and "**Mixed runs.**" in text and full.run_id in text and quick.run_id in text
     (rep / "01_a.md").unlink()
-    assert "**Mode: quick.**" in notebooks.assemble_report(tmp_path).read_text()
+    text = notebooks.assemble_report(tmp_path, expected=["01_a", "02_b"]).read_text()
+    assert "**Mode: quick.**" in text and "**Incomplete build.**" in text and "missing: 01_a" in text
 
 
 def test_headless_kernel_environment(monkeypatch):

@@ -24,9 +24,11 @@ def test_save_figure_resolves_from_repo_root_and_is_deterministic(tmp_path, monk
     (p2,) = plotting.save_figure(fig, "test_determinism", output_dir=tmp_path / "b")
     assert p1 == p2 and p2.read_bytes() == first
     assert p1.parent == tmp_path / "b" / "figures"
-    default = paths.figures_dir()
-    assert default == paths.repo_root() / "build" / "figures"
     assert (paths.repo_root() / "pyproject.toml").is_file()
+    monkeypatch.setenv("CISLUNAR_ROOT", str(tmp_path / "repo"))  # a hand run: the scratch folder, never build/
+    (p3,) = plotting.save_figure(fig, "test_determinism")
+    assert p3 == tmp_path / "repo" / "build-scratch" / "figures" / "test_determinism.png"
+    assert p3.read_bytes() == first
     plt.close(fig)
 
 

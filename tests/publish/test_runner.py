@@ -1,0 +1,142 @@
+"""The command-line runner: parameters, a staging folder that replaces the build only when everything ran,
+provenance in every output, per-cell time limits, and Ctrl-C that ends every process of the run."""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from cislunar.publish import notebooks, provenance
+
+pytestmark = pytest.mark.xdist_group("runner")
+
+HEADER = '# %% tags=["parameters"]\nQUICK = False\nSEED = 0\nOUTPUT_DIR = ""\n{extra}\n'
+TABLE = ("# %%\nfrom cislunar.publish.claims import Claim\nfrom cislunar.publish.report import ComparisonTable\n"
+         "ComparisonTable('t').add(Claim('x [-]', kind='derived').judge({value})).display()\n")
+
+
+def source(folder: Path, name: str, body: str = "", extra: str = "", value: str = "1") -> Path:
+    path = folder / f"{name}.py"
+    path.write_text(HEADER.format(extra=extra) + ("\n# %%\n" + body + "\n" if body else "") + "\n"
+                    + TABLE.format(value=value))
+    return path
+
+
+def test_parameters_are_parsed_and_checked(tmp_path):
+    assert notebooks.parse_parameter("N_NODES=24") == ("N_NODES", 24)
+    assert notebooks.parse_parameter("SIGMAS=(1e-3, 2)") == ("SIGMAS", (1e-3, 2))
+    assert notebooks.parse_parameter("LABEL=dro") == ("LABEL", "dro")
+    with pytest.raises(ValueError, match="NAME=VALUE"):
+        notebooks.parse_parameter("N_NODES")
+    with pytest.raises(ValueError, match="identifier"):
+        notebooks.parse_parameter("2N=3")
+    src = source(tmp_path, "90_a", extra="N_NODES = 12\nWORKERS = 2")
+    assert set(notebooks.parameter_names(src)) == {"QUICK", "SEED", "OUTPUT_DIR", "N_NODES", "WORKERS"}
+    assert notebooks._workers_asked(src, {}) == 2 and notebooks._workers_asked(src, {"WORKERS": 1}) == 1
+    with pytest.raises(ValueError, match="has no parameter N_NODE"):
+        notebooks.run_notebook(src, quick=True, output_dir=tmp_path / "b", parameters={"N_NODE": 3})
+
+
+def test_a_parameter_changes_the_output_and_provenance_is_recorded(tmp_path):
+    src = source(tmp_path, "90_param", extra="N_NODES = 12", body="print('nodes', N_NODES)",
+                 value="N_NODES")
+    res = notebooks.run_notebook(src, quick=True, output_dir=tmp_path / "b", parameters={"N_NODES": 7})
+    text = res.executed_path.read_text()
+    assert "nodes 7" in text and "nodes 12" not in text
+    meta = json.loads(text)["metadata"]["cislunar"]
+    rec = provenance.read_records(tmp_path / "b")["90_param"]
+    assert meta["run_id"] == rec["run_id"] and rec["status"] == "ok" and meta["mode"] == "quick"
+    section = (tmp_path / "b" / "report" / "90_param.md").read_text()
+    assert provenance.parse_provenance_line(section)["run_id"] == rec["run_id"]
+    assert "| x [-] | - | 7 | derived |" in section
+    assert provenance.audit_build(tmp_path / "b", ["90_param"]) == []
+
+
+def test_a_hung_cell_ends_with_an_error_naming_the_notebook_and_cell(tmp_path):
+    src = source(tmp_path, "91_hang", body="import time\ntime.sleep(60)")
+    start = time.monotonic()
+    with pytest.raises(notebooks.NotebookFailure, match=r"91_hang: cell \d+ .*'import time'.*time limit of 2 s"):
+        notebooks.run_notebook(src, quick=True, output_dir=tmp_path / "b", timeout=2)
+    assert time.monotonic() - start < 40
+    assert provenance.read_records(tmp_path / "b")["91_hang"]["status"] == "failed"
+
+
+def test_the_build_is_replaced_only_when_everything_ran(tmp_path):
+    ok_a, ok_b = source(tmp_path, "92_a"), source(tmp_path, "92_b", value="2")
+    target = tmp_path / "build-quick"
+    log = io.StringIO()
+    assert notebooks.run_all([ok_a, ok_b], quick=True, output_dir=target, out=log, heartbeat=0) == 0
+    assert provenance.audit_build(target, ["92_a", "92_b"]) == []
+    first = provenance.read_records(target)["92_a"]["run_id"]
+    assert "Run " + first in (target / "report.md").read_text()
+    assert (target / "logs" / "92_a.log").is_file()
+    assert not list(tmp_path.glob("build-quick.staging-*"))
+    # a failing notebook: the previous build stays as it was, the attempt is set aside and says what is missing
+    bad = source(tmp_path, "92_b", body="raise ValueError('boom')")
+    assert notebooks.run_all([ok_a, bad], quick=True, output_dir=target, out=log, heartbeat=0) == 1
+    assert provenance.read_records(target)["92_a"]["run_id"] == first
+    incomplete = tmp_path / "build-quick-incomplete"
+    report = (incomplete / "report.md").read_text()
+    assert "**Incomplete build.**" in report and "92_b" in report
+    problems = provenance.audit_build(incomplete, ["92_a", "92_b"])
+    assert any(p.startswith("92_b: failed") for p in problems)
+
+
+DRIVER = textwrap.dedent("""
+    import sys
+    from pathlib import Path
+    from cislunar.publish import notebooks
+    srcs = [Path(p) for p in sys.argv[2:]]
+    sys.exit(notebooks.run_all(srcs, quick=True, output_dir=sys.argv[1], heartbeat=0))
+""")
+
+
+def test_sigint_mid_notebook_ends_every_process_and_leaves_the_build(tmp_path):
+    """SIGINT while a notebook's pool worker runs: exit 130 within seconds, no process of the run survives, the
+    previous build untouched, no temporary folder left."""
+    target = tmp_path / "build-quick"
+    done = source(tmp_path, "93_done")
+    assert notebooks.run_all([done], quick=True, output_dir=target, out=io.StringIO(), heartbeat=0) == 0
+    before = provenance.read_records(target)
+    pids = tmp_path / "pids.txt"
+    body = (f"import os, subprocess, sys, time\n"
+            f"worker = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(120)'])\n"
+            f"open({str(pids)!r}, 'w').write(f'{{os.getpid()}} {{worker.pid}}')\n"
+            f"time.sleep(120)")
+    slow = source(tmp_path, "93_slow", body=body)
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    env = dict(os.environ, TMPDIR=str(scratch))
+    proc = subprocess.Popen([sys.executable, "-c", DRIVER, str(target), str(done), str(slow)], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    deadline = time.monotonic() + 120
+    while not pids.exists() or len(pids.read_text().split()) < 2:
+        assert time.monotonic() < deadline and proc.poll() is None, proc.stdout.read() if proc.poll() else ""
+        time.sleep(0.2)
+    kernel, worker = (int(x) for x in pids.read_text().split())
+    sent = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    output, _ = proc.communicate(timeout=60)
+    assert proc.returncode == 130, output
+    assert time.monotonic() - sent < 15, output
+    time.sleep(0.5)
+    import psutil
+
+    for pid in (kernel, worker):
+        assert not psutil.pid_exists(pid) or psutil.Process(pid).status() == psutil.STATUS_ZOMBIE, pid
+    assert provenance.read_records(target) == before
+    assert list(scratch.iterdir()) == [], list(scratch.iterdir())
+    import glob
+    left = [d for d in glob.glob('/tmp/cl-*/spec.json') if str(slow) in Path(d).read_text()]
+    assert not left, left
+    rec = provenance.read_records(tmp_path / "build-quick-incomplete")
+    assert rec["93_slow"]["status"] == "interrupted"
