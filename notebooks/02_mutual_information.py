@@ -25,7 +25,10 @@
 # and test case 2 (Tables 4 and 5). Measurement models also follow Greaves & Scheeres 2021 (Eqs. 6-13) and
 # their AMOS 2023 paper (Eqs. 15-20).
 #
-# All computation lives in `cislunar.sensing.measurements`, `cislunar.sensing.covariance` and `cislunar.sensing.information`.
+# The methods live in `cislunar.sensing.measurements`, `cislunar.sensing.covariance` and
+# `cislunar.sensing.information`; the studies of this chapter (the window, the CRLB, the gradient check, the
+# baseline and timing sweeps, and the figures) in `cislunar.papers.wolf_jones.mutual_information_study`; the rows
+# of the closing table are claims declared in `cislunar.papers.wolf_jones.claims.mutual_information`.
 
 # %% tags=["parameters"]
 QUICK = False
@@ -39,12 +42,12 @@ N_BASELINES = 5 if QUICK else 10  # observer phase offsets in the baseline study
 TIMING_SIZES = [5, 9, 17] if QUICK else [5, 9, 17, 33, 65]  # measurement times per window in the timing study
 TIMING_MIN_TIME = 0.02 if QUICK else 0.1  # seconds per timing run
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
-from cislunar.cr3bp.propagation import find_events, propagate
 from cislunar.guidance import scvx
+from cislunar.papers.wolf_jones import mutual_information_study as study
+from cislunar.papers.wolf_jones.claims import mutual_information as claims
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
 from cislunar.sensing import covariance as cov
@@ -73,17 +76,11 @@ table = ComparisonTable("02 Mutual information (Wolf & Jones Eqs. 9-23, 44-52, P
 # Monte Carlo average of $\ln p(y|x) - \ln p(y)$ from `monte_carlo_mutual_information`.
 
 # %%
-p, h, r = 4.0, 1.0, 1.0
-closed = 0.5 * np.log(1 + h**2 * p / r)
-xs = rng.normal(0.0, np.sqrt(p), size=MC_SAMPLES)
-kl = info.gaussian_kl((h * xs)[:, None], [[r]], [0.0], [[h**2 * p + r]])  # KL(p(y|x) || p(y)) for each x
-mc, se = info.monte_carlo_mutual_information([[p]], np.zeros((0, 1, 1)), np.zeros((0, 1, 1)), [[[h]]], [[r]],
-                                             MC_SAMPLES, rng)
-print(f"closed form 0.5 ln(1 + h^2 p / r)  = {closed:.5f} nats")
-print(f"E_x[KL] over {MC_SAMPLES} samples    = {kl.mean():.5f} +- {kl.std(ddof=1) / np.sqrt(MC_SAMPLES):.5f}")
-print(f"joint Monte Carlo of log ratio       = {mc:.5f} +- {se:.5f}")
-print(f"posterior/prior std ratio: {np.sqrt(1 / (1 / p + h**2 / r)) / np.sqrt(p):.4f} "
-      f"= exp(-I) = {np.exp(-closed):.4f}")
+ex = study.scalar_worked_example(MC_SAMPLES, rng, p=4.0, h=1.0, r=1.0)
+print(f"closed form 0.5 ln(1 + h^2 p / r)  = {ex.closed:.5f} nats")
+print(f"E_x[KL] over {MC_SAMPLES} samples    = {ex.kl_mean:.5f} +- {ex.kl_se:.5f}")
+print(f"joint Monte Carlo of log ratio       = {ex.monte_carlo:.5f} +- {ex.monte_carlo_se:.5f}")
+print(f"posterior/prior std ratio: {ex.std_ratio:.4f} = exp(-I) = {np.exp(-ex.closed):.4f}")
 
 # %% [markdown]
 # ## 2 · The stacked window (Eqs. 12-23) on a toy problem
@@ -101,17 +98,12 @@ print(f"posterior/prior std ratio: {np.sqrt(1 / (1 / p + h**2 / r)) / np.sqrt(p)
 # matrices. The block lower-triangular shape of $\tilde H$ is what makes the dense form cost $O(N^3)$.
 
 # %%
-dt = 1.0
-F_toy = np.tile([[1.0, dt], [0.0, 1.0]], (2, 1, 1))
-Q_toy = np.tile(0.01 * np.array([[dt**3 / 3, dt**2 / 2], [dt**2 / 2, dt]]), (2, 1, 1))  # Van Loan, PSD 0.01
-H_toy = np.tile([[[1.0, 0.0]]], (3, 1, 1))
-R_toy = np.tile([[[0.25]]], (3, 1, 1))
-P0_toy = np.diag([1.0, 0.5])
-Pt, Ht, Rt = info.stacked_matrices(P0_toy, F_toy, Q_toy, H_toy, R_toy)
+toy = study.constant_velocity_toy(dt=1.0, n_times=3, psd=0.01, r=0.25)
+Pt, Ht, Rt = info.stacked_matrices(*toy.arrays)
 np.set_printoptions(precision=3, suppress=True)
 print("P~ (Eq. 19):\n", Pt, "\nH~ (Eq. 20):\n", Ht, "\nR~ (Eq. 23):\n", Rt)
-dense_toy = info.mutual_information_dense(P0_toy, F_toy, Q_toy, H_toy, R_toy)
-total_toy, terms_toy = info.mutual_information(P0_toy, F_toy, Q_toy, H_toy, R_toy, return_terms=True)
+dense_toy = info.mutual_information_dense(*toy.arrays)
+total_toy, terms_toy = info.mutual_information(*toy.arrays, return_terms=True)
 print(f"Eq. 18 dense: {dense_toy:.12f} nats; chain rule: {total_toy:.12f} nats = sum of {np.round(terms_toy, 4)}")
 
 # %% [markdown]
@@ -135,15 +127,7 @@ print(f"Eq. 18 dense: {dense_toy:.12f} nats; chain rule: {total_toy:.12f} nats =
 # $D$ = 4 m = 0.004 km): resolution dominates below $D/\sigma_{min}$ = 0.004 km / 10 µrad = 400 km, pointing above.
 
 # %%
-rho_km = np.logspace(0, 5, 200)  # 1 km up: below it the noise exceeds 4 mrad, of no use for tracking
-sig = meas.angular_sigma(rho_km, meas.AMOS_SIGMA_MIN_RAD, meas.AMOS_RESOLUTION_KM)
-fig, ax = plt.subplots(figsize=(5.5, 3.5))
-ax.loglog(rho_km, sig * 1e6, label=r"$\sqrt{\sigma_{min}^2 + D^2/\rho^2}$ (AMOS Eq. 20)")
-ax.axvline(meas.AMOS_RESOLUTION_KM / meas.AMOS_SIGMA_MIN_RAD, color="0.5", ls=":",
-           label=r"$\rho = D/\sigma_{min}$ = 400 km")
-ax.axvline(215.0, color="C3", ls="--", label="215 km: AMOS mean agent-target range")
-ax.set(xlabel="range [km]", ylabel=r"$\sigma_\theta$ [µrad]", title="Angular noise model")
-ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=1, frameon=False)  # below the axes
+fig = study.figure_angular_noise(mean_range_km=215.0)
 _ = plotting.save_figure(fig, "02_angular_noise_model", output_dir=out)
 print(f"sigma_theta at 215 km: "
       f"{meas.angular_sigma(215.0, meas.AMOS_SIGMA_MIN_RAD, meas.AMOS_RESOLUTION_KM) * 1e6:.3f} µrad")
@@ -166,33 +150,25 @@ print(f"sigma_theta at 215 km: "
 # readings are in notebook 06), and discretise it *exactly* along each reference trajectory,
 # $Q_k = \int\Phi(t_{k+1},\tau)GqG^T\Phi(t_{k+1},\tau)^Td\tau$ (time-varying Van Loan; Gauss-Legendre quadrature of
 # heyoka STMs, checked against the Lyapunov ODE in the tests).
+#
+# In code, `case_2_window` propagates the four spacecraft to the window start, lays out the daily measurement
+# times and linearises the augmented 24-state system with the derivatives the gradient of section 5 needs;
+# `window_crlb` then runs the covariance recursion once and returns, per object and time, the total, in-plane and
+# out-of-plane position RMS, together with Eq. 18 evaluated both ways and the chain-rule gains.
 
 # %%
-observer_x0 = np.array([7.80136159e-1, 0, 0, 0, 5.53104815e-1, 0])
-targets_x0 = np.array([[7.78717734e-1, 0, 0, 0, 5.55157488e-1, 0],
-                       [7.79426943e-1, 0, 0, 0, 5.54128887e-1, 0],
-                       [7.81554639e-1, 0, 0, 0, 5.51070308e-1, 0]])
-P_ref = float(find_events(em, observer_x0, 10.0, ("y_crossing",)).t[1])
-start = propagate(em, np.vstack([observer_x0, targets_x0]), [0.0, P_ref]).x[:, -1]
-day = float(em.days_to_tu(1.0))
-t_win = P_ref + np.arange(0.0, P_ref + 1e-12, day)
-P_obj = cov.state_covariance(cov.WOLF_JONES_SIGMA_POS_KM, cov.WOLF_JONES_SIGMA_VEL_KM_S, em)
-R_rr = meas.range_range_rate_noise(meas.WOLF_JONES_RANGE_SIGMA_KM, meas.WOLF_JONES_RANGE_RATE_SIGMA_KM_S, em)
-q_nd = cov.psd_to_nondimensional(cov.WOLF_JONES_PSD_KM2_S3, em)
-lin = cov.linearize_augmented(em, start[0], start[1:], t_win, meas.RANGE_RANGE_RATE, R_rr,
-                              cov.block_diag([P_obj] * 4), q=q_nd, derivatives=True)
-print(f"P_ref = {em.tu_to_days(P_ref):.3f} d; window {em.tu_to_days(t_win[0]):.2f}-{em.tu_to_days(t_win[-1]):.2f} d, "
-      f"{t_win.size} measurement times, state dim {lin.P0.shape[0]}")
+win = study.case_2_window(em)
+lin, days = win.lin, win.days
+print(f"P_ref = {em.tu_to_days(win.P_ref):.3f} d; window {days[0]:.2f}-{days[-1]:.2f} d, "
+      f"{win.t.size} measurement times, state dim {lin.P0.shape[0]}")
 # any [P, 2P] window on these DROs starts at about 16 d: the periods of the three target DROs
-P_targets_d = [float(em.tu_to_days(find_events(em, x, 10.0, ("y_crossing",)).t[1])) for x in targets_x0]
-print("target DRO periods [d]:", np.round(P_targets_d, 2))
-print(f"q = {q_nd:.4e} LU^2/TU^3; one-day Q_S velocity sigma = "
+print("target DRO periods [d]:", np.round(win.target_periods_d, 2))
+print(f"q = {win.q:.4e} LU^2/TU^3; one-day Q_S velocity sigma = "
       f"{np.sqrt(lin.Q[0, 3, 3]) * em.velocity_unit_km_s * 1e3:.3f} m/s "
       f"(sqrt(q dt) = {np.sqrt(cov.WOLF_JONES_PSD_KM2_S3 * 86400) * 1e3:.3f} m/s)")
-mi_dense = info.window_information(lin, method="dense")
-mi_struct, gains = info.mutual_information(*lin.arrays, return_terms=True)
-print(f"I(X;Y): dense Eq. 18 = {mi_dense:.9f} nats, chain rule = {mi_struct:.9f} nats "
-      f"(rel. diff {abs(mi_dense - mi_struct) / mi_dense:.1e})")
+crlb = study.window_crlb(win)
+print(f"I(X;Y): dense Eq. 18 = {crlb.mi_dense:.9f} nats, chain rule = {crlb.mi_chain:.9f} nats "
+      f"(rel. diff {crlb.relative_difference:.1e})")
 
 # %% [markdown]
 # **Performance evaluation (CRLB).** Linearised about the true trajectories, the EKF covariance recursion
@@ -213,45 +189,17 @@ print(f"I(X;Y): dense Eq. 18 = {mi_dense:.9f} nats, chain rule = {mi_struct:.9f}
 # could show.
 
 # %%
-hist = cov.covariance_analysis(*lin.arrays)
-days = em.tu_to_days(t_win)
-names = ["observer", "target 1", "target 2", "target 3"]
-sig_post = np.array([cov.position_sigma_km(hist.posterior, i, em) for i in range(4)])
-sig_prior = np.array([cov.position_sigma_km(hist.prior, i, em) for i in range(4)])
-sig_z = np.array([cov.position_sigma_km(hist.posterior, i, em, axes=(2,)) for i in range(4)])  # out of plane
-sig_xy = np.array([cov.position_sigma_km(hist.posterior, i, em, axes=(0, 1)) for i in range(4)])  # in-plane
-z_cols = np.abs(lin.H[..., [6 * i + j for i in range(4) for j in (2, 5)]]).max()
-print(f"largest |dH/dz|, |dH/dvz| over the window: {z_cols:.1e} (out-of-plane errors unobserved)")
-fig, (ax1, ax2, ax3) = plt.subplots(1, 3, figsize=(14, 4.0), layout="constrained")
-for i, name in enumerate(names):
-    ax1.semilogy(days, sig_post[i], "-", lw=2.5, color="0.8", label="total, all four (coincide)" if i == 0 else None,
-                 zorder=1)
-for i, name in enumerate(names):
-    ax1.semilogy(days, sig_xy[i], "o-", ms=3, lw=1, color=f"C{i}", label=f"in-plane, {name}", zorder=3)
-ax1.semilogy(days, sig_z[0], "k--", lw=1, label=r"out-of-plane $\sigma_z$ (free flight)", zorder=2)
-ax1.set(xlabel="time [days]", ylabel="position RMS (CRLB) [km]", title="CRLB along the window (cf. Fig. 9)")
-ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=2, frameon=False)
-for i in range(1, 4):
-    ax2.plot(days, sig_xy[i] / sig_xy[0], "o-", ms=3, lw=1, color=f"C{i}", label=names[i])
-ax2.axhline(1.0, color="0.4", lw=0.8, ls=":")
-ax2.set(xlabel="time [days]", ylabel="in-plane RMS, target / observer [-]",
-        title="above 1: observer better determined")
-ax2.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=3, frameon=False)
-ax3.bar(days, gains, width=0.6)
-ax3.set(xlabel="time [days]", ylabel="information gain [nats]", title=r"per-measurement $\mathcal{I}_k$ (chain rule)")
+names = study.OBJECT_NAMES
+print(f"largest |dH/dz|, |dH/dvz| over the window: {crlb.largest_z_jacobian:.1e} (out-of-plane errors unobserved)")
+fig = study.figure_crlb(crlb)
 _ = plotting.save_figure(fig, "02_test_case_2_crlb_and_gains", output_dir=out)
-print("terminal position RMS [km]:", dict(zip(names, np.round(sig_post[:, -1], 3).tolist())))
-print("mean position RMS over the window [km]:", dict(zip(names, np.round(sig_post.mean(axis=1), 3).tolist())))
-print("mean in-plane RMS over the window [km]:", dict(zip(names, np.round(sig_xy.mean(axis=1), 3).tolist())))
-print(f"out-of-plane share of the summed position variance at the window end: "
-      f"{np.sum(sig_z[:, -1]**2) / np.sum(sig_post[:, -1]**2):.2%}")
-# in-plane RMS after the second update above that after the first (the total is the free-flight sigma_z, which
-# grows whatever P0 is, so it cannot show the effect)
-transient = sig_xy[:, 1] > sig_xy[:, 0]
+print("terminal position RMS [km]:", dict(zip(names, np.round(crlb.total[:, -1], 3).tolist())))
+print("mean position RMS over the window [km]:", dict(zip(names, np.round(crlb.total.mean(axis=1), 3).tolist())))
+print("mean in-plane RMS over the window [km]:", dict(zip(names, np.round(crlb.in_plane.mean(axis=1), 3).tolist())))
+print(f"out-of-plane share of the summed position variance at the window end: {crlb.out_of_plane_share:.2%}")
 print("in-plane RMS after the 1st / 2nd update [km]:",
-      {n: (round(float(a), 1), round(float(b), 1)) for n, a, b in zip(names, sig_xy[:, 0], sig_xy[:, 1])},
-      f"; largest in-plane RMS over the window {sig_xy.max():.0f} km")
-
+      {n: (round(float(a), 1), round(float(b), 1)) for n, a, b in zip(names, *crlb.in_plane[:, :2].T)},
+      f"; largest in-plane RMS over the window {crlb.in_plane.max():.0f} km")
 
 # %% [markdown]
 # ## 5 · The gradient with respect to the observer (Eqs. 44-52)
@@ -281,24 +229,10 @@ print("in-plane RMS after the 1st / 2nd update [km]:",
 # printed below).
 
 # %%
-I0, g_struct = info.window_information(lin, gradient=True)
-_, g_dense = info.window_information(lin, gradient=True, method="dense")
-
-
-def mi_of_observer(x):
-    return info.window_information(cov.linearize_augmented(em, x, start[1:], t_win, meas.RANGE_RANGE_RATE, R_rr,
-                                                           lin.P0, Q=lin.Q))
-
-
-hfd = 1e-6
-g_fd = np.array([(8 * (mi_of_observer(start[0] + hfd * e) - mi_of_observer(start[0] - hfd * e))
-                  - (mi_of_observer(start[0] + 2 * hfd * e) - mi_of_observer(start[0] - 2 * hfd * e))) / (12 * hfd)
-                 for e in np.eye(6)])
-grad_err = np.max(np.abs(g_struct - g_fd)) / np.max(np.abs(g_fd))
-print("gradient [nats/LU, nats/(LU/TU)]\n structured:", g_struct, "\n dense:     ", g_dense, "\n central FD:",
-      np.round(g_fd, 3) + 0.0)
-print(f"max |structured - FD| / max |FD| = {grad_err:.1e}; structured vs dense "
-      f"{np.max(np.abs(g_struct - g_dense)) / np.max(np.abs(g_dense)):.1e}")
+grad = study.gradient_check(win, step=1e-6)
+print("gradient [nats/LU, nats/(LU/TU)]\n structured:", grad.structured, "\n dense:     ", grad.dense,
+      "\n central FD:", np.round(grad.finite_difference, 3) + 0.0)
+print(f"max |structured - FD| / max |FD| = {grad.error:.1e}; structured vs dense {grad.dense_error:.1e}")
 
 # %% [markdown]
 # **How far does the linearisation of Eq. 44 hold?** Step the observer's initial state along the unit gradient
@@ -311,16 +245,8 @@ print(f"max |structured - FD| / max |FD| = {grad_err:.1e}; structured vs dense "
 # notebook 05 compares the linear and quadratic models.
 
 # %%
-direction = g_struct / np.linalg.norm(g_struct)
-steps_km = np.array([1.0, 10.0, 100.0, 1000.0])
-true_mi, lin_mi = [], []
-for s_km in steps_km:
-    dx = direction * em.km_to_lu(s_km)
-    true_mi.append(mi_of_observer(start[0] + dx))
-    lin_mi.append(I0 + g_struct @ dx)
-lin_err = np.abs(np.array(true_mi) - np.array(lin_mi))
-for s_km, a, b in zip(steps_km, true_mi, lin_mi):
-    dx = direction * em.km_to_lu(s_km)
+lc = study.linearisation_check(win, grad, steps_km=[1.0, 10.0, 100.0, 1000.0])
+for s_km, dx, a, b in zip(lc.steps_km, lc.dx, lc.true, lc.linear):
     print(f"|dx| = {s_km:7.1f} km-equivalent (position {np.linalg.norm(dx[:3]) * em.length_unit_km:.1f} km, velocity "
           f"{np.linalg.norm(dx[3:]) * em.velocity_unit_km_s * 1e6:.3f} mm/s): true {a:.4f}, Eq. 44 {b:.4f}, "
           f"error {abs(a - b):.2e} nats")
@@ -344,65 +270,19 @@ print(f"package SCvx defaults: information_model = {scvx_defaults.information_mo
 # to the baseline.
 
 # %%
-tgt = targets_x0[0]
-P_tgt = float(find_events(em, tgt, 10.0, ("y_crossing",)).t[1])
-phases = np.geomspace(0.002, 0.5, N_BASELINES)  # fraction of the period the observer leads by
-obs_starts = propagate(em, tgt, np.r_[0.0, phases * P_tgt]).x[1:]
-t_base = np.arange(0.0, P_tgt + 1e-12, day)
-P0_pair = cov.block_diag([P_obj] * 2)
-models = {"relative position (100 m)": (meas.RELATIVE_POSITION, meas.relative_position_noise(0.1, em)),
-          "range + range rate": (meas.RANGE_RANGE_RATE, R_rr)}
-study = {name: {"baseline": [], "mi": [], "obs": [], "tgt": [], "obs_z": [], "obs_xy": [], "tgt_xy": []}
-         for name in models}
-for name, (model, noise) in models.items():
-    for xo in obs_starts:
-        lb = cov.linearize_augmented(em, xo, tgt[None], t_base, model, noise, P0_pair, q=q_nd)
-        hb = cov.covariance_analysis(*lb.arrays)
-        study[name]["baseline"].append(np.mean(np.linalg.norm(lb.targets[0, :, :3] - lb.observer[:, :3], axis=1)))
-        study[name]["mi"].append(info.mutual_information(*lb.arrays))
-        study[name]["obs"].append(cov.position_sigma_km(hb.posterior[-1], 0, em))
-        study[name]["tgt"].append(cov.position_sigma_km(hb.posterior[-1], 1, em))
-        study[name]["obs_z"].append(cov.position_sigma_km(hb.posterior[-1], 0, em, axes=(2,)))  # observer's sigma_z
-        # in-plane terminal RMS sqrt(P_xx + P_yy)
-        study[name]["obs_xy"].append(cov.position_sigma_km(hb.posterior[-1], 0, em, axes=(0, 1)))
-        study[name]["tgt_xy"].append(cov.position_sigma_km(hb.posterior[-1], 1, em, axes=(0, 1)))
-study = {k: {kk: np.array(vv) for kk, vv in v.items()} for k, v in study.items()}
-fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.6))
-for k, (name, res) in enumerate(study.items()):
-    b_km = em.lu_to_km(res["baseline"])
-    ax1.semilogx(b_km, res["mi"] - res["mi"][0], "o-", color=f"C{k}",
-                 label=f"{name} (I at shortest = {res['mi'][0]:.1f} nats)")
-    # in-plane RMS: target first, as large open squares, so the observer's filled dots stay visible where they meet
-    ax2.loglog(b_km, res["tgt_xy"], "s", ms=9, mfc="none", mew=1.2, color=f"C{k}")
-    ax2.loglog(b_km, res["obs_xy"], "o-", ms=4, color=f"C{k}", zorder=3)
-    ax2.loglog(b_km, res["obs"], ":", lw=1.2, color=f"C{k}", zorder=2)  # observer's total RMS
-ax1.set(xlabel="mean baseline [km]", ylabel=r"$\mathcal{I} - \mathcal{I}_{shortest}$ [nats]",
-        title="MI gain vs baseline")
-ax2.set(xlabel="mean baseline [km]", ylabel="terminal position RMS [km]", title="CRLB vs baseline (colours as left)")
-ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)  # legends below the axes
-roles = [plt.Line2D([], [], marker="o", ms=4, color="0.3", label="observer, in-plane"),
-         plt.Line2D([], [], marker="s", ms=9, mfc="none", ls="none", color="0.3", label="target, in-plane"),
-         plt.Line2D([], [], ls=":", lw=1.2, color="0.3", label="observer, total (incl. out-of-plane)")]
-ax2.legend(handles=roles, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, frameon=False)
+curves = study.baseline_study(win, N_BASELINES)  # relative position, then range + range rate
+fig = study.figure_baseline(curves)
 _ = plotting.save_figure(fig, "02_baseline_study", output_dir=out)
-for name, res in study.items():
-    print(name, "\n  baseline [km]:", np.round(em.lu_to_km(res["baseline"])), "\n  MI [nats]:", np.round(res["mi"], 2),
-          "\n  observer RMS [km]:", np.round(res["obs"], 3), "\n  target RMS [km]:  ", np.round(res["tgt"], 3),
-          "\n  observer sigma_z [km]:", np.round(res["obs_z"], 3),
-          "\n  observer in-plane RMS [km]:", np.round(res["obs_xy"], 3),
-          "\n  target in-plane RMS [km]:  ", np.round(res["tgt_xy"], 3))
-gain = {name: float(res["mi"].max() - res["mi"][0]) for name, res in study.items()}
-# the status below uses the observer's in-plane terminal RMS: for range + range rate the total is ~all sigma_z
-rms_drop = {name: float(res["obs_xy"][0] / res["obs_xy"].min()) for name, res in study.items()}
-peak = {name: float(em.lu_to_km(res["baseline"][np.argmax(res["mi"])])) for name, res in study.items()}
-same_peak = {name: int(np.argmax(res["mi"])) == int(np.argmin(res["obs_xy"])) for name, res in study.items()}
-for name, res in study.items():
-    print(f"{name}: MI peak at {peak[name]:.0f} km, in-plane CRLB minimum at "
-          f"{em.lu_to_km(res['baseline'][np.argmin(res['obs_xy'])]):.0f} km "
-          f"({'the same baseline' if same_peak[name] else 'different baselines'})")
-obs_above = {name: [f"{b:.0f}" for b, o, g in zip(em.lu_to_km(res["baseline"]), res["obs"], res["tgt"]) if o > 1.05 * g]
-             for name, res in study.items()}
-print("baselines [km] where the observer's total RMS exceeds the target's by > 5%:", obs_above)
+for c in curves:
+    print(c.name, "\n  baseline [km]:", np.round(c.baseline_km), "\n  MI [nats]:", np.round(c.mi, 2),
+          "\n  observer RMS [km]:", np.round(c.obs, 3), "\n  target RMS [km]:  ", np.round(c.tgt, 3),
+          "\n  observer sigma_z [km]:", np.round(c.obs_z, 3), "\n  observer in-plane RMS [km]:", np.round(c.obs_xy, 3),
+          "\n  target in-plane RMS [km]:  ", np.round(c.tgt_xy, 3))
+for c in curves:
+    print(f"{c.name}: MI peak at {c.peak_km:.0f} km, in-plane CRLB minimum at {c.baseline_km[c.best]:.0f} km "
+          f"({'the same baseline' if c.same_peak else 'different baselines'})")
+print("baselines [km] where the observer's total RMS exceeds the target's by > 5%:",
+      {c.name: c.observer_above_target_km for c in curves})
 
 # %% [markdown]
 # **Reading the right panel.** With relative position the observer's and the target's RMS agree to a fraction of a
@@ -429,127 +309,88 @@ print("baselines [km] where the observer's total RMS exceeds the target's by > 5
 # faster at the smallest size run, the crossover is only bounded from above — and compares with test case 2's
 # $N$ = 17. Times are best-of-3 wall clock on one BLAS thread (the machine is shared, so absolute numbers vary by
 # tens of percent, and the crossover moves with them).
+#
+# `timing_study` re-linearises the window for each size and times the four evaluations in interleaved rounds, so
+# that a change of load on the machine affects the dense and the structured times alike.
 
 # %%
-timings = []
-for N in TIMING_SIZES:
-    t_n = np.linspace(P_ref, 2 * P_ref, N)
-    ln = cov.linearize_augmented(em, start[0], start[1:], t_n, meas.RANGE_RANGE_RATE, R_rr, lin.P0, q=q_nd,
-                                 derivatives=True)
-    timings.append(info.time_evaluations(*ln.arrays, ln.dF, ln.dH, repeat=3, min_time=TIMING_MIN_TIME))
-fig, ax = plt.subplots(figsize=(5.5, 3.8))
-ax.loglog(TIMING_SIZES, [1e3 * r.dense_value for r in timings], "o-", label="dense Eq. 18")
-ax.loglog(TIMING_SIZES, [1e3 * r.structured_value for r in timings], "s-", label="chain rule")
-ax.loglog(TIMING_SIZES, [1e3 * r.dense_gradient for r in timings], "o--", label="dense Eq. 18 + Eqs. 47-50")
-ax.loglog(TIMING_SIZES, [1e3 * r.structured_gradient for r in timings], "s--",
-          label="chain rule + gradient (square-root reverse mode)")
-ax.set(xlabel="measurement times N [-]", ylabel="time per evaluation [ms]", title="Evaluation cost")
-ax.set_xticks(TIMING_SIZES, [str(n) for n in TIMING_SIZES])  # plain labels at the sizes run, no minor labels
-ax.xaxis.set_minor_formatter(plt.NullFormatter())
-ax.yaxis.set_major_locator(plt.LogLocator(subs=(1.0, 2.0, 5.0)))
-ax.yaxis.set_major_formatter(plt.FormatStrFormatter("%g"))
-ax.yaxis.set_minor_formatter(plt.NullFormatter())
-ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=2, frameon=False)  # below the axes
+timing = study.timing_study(win, TIMING_SIZES, min_time=TIMING_MIN_TIME, repeat=3)
+fig = study.figure_timing(timing)
 _ = plotting.save_figure(fig, "02_timing_dense_vs_structured", output_dir=out)
-for N, r in zip(TIMING_SIZES, timings):
+for N, r in zip(timing.sizes, timing.results):
     print(f"N = {N:3d}: MI {r.ratio_value:5.1f}x, MI + gradient {r.ratio_gradient:5.1f}x faster structured "
           f"(dense {1e3 * r.dense_gradient:.2f} ms, structured {1e3 * r.structured_gradient:.2f} ms)")
-r17 = timings[TIMING_SIZES.index(17)]
-
-
-def crossover(sizes, ratios):
-    """Window size where the dense/structured time ratio first reaches 1 (log-log interpolation), as text."""
-    ratios = np.asarray(ratios)
-    if ratios[0] >= 1.0:
-        return f"at or below N = {sizes[0]}"
-    j = int(np.argmax(ratios >= 1.0))
-    if ratios[j] < 1.0:
-        return f"above N = {sizes[-1]} (not reached)"
-    n_star = np.exp(np.interp(0.0, np.log(ratios[j - 1:j + 1]), np.log(sizes[j - 1:j + 1])))
-    return f"N = {n_star:.0f} (between {sizes[j - 1]} and {sizes[j]})"
-
-
-cross_value = crossover(TIMING_SIZES, [r.ratio_value for r in timings])
-cross_gradient = crossover(TIMING_SIZES, [r.ratio_gradient for r in timings])
-print(f"chain rule faster than dense from {cross_value} for the MI, from {cross_gradient} for MI + gradient; "
-      f"at N = 17: {r17.ratio_value:.1f}x and {r17.ratio_gradient:.1f}x")
+r17 = timing.at(17)
+print(f"chain rule faster than dense from {timing.crossover_value} for the MI, from {timing.crossover_gradient} for "
+      f"MI + gradient; at N = 17: {r17.ratio_value:.1f}x and {r17.ratio_gradient:.1f}x")
 
 # %% [markdown]
 # ## 8 · Paper versus reproduction
+#
+# Each row is a claim declared, with its criterion, in `cislunar.papers.wolf_jones.claims.mutual_information`
+# before anything is compared; here it is only judged. The scalar check holds within 3 Monte Carlo standard errors
+# of the closed form; the gradient within $10^{-5}$ (largest relative difference) of the central differences; each
+# end of the window within 1 day of the text's "roughly 17 and 32 days"; the baseline argument when the MI gains,
+# the observer's in-plane terminal RMS drops by more than 1.5x and rebounds by less than 1.2x at the longest
+# baseline. The process-noise reading was chosen while looking at the paper's result, so its row says so.
 
 # %%
-table.add_typed("Eq. 11: I = E_X[KL(p(Y|X)||p(Y))] (scalar worked example)", "formula only (Eq. 11)",
-          f"Monte Carlo {mc:.4f} +- {se:.4f} vs closed form {closed:.4f} nats",
-          "beyond paper" if abs(mc - closed) < 3 * se else "differs: Monte Carlo outside 3 standard errors",
-          "our worked example (p = 4, h = r = 1); tolerance: 3 standard errors of the Monte Carlo mean")
-table.add_typed("Eq. 18 on test case 2 window (dense)", "formula only", f"{mi_dense:.4f} nats", "derived",
-          "no numerical MI values are printed in the paper")
-table.add_typed("Eq. 18 by chain rule (Kalman recursion)", "not in paper",
-          f"rel. diff {abs(mi_dense - mi_struct) / mi_dense:.1e}",
-          "beyond paper", "same value at O(N) cost; square-root form (the dense log-determinant loses digits when "
-          "the measurements are far more precise than the prior)")
-grad_dense_err = float(np.max(np.abs(g_struct - g_dense)) / np.max(np.abs(g_dense)))
-table.add_typed("Eqs. 44-52 gradient vs central differences", "formula only",
-          f"structured vs FD {grad_err:.1e}; structured vs dense Eq. 48 {grad_dense_err:.1e} (max rel.)",
-          "beyond paper" if grad_err < 1e-5 else "differs: gradient disagrees with finite differences",
-          "tolerance 1e-5 on structured vs FD; P~ held fixed as in the paper; FD of the structured value (the dense "
-          "log-determinant has too few digits for differences at step 1e-6), so the dense gradient agrees only to "
-          "the level shown")
-table.add_typed("Eq. 44 linearisation error at 10 km / 100 km steps", "not in paper",
-          f"{lin_err[1]:.2e} / {lin_err[2]:.2e} nats", "beyond paper",
-          f"the range where Eq. 44 alone holds; the package's SCvx uses a quadratic information model by default and a "
-          f"trust region of {em.lu_to_km(scvx_defaults.eta0):,.0f}-{em.lu_to_km(scvx_defaults.eta_max):,.0f} km "
-          "(notebook 05 compares linear and quadratic)")
-table.add_typed("Process-noise PSD (Table 5)", "1e-11 km/s^3",
-          f"{q_nd:.1e} LU^2/TU^3 = {cov.WOLF_JONES_PSD_KM2_S3:.2e} km^2/s^3", "consistent (tuned)",
-          "normalised reading, chosen because 1e-11 km^2/s^3 would let test case 1's CRLB grow without bound, "
-          "against the paper's text; notebook 06 sweeps the readings")
-win_tol_d = 1.0  # tolerance on each end of the window, days
-win_ok = abs(days[0] - 17.0) <= win_tol_d and abs(days[-1] - 32.0) <= win_tol_d
-table.add_typed("Reference DRO period / observation window", "window roughly 17-32 days (Fig. 8 text); [P_ref, 2 P_ref]",
-          f"P_ref = {em.tu_to_days(P_ref):.2f} d, window {days[0]:.2f}-{days[-1]:.2f} d",
-          "reproduced" if win_ok else "differs: window ends more than 1 d from the paper's",
-          f"tolerance +-{win_tol_d:g} d on each end; P_ref from the Table 4 observer_tf DRO. The paper's own definition "
-          f"forces the start to be half the end (~16 d; target DRO periods {', '.join(f'{p:.2f}' for p in P_targets_d)}"
-          f" d), so 'roughly 17' is loose: our start is {17.0 - days[0]:.2f} d earlier")
-table.add_typed("Observer trajectory in the window", "SCvx-optimised (not published)", "coasting on observer_tf DRO",
-          "not in paper: our choice; the optimised trajectory is not given and the printed observer_t0 row is not "
-          "periodic", "a coasting stand-in, not the alpha_h = 0 solution (Table 4's x_S(t0) and x_S(tf) are "
-          "different orbits, so alpha_h = 0 still needs a transfer)")
-table.add_typed("In-plane RMS growth after the first update (test case 2 analogue of the Fig. 4 remark)",
-          "noticeable growth at the window start (attributed to a diagonal P0)",
-          f"in-plane RMS grows from the 1st to the 2nd update for {int(transient.sum())} of 4 objects "
-          f"(observer {sig_xy[0, 0]:.0f} -> {sig_xy[0, 1]:.0f} km)",
-          "reproduced" if transient.any() else "differs: no initial growth in this geometry",
-          "criterion: in-plane RMS after the 2nd update above that after the 1st for at least one object; symptom "
-          "only, the cause (diagonal P0) is not tested; the paper's Fig. 4 is test case 1 (notebook 05)")
-obs_better = sig_post[0].mean() < sig_post[1:].mean()
-table.add_typed("Observer RMS below targets on average (Fig. 9)", "yes",
-          f"observer {sig_post[0].mean():.2f} km vs targets {sig_post[1:].mean():.2f} km (mean over window)",
-          "reproduced" if obs_better else "differs: observer is not better determined than the targets here",
-          "un-manoeuvred observer, so only qualitative; the total is the unobserved out-of-plane error, the same "
-          f"for all four; in-plane: observer {sig_xy[0].mean():.1f} km vs targets "
-          f"{', '.join(f'{v:.1f}' for v in sig_xy[1:].mean(axis=1))} km")
-for name, res in study.items():
-    b_km, obs_xy, mi = em.lu_to_km(res["baseline"]), res["obs_xy"], res["mi"]
-    k_best = int(np.argmin(obs_xy))
-    improves = gain[name] > 0 and rms_drop[name] > 1.5
-    rebound = float(obs_xy[-1] / obs_xy[k_best])  # > 1: the in-plane CRLB gets worse again at the longest baselines
-    mi_drop = float(mi.max() - mi[-1])
-    status = ("reproduced" if improves and rebound < 1.2 else
-              f"differs: improves up to about {b_km[k_best]:.0f} km, then the in-plane CRLB worsens "
-              f"({rebound:.1f}x) and the MI drops" if improves else
-              "differs: the in-plane CRLB gains little from the baseline")
-    table.add_typed(f"MI and CRLB improve with baseline ({name})", "yes (Markley/Psiaki argument, qualitative)",
-              f"MI +{gain[name]:.2f} nats up to {peak[name]:.0f} km (then -{mi_drop:.2f}); observer in-plane RMS "
-              f"{obs_xy[0]:.1f} -> {obs_xy[k_best]:.1f} km at {b_km[k_best]:.0f} km, {obs_xy[-1]:.1f} km at "
-              f"{b_km[-1]:.0f} km, rebound {obs_xy[-1] / obs_xy[k_best]:.3f}x (threshold 1.2x)", status,
-              "criterion fixed before comparing: MI gain > 0, in-plane RMS drop > 1.5x, rebound at the longest "
-              "baseline < 1.2x; observer phase-shifted on the target's DRO; MI peak and in-plane CRLB minimum at "
-              f"{'the same' if same_peak[name] else 'different'} baselines; out-of-plane share of the observer's "
-              f"terminal variance {np.mean(res['obs_z']**2 / res['obs']**2):.0%} (mean over baselines)")
-table.add_typed("Structured vs dense speed at test-case-2 size (N = 17)", "not in paper",
-          f"MI {r17.ratio_value:.1f}x, MI + gradient {r17.ratio_gradient:.1f}x", "beyond paper",
-          f"crossover from this run's times: {cross_value} (MI), {cross_gradient} (MI + gradient); O(N) against "
-          "O(N^3) shows at larger N (timing figure)")
+table.add(claims.CLAIMS["eq11_scalar"].judge(
+    ex.monte_carlo, standard_error=ex.monte_carlo_se, note="our worked example (p = 4, h = r = 1)",
+    shown=f"Monte Carlo {ex.monte_carlo:.4f} +- {ex.monte_carlo_se:.4f} vs closed form {ex.closed:.4f} nats"))
+table.add(claims.CLAIMS["eq18_dense"].judge(crlb.mi_dense, shown=f"{crlb.mi_dense:.4f} nats",
+                                     note="no numerical MI values are printed in the paper"))
+table.add(claims.CLAIMS["eq18_chain_rule"].judge(
+    crlb.relative_difference, shown=f"rel. diff {crlb.relative_difference:.1e}",
+    note="same value at O(N) cost; square-root form (the dense log-determinant loses digits when the measurements "
+         "are far more precise than the prior)"))
+table.add(claims.CLAIMS["gradient"].judge(
+    grad.error,
+    shown=f"structured vs FD {grad.error:.1e}; structured vs dense Eq. 48 {grad.dense_error:.1e} (max rel.)",
+    note="P~ held fixed as in the paper; FD of the structured value (the dense log-determinant has too few digits for "
+         "differences at step 1e-6), so the dense gradient agrees only to the level shown"))
+table.add(claims.CLAIMS["eq44_linearisation"].judge(
+    lc.error[2], shown=f"{lc.error[1]:.2e} / {lc.error[2]:.2e} nats",
+    note=f"the range where Eq. 44 alone holds; the package's SCvx uses a quadratic information model by default and "
+         f"a trust region of {em.lu_to_km(scvx_defaults.eta0):,.0f}-{em.lu_to_km(scvx_defaults.eta_max):,.0f} km "
+         "(notebook 05 compares linear and quadratic)"))
+table.add(claims.CLAIMS["process_noise"].judge(
+    win.q / 1e-11, shown=f"{win.q:.1e} LU^2/TU^3 = {cov.WOLF_JONES_PSD_KM2_S3:.2e} km^2/s^3",
+    note="judged on q in units of 1e-11 LU^2/TU^3"))
+table.add(claims.CLAIMS["window"].judge(
+    max(abs(days[0] - 17.0), abs(days[-1] - 32.0)),
+    shown=f"P_ref = {em.tu_to_days(win.P_ref):.2f} d, window {days[0]:.2f}-{days[-1]:.2f} d",
+    note="P_ref from the Table 4 observer_tf DRO. The paper's own definition forces the start to be half the end "
+         f"(~16 d; target DRO periods {', '.join(f'{p:.2f}' for p in win.target_periods_d)} d), so 'roughly 17' is "
+         f"loose: our start is {17.0 - days[0]:.2f} d earlier"))
+table.add(claims.CLAIMS["observer_trajectory"].judge(
+    "coasting on observer_tf DRO", note="a coasting stand-in, not the alpha_h = 0 solution (Table 4's x_S(t0) and "
+    "x_S(tf) are different orbits, so alpha_h = 0 still needs a transfer)"))
+table.add(claims.CLAIMS["in_plane_growth"].judge(
+    bool(crlb.transient.any()),
+    shown=f"in-plane RMS grows from the 1st to the 2nd update for {int(crlb.transient.sum())} of 4 objects "
+          f"(observer {crlb.in_plane[0, 0]:.0f} -> {crlb.in_plane[0, 1]:.0f} km)",
+    note="symptom only, the cause (diagonal P0) is not tested; the paper's Fig. 4 is test case 1 (notebook 05)"))
+table.add(claims.CLAIMS["observer_below_targets"].judge(
+    crlb.observer_below_targets,
+    shown=f"observer {crlb.total[0].mean():.2f} km vs targets {crlb.total[1:].mean():.2f} km (mean over window)",
+    note="un-manoeuvred observer, so only qualitative; the total is the unobserved out-of-plane error, the same for "
+         f"all four; in-plane: observer {crlb.in_plane[0].mean():.1f} km vs targets "
+         f"{', '.join(f'{v:.1f}' for v in crlb.in_plane[1:].mean(axis=1))} km"))
+for key, c in zip(("baseline_relative_position", "baseline_range_rate"), curves):
+    b_km, k = c.baseline_km, c.best
+    gains_first = c.gain > 0 and c.rms_drop > claims.BASELINE_MIN_DROP  # then only the rebound can fail
+    table.add(claims.CLAIMS[key].judge(
+        c.improves(claims.BASELINE_MIN_DROP, claims.BASELINE_MAX_REBOUND),
+        shown=f"MI +{c.gain:.2f} nats up to {c.peak_km:.0f} km (then -{c.mi_drop:.2f}); observer in-plane RMS "
+              f"{c.obs_xy[0]:.1f} -> {c.obs_xy[k]:.1f} km at {b_km[k]:.0f} km, {c.obs_xy[-1]:.1f} km at "
+              f"{b_km[-1]:.0f} km, rebound {c.rebound:.3f}x (threshold {claims.BASELINE_MAX_REBOUND:g}x)",
+        reason=(f"improves up to about {b_km[k]:.0f} km, then the in-plane CRLB worsens ({c.rebound:.1f}x) and the "
+                "MI drops") if gains_first else "",
+        note=f"MI peak and in-plane CRLB minimum at {'the same' if c.same_peak else 'different'} baselines; out-of-"
+             f"plane share of the observer's terminal variance {c.out_of_plane_share:.0%} (mean over baselines)"))
+table.add(claims.CLAIMS["timing"].judge(
+    r17.ratio_value, shown=f"MI {r17.ratio_value:.1f}x, MI + gradient {r17.ratio_gradient:.1f}x",
+    note=f"crossover from this run's times: {timing.crossover_value} (MI), {timing.crossover_gradient} (MI + "
+         "gradient); O(N) against O(N^3) shows at larger N (timing figure)"))
 table.display()

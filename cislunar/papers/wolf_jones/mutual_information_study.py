@@ -1,0 +1,580 @@
+r"""The studies of the mutual-information chapter (notebook 02): Wolf & Jones Eqs. 9-23 and 44-52 on test case 2.
+
+What is here
+------------
+* :func:`scalar_worked_example`: the mutual information of a scalar linear-Gaussian measurement three ways
+  (closed form, expected KL divergence of Eq. 11, joint Monte Carlo of the log ratio).
+* :func:`constant_velocity_toy`: a 1-D constant-velocity window whose stacked matrices (Eqs. 19-23) are small
+  enough to print.
+* :func:`case_2_window`: test case 2's observation window :math:`[P_{ref}, 2P_{ref}]` with the observer coasting on
+  the Table 4 ``observer_tf`` DRO, linearised with derivatives (the model the gradient needs).
+* :func:`window_crlb`: the CRLB (EKF covariance recursion) along that window, split into total, in-plane and
+  out-of-plane position RMS, with the per-measurement information gains (chain rule).
+* :func:`gradient_check`, :func:`linearisation_check`: the gradient of Eqs. 44-52 against fourth-order central
+  differences, and the range over which the first-order model of Eq. 44 holds.
+* :func:`baseline_study`: MI and terminal CRLB as an observer leads a target along the same DRO (Markley / Psiaki).
+* :func:`timing_study`, :func:`crossover`: dense Eq. 18 against the chain rule, value and gradient.
+* ``figure_*``: the chapter's figures from these results.
+
+Units: states and times non-dimensional (LU, LU/TU, TU) unless a name says ``_km``, ``_d`` or ``_s``; frames are the
+Earth-Moon rotating frame; information in nats.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from cislunar.cr3bp.dynamics import CR3BP, EARTH_MOON, check_system
+from cislunar.cr3bp.propagation import find_events, propagate
+from cislunar.sensing import covariance as cov
+from cislunar.sensing import information as info
+from cislunar.sensing import measurements as meas
+from cislunar.sensing.covariance import AugmentedLinearization
+from cislunar.utils import validation
+
+__all__ = [
+    "OBSERVER_TF_X0",
+    "TARGETS_X0",
+    "BaselineCurve",
+    "Case2Window",
+    "GradientCheck",
+    "LinearisationCheck",
+    "ScalarExample",
+    "TimingStudy",
+    "ToyWindow",
+    "WindowCRLB",
+    "baseline_study",
+    "case_2_window",
+    "constant_velocity_toy",
+    "crossover",
+    "figure_angular_noise",
+    "figure_baseline",
+    "figure_crlb",
+    "figure_timing",
+    "gradient_check",
+    "linearisation_check",
+    "observer_information",
+    "scalar_worked_example",
+    "timing_study",
+    "window_crlb",
+]
+
+#: Table 4 ``observer_tf`` DRO (closes as a periodic orbit; the observer's coasting stand-in), LU and LU/TU.
+OBSERVER_TF_X0 = np.array([7.80136159e-1, 0, 0, 0, 5.53104815e-1, 0])
+#: Table 4 target DROs of test case 2, one row each, LU and LU/TU.
+TARGETS_X0 = np.array([[7.78717734e-1, 0, 0, 0, 5.55157488e-1, 0],
+                       [7.79426943e-1, 0, 0, 0, 5.54128887e-1, 0],
+                       [7.81554639e-1, 0, 0, 0, 5.51070308e-1, 0]])
+OBJECT_NAMES = ("observer", "target 1", "target 2", "target 3")
+
+
+def _period(system: CR3BP, x0) -> float:
+    """Period of a planar symmetric orbit (second y-crossing), TU."""
+    return float(find_events(system, x0, 10.0, ("y_crossing",)).t[1])
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Eqs. 9-11 and 12-23 on small examples
+# ---------------------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ScalarExample:
+    """Mutual information of ``y = h x + v``, ``x ~ N(0, p)``, ``v ~ N(0, r)``, three ways (nats)."""
+
+    p: float
+    h: float
+    r: float
+    n_samples: int
+    closed: float  #: 0.5 ln(1 + h^2 p / r)
+    kl_mean: float  #: sample mean of KL(p(y|x) || p(y)) over x (Eq. 11)
+    kl_se: float  #: its standard error
+    monte_carlo: float  #: joint Monte Carlo mean of ln p(y|x) - ln p(y)
+    monte_carlo_se: float
+
+    @property
+    def std_ratio(self) -> float:
+        """Posterior over prior standard deviation, equal to exp(-I)."""
+        return float(np.sqrt(1 / (1 / self.p + self.h**2 / self.r)) / np.sqrt(self.p))
+
+
+def scalar_worked_example(n_samples: int, rng: np.random.Generator, *, p: float = 4.0, h: float = 1.0,
+                          r: float = 1.0) -> ScalarExample:
+    """The scalar worked example of Eq. 11: closed form, expected KL over ``n_samples`` draws of ``x`` and the
+    joint Monte Carlo estimate, in that order of random draws from ``rng``."""
+    n = validation.integer(n_samples, "n_samples", minimum=2)
+    validation.instance(rng, "rng", np.random.Generator)
+    p, r = validation.positive(p, "p"), validation.positive(r, "r")
+    h = float(validation.real(h, "h"))
+    closed = 0.5 * np.log(1 + h**2 * p / r)
+    xs = rng.normal(0.0, np.sqrt(p), size=n)
+    kl = info.gaussian_kl((h * xs)[:, None], [[r]], [0.0], [[h**2 * p + r]])  # KL(p(y|x) || p(y)) for each x
+    mc, se = info.monte_carlo_mutual_information([[p]], np.zeros((0, 1, 1)), np.zeros((0, 1, 1)), [[[h]]], [[r]],
+                                                 n, rng)
+    return ScalarExample(p, h, r, n, float(closed), float(kl.mean()), float(kl.std(ddof=1) / np.sqrt(n)), mc, se)
+
+
+@dataclass(frozen=True)
+class ToyWindow:
+    """A linear window: prior ``P0``, transitions ``F``, process noises ``Q``, Jacobians ``H``, noises ``R``."""
+
+    P0: np.ndarray
+    F: np.ndarray
+    Q: np.ndarray
+    H: np.ndarray
+    R: np.ndarray
+
+    @property
+    def arrays(self) -> tuple:
+        return self.P0, self.F, self.Q, self.H, self.R
+
+
+def constant_velocity_toy(dt: float = 1.0, n_times: int = 3, *, psd: float = 0.01, r: float = 0.25) -> ToyWindow:
+    """1-D constant velocity (position, velocity), position measured at ``n_times`` times ``dt`` apart with noise
+    variance ``r``; process noise of PSD ``psd`` discretised exactly (Van Loan); prior ``diag(1, 0.5)``."""
+    dt = validation.positive(dt, "dt")
+    n = validation.integer(n_times, "n_times", minimum=2)
+    F = np.tile([[1.0, dt], [0.0, 1.0]], (n - 1, 1, 1))
+    Q = np.tile(psd * np.array([[dt**3 / 3, dt**2 / 2], [dt**2 / 2, dt]]), (n - 1, 1, 1))
+    H = np.tile([[[1.0, 0.0]]], (n, 1, 1))
+    R = np.tile([[[r]]], (n, 1, 1))
+    return ToyWindow(np.diag([1.0, 0.5]), F, Q, H, R)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Test case 2 window and its CRLB
+# ---------------------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Case2Window:
+    """Test case 2's observation window with a coasting observer.
+
+    Attributes
+    ----------
+    P_ref : float
+        Period of the observer's DRO, TU; the window is ``[P_ref, 2 P_ref]``.
+    start : ndarray, shape (4, 6)
+        Observer and the three targets at the window start (rotating frame, LU, LU/TU).
+    t : ndarray
+        Measurement times (daily), TU.
+    day : float
+        One day, TU.
+    P_obj, R, q : per-object prior covariance, range/range-rate noise covariance, process-noise PSD (LU^2/TU^3).
+    lin : AugmentedLinearization
+        The window linearised with derivatives with respect to the observer's window-start state.
+    target_periods_d : tuple of float
+        Periods of the three target DROs, days.
+    """
+
+    system: CR3BP
+    P_ref: float
+    start: np.ndarray
+    t: np.ndarray
+    day: float
+    P_obj: np.ndarray
+    R: np.ndarray
+    q: float
+    lin: AugmentedLinearization
+    target_periods_d: tuple
+
+    @property
+    def days(self) -> np.ndarray:
+        return np.asarray(self.system.tu_to_days(self.t))
+
+
+def case_2_window(system: CR3BP = EARTH_MOON, t: np.ndarray | None = None) -> Case2Window:
+    """Linearise test case 2's window ``[P_ref, 2 P_ref]`` (daily measurements unless ``t`` is given, TU) about the
+    coasting observer and the Table 4 targets; range and range rate (Table 5 noise), Table 5 priors, process noise
+    of the normalised reading (1e-11 LU^2/TU^3)."""
+    check_system(system)
+    P_ref = _period(system, OBSERVER_TF_X0)
+    start = propagate(system, np.vstack([OBSERVER_TF_X0, TARGETS_X0]), [0.0, P_ref]).x[:, -1]
+    day = float(system.days_to_tu(1.0))
+    t_win = P_ref + np.arange(0.0, P_ref + 1e-12, day) if t is None else np.asarray(t, dtype=float)
+    P_obj = cov.state_covariance(cov.WOLF_JONES_SIGMA_POS_KM, cov.WOLF_JONES_SIGMA_VEL_KM_S, system)
+    R_rr = meas.range_range_rate_noise(meas.WOLF_JONES_RANGE_SIGMA_KM, meas.WOLF_JONES_RANGE_RATE_SIGMA_KM_S, system)
+    q_nd = cov.psd_to_nondimensional(cov.WOLF_JONES_PSD_KM2_S3, system)
+    lin = cov.linearize_augmented(system, start[0], start[1:], t_win, meas.RANGE_RANGE_RATE, R_rr,
+                                  cov.block_diag([P_obj] * 4), q=q_nd, derivatives=True)
+    periods = tuple(float(system.tu_to_days(_period(system, x))) for x in TARGETS_X0)
+    return Case2Window(system, P_ref, start, t_win, day, P_obj, R_rr, q_nd, lin, periods)
+
+
+@dataclass(frozen=True)
+class WindowCRLB:
+    """CRLB along the window, per object (rows: observer, targets 1-3), position RMS in km.
+
+    ``total``, ``prior``: sqrt of the trace of the position block after / before each update; ``in_plane``: over
+    x and y; ``out_of_plane``: z alone.  ``gains``: information gain of each measurement (chain rule), nats.
+    """
+
+    days: np.ndarray
+    total: np.ndarray
+    prior: np.ndarray
+    in_plane: np.ndarray
+    out_of_plane: np.ndarray
+    gains: np.ndarray
+    mi_dense: float
+    mi_chain: float
+    largest_z_jacobian: float  #: largest |dH/dz|, |dH/dvz| entry over the window
+
+    @property
+    def relative_difference(self) -> float:
+        """|dense - chain rule| / dense for Eq. 18."""
+        return abs(self.mi_dense - self.mi_chain) / self.mi_dense
+
+    @property
+    def transient(self) -> np.ndarray:
+        """Per object: in-plane RMS after the second update above that after the first."""
+        return self.in_plane[:, 1] > self.in_plane[:, 0]
+
+    @property
+    def out_of_plane_share(self) -> float:
+        """Out-of-plane share of the summed terminal position variance."""
+        return float(np.sum(self.out_of_plane[:, -1]**2) / np.sum(self.total[:, -1]**2))
+
+    @property
+    def observer_below_targets(self) -> bool:
+        """The observer's mean total RMS over the window is below the targets' mean."""
+        return bool(self.total[0].mean() < self.total[1:].mean())
+
+
+def window_crlb(window: Case2Window) -> WindowCRLB:
+    """The CRLB of the window by the EKF covariance recursion (Joseph form), with Eq. 18 dense and by chain rule."""
+    validation.instance(window, "window", Case2Window)
+    lin, em = window.lin, window.system
+    mi_dense = info.window_information(lin, method="dense")
+    mi_chain, gains = info.mutual_information(*lin.arrays, return_terms=True)
+    hist = cov.covariance_analysis(*lin.arrays)
+
+    def sig(P, axes=(0, 1, 2)):
+        return np.array([cov.position_sigma_km(P, i, em, axes=axes) for i in range(4)])
+
+    z_cols = np.abs(lin.H[..., [6 * i + j for i in range(4) for j in (2, 5)]]).max()
+    return WindowCRLB(window.days, sig(hist.posterior), sig(hist.prior), sig(hist.posterior, (0, 1)),
+                      sig(hist.posterior, (2,)), np.asarray(gains), float(mi_dense), float(mi_chain), float(z_cols))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Eqs. 44-52: gradient and the range of the first-order model
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def observer_information(window: Case2Window, x) -> float:
+    """Eq. 18 (chain rule) of the window re-propagated from observer window-start state ``x`` (LU, LU/TU), with the
+    process noise held at the reference's (as the paper's gradient assumes)."""
+    lin = window.lin
+    return info.window_information(cov.linearize_augmented(window.system, x, window.start[1:], window.t,
+                                                           meas.RANGE_RANGE_RATE, window.R, lin.P0, Q=lin.Q))
+
+
+@dataclass(frozen=True)
+class GradientCheck:
+    """Gradient of Eq. 18 with respect to the observer's window-start state (nats/LU, nats/(LU/TU))."""
+
+    value: float
+    structured: np.ndarray
+    dense: np.ndarray
+    finite_difference: np.ndarray
+    step: float
+
+    @property
+    def error(self) -> float:
+        """max |structured - FD| / max |FD|."""
+        return float(np.max(np.abs(self.structured - self.finite_difference)) / np.max(np.abs(self.finite_difference)))
+
+    @property
+    def dense_error(self) -> float:
+        """max |structured - dense| / max |dense|."""
+        return float(np.max(np.abs(self.structured - self.dense)) / np.max(np.abs(self.dense)))
+
+
+def gradient_check(window: Case2Window, step: float = 1e-6) -> GradientCheck:
+    """Structured (reverse-mode square-root) and dense (Eqs. 47-50) gradients against fourth-order central
+    differences of :func:`observer_information` at ``step`` (non-dimensional)."""
+    validation.instance(window, "window", Case2Window)
+    h = validation.positive(step, "step")
+    value, g_struct = info.window_information(window.lin, gradient=True)
+    _, g_dense = info.window_information(window.lin, gradient=True, method="dense")
+    x0 = window.start[0]
+
+    def f(x):
+        return observer_information(window, x)
+
+    g_fd = np.array([(8 * (f(x0 + h * e) - f(x0 - h * e)) - (f(x0 + 2 * h * e) - f(x0 - 2 * h * e))) / (12 * h)
+                     for e in np.eye(6)])
+    return GradientCheck(float(value), np.asarray(g_struct), np.asarray(g_dense), g_fd, h)
+
+
+@dataclass(frozen=True)
+class LinearisationCheck:
+    """True MI against Eq. 44 along the unit gradient direction; steps in km-equivalent (norm of the 6-vector)."""
+
+    steps_km: np.ndarray
+    dx: np.ndarray  #: (n, 6) steps, LU and LU/TU
+    true: np.ndarray
+    linear: np.ndarray
+
+    @property
+    def error(self) -> np.ndarray:
+        return np.abs(self.true - self.linear)
+
+
+def linearisation_check(window: Case2Window, gradient: GradientCheck,
+                        steps_km=(1.0, 10.0, 100.0, 1000.0)) -> LinearisationCheck:
+    """Step the observer along the unit structured gradient by each of ``steps_km`` (km converted to LU) and compare
+    the re-propagated MI with ``I + grad . dx`` (Eq. 44)."""
+    validation.instance(gradient, "gradient", GradientCheck)
+    steps = np.asarray(steps_km, dtype=float)
+    direction = gradient.structured / np.linalg.norm(gradient.structured)
+    dx = np.array([direction * window.system.km_to_lu(s) for s in steps])
+    true = np.array([observer_information(window, window.start[0] + d) for d in dx])
+    linear = np.array([gradient.value + gradient.structured @ d for d in dx])
+    return LinearisationCheck(steps, dx, true, linear)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Baseline (Markley / Psiaki)
+# ---------------------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class BaselineCurve:
+    """MI and terminal CRLB against the observer-target baseline for one measurement type.
+
+    Arrays per baseline: ``baseline`` (mean separation, LU), ``mi`` (nats), terminal position RMS in km of the
+    observer (``obs``: total, ``obs_z``: z, ``obs_xy``: in-plane) and target (``tgt``, ``tgt_xy``).
+    """
+
+    name: str
+    baseline: np.ndarray
+    mi: np.ndarray
+    obs: np.ndarray
+    tgt: np.ndarray
+    obs_z: np.ndarray
+    obs_xy: np.ndarray
+    tgt_xy: np.ndarray
+    length_unit_km: float
+
+    @property
+    def baseline_km(self) -> np.ndarray:
+        return self.baseline * self.length_unit_km
+
+    @property
+    def gain(self) -> float:
+        """Largest MI gain over the shortest baseline, nats."""
+        return float(self.mi.max() - self.mi[0])
+
+    @property
+    def peak_km(self) -> float:
+        """Baseline of the MI peak, km."""
+        return float(self.baseline_km[np.argmax(self.mi)])
+
+    @property
+    def best(self) -> int:
+        """Index of the smallest in-plane observer RMS."""
+        return int(np.argmin(self.obs_xy))
+
+    @property
+    def same_peak(self) -> bool:
+        return int(np.argmax(self.mi)) == self.best
+
+    @property
+    def rms_drop(self) -> float:
+        """In-plane observer RMS at the shortest baseline over its minimum."""
+        return float(self.obs_xy[0] / self.obs_xy.min())
+
+    @property
+    def rebound(self) -> float:
+        """In-plane observer RMS at the longest baseline over its minimum (> 1: worse again)."""
+        return float(self.obs_xy[-1] / self.obs_xy[self.best])
+
+    @property
+    def mi_drop(self) -> float:
+        return float(self.mi.max() - self.mi[-1])
+
+    @property
+    def out_of_plane_share(self) -> float:
+        """Mean over baselines of the out-of-plane share of the observer's terminal variance."""
+        return float(np.mean(self.obs_z**2 / self.obs**2))
+
+    @property
+    def observer_above_target_km(self) -> list:
+        """Baselines (km, as text) where the observer's total RMS exceeds the target's by more than 5 %."""
+        return [f"{b:.0f}" for b, o, g in zip(self.baseline_km, self.obs, self.tgt) if o > 1.05 * g]
+
+    def improves(self, min_drop: float = 1.5, max_rebound: float = 1.2) -> bool:
+        """MI gain > 0, in-plane RMS drop > ``min_drop`` and rebound < ``max_rebound``."""
+        return self.gain > 0 and self.rms_drop > min_drop and self.rebound < max_rebound
+
+
+def baseline_study(window: Case2Window, n_baselines: int, *, min_phase: float = 0.002,
+                   max_phase: float = 0.5) -> tuple:
+    """Observer on the first Table 4 target's DRO, ahead by a phase (fraction of the period, geometric from
+    ``min_phase`` to ``max_phase``); one period of daily measurements, relative position (100 m per axis) and
+    range + range rate.  Returns one :class:`BaselineCurve` per measurement type."""
+    validation.instance(window, "window", Case2Window)
+    n = validation.integer(n_baselines, "n_baselines", minimum=2)
+    em = window.system
+    tgt = TARGETS_X0[0]
+    P_tgt = _period(em, tgt)
+    phases = np.geomspace(min_phase, max_phase, n)
+    obs_starts = propagate(em, tgt, np.r_[0.0, phases * P_tgt]).x[1:]
+    t_base = np.arange(0.0, P_tgt + 1e-12, window.day)
+    P0_pair = cov.block_diag([window.P_obj] * 2)
+    models = {"relative position (100 m)": (meas.RELATIVE_POSITION, meas.relative_position_noise(0.1, em)),
+              "range + range rate": (meas.RANGE_RANGE_RATE, window.R)}
+    curves = []
+    for name, (model, noise) in models.items():
+        rows = []
+        for xo in obs_starts:
+            lb = cov.linearize_augmented(em, xo, tgt[None], t_base, model, noise, P0_pair, q=window.q)
+            P_end = cov.covariance_analysis(*lb.arrays).posterior[-1]
+            rows.append((np.mean(np.linalg.norm(lb.targets[0, :, :3] - lb.observer[:, :3], axis=1)),
+                         info.mutual_information(*lb.arrays), cov.position_sigma_km(P_end, 0, em),
+                         cov.position_sigma_km(P_end, 1, em), cov.position_sigma_km(P_end, 0, em, axes=(2,)),
+                         cov.position_sigma_km(P_end, 0, em, axes=(0, 1)),
+                         cov.position_sigma_km(P_end, 1, em, axes=(0, 1))))
+        cols = [np.array([float(r[j]) for r in rows]) for j in range(7)]
+        curves.append(BaselineCurve(name, *cols, em.length_unit_km))
+    return tuple(curves)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Cost of dense Eq. 18 against the chain rule
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def crossover(sizes, ratios) -> str:
+    """Window size at which the dense/structured time ratio first reaches 1 (log-log interpolation), as text."""
+    sizes, ratios = list(sizes), np.asarray(ratios, dtype=float)
+    if len(sizes) != ratios.size or not sizes:
+        raise ValueError("sizes and ratios must be non-empty and of equal length")
+    if ratios[0] >= 1.0:
+        return f"at or below N = {sizes[0]}"
+    j = int(np.argmax(ratios >= 1.0))
+    if ratios[j] < 1.0:
+        return f"above N = {sizes[-1]} (not reached)"
+    n_star = np.exp(np.interp(0.0, np.log(ratios[j - 1:j + 1]), np.log(sizes[j - 1:j + 1])))
+    return f"N = {n_star:.0f} (between {sizes[j - 1]} and {sizes[j]})"
+
+
+@dataclass(frozen=True)
+class TimingStudy:
+    """Best-of-3 times (s) per evaluation for each window size (``results[i]`` for ``sizes[i]``)."""
+
+    sizes: tuple
+    results: tuple
+
+    def at(self, n: int) -> info.TimingResult:
+        return self.results[self.sizes.index(n)]
+
+    @property
+    def crossover_value(self) -> str:
+        return crossover(self.sizes, [r.ratio_value for r in self.results])
+
+    @property
+    def crossover_gradient(self) -> str:
+        return crossover(self.sizes, [r.ratio_gradient for r in self.results])
+
+
+def timing_study(window: Case2Window, sizes, *, min_time: float = 0.1, repeat: int = 3) -> TimingStudy:
+    """Time dense Eq. 18 and the chain rule (value, value + gradient) on one DRO period of the window's geometry
+    with ``N`` equally spaced measurement times for each ``N`` in ``sizes``."""
+    validation.instance(window, "window", Case2Window)
+    sizes = tuple(validation.integer(n, "size", minimum=2) for n in sizes)
+    results = []
+    for n in sizes:
+        t_n = np.linspace(window.P_ref, 2 * window.P_ref, n)
+        ln = cov.linearize_augmented(window.system, window.start[0], window.start[1:], t_n, meas.RANGE_RANGE_RATE,
+                                     window.R, window.lin.P0, q=window.q, derivatives=True)
+        results.append(info.time_evaluations(*ln.arrays, ln.dF, ln.dH, repeat=repeat, min_time=min_time))
+    return TimingStudy(sizes, tuple(results))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Figures
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def figure_angular_noise(mean_range_km: float = 215.0):
+    """AMOS Eq. 20 angular noise against range, with the resolution/pointing crossover and the AMOS mean range."""
+    rho_km = np.logspace(0, 5, 200)  # 1 km up: below it the noise exceeds 4 mrad, of no use for tracking
+    sig = meas.angular_sigma(rho_km, meas.AMOS_SIGMA_MIN_RAD, meas.AMOS_RESOLUTION_KM)
+    fig, ax = plt.subplots(figsize=(5.5, 3.5))
+    ax.loglog(rho_km, sig * 1e6, label=r"$\sqrt{\sigma_{min}^2 + D^2/\rho^2}$ (AMOS Eq. 20)")
+    ax.axvline(meas.AMOS_RESOLUTION_KM / meas.AMOS_SIGMA_MIN_RAD, color="0.5", ls=":",
+               label=r"$\rho = D/\sigma_{min}$ = 400 km")
+    ax.axvline(mean_range_km, color="C3", ls="--", label=f"{mean_range_km:g} km: AMOS mean agent-target range")
+    ax.set(xlabel="range [km]", ylabel=r"$\sigma_\theta$ [µrad]", title="Angular noise model")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=1, frameon=False)  # below the axes
+    return fig
+
+
+def figure_crlb(crlb: WindowCRLB):
+    """Total / in-plane / out-of-plane RMS along the window, target over observer in-plane RMS, and the gains."""
+    days = crlb.days
+    fig, (ax1, ax2, ax3) = plt.subplots(1, 3, figsize=(14, 4.0), layout="constrained")
+    for i in range(4):
+        ax1.semilogy(days, crlb.total[i], "-", lw=2.5, color="0.8",
+                     label="total, all four (coincide)" if i == 0 else None, zorder=1)
+    for i, name in enumerate(OBJECT_NAMES):
+        ax1.semilogy(days, crlb.in_plane[i], "o-", ms=3, lw=1, color=f"C{i}", label=f"in-plane, {name}", zorder=3)
+    ax1.semilogy(days, crlb.out_of_plane[0], "k--", lw=1, label=r"out-of-plane $\sigma_z$ (free flight)", zorder=2)
+    ax1.set(xlabel="time [days]", ylabel="position RMS (CRLB) [km]", title="CRLB along the window (cf. Fig. 9)")
+    ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=2, frameon=False)
+    for i in range(1, 4):
+        ax2.plot(days, crlb.in_plane[i] / crlb.in_plane[0], "o-", ms=3, lw=1, color=f"C{i}", label=OBJECT_NAMES[i])
+    ax2.axhline(1.0, color="0.4", lw=0.8, ls=":")
+    ax2.set(xlabel="time [days]", ylabel="in-plane RMS, target / observer [-]",
+            title="above 1: observer better determined")
+    ax2.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=3, frameon=False)
+    ax3.bar(days, crlb.gains, width=0.6)
+    ax3.set(xlabel="time [days]", ylabel="information gain [nats]",
+            title=r"per-measurement $\mathcal{I}_k$ (chain rule)")
+    return fig
+
+
+def figure_baseline(curves):
+    """MI gain and terminal CRLB (in-plane and total) against the mean baseline, one colour per measurement type."""
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.6))
+    for k, c in enumerate(curves):
+        b_km = c.baseline_km
+        ax1.semilogx(b_km, c.mi - c.mi[0], "o-", color=f"C{k}", label=f"{c.name} (I at shortest = {c.mi[0]:.1f} nats)")
+        # in-plane RMS: target first, as large open squares, so the observer's filled dots stay visible where they meet
+        ax2.loglog(b_km, c.tgt_xy, "s", ms=9, mfc="none", mew=1.2, color=f"C{k}")
+        ax2.loglog(b_km, c.obs_xy, "o-", ms=4, color=f"C{k}", zorder=3)
+        ax2.loglog(b_km, c.obs, ":", lw=1.2, color=f"C{k}", zorder=2)  # observer's total RMS
+    ax1.set(xlabel="mean baseline [km]", ylabel=r"$\mathcal{I} - \mathcal{I}_{shortest}$ [nats]",
+            title="MI gain vs baseline")
+    ax2.set(xlabel="mean baseline [km]", ylabel="terminal position RMS [km]",
+            title="CRLB vs baseline (colours as left)")
+    ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)  # legends below the axes
+    roles = [plt.Line2D([], [], marker="o", ms=4, color="0.3", label="observer, in-plane"),
+             plt.Line2D([], [], marker="s", ms=9, mfc="none", ls="none", color="0.3", label="target, in-plane"),
+             plt.Line2D([], [], ls=":", lw=1.2, color="0.3", label="observer, total (incl. out-of-plane)")]
+    ax2.legend(handles=roles, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, frameon=False)
+    return fig
+
+
+def figure_timing(timing: TimingStudy):
+    """Time per evaluation against the number of measurement times, log-log."""
+    sizes, res = list(timing.sizes), timing.results
+    fig, ax = plt.subplots(figsize=(5.5, 3.8))
+    ax.loglog(sizes, [1e3 * r.dense_value for r in res], "o-", label="dense Eq. 18")
+    ax.loglog(sizes, [1e3 * r.structured_value for r in res], "s-", label="chain rule")
+    ax.loglog(sizes, [1e3 * r.dense_gradient for r in res], "o--", label="dense Eq. 18 + Eqs. 47-50")
+    ax.loglog(sizes, [1e3 * r.structured_gradient for r in res], "s--",
+              label="chain rule + gradient (square-root reverse mode)")
+    ax.set(xlabel="measurement times N [-]", ylabel="time per evaluation [ms]", title="Evaluation cost")
+    ax.set_xticks(sizes, [str(n) for n in sizes])  # plain labels at the sizes run, no minor labels
+    ax.xaxis.set_minor_formatter(plt.NullFormatter())
+    ax.yaxis.set_major_locator(plt.LogLocator(subs=(1.0, 2.0, 5.0)))
+    ax.yaxis.set_major_formatter(plt.FormatStrFormatter("%g"))
+    ax.yaxis.set_minor_formatter(plt.NullFormatter())
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=2, frameon=False)  # below the axes
+    return fig

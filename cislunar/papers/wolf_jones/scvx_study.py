@@ -1,0 +1,262 @@
+r"""The studies of the SCvx chapter (notebook 03): a minimum-impulse transfer on Wolf & Jones test case 1's boundary
+conditions, solved by successive convexification with first-order hold (Eqs. 24-36, 42-43, Table 1).
+
+What is here
+------------
+* :func:`transfer_problem`: the problem (corrected Table 2 observer DRO to the printed :math:`x_{\mathcal S}(t_f)`,
+  Sundman nodes with the window ends on nodes, zero thrust bound inside the observation window).
+* :func:`solve` : one SCvx run of the problem from the ballistic guess.
+* :func:`iteration_summary`: what the iteration history says (accepted steps, the noise rule, multiplier updates,
+  the largest-defect ratios that a superlinear rate would drive to zero).
+* :func:`single_shooting`: the converged first-order-hold control re-flown from the initial state alone.
+* :func:`guess_study`: the same problem from random initial guesses.
+* ``figure_*``: the chapter's figures.
+
+Units: non-dimensional (LU, TU, LU/TU, LU/TU^2) unless a name says ``_km``, ``_mm_s`` or ``_d``; Earth-Moon
+rotating frame.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from cislunar.cr3bp.propagation import propagate
+from cislunar.guidance import discretization as D
+from cislunar.guidance import scvx
+from cislunar.papers.wolf_jones import scenarios
+from cislunar.publish import plotting
+from cislunar.utils import validation
+
+__all__ = [
+    "GuessStudy",
+    "IterationSummary",
+    "ShootingCheck",
+    "TransferProblem",
+    "figure_converged_control",
+    "figure_iterations",
+    "guess_study",
+    "iteration_summary",
+    "single_shooting",
+    "solve",
+    "transfer_problem",
+]
+
+
+@dataclass(frozen=True)
+class TransferProblem:
+    """Minimum-impulse transfer with test case 1's boundary conditions.
+
+    Attributes
+    ----------
+    scenario : scenarios.Scenario
+    x0, x_final : ndarray (6,)
+        Corrected initial DRO state and the printed final state, LU and LU/TU.
+    t : ndarray
+        Sundman node times (window ends on nodes), TU.
+    k_window : tuple of int
+        First and last node of the observation window.
+    u_max : ndarray
+        Thrust-acceleration bound per node, LU/TU^2 (``a_max`` outside the window, zero inside).
+    x_guess : ndarray (N, 6)
+        Ballistic initial guess at the nodes.
+    """
+
+    scenario: scenarios.Scenario
+    x0: np.ndarray
+    x_final: np.ndarray
+    t: np.ndarray
+    k_window: tuple
+    u_max: np.ndarray
+    x_guess: np.ndarray
+    sigma: float
+
+    @property
+    def in_window(self) -> np.ndarray:
+        return self.u_max == 0
+
+    @property
+    def system(self):
+        return self.scenario.system
+
+    @property
+    def ballistic_miss(self) -> float:
+        """|x_f - x(T)| of the ballistic arc over the transfer time, non-dimensional 6-vector norm."""
+        return float(np.linalg.norm(propagate(self.system, self.x0, self.scenario.duration).x[-1] - self.x_final))
+
+
+def transfer_problem(n_nodes: int, sigma: float = 1.0) -> TransferProblem:
+    """Test case 1's transfer on ``n_nodes`` Sundman nodes of exponent ``sigma`` (window ends moved onto nodes)."""
+    n = validation.integer(n_nodes, "n_nodes", minimum=4)
+    sigma = validation.positive(sigma, "sigma", allow_zero=True)
+    sc = scenarios.test_case_1()
+    dro = sc.row_checks["observer_t0"].corrected
+    t, k_ws, k_we = sc.node_times(n, sigma)
+    x_guess = propagate(sc.system, dro.x0, t).x
+    return TransferProblem(sc, np.asarray(dro.x0), np.asarray(sc.observer_xf), t, (int(k_ws), int(k_we)),
+                           sc.control_bounds(t), x_guess, float(sigma))
+
+
+def solve(problem: TransferProblem, settings: scvx.SCvxSettings | None = None, *, x_guess=None,
+          u_guess=None) -> scvx.SCvxResult:
+    """One SCvx run of ``problem`` (default: ballistic state guess, zero controls, default settings)."""
+    validation.instance(problem, "problem", TransferProblem)
+    x = problem.x_guess if x_guess is None else x_guess
+    u = np.zeros((problem.t.size, 3)) if u_guess is None else u_guess
+    return scvx.solve_scvx(problem.system, problem.t, x, u, problem.u_max, x_final=problem.x_final,
+                           settings=scvx.SCvxSettings() if settings is None else settings)
+
+
+@dataclass(frozen=True)
+class IterationSummary:
+    """What an SCvx history says.
+
+    ``forced``: iterations whose predicted decrease was at the noise level, ``|J - L| <= noise_tol (1 + |J|)``, so
+    that rho was set to 1; ``forced_negative``: how many of them had a negative prediction; ``rho_range``: (min,
+    max) of rho over the other steps; ``updates``: iterations after which the multipliers were updated;
+    ``defect_ratio``: largest defect after each step over that after the previous step.
+    """
+
+    n_steps: int
+    n_accepted: int
+    forced: tuple
+    forced_predicted: tuple
+    forced_negative: int
+    n_real: int
+    rho_range: tuple
+    updates: tuple
+    eta_start: float
+    eta_end: float
+    defect_ratio: np.ndarray
+
+
+def iteration_summary(result, settings: scvx.SCvxSettings) -> IterationSummary:
+    """Summarise ``result.history`` under the noise rule of ``settings``."""
+    hist = result.history
+    if not hist:
+        raise ValueError("the result has no iteration history")
+    noise = [abs(h["predicted"]) <= settings.noise_tol * (1 + abs(h["cost"])) for h in hist]
+    forced = tuple(h["iteration"] for h, nl in zip(hist, noise) if nl)
+    real = [h["rho"] for h, nl in zip(hist, noise) if not nl]
+    defects = np.array([h["max_defect"] for h in hist])
+    return IterationSummary(
+        len(hist), int(sum(h["accepted"] for h in hist)), forced, tuple(hist[i]["predicted"] for i in forced),
+        int(sum(hist[i]["predicted"] < 0 for i in forced)), len(real),
+        (min(real), max(real)) if real else (float("nan"), float("nan")),
+        tuple(h["iteration"] for h in hist if h["multiplier_update"]), float(hist[0]["eta"]), float(hist[-1]["eta"]),
+        defects[1:] / defects[:-1])
+
+
+@dataclass(frozen=True)
+class ShootingCheck:
+    """The converged control flown from the initial state alone: states at the nodes and the terminal miss."""
+
+    x: np.ndarray
+    miss_km: float
+    miss_mm_s: float
+
+
+def single_shooting(problem: TransferProblem, u) -> ShootingCheck:
+    """Fly the first-order-hold control ``u`` (LU/TU^2 at the nodes) through the nonlinear dynamics from ``x0``."""
+    em = problem.system
+    x = D.propagate_foh(em, problem.x0, problem.t, u)
+    return ShootingCheck(x, float(np.linalg.norm(x[-1, :3] - problem.x_final[:3]) * em.length_unit_km),
+                         float(np.linalg.norm(x[-1, 3:] - problem.x_final[3:]) * em.velocity_unit_km_s * 1e6))
+
+
+@dataclass(frozen=True)
+class GuessStudy:
+    """Impulses (LU/TU) and iteration counts from random initial guesses; ``spread`` relative to a reference."""
+
+    impulses: np.ndarray
+    iterations: tuple
+    spread: float
+
+
+def guess_study(problem: TransferProblem, n_guesses: int, rng: np.random.Generator, reference_impulse: float, *,
+                control_scale: float = 0.05, max_iter: int = 200) -> GuessStudy:
+    """Solve from ``n_guesses`` guesses: the straight blend of the forward and backward ballistic arcs, with random
+    node controls of ``control_scale * a_max`` per axis (zero in the window)."""
+    n = validation.integer(n_guesses, "n_guesses", minimum=1)
+    validation.instance(rng, "rng", np.random.Generator)
+    ref = validation.positive(reference_impulse, "reference_impulse")
+    t, em = problem.t, problem.system
+    impulses, iterations = [], []
+    for _ in range(n):
+        back = propagate(em, problem.x_final, t[::-1]).x[::-1]
+        s = (t / t[-1])[:, None]
+        guess = (1 - s) * problem.x_guess + s * back
+        u0 = control_scale * problem.scenario.a_max * rng.standard_normal((t.size, 3)) * (problem.u_max > 0)[:, None]
+        r = solve(problem, scvx.SCvxSettings(max_iter=max_iter), x_guess=guess, u_guess=u0)
+        impulses.append(r.impulse)
+        iterations.append(len(r.history))
+    impulses = np.array(impulses)
+    return GuessStudy(impulses, tuple(iterations), float((impulses.max() - impulses.min()) / ref))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Figures
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def figure_iterations(result, settings: scvx.SCvxSettings, velocity_unit_km_s: float):
+    """Cost per step (with the multiplier-update jumps), impulse after each step and largest defect after each step."""
+    hist = result.history
+    updates = [h["iteration"] for h in hist if h["multiplier_update"]]
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4), layout="constrained")
+    # J as a sawtooth: each step runs from J before (at x = it) to J after (at x = it + 1); a multiplier/weight update
+    # then redefines J at the same trajectory (vertical jump at x = it + 1)
+    for h in hist:
+        it = h["iteration"]
+        axes[0].semilogy([it, it + 1], [h["cost"], h["new_cost"]], "-", color="C0", marker="o", ms=3)
+    for h, nxt in itertools.pairwise(hist):
+        if h["multiplier_update"]:
+            axes[0].semilogy([h["iteration"] + 1] * 2, [h["new_cost"], nxt["cost"]], ":", color="C1", lw=1.5)
+    axes[0].plot([], [], "-o", ms=3, color="C0", label="SCvx step (J does not rise)")
+    axes[0].plot([], [], ":", lw=1.5, color="C1", label=r"$\lambda$ update, $w$ raised (J redefined)")
+    axes[0].set(xlabel="iteration [-]", ylabel=r"augmented-Lagrangian cost $\mathcal{J}$ [non-dim.]",
+                title="cost per SCvx step")
+    impulse_hist = np.array([h["impulse"] for h in hist]) * velocity_unit_km_s * 1e3
+    axes[1].plot([h["iteration"] + 1 for h in hist], impulse_hist, "o-", color="C2")
+    axes[1].set(xlabel="iteration [-]", ylabel="total impulse after the step [m/s]",
+                title="impulse rises as the defects close")
+    axes[2].semilogy([h["iteration"] + 1 for h in hist], [max(h["max_defect"], 1e-16) for h in hist], "o-",
+                     color="C0")
+    axes[2].axhline(settings.defect_tol, color="0.4", ls="--", lw=0.8, label="convergence tolerance")
+    axes[2].set(xlabel="iteration [-]", ylabel="largest defect after the step\n[LU or LU/TU]", title="defects")
+    for ax in axes:
+        ax.xaxis.set_major_locator(plt.MaxNLocator(integer=True))
+        for it in updates:  # the updates happen between steps: mark them in every panel
+            ax.axvline(it + 1, color="C1", lw=0.6, alpha=0.35, zorder=0)
+    for ax in (axes[0], axes[2]):
+        ax.yaxis.set_minor_formatter(plt.NullFormatter())  # decade labels only: no colliding minor tick labels
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)  # below the axes
+    fig.suptitle("SCvx iterations, minimum-impulse DRO transfer (test case 1 boundary conditions); "
+                 "faint red lines: multiplier updates")
+    return fig
+
+
+def figure_converged_control(problem: TransferProblem, u, shooting: ShootingCheck):
+    """Thrust-acceleration norm at the nodes (window shaded) and the flown trajectory minus the initial DRO."""
+    em, t = problem.system, problem.t
+    k_ws, k_we = problem.k_window
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.6), layout="constrained")
+    unorm = np.linalg.norm(u, axis=1) * em.acceleration_unit_km_s2 * 1e9  # µm/s²
+    a_max_um = problem.scenario.a_max * em.acceleration_unit_km_s2 * 1e9
+    ax1.axvspan(em.tu_to_days(t[k_ws]), em.tu_to_days(t[k_we]), color="0.9", label="observation window (no thrust)")
+    ax1.plot(em.tu_to_days(t), unorm, ".-", label="|u| at the nodes")
+    ax1.set(xlabel="time [days]", ylabel="thrust acceleration [µm/s²]", ylim=(0, None),
+            title=f"converged control ($a_{{max}}$ = {a_max_um:.0f} µm/s², off the scale)")
+    ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.15), frameon=False)  # below the axes
+    rel = shooting.x - propagate(em, problem.x0, t).x
+    rel_km = rel[:, :2] * em.length_unit_km
+    plotting.plot_rotating(ax2, rel[None], em, "xy", units="km", marker=".")
+    ax2.plot(*rel_km[0], "o", color="C2", ms=7, zorder=3, label="start (same state)")
+    ax2.plot(*rel_km[-1], "s", color="C3", ms=7, zorder=3, label=r"end: $x_f$ on the neighbouring DRO")
+    ax2.set(xlabel=r"$\Delta x$ [km]", ylabel=r"$\Delta y$ [km]",
+            title="converged minus initial DRO, at the nodes (rotating frame)")
+    ax2.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=2, frameon=False)
+    return fig

@@ -1,0 +1,79 @@
+"""Notebook 02's studies: the scalar worked example against its closed form, the stacked toy window, the CRLB
+decomposition and the gradient on a short test-case-2 window, the baseline summaries and the timing crossover."""
+
+import numpy as np
+import pytest
+
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.papers.wolf_jones import mutual_information_study as S
+from cislunar.sensing import information as info
+
+
+def test_scalar_example_agrees_with_its_closed_form():
+    ex = S.scalar_worked_example(4000, np.random.default_rng(1), p=2.0, h=0.5, r=0.3)
+    assert ex.closed == pytest.approx(0.5 * np.log(1 + 0.25 * 2.0 / 0.3))
+    assert abs(ex.kl_mean - ex.closed) < 4 * ex.kl_se
+    assert abs(ex.monte_carlo - ex.closed) < 4 * ex.monte_carlo_se
+    assert ex.std_ratio == pytest.approx(np.exp(-ex.closed))  # posterior/prior std = exp(-I) for a scalar
+    with pytest.raises(ValueError):
+        S.scalar_worked_example(1, np.random.default_rng(0))
+
+
+def test_toy_window_dense_equals_chain_rule():
+    toy = S.constant_velocity_toy(dt=0.5, n_times=4)
+    assert toy.F.shape == (3, 2, 2) and toy.H.shape == (4, 1, 2)
+    assert np.all(np.linalg.eigvalsh(toy.Q[0]) > 0)
+    total, terms = info.mutual_information(*toy.arrays, return_terms=True)
+    assert info.mutual_information_dense(*toy.arrays) == pytest.approx(total, rel=1e-10)
+    assert np.sum(terms) == pytest.approx(total) and terms[0] == max(terms)
+
+
+@pytest.fixture(scope="module")
+def short_window():
+    P = float(S._period(em, S.OBSERVER_TF_X0))
+    return S.case_2_window(em, t=P + np.arange(4) * float(em.days_to_tu(1.0)))
+
+
+def test_window_crlb_decomposes_and_matches_eq18(short_window):
+    w = short_window
+    assert w.start.shape == (4, 6) and w.lin.P0.shape == (24, 24) and len(w.target_periods_d) == 3
+    assert w.days[0] == pytest.approx(em.tu_to_days(w.P_ref))
+    c = S.window_crlb(w)
+    assert c.total.shape == (4, 4)
+    assert c.relative_difference < 1e-6 and np.sum(c.gains) == pytest.approx(c.mi_chain)
+    # position variance = in-plane + out-of-plane variance, and the update never raises the variance
+    assert np.allclose(c.total**2, c.in_plane**2 + c.out_of_plane**2)
+    assert np.all(c.total <= c.prior * (1 + 1e-12))
+    # planar DROs: range and range rate do not see z
+    assert c.largest_z_jacobian < 1e-12 and 0 < c.out_of_plane_share <= 1
+
+
+def test_gradient_matches_finite_differences(short_window):
+    g = S.gradient_check(short_window, step=1e-6)
+    assert g.error < 1e-5
+    assert g.value == pytest.approx(S.observer_information(short_window, short_window.start[0]), rel=1e-9)
+    lc = S.linearisation_check(short_window, g, steps_km=[1.0, 100.0])
+    # Eq. 44 is first order: the error grows faster than the step
+    assert lc.error[1] / lc.error[0] > 100.0
+    assert np.allclose(np.linalg.norm(lc.dx, axis=1), em.km_to_lu(np.array([1.0, 100.0])))
+
+
+def test_baseline_curve_summaries():
+    c = S.BaselineCurve("x", np.array([1.0, 2.0, 3.0]), np.array([1.0, 3.0, 2.0]), np.array([5.0, 2.0, 4.0]),
+                        np.array([5.0, 2.0, 3.0]), np.array([3.0, 1.0, 2.0]), np.array([4.0, 1.0, 3.0]),
+                        np.array([4.0, 1.0, 3.0]), 10.0)
+    assert c.gain == 2.0 and c.peak_km == 20.0 and c.best == 1 and c.same_peak
+    assert c.rms_drop == 4.0 and c.rebound == 3.0 and c.mi_drop == 1.0
+    assert c.observer_above_target_km == ["30"]
+    assert not c.improves(1.5, 1.2) and c.improves(1.5, 3.5) and not c.improves(5.0, 3.5)
+
+
+def test_crossover_interpolates_on_log_axes():
+    assert S.crossover([4, 16], [0.5, 2.0]) == "N = 8 (between 4 and 16)"
+    assert S.crossover([4, 16], [1.2, 2.0]) == "at or below N = 4"
+    assert S.crossover([4, 16], [0.2, 0.5]) == "above N = 16 (not reached)"
+    with pytest.raises(ValueError):
+        S.crossover([4], [0.5, 2.0])
+    t = S.TimingStudy((4, 16), (info.TimingResult(1.0, 2.0, 1.0, 1.0), info.TimingResult(4.0, 2.0, 3.0, 1.0)))
+    assert t.at(16).ratio_value == 2.0 and t.crossover_value == "N = 8 (between 4 and 16)"
+    assert t.crossover_gradient == "at or below N = 4"

@@ -1,0 +1,56 @@
+"""Notebook 03's studies: the transfer problem, one SCvx solve on few nodes, the reading of an iteration history and
+the single-shooting check."""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from cislunar.guidance import scvx
+from cislunar.papers.wolf_jones import scvx_study as S
+
+
+@pytest.fixture(scope="module")
+def problem():
+    return S.transfer_problem(16, 1.0)
+
+
+def test_problem_has_a_thrust_free_window(problem):
+    k0, k1 = problem.k_window
+    assert 0 < k0 < k1 < problem.t.size - 1
+    assert np.all(problem.u_max[k0:k1 + 1] == 0) and np.all(problem.u_max[:k0] == problem.scenario.a_max)
+    assert np.all(problem.in_window == (problem.u_max == 0))
+    assert np.allclose(problem.x_guess[0], problem.x0) and problem.ballistic_miss > 1e-4  # a transfer is needed
+    with pytest.raises(ValueError):
+        S.transfer_problem(2)
+
+
+def test_zero_control_single_shooting_is_the_ballistic_arc(problem):
+    shot = S.single_shooting(problem, np.zeros((problem.t.size, 3)))
+    assert np.allclose(shot.x, problem.x_guess, atol=1e-9)
+    em = problem.system
+    miss = problem.x_guess[-1] - problem.x_final
+    assert shot.miss_km == pytest.approx(np.linalg.norm(miss[:3]) * em.length_unit_km, rel=1e-6)
+
+
+def test_solve_converges_and_flies(problem):
+    res = S.solve(problem)
+    assert res.max_defect < 1e-9 and res.impulse > 0
+    assert np.max(np.linalg.norm(res.u[problem.in_window], axis=1)) == 0
+    assert S.single_shooting(problem, res.u).miss_km < 1.0
+    summary = S.iteration_summary(res, scvx.SCvxSettings())
+    assert summary.n_steps == len(res.history) and summary.defect_ratio.size == summary.n_steps - 1
+
+
+def test_iteration_summary_applies_the_noise_rule():
+    settings = scvx.SCvxSettings()
+    base = {"accepted": True, "multiplier_update": False, "eta": 0.05}
+    hist = [dict(base, iteration=0, cost=1.0, predicted=0.5, rho=0.9, max_defect=1e-2),
+            dict(base, iteration=1, cost=0.5, predicted=-1e-12, rho=1.0, max_defect=1e-3, multiplier_update=True),
+            dict(base, iteration=2, cost=0.6, predicted=0.1, rho=0.8, max_defect=1e-3, accepted=False, eta=0.1)]
+    s = S.iteration_summary(SimpleNamespace(history=hist), settings)
+    assert s.forced == (1,) and s.forced_negative == 1 and s.n_real == 2 and s.rho_range == (0.8, 0.9)
+    assert s.n_accepted == 2 and s.updates == (1,) and (s.eta_start, s.eta_end) == (0.05, 0.1)
+    assert np.allclose(s.defect_ratio, [0.1, 1.0])
+    with pytest.raises(ValueError):
+        S.iteration_summary(SimpleNamespace(history=[]), settings)
