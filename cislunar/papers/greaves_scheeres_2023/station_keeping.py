@@ -48,6 +48,7 @@ from cislunar.cr3bp.propagation import (
     propagate,
     propagate_stm,
 )
+from cislunar.estimation.consistency import _nees
 from cislunar.guidance.ssat import (
     ImpulsiveTrajectory,
     _initial_cov,
@@ -69,20 +70,20 @@ from cislunar.utils import validation
 from cislunar.utils.progress import progress as _progress
 
 __all__ = [
-    "TransferConvergenceError",
-    "position_transfer",
-    "two_burn_transfer",
-    "target_trajectory",
-    "StationKeepingSurface",
-    "station_keeping_surface",
-    "informed_choice",
-    "first_burn_only_range_sigma_km",
     "FilterScenario",
     "FilterTrialResult",
+    "StationKeepingSurface",
+    "TransferConvergenceError",
     "execution_sigma",
     "filter_scenario",
     "filter_trial",
+    "first_burn_only_range_sigma_km",
+    "informed_choice",
+    "position_transfer",
     "random_choice_trial",
+    "station_keeping_surface",
+    "target_trajectory",
+    "two_burn_transfer",
 ]
 
 
@@ -381,7 +382,7 @@ class StationKeepingSurface:
         """Smallest :math:`\\sqrt{J_\\rho}` at ``t[-1]`` per arrival time, km, (n_t,)."""
         return self.range_sigma_km[self._rows(), self.best]
 
-    def reselect(self, criterion: str) -> "StationKeepingSurface":
+    def reselect(self, criterion: str) -> StationKeepingSurface:
         """The same surface with :math:`\\mathbf u^*` chosen by another reading of Eq. 25 (see :func:`informed_choice`)."""
         align, cand, pick = informed_choice(self.dv1, self.u_y, self.range_sigma_km, criterion)
         return replace(self, alignment=align, candidates=cand, informed=pick)
@@ -855,7 +856,7 @@ def filter_trial(rng: np.random.Generator, scenario: FilterScenario, *, n_iter: 
             if k < N and t[k] == te:
                 x, P = _iterated_update(sys_, x, P, y[k], sc, n_iter)
                 e = x - np.r_[truth_a[k], truth_t[k]]
-                nees[k] = e @ np.linalg.solve(P, e)
+                nees[k] = _nees(x, P, np.r_[truth_a[k], truth_t[k]])
                 M = range_projection(np.r_[truth_a[k], truth_t[k]])
                 err[k] = (M @ e) * sys_.length_unit_km
                 sdev[k] = np.sqrt(M @ P @ M) * sys_.length_unit_km

@@ -1,0 +1,67 @@
+"""Claims of notebook 07, SSAT and MMD guidance (Greaves & Scheeres AMOS 2023, Secs. 3.1-4.1, Eqs. 1-24).
+
+Declarations only: each closing-table row of the chapter, its criterion fixed before comparing.  Percentages are of
+the 1-sigma range uncertainty sqrt(J_rho) at the end of the coast: the perpendicular row compares the best direction
+of the perpendicular circle with the true minimiser (percent above it), the "nearly optimal" rows MMD's excess over
+the true minimiser (percent).
+"""
+
+from __future__ import annotations
+
+import math
+
+from cislunar.publish.claims import AtMost, Claim, Holds, Within
+
+_NOT_GIVEN = "the paper's MMD scenarios (its Ref. [8]: orbits, burn timing, coast) are not given"
+
+CLAIMS = {
+    "eq7_identity": Claim(
+        "Eq. 7: T P T^T and its inverse (identity)", "exact", AtMost(1e-12), kind="derived", source="Eqs. 3-7"),
+    "agent_based_equivalent": Claim(
+        "agent-based absolute state equivalent (same relative block, same J_rho)", "stated, not shown",
+        AtMost(1e-12), kind="derived", source="Sec. 3.1"),
+    "initial_range_sigma": Claim(
+        "initial 1-sigma range uncertainty from 3-sigma 60 km per axis, both vehicles", None,
+        Within(20.0 * math.sqrt(2.0), 1e-6, relative=True), kind="derived", source="Sec. 5 (initial covariance)"),
+    "sri_vs_ekf": Claim(
+        "covariance analysis: SRI batch form vs EKF recursion", None, AtMost(1e-6), kind="beyond paper"),
+    "no_maneuver_sigma": Claim(
+        "sqrt(J_rho) without maneuver after 24 h / 72 h (demonstration pair)", None, kind="not in paper",
+        reason=f"{_NOT_GIVEN}; our pair: same 9:2 NRHO, 215 km at apolune"),
+    "mmd_is_eigenvector": Claim(
+        "MMD (Eq. 23 read as the eigenvector) = brute-force maximiser of its surrogate",
+        "u_y = +/- upsilon max(eig(Q)) (Eq. 23)",
+        Holds("both brute-force maximisers lie within one grid spacing of the eigenvector"), kind="derived",
+        source="Eqs. 23-24"),
+    "perpendicular_contains_optimum": Claim(
+        "Ref. [8]: perpendicular-to-LOS set contains the optimum (tested at the shortest coast)", "stated",
+        AtMost(2.0), source="Sec. 4.1, citing Ref. [8]",
+        reason="the best perpendicular direction is more than 2 % above the optimum at the shortest coast"),
+    "mmd_near_optimal_start": Claim(
+        "MMD near-optimal, burn at the start of tracking (first pair; excess over the true minimiser)",
+        "'nearly optimal'", AtMost(5.0), source="Sec. 4.1",
+        reason=f"MMD's excess over the true minimiser (percent, 1 m/s burn, worst coast) exceeds 5 %; {_NOT_GIVEN}"),
+    "mmd_near_optimal_qpo": Claim(
+        "MMD near-optimal, burn at the start of tracking, agent on the 215-km QPO (4 ring angles 0, 45, 90, 135 deg, "
+        "1.0 m/s)", "'nearly optimal'", AtMost(5.0), kind="beyond paper", source="Sec. 4.1",
+        reason="MMD's median excess over the true minimiser (percent, all ring angles and coasts) exceeds 5 %: the "
+               "verdict depends on geometry and coast time"),
+    "mmd_near_optimal_arc_short": Claim(
+        "MMD near-optimal, burn after 24 h of tracking (first pair, 1.0 m/s), short coasts", "'nearly optimal'",
+        AtMost(5.0), source="Sec. 4.1",
+        tuned="nothing in the computation was fitted, but the setting was: the mid-arc burn (24 h of tracking "
+              "before it) was adopted after the start-of-tracking comparison missed the paper's 'nearly optimal', a "
+              "choice made while looking at the paper's claim, hence not 'reproduced'",
+        reason="MMD's worst excess over the optimum in the leading run of coasts exceeds 5 %"),
+    "mmd_near_optimal_arc_long": Claim(
+        "MMD near-optimal, burn after 24 h of tracking (first pair, 1.0 m/s), longer coasts", "'nearly optimal'",
+        AtMost(5.0), source="Sec. 4.1",
+        tuned="the mid-arc burn setting, as in the row above",
+        reason="MMD maximises the measurement change at tau_f only, while J_rho accumulates every measurement of the "
+               f"coast; {_NOT_GIVEN}"),
+    "sign_choice": Claim(
+        "+/- sign choice by quick covariance analysis", "needed", kind="beyond paper", source="Sec. 3.4"),
+    "computation_time": Claim(
+        "computation time: true minimiser / MMD (Sec. 4.1: 'exponentially faster')", "no number",
+        kind="beyond paper", source="Sec. 4.1"),
+}

@@ -1,0 +1,393 @@
+r"""Studies of informed station keeping on the QPO (Greaves & Scheeres AMOS 2023, Secs. 4-5; notebook 08).
+
+Each function runs one study over :func:`cislunar.papers.greaves_scheeres_2023.station_keeping.station_keeping_surface`
+and returns a frozen result object:
+
+* :func:`slice_statistics`: where :math:`\mathbf u^*` ranks within each arrival slice (range uncertainty, fuel);
+* :func:`grid_resolution_study`: both readings of Eq. 25 as the ring-angle grid is refined;
+* :func:`scenario_sweep`: the unstated scenario inputs (tracking start, burn lead, agent phase, read-out time);
+* :func:`offset_study`: an agent that has drifted off the torus;
+* :func:`member_study`: torus members matching 215 km under other readings of "average range";
+* :func:`filter_monte_carlo`: the iterated-EKF Monte Carlo with execution errors (beyond the paper).
+
+Units: times in hours where named ``*_h``/``*_hours``, otherwise CR3BP time units (TU); :math:`\sqrt{J_\rho}` in
+km (``*_km``) or m (``*_m``); fuel in m/s; percentiles in percent of the maneuvers of a slice.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import chi2, spearmanr
+
+from cislunar.cr3bp.dynamics import CR3BP, check_system
+from cislunar.cr3bp.propagation import propagate
+from cislunar.cr3bp.torus import qpo_for_mean_range
+from cislunar.guidance import ssat
+from cislunar.papers.greaves_scheeres_2023 import station_keeping as sk
+from cislunar.utils import validation
+from cislunar.utils.montecarlo import run_monte_carlo
+
+__all__ = [
+    "POLICIES",
+    "GridRow",
+    "GridStudy",
+    "MonteCarloStudy",
+    "SliceStatistics",
+    "SweepRow",
+    "execution_levels",
+    "filter_monte_carlo",
+    "format_sweep",
+    "grid_resolution_study",
+    "member_study",
+    "offset_study",
+    "scenario_sweep",
+    "slice_statistics",
+]
+
+
+def _surface(value, name="surface"):
+    return validation.instance(value, name, sk.StationKeepingSurface, "a StationKeepingSurface")
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Where u* ranks within its slices
+# ---------------------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class SliceStatistics:
+    """The informed maneuver against the other maneuvers of its arrival slice.
+
+    Attributes
+    ----------
+    percentile : ndarray (n_t,)
+        Percent of the slice's maneuvers with a smaller :math:`\\sqrt{J_\\rho}` than :math:`\\mathbf u^*` (0 = best).
+    fuel_percentile : ndarray (n_t,)
+        Percent of the slice's maneuvers that use more fuel than :math:`\\mathbf u^*`.
+    cheaper_best_km : ndarray (n_t,)
+        Smallest :math:`\\sqrt{J_\\rho}` among the maneuvers using at most the fuel of :math:`\\mathbf u^*`, km.
+    below_median_fuel : float
+        Fraction of slices where :math:`\\mathbf u^*` uses at most the slice's median fuel.
+    valley_phase, informed_phase, fuel_peak_phase : float
+        Median normalised phase of the best maneuver, of :math:`\\mathbf u^*` and of the most expensive maneuver.
+    rank_correlation : float
+        Median over slices of Spearman's correlation of fuel and :math:`\\sqrt{J_\\rho}` (maneuvers only).
+    """
+
+    percentile: np.ndarray
+    fuel_percentile: np.ndarray
+    cheaper_best_km: np.ndarray
+    below_median_fuel: float
+    valley_phase: float
+    informed_phase: float
+    fuel_peak_phase: float
+    rank_correlation: float
+
+    @property
+    def median_percentile(self) -> float:
+        return float(np.median(self.percentile))
+
+    @property
+    def best_quartile_share(self) -> float:
+        """Percent of slices with :math:`\\mathbf u^*` in the best quartile."""
+        return float(np.mean(self.percentile < 25) * 100)
+
+    def format(self, surface) -> str:
+        """One line per slice of ``surface`` (the one these statistics were computed from): arrival, phase of u*,
+        its sqrt(J_rho), the slice's best, the best with at most its fuel, percentile, fuel, more-fuel share."""
+        S = _surface(surface)
+        lines = [("arrival h | u* phase | u* sqrt(J) m | best m | best with <= fuel m | percentile | fuel m/s | "
+                 "more fuel %")]
+        for j in range(S.t_arrival.size):
+            lines.append(f" {S.t_arrival_hours[j]:8.2f} | {S.phase[S.informed[j]]:8.3f} | "
+                         f"{S.informed_range_sigma_km[j] * 1e3:12.2f} | {S.best_range_sigma_km[j] * 1e3:6.2f} | "
+                         f"{self.cheaper_best_km[j] * 1e3:19.2f} | {self.percentile[j]:10.1f} | "
+                         f"{S.informed_fuel_m_s[j]:8.3f} | {self.fuel_percentile[j]:6.1f}")
+        return "\n".join(lines)
+
+
+def slice_statistics(surface) -> SliceStatistics:
+    """Rank the informed maneuver of every slice of ``surface`` by range uncertainty and by fuel."""
+    S = _surface(surface)
+    rows = np.arange(S.t_arrival.size)
+    cheaper = np.array([S.range_sigma_km[j, S.fuel_m_s[j] <= S.informed_fuel_m_s[j] + 1e-12].min() for j in rows])
+    moving = S.fuel_m_s > 1e-9
+    rank = np.median([spearmanr(S.fuel_m_s[j, moving[j]], S.range_sigma_km[j, moving[j]])[0] for j in rows])
+    return SliceStatistics(S.informed_percentile, S.informed_fuel_percentile, cheaper,
+                           float(np.mean(S.informed_fuel_m_s <= np.median(S.fuel_m_s, axis=1))),
+                           float(np.median(S.phase[S.best])), float(np.median(S.phase[S.informed])),
+                           float(np.median(S.phase[np.argmax(S.fuel_m_s, axis=1)])), float(rank))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Eq. 25 readings against the grid resolution
+# ---------------------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class GridRow:
+    """Medians over the arrival slices of one (agent phase, ring-angle count, reading)."""
+
+    agent_phase: float
+    n: int
+    reading: str
+    percentile: float
+    sigma_m: float
+    fuel_m_s: float
+    more_fuel_percent: float
+    best_m: float
+
+
+@dataclass(frozen=True)
+class GridStudy:
+    """Rows of :func:`grid_resolution_study`; ``n_grid`` the ring-angle counts in order."""
+
+    rows: tuple
+    n_grid: tuple
+
+    def format(self) -> str:
+        """The study as a text table, one line per row."""
+        lines = [("agent phase | ring angles | reading    | percentile of u* % | sqrt(J) of u* m | fuel of u* m/s | "
+                 "more fuel % | best of slice m")]
+        lines += [f" {g.agent_phase:10.2f} | {g.n:11d} | {g.reading:10s} | {g.percentile:18.1f} | {g.sigma_m:15.1f} | "
+                  f"{g.fuel_m_s:14.3f} | {g.more_fuel_percent:11.1f} | {g.best_m:15.1f}" for g in self.rows]
+        return "\n".join(lines)
+
+    def series(self, agent_phase: float, reading: str, key: str) -> np.ndarray:
+        """One column (``key`` a :class:`GridRow` field) against ``n_grid`` for an agent phase and a reading."""
+        return np.array([getattr(g, key) for g in self.rows if g.agent_phase == agent_phase and g.reading == reading])
+
+
+def grid_resolution_study(system: CR3BP, torus, n_grid, t_arrival, t_burn: float, t_final: float, *,
+                          agent_phases=(0.0, 0.75)) -> GridStudy:
+    """Both readings of Eq. 25 on surfaces with ``n`` equally spaced ring angles for each ``n`` in ``n_grid``, for
+    each agent phase (fraction of a turn); arrival times ``t_arrival`` and burn/read-out times in TU."""
+    check_system(system)
+    ns = tuple(validation.integer(n, "n_grid entry", minimum=2) for n in n_grid)
+    rows = []
+    for phase in agent_phases:
+        for n in ns:
+            s = sk.station_keeping_surface(system, torus, 2 * np.pi * np.arange(n) / n, t_arrival, t_burn, t_final,
+                                           agent_theta=2 * np.pi * phase, progress=False)
+            for crit in ("angle", "projection"):
+                r = s.reselect(crit)
+                rows.append(GridRow(float(phase), n, crit, float(np.median(r.informed_percentile)),
+                                    float(np.median(r.informed_range_sigma_km) * 1e3),
+                                    float(np.median(r.informed_fuel_m_s)),
+                                    float(np.median(r.informed_fuel_percentile)),
+                                    float(np.median(r.best_range_sigma_km) * 1e3)))
+    return GridStudy(tuple(rows), ns)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Sweep over the unstated scenario inputs
+# ---------------------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class SweepRow:
+    """One setting of :func:`scenario_sweep` (percentiles in percent, medians over slices).
+
+    ``pct_tf``/``q_tf``: median percentile of :math:`\\mathbf u^*` and share of best-quartile slices with
+    :math:`\\sqrt{J_\\rho}` read at :math:`t_f`; ``pct_arr``/``q_arr``: the same read at each arrival; ``fuel_pct``:
+    share of maneuvers using more fuel; ``*_proj``: projection reading.
+    """
+
+    pre_h: float
+    lead_h: float
+    agent_phase: float
+    pct_tf: float
+    q_tf: float
+    pct_arr: float
+    q_arr: float
+    fuel_pct: float
+    pct_proj: float
+    fuel_pct_proj: float
+
+
+def scenario_sweep(system: CR3BP, torus, theta, t_arrival, arrival_start_h: float, t_final: float, *,
+                   pre_arcs_h=(0.0, 24.0), leads_h=(12.0, 24.0, 48.0),
+                   agent_thetas=(0.0, np.pi / 2, np.pi, 3 * np.pi / 2)) -> tuple:
+    """One surface per (tracking arc before the first burn, burn lead before ``arrival_start_h``, agent ring angle);
+    returns a tuple of :class:`SweepRow`."""
+    check_system(system)
+    HR = 3600.0 / system.time_unit_s
+    rows = []
+    for pre_h in pre_arcs_h:
+        for lead_h in leads_h:
+            for ang in agent_thetas:
+                t_b = (arrival_start_h - lead_h) * HR
+                s = sk.station_keeping_surface(system, torus, theta, t_arrival, t_b, t_final, agent_theta=ang,
+                                               t_track_start=t_b - pre_h * HR, progress=False)
+                sig_a = s.range_sigma_at_arrival_km
+                arr_pct = 100 * np.mean(sig_a < sig_a[np.arange(s.t_arrival.size), s.informed][:, None], axis=1)
+                sp = s.reselect("projection")
+                rows.append(SweepRow(float(pre_h), float(lead_h), float(ang / (2 * np.pi)),
+                                     float(np.median(s.informed_percentile)),
+                                     float(np.mean(s.informed_percentile < 25) * 100), float(np.median(arr_pct)),
+                                     float(np.mean(arr_pct < 25) * 100), float(np.median(s.informed_fuel_percentile)),
+                                     float(np.median(sp.informed_percentile)),
+                                     float(np.median(sp.informed_fuel_percentile))))
+    return tuple(rows)
+
+
+def format_sweep(rows) -> str:
+    """The rows of :func:`scenario_sweep` as a text table."""
+    lines = ["angle reading" + " " * 57 + "| projection reading",
+             ("pre-arc h | lead h | agent phase | median pct (t_f) | best-quartile % (t_f) | median pct (arrival) | "
+             "best-quartile % (arrival) | more-fuel % | median pct (t_f) | more-fuel %")]
+    lines += [f" {r.pre_h:8.0f} | {r.lead_h:5.0f} | {r.agent_phase:11.2f} | {r.pct_tf:16.1f} | {r.q_tf:21.0f} | "
+              f"{r.pct_arr:20.1f} | {r.q_arr:26.0f} | {r.fuel_pct:11.1f} | {r.pct_proj:16.1f} | "
+              f"{r.fuel_pct_proj:10.1f}" for r in rows]
+    return "\n".join(lines)
+
+
+def offset_study(system: CR3BP, torus, theta, t_arrival, t_burn: float, t_final: float, rng: np.random.Generator,
+                 *, distances_km=(0.0, 1.0, 10.0, 50.0), n_directions: int = 3, agent_theta: float = 0.0) -> dict:
+    """Median percentile of :math:`\\mathbf u^*` (angle reading) for an agent off the torus at the first burn.
+
+    For each distance ``d`` (km) and each of ``n_directions`` random directions drawn from ``rng``: position offset
+    ``d`` km and velocity offset ``d`` times the ring's velocity-to-position size ratio.  Returns ``{d: [percentile,
+    ...]}`` (percent).
+    """
+    check_system(system)
+    validation.rng(rng)
+    n_directions = validation.integer(n_directions, "n_directions", minimum=1)
+    L, V = system.length_unit_km, system.velocity_unit_km_s
+    vel_per_km = torus.velocity_size_mps / torus.size_km  # m/s per km
+    out = {}
+    for d_km in distances_km:
+        vals = []
+        for _ in range(n_directions):
+            dr, dv = rng.standard_normal(3), rng.standard_normal(3)
+            off = np.r_[d_km * dr / np.linalg.norm(dr) / L, d_km * vel_per_km * 1e-3 * dv / np.linalg.norm(dv) / V]
+            s = sk.station_keeping_surface(system, torus, theta, t_arrival, t_burn, t_final, agent_theta=agent_theta,
+                                           agent_offset=off, progress=False)
+            vals.append(float(np.median(s.informed_percentile)))
+        out[float(d_km)] = vals
+    return out
+
+
+def member_study(system: CR3BP, orbit, theta, t_arrival, t_burn: float, t_final: float, *, target_km: float = 215.0,
+                 statistics=("ring_mean_km", "rms_km"), agent_theta: float = 0.0) -> dict:
+    """For the torus member whose ``statistic`` (another reading of "average range") equals ``target_km``: its torus
+    mean range and ring size (km), and per reading of Eq. 25 the median percentile of :math:`\\mathbf u^*` and the
+    percent of slices where it uses at most the median fuel.  Returns ``{statistic: dict}``."""
+    check_system(system)
+    out = {}
+    for stat in statistics:
+        tor, st = qpo_for_mean_range(orbit, target_km, statistic=stat)
+        s = sk.station_keeping_surface(system, tor, theta, t_arrival, t_burn, t_final, agent_theta=agent_theta,
+                                       progress=False)
+        row = {"mean_km": float(st.mean_km), "size_km": float(tor.size_km)}
+        for crit in ("angle", "projection"):
+            r = s.reselect(crit)
+            row[crit] = (float(np.median(r.informed_percentile)),
+                         float(np.mean(r.informed_fuel_m_s <= np.median(r.fuel_m_s, axis=1)) * 100))
+        out[stat] = row
+    return out
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Full-filter Monte Carlo (beyond the paper)
+# ---------------------------------------------------------------------------------------------------------------
+#: Policy labels of :func:`filter_monte_carlo`, in order.
+POLICIES = ("informed u*\n(angle reading)", "informed u*\n(projection)", "uninformed\n(random phase)", "no maneuver")
+
+
+def execution_levels(exec_abs_m_s: float, exec_rel: float) -> dict:
+    """Execution-error levels: tag -> (1-sigma absolute m/s, relative fraction) per axis."""
+    return {"perfect": (0.0, 0.0), "small": (exec_abs_m_s / 10, exec_rel / 10), "exec": (exec_abs_m_s, exec_rel)}
+
+
+@dataclass(frozen=True)
+class MonteCarloStudy:
+    """Summary of the filter runs per (policy, execution level).
+
+    Attributes
+    ----------
+    summary : dict
+        ``(policy, level) -> dict(nees, rms, fsig, ca, failed)``: mean NEES of the 12-dimensional SSAT state at
+        :math:`t_f`, RMS range error (m), filter RMS 1-sigma (m), covariance-analysis prediction (m), failed runs.
+    levels : dict
+        Level tag -> (m/s, fraction).
+    n_trials : int
+    band : tuple of float
+        95 % chi-square band of the mean NEES over ``n_trials`` runs.
+    seconds : float
+        Wall-clock time of the runs.
+    slice_index, no_maneuver_index : int
+        Arrival slice used and the ring-angle index of the agent's own phase (no maneuver).
+    prior_range_m : float
+        Range 1-sigma of the prior at the start of tracking, m.
+    """
+
+    summary: dict
+    levels: dict
+    n_trials: int
+    band: tuple
+    seconds: float
+    slice_index: int
+    no_maneuver_index: int
+    prior_range_m: float
+
+    def format(self) -> str:
+        """Runs, band and one line per (policy, level): failures, mean NEES, RMS error, filter and predicted sigma."""
+        lo, hi = self.band
+        lines = [(f"{len(self.summary)} x {self.n_trials} filter runs in {self.seconds:.1f} s; 95 % band of the mean "
+                 f"NEES: [{lo:.2f}, {hi:.2f}]"),
+                 ("policy                      | burns   | failed | mean NEES(t_f) | RMS range error m | filter sigma m | "
+                 "cov. analysis m")]
+        lines += [f"{pol.replace(chr(10), ' '):27s} | {tag:7s} | {s['failed']:6d} | {s['nees']:14.2f} | "
+                  f"{s['rms']:17.1f} | {s['fsig']:14.1f} | {s['ca']:15.1f}" for (pol, tag), s in self.summary.items()]
+        lines.append(f"range 1-sigma of the prior at the start of tracking: {self.prior_range_m:.0f} m")
+        return "\n".join(lines)
+
+    def ratio(self, policy: str, level: str = "perfect") -> float:
+        """RMS range error of ``policy`` over that of the uninformed choice."""
+        return self.summary[(policy, level)]["rms"] / self.summary[(POLICIES[2], level)]["rms"]
+
+
+def filter_monte_carlo(system: CR3BP, surface, surface_projection, target_apolune_state, *, n_trials: int,
+                       seed: int, exec_abs_m_s: float = 1e-3, exec_rel: float = 0.01, executor=None) -> MonteCarloStudy:
+    """Iterated-EKF runs (:func:`station_keeping.filter_trial`) for the arrival slice closest to apoapsis.
+
+    Policies (:data:`POLICIES`): :math:`\\mathbf u^*` of ``surface`` (angle reading) and of ``surface_projection``,
+    a ring angle drawn at random in each trial (the agent's own phase excluded), and no maneuver (perfect level only:
+    no burn, nothing to execute); levels from :func:`execution_levels`.  Trial streams ``[seed, k]`` for the k-th (policy,
+    level) pair, so the result does not depend on ``executor``.
+    """
+    check_system(system)
+    S, SP = _surface(surface), _surface(surface_projection, "surface_projection")
+    n_trials = validation.integer(n_trials, "n_trials", minimum=1)
+    seed = validation.integer(seed, "seed", minimum=0)
+    inf, infp, uni, none = POLICIES
+    j = int(np.argmin(np.abs(S.t_arrival_hours)))
+    tgt_b = propagate(system, target_apolune_state, np.array([0.0, S.t[0]])).x[-1]  # target at start of tracking
+    zero = int(np.argmin(S.fuel_m_s[j]))  # phase 0: no maneuver
+    levels = execution_levels(exec_abs_m_s, exec_rel)
+    policies = {}
+    for tag, (a, r) in levels.items():
+        def mk(i, lab, a=a, r=r):
+            return sk.filter_scenario(S, j, i, tgt_b, system, exec_sigma_abs_m_s=a, exec_sigma_rel=r, label=lab)
+        policies[(inf, tag)] = (sk.filter_trial, (mk(S.informed[j], "informed"),))
+        policies[(infp, tag)] = (sk.filter_trial, (mk(SP.informed[j], "informed, projection"),))
+        policies[(uni, tag)] = (sk.random_choice_trial,
+                                (tuple(mk(i, "random") for i in range(S.theta.size) if i != zero),))
+        if tag == "perfect":
+            policies[(none, tag)] = (sk.filter_trial, (mk(zero, "none"),))
+    t0 = time.perf_counter()
+    mc = {key: run_monte_carlo(fn, n_trials, [seed, k], args=args, executor=executor,
+                               desc=f"{key[0].replace(chr(10), ' ')}, {key[1]}")
+          for k, (key, (fn, args)) in enumerate(policies.items())}
+    seconds = time.perf_counter() - t0
+    lo, hi = chi2.ppf([0.025, 0.975], 12 * n_trials) / n_trials
+    ca_of = {inf: S.informed_range_sigma_km[j], infp: SP.informed_range_sigma_km[j], none: S.range_sigma_km[j, zero],
+             uni: np.sqrt(np.mean(np.delete(S.range_sigma_km[j], zero) ** 2))}
+    summary = {}
+    for (pol, tag), res in mc.items():
+        ok = [r for r in res if not r.failure]
+        summary[(pol, tag)] = {"nees": float(np.mean([r.nees[-1] for r in ok])),
+                               "rms": float(np.sqrt(np.mean([r.range_error_km[-1] ** 2 for r in ok])) * 1e3),
+                               "fsig": float(np.sqrt(np.mean([r.range_sigma_km[-1] ** 2 for r in ok])) * 1e3),
+                               "ca": float(ca_of[pol] * 1e3), "failed": len(res) - len(ok)}
+    M0 = ssat.range_projection(np.r_[S.agent_x0, tgt_b])
+    prior = float(np.sqrt(M0 @ ssat.initial_covariance(system) @ M0) * system.length_unit_km * 1e3)
+    return MonteCarloStudy(summary, levels, n_trials, (float(lo), float(hi)), seconds, j, zero, prior)

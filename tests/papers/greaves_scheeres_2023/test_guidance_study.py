@@ -1,0 +1,96 @@
+"""Studies of notebook 07 (SSAT and MMD guidance) on small sizes: identities, invariants and consistency."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.cr3bp.orbits import nrho_9_2
+from cislunar.cr3bp.torus import torus_from_orbit
+from cislunar.papers.greaves_scheeres_2023 import guidance_study as gs
+
+
+@pytest.fixture(scope="module")
+def pair():
+    return gs.demonstration_pair(em, nrho_9_2(em), lead_days=1.0, apolune_range_km=215.0, days=1)
+
+
+@pytest.fixture(scope="module")
+def study(pair):
+    return gs.policy_study(em, pair, [1, 3], [1.0], n_grid=60, n_perp=8)
+
+
+def test_leading_hours():
+    h = np.array([1.0, 2.0, 4.0, 8.0])
+    assert gs.leading_hours(h, [True, True, False, True]) == 2.0
+    assert gs.leading_hours(h, [True] * 4) == 8.0
+    assert gs.leading_hours(h, [False, True, True, True]) == 0.0
+    with pytest.raises(ValueError, match="shape"):
+        gs.leading_hours(h, [True])
+
+
+def test_coordinate_identities_hold_to_round_off():
+    c = gs.coordinate_checks(np.random.default_rng(3))
+    assert c.state_round_trip < 1e-12 and c.covariance_round_trip < 1e-12
+    assert c.relative_block < 1e-12 and c.range_variance_spread < 1e-12
+
+
+def test_demonstration_pair_geometry(pair):
+    # 24 h after the burn epoch the target is at apolune, where the pair is 215 km apart
+    assert pair.baseline.range_km[0, 24] == pytest.approx(215.0, abs=1e-6)
+    assert pair.hours[24] == pytest.approx(24.0)
+    # a pair of angles knows nothing about range: the prior of both vehicles, sqrt(2) x 20 km
+    assert pair.baseline.range_sigma_km[0, 0] == pytest.approx(20.0 * np.sqrt(2.0), rel=1e-9)
+    assert 0 < pair.first_hour_drop_percent < 100
+    assert max(pair.ekf_difference.values()) < 1e-6
+    assert 0.05 < pair.lag_hours < 2.0
+
+
+def test_equations_as_printed_match_the_package(pair):
+    eq = gs.equation_checks(em, pair.agent_x0, pair.target_x0)
+    assert eq.eq11 < 1e-12 and eq.eq18 < 1e-10
+
+
+def test_surrogate_is_the_top_eigenvector(pair):
+    s = gs.surrogate_check(em, pair, coast_hours=3, n_grid=400)
+    assert s.eigenvalues[0] <= 1e-9 * s.eigenvalues[-1]  # rank 2: two angles
+    assert np.linalg.norm(s.direction) == pytest.approx(1.0)
+    assert np.allclose(s.Q @ s.direction, s.eigenvalues[-1] * s.direction, rtol=1e-8, atol=1e-12 * s.eigenvalues[-1])
+    assert s.within_grid and s.spacing_deg == pytest.approx(np.degrees(np.sqrt(4 * np.pi / 400)))
+
+
+def test_policy_study_orders_the_policies(study):
+    r = study.results[1.0]
+    assert r.coast_hours == pytest.approx([1.0, 3.0]) and study.coast_indices == (1, 3)
+    assert np.all(r.optimum <= r.mmd + 1e-12) and np.all(r.optimum <= r.grid_median)
+    assert np.all(study.sign_percent(1.0) >= 0)  # the selected sign is the better one
+    ok = r.perp_best <= 1.02 * r.optimum
+    assert study.perpendicular_hours(1.0) == gs.leading_hours(r.coast_hours, ok)
+
+
+def test_direction_map(pair, study):
+    d = gs.direction_map(em, pair, study, coast_hours=3, n_grid=60)
+    assert d.range_sigma_km.shape == (60,) and np.linalg.norm(d.line_of_sight) == pytest.approx(1.0)
+    # the refined optimum is no worse than the best direction of the same sphere
+    assert study.results[1.0].optimum[1] <= d.range_sigma_km.min() + 1e-12
+    assert d.los_angle_deg == pytest.approx(90.0 - d.optimum_perp_angle_deg)
+
+
+def test_tracking_arc_study_runs_and_counts(pair):
+    arcs = gs.tracking_arc_study(em, pair, [2], [1, 2], 1.0, n_grid=40, n_perp=6)
+    r = arcs.results[2]
+    n = arcs.leading_run(2)
+    assert 0 <= n <= 2 and np.all(r.mmd_excess_percent[:n] <= 5.0)
+    assert arcs.within_hours(2) == (r.coast_hours[n - 1] if n else 0.0)
+    assert arcs.worst_excess_percent[0] == pytest.approx(r.mmd_excess_percent.max())
+
+
+def test_qpo_pair_study_needs_ring_angle_zero(pair):
+    torus = torus_from_orbit(nrho_9_2(em), N=15, size_km=100.0)
+    with pytest.raises(ValueError, match="include 0"):
+        gs.qpo_pair_study(em, torus, pair, [45.0], [1], n_grid=20, n_perp=4)
+    q = gs.qpo_pair_study(em, torus, pair, [0.0], [1], n_grid=20, n_perp=4)
+    assert q.excess_percent.shape == (1,) and q.percentile.shape == (1,)
+    opt, mmd, pct = q.antipode_differences()
+    assert opt >= 0 and mmd >= 0 and pct >= 0 and q.mirror_ratio >= 0
