@@ -23,7 +23,9 @@
 # (Eqs. 20-23), §IV-B (Fig. 2, Eq. 24 and the 0.1 deg / 0.08 deg result at gamma = 0.0013). Beyond the paper: the
 # independent verification and the trade curve of required precision against gamma.
 #
-# All computation lives in `cislunar.estimation.lpv`; cells call it and plot.
+# The methods live in `cislunar.estimation.lpv`; the chapter's studies in
+# `cislunar.papers.nychka_bhattacharya.sensing_precision` (each returns a frozen result), its figures in
+# `...figures` and its claims, declared before comparing, in `...claims.sensing_precision`. Cells call, print and plot.
 
 # %% tags=["parameters"]
 QUICK = False
@@ -36,28 +38,29 @@ N_ORBIT = 600 if QUICK else 4000  # samples along the orbit that bound rho
 N_CHECK = 300 if QUICK else 5000  # random states for the exactness checks
 N_VERIFY = 20 if QUICK else 1000  # random interior points of the polytope in the verification
 N_STUDY = 400 if QUICK else 1000  # samples per orbit period in the sensitivity study
-STUDY_ORBITS = [(3, 1, 0.3), (2, 1, 0.3), (2, 1, 0.4)] if QUICK else None  # None: all lpv.RESONANT_CANDIDATES
+STUDY_ORBITS = [(3, 1, 0.3), (2, 1, 0.3), (2, 1, 0.4)] if QUICK else None  # None: all RESONANT_CANDIDATES
 STUDY_LEVELS = [0.0, 1e-3] if QUICK else [0.0, 1e-4, 1e-3, 1e-2]
 N_GAMMA = 4 if QUICK else 13  # gammas on the trade curve
 R_LIST = [200.0, 1000.0, 5000.0] if QUICK else [100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0]  # 1/TU
-R_BW = 1000.0  # 1/TU: the H-infinity bandwidth bound used for the comparison (about 1 per 6 min)
 
-import warnings
-
-import matplotlib.pyplot as plt
-import matplotlib.ticker as mticker
 import numpy as np
-from matplotlib.lines import Line2D
-from matplotlib.patches import Patch
 
 from cislunar.estimation import lpv
+from cislunar.papers.nychka_bhattacharya import figures
+from cislunar.papers.nychka_bhattacharya import sensing_precision as sp
+from cislunar.papers.nychka_bhattacharya.claims.sensing_precision import CLAIMS
+from cislunar.papers.nychka_bhattacharya.scenarios import (
+    GAMMA,
+    POLE_RADIUS,
+    RESONANT_CANDIDATES,
+    paper_scenario,
+)
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
 
 plotting.use_style()
 out = OUTPUT_DIR or None
 rng = np.random.default_rng(SEED)
-GAMMA = 0.0013  # LU, the paper's bound (about 500 km)
 table = ComparisonTable("11 LPV optimal sensing precision (Nychka & Bhattacharya 2024, §III-IV, Fig. 2, Eq. 24)")
 
 # %% [markdown]
@@ -75,14 +78,10 @@ table = ComparisonTable("11 LPV optimal sensing precision (Nychka & Bhattacharya
 
 # %%
 model = lpv.CR3BPLPV()
-states = np.column_stack([rng.uniform(-1.5, 1.5, (N_CHECK, 2)), rng.uniform(-2, 2, (N_CHECK, 2))])
-f_nl = model.f(states)
-err_dyn = np.max(np.abs(model.lpv_rhs(states) - f_nl) / np.maximum(1.0, np.abs(f_nl)))
-print(f"max relative |A(rho)x + b(rho) - f(x)| over {N_CHECK} states: {err_dyn:.2e}")
-EXACT_TOL = 1e-12  # fixed before: "exact" means agreement to rounding, max error below 1e-12
-_ = table.add_typed("LPV form Eqs. 21/23 = CR3BP (Eq. 20)", "exact", f"max rel. error {err_dyn:.1e}",
-              "reproduced" if err_dyn < EXACT_TOL else "differs: LPV form not exact",
-              f"A(rho), b(rho) as printed; checked at random states; tolerance {EXACT_TOL:.0e} fixed before")
+ex = sp.exactness_checks(model, N_CHECK, rng)
+print(f"max relative |A(rho)x + b(rho) - f(x)| over {N_CHECK} states: {ex.dynamics:.2e}")
+_ = table.add(CLAIMS["lpv_exact"].judge(ex.dynamics, shown=f"max rel. error {ex.dynamics:.1e}",
+                                        note="A(rho), b(rho) as printed; checked at random states"))
 
 # %% [markdown]
 # ## 2 · Sensor model (Eq. 22 versus Eq. 23)
@@ -97,19 +96,11 @@ _ = table.add_typed("LPV form Eqs. 21/23 = CR3BP (Eq. 20)", "exact", f"max rel. 
 # column of $C$ and drops the $\pi_2$ factors. Eq. 22's form is used; both are tested below.
 
 # %%
-y_nl = model.measure(states)
-rho_s = model.rho(states)
-err_22 = np.max(np.abs(model.lpv_measure(states) - y_nl))
-y_23 = np.einsum("nij,nj->ni", model.C(rho_s), states) + model.d_as_printed_eq23(rho_s)
-err_23 = np.max(np.abs(y_23 - y_nl))
-err_tri = np.max(np.abs(model.rho_from_angles(*model.angles(states)) - rho_s) / np.abs(rho_s).clip(1e-3))
-print(f"Eq. 22: max |C x + d - y| = {err_22:.2e};  Eq. 23 as printed: {err_23:.3f}")
-print(f"rho from the two angles (law of sines): max relative error {err_tri:.1e}")
-table.add_typed("sensor model Eq. 22 = geometry", "exact", f"max error {err_22:.1e}",
-          "reproduced" if err_22 < EXACT_TOL else "differs: sensor model not exact",
-          f"rho5 = x, rho6 = y (undefined in paper); tolerance {EXACT_TOL:.0e} fixed before")
-_ = table.add_typed("Eq. 23 d(rho) as printed", "same model as Eq. 22", f"error up to {err_23:.2f}",
-              "differs: Eq. 23's d(rho) is a misprint; Eq. 22 used", "Eq. 23 repeats a C column, drops pi2 factors")
+print(f"Eq. 22: max |C x + d - y| = {ex.sensors_eq22:.2e};  Eq. 23 as printed: {ex.sensors_eq23:.3f}")
+print(f"rho from the two angles (law of sines): max relative error {ex.triangulation:.1e}")
+table.add(CLAIMS["eq22_exact"].judge(ex.sensors_eq22, shown=f"max error {ex.sensors_eq22:.1e}",
+                                     note="rho5 = x, rho6 = y (undefined in paper)"),
+          CLAIMS["eq23_d"].judge(ex.sensors_eq23, shown=f"error up to {ex.sensors_eq23:.2f}"))
 
 # %% [markdown]
 # ## 3 · The scheduling polytope from a planar resonant orbit
@@ -124,22 +115,16 @@ _ = table.add_typed("Eq. 23 d(rho) as printed", "same model as Eq. 22", f"error 
 # (four resonances, several perigees).
 
 # %%
-sc = lpv.paper_scenario(n_samples=N_ORBIT)
+sc = paper_scenario(n_samples=N_ORBIT)
 box = sc.box
 print(box.source)
 for name, lo, hi in zip(lpv.RHO_NAMES, box.lower, box.upper):
     print(f"  rho {name:8s}: [{lo:9.4f}, {hi:9.4f}]")
 V = box.vertices()
-r13 = 1.0 / sc.rho[:, 2]
-fig, ax = plt.subplots(figsize=(5.5, 5))
-plotting.plot_rotating(ax, model.spatial(sc.states), label="2:1 resonant orbit")
-plotting.plot_primaries(ax, model.system)
-ax.legend(loc="upper right")
-ax.set_title(f"scheduling box from this orbit: r13 in [{r13.min():.3f}, {r13.max():.3f}] LU")
-_ = plotting.save_figure(fig, "11_resonant_orbit", output_dir=out)
-table.add_typed("resonant orbit (planar)", "not stated", f"2:1, T = {sc.orbit.period:.4f} TU, r13 {r13.min():.3f}-"
-          f"{r13.max():.3f} LU", "not in paper", "choice of this reproduction (paper gives no orbit)")
-_ = table.add_typed("polytope vertices", "not stated", f"{V.shape[0]}", "derived", "2^6 box vertices of rho")
+_ = plotting.save_figure(figures.resonant_orbit(sc), "11_resonant_orbit", output_dir=out)
+r13 = sc.r13_range
+table.add(CLAIMS["orbit"].judge(f"2:1, T = {sc.orbit.period:.4f} TU, r13 {r13[0]:.3f}-{r13[1]:.3f} LU"),
+          CLAIMS["vertices"].judge(V.shape[0], shown=f"{V.shape[0]}", note="2^6 box vertices of rho"))
 
 # %% [markdown]
 # ## 4 · Theorems 1 and 2 as derived (and where the printed text disagrees)
@@ -189,21 +174,17 @@ GM_SUN, D_SUN = 1.32712440018e11, 1.495978707e8  # km^3/s^2, km
 tide = 2 * GM_SUN * np.array([0.3, 1.0]) * model.system.length_unit_km / D_SUN**3  # km/s^2 at r13 = 0.3, 1 LU
 print(f"default S_d = 1e-3 LU/TU^2 = {1e-3 * ACC_KMS2:.1e} km/s^2; solar tide 2 GM_sun r / d^3 at r13 = 0.3-1 LU: "
       f"{tide[0]:.1e}-{tide[1]:.1e} km/s^2 = {tide[0] / ACC_KMS2:.4f}-{tide[1] / ACC_KMS2:.4f} LU/TU^2")
-lmi = {"h2": lpv.PrecisionLMI.for_cr3bp(model, V, "h2"),
-       "hinf": lpv.PrecisionLMI.for_cr3bp(model, V, "hinf", pole_radius=R_BW)}
-des_all = {norm: lmi[norm].solve(GAMMA) for norm in lmi}
-lmi1 = {"h2": lpv.PrecisionLMI.for_cr3bp(model, V, "h2", sensors=[0, 1]),
-        "hinf": lpv.PrecisionLMI.for_cr3bp(model, V, "hinf", sensors=[0, 1], pole_radius=R_BW)}
-des = {norm: lmi1[norm].solve(GAMMA) for norm in lmi1}
-for norm in des:
+D = sp.paper_designs(sc, GAMMA, POLE_RADIUS)
+des, des_all = D.theta1, D.all
+for norm in sp.NORMS:
     for label, d in (("all sensors", des_all[norm]), ("theta1 only", des[norm])):
         print(f"{norm:4s} {label:12s}: status {d.status}, |L| = {d.gain_norm:7.1f}, kappa(sin, cos th1) = "
               f"{np.array2string(d.kappa[:2], precision=2)}, Eq. 24 noise {d.noise_deg[0]:.5f} deg; sensors used: "
               f"{[n for n, u in zip(lpv.SENSOR_NAMES, d.used) if u]}")
-for norm in des:
-    table.add_typed(f"{norm} LMI at gamma = 0.0013: solver status", "-", f"{des_all[norm].status} (6 sensors), "
-              f"{des[norm].status} (theta1); |L| = {des[norm].gain_norm:.0f}", "beyond paper",
-              "Clarabel; Hinf with bandwidth bound R = 1000/TU" if norm == "hinf" else "Clarabel, no gain bound needed")
+for norm, how in (("h2", "Clarabel, no gain bound needed"), ("hinf", "Clarabel; Hinf with bandwidth bound R = 1000/TU")):
+    _ = table.add(CLAIMS[f"{norm}_status"].judge(
+        des_all[norm].optimal and des[norm].optimal, note=how,
+        shown=f"{des_all[norm].status} (6 sensors), {des[norm].status} (theta1); |L| = {des[norm].gain_norm:.0f}"))
 
 # %% [markdown]
 # ## 5 · The solves are well posed: the numbers belong to the problem, not to the solver
@@ -217,41 +198,19 @@ for norm in des:
 # beyond it the strictness margin of the scaled problem starts to act as a gain bound and the optimum stops growing.)
 
 # %%
-checks = {}
-for norm, kw in (("h2", {}), ("hinf", {"pole_radius": R_BW})):
-    alt = [lmi1[norm].solve(GAMMA, tol=1e-9),
-           lpv.PrecisionLMI.for_cr3bp(model, V, norm, sensors=[0, 1], eps=1e-9, **kw).solve(GAMMA),
-           lpv.PrecisionLMI.for_cr3bp(model, V, norm, sensors=[0, 1], variable_scale=3.0, **kw).solve(GAMMA)]
-    dev = max(abs(a.kappa[0] / des[norm].kappa[0] - 1) for a in alt)
-    checks[norm] = (dev, [a.status for a in alt])
-    print(f"{norm:4s}: tol 1e-9 / eps 1e-9 / scale 3: statuses {checks[norm][1]}, max relative change of kappa "
-          f"{dev:.1e}")
-    table.add_typed(f"{norm} precision independent of solver settings", "-", f"max rel. change {dev:.0e} "
-              f"({', '.join(checks[norm][1])})", "beyond paper" if dev < 1e-4 else "differs: solver-dependent",
-              "tolerance 1e-9, margin 1e-9, variable scale 3 (criterion 1e-4 fixed before)")
-
-r13max = 1.0 / box.lower[2]
-limit = float(np.degrees(np.arcsin(GAMMA / r13max)))
-lmi_R = {R: lpv.PrecisionLMI.for_cr3bp(model, V, "hinf", sensors=[0, 1], pole_radius=R) for R in R_LIST}
-dR = {R: l.solve(GAMMA) for R, l in lmi_R.items()}
-for R, d in dR.items():
-    print(f"R = {R:7.0f}/TU: {d.status:18s} noise {d.noise_deg[0]:.5f} deg, |L| = {d.gain_norm:9.1f}")
-fig, ax = plt.subplots(1, 2, figsize=(10, 3.6))
-ax[0].semilogx(R_LIST, [dR[R].noise_deg[0] for R in R_LIST], "o-", label="bandwidth-bounded optimum")
-ax[0].axhline(limit, color="k", ls="--", lw=0.8, label=rf"limit $\sin^{{-1}}(\gamma/\max r_{{13}})$ = {limit:.4f}°")
-ax[0].set_xlabel("bandwidth bound R [1/TU]")
-ax[0].set_ylabel(r"allowable $\theta_1$ noise [deg]")
-ax[0].legend(loc="lower right")
-ax[1].loglog(R_LIST, [dR[R].gain_norm for R in R_LIST], "s-", color="C1")
-ax[1].set_xlabel("bandwidth bound R [1/TU]")
-ax[1].set_ylabel(r"gain norm $\|L\|_2$ [non-dim.]")
-fig.suptitle(r"H$_\infty$ (Theorem 2) at $\gamma$ = 0.0013 LU: precision and gain against the bandwidth bound")
-for a in ax:
-    a.xaxis.set_minor_formatter(mticker.NullFormatter())
-_ = plotting.save_figure(fig, "11_hinf_bandwidth", output_dir=out)
-_ = table.add_typed("Hinf precision vs bandwidth bound R", "-", f"{dR[R_LIST[0]].noise_deg[0]:.4f} deg (R={R_LIST[0]:.0f}) "
-              f"-> {dR[R_LIST[-1]].noise_deg[0]:.4f} deg (R={R_LIST[-1]:.0f}); limit {limit:.4f} deg",
-              "beyond paper", "the unbounded optimum is an infimum: gain grows like R")
+checks = sp.solver_independence(sc, D)
+for norm in sp.NORMS:
+    dev, st = checks.deviation[norm], checks.statuses[norm]
+    print(f"{norm:4s}: tol 1e-9 / eps 1e-9 / scale 3: statuses {st}, max relative change of kappa {dev:.1e}")
+    table.add(CLAIMS[f"{norm}_solver"].judge(dev, shown=f"max rel. change {dev:.0e} ({', '.join(st)})",
+                                             note="tolerance 1e-9, margin 1e-9, variable scale 3"))
+bw = sp.bandwidth_study(sc, R_LIST, GAMMA)
+for R, nd, g, st in zip(bw.radii, bw.noise_deg, bw.gain_norm, bw.status):
+    print(f"R = {R:7.0f}/TU: {st:18s} noise {nd:.5f} deg, |L| = {g:9.1f}")
+_ = plotting.save_figure(figures.bandwidth(bw), "11_hinf_bandwidth", output_dir=out)
+_ = table.add(CLAIMS["bandwidth"].judge(
+    bw.noise_deg[-1], shown=f"{bw.noise_deg[0]:.4f} deg (R={bw.radii[0]:.0f}) -> {bw.noise_deg[-1]:.4f} deg "
+    f"(R={bw.radii[-1]:.0f}); limit {bw.limit_deg:.4f} deg", note="the unbounded optimum is an infimum: gain grows like R"))
 
 # %% [markdown]
 # ## 6 · Fig. 2 — optimal precision per sensor, and verification beyond the solver's word
@@ -266,41 +225,19 @@ _ = table.add_typed("Hinf precision vs bandwidth bound R", "-", f"{dR[R_LIST[0]]
 # the error system with noise $1/\kappa_i$, at the 64 vertices and at `N_VERIFY` uniform random points in the box.
 
 # %%
-fig, ax = plt.subplots(figsize=(7.5, 3.8))
-w = 0.38
-xs = np.arange(6)
-for i, (norm, label) in enumerate((("h2", "H2 (Thm 1)"), (
-        "hinf", rf"H$_\infty$ (Thm 2, R = {R_BW:.0f}/TU)"))):
-    d = des_all[norm]
-    pos = xs + (i - 0.5) * w
-    ax.bar(pos[d.used], d.kappa[d.used], w, label=label, color=f"C{i}")
-    for x in pos[~d.used]:
-        ax.text(x, 1.5, "unused", rotation=90, ha="center", va="bottom", fontsize=8, color=f"C{i}")
-ax.set_yscale("log")
-ax.set_ylim(1, 2e4)
-ax.set_xticks(xs, lpv.SENSOR_NAMES)
-ax.set_xlabel("sensor [-]")
-ax.set_ylabel(r"precision $\kappa_i = \sqrt{\beta_i}$" "\n" r"[H$_\infty$: per unit output; H2: TU$^{-1/2}$]")
-ax.set_title(rf"Fig. 2 analogue: optimal sensing precision, $\gamma$ = {GAMMA} LU, $\|\beta\|_1$")
-ax.legend(loc="upper right")
-_ = plotting.save_figure(fig, "11_fig2_precision", output_dir=out)
+_ = plotting.save_figure(figures.precision_per_sensor(D), "11_fig2_precision", output_dir=out)
 
 # %%
-ver = {}
-for key, d in (("h2", des["h2"]), ("hinf", des["hinf"]), ("h2 (6 sensors)", des_all["h2"]),
-               ("hinf (6 sensors)", des_all["hinf"])):
-    v = lpv.verify_observer(model, d, box, N_VERIFY, rng, L=d.L)
-    ver[key] = v
+ver = sp.verify_designs(sc, D, N_VERIFY, rng)
+for key, v in ver.items():
     print(f"{key:16s}: {v.n_vertices} vertices + {v.n_samples} samples; max Re eig = {v.max_real_eig:.3f} /TU; "
           f"worst H2 = {v.worst_h2:.4e}, worst Hinf = {v.worst_hinf:.4e} (gamma {GAMMA}); passed: {v.passed}")
-for norm in ("h2", "hinf"):
+for norm in sp.NORMS:
     v, v6 = ver[norm], ver[f"{norm} (6 sensors)"]
-    table.add_typed(f"{norm} design verified (Hurwitz, norm < gamma)", "guaranteed by LMI",
-              f"max Re eig {max(v.max_real_eig, v6.max_real_eig):.2f}, worst {norm} norm "
-              f"{max(v.worst, v6.worst):.4e}", "beyond paper" if v.passed and v6.passed else
-              "differs: verification failed", f"theta1-only and 6-sensor gains; {v.n_vertices} vertices + "
-              f"{v.n_samples} samples")
-
+    table.add(CLAIMS[f"{norm}_verified"].judge(
+        v.passed and v6.passed, shown=f"max Re eig {max(v.max_real_eig, v6.max_real_eig):.2f}, worst {norm} norm "
+        f"{max(v.worst, v6.worst):.4e}", note=f"theta1-only and 6-sensor gains; {v.n_vertices} vertices + "
+        f"{v.n_samples} samples"))
 
 # %% [markdown]
 # **The objective norm is a choice.** The paper writes $\min\|\beta\|_p$ without fixing $p$; only a Remark says
@@ -311,55 +248,28 @@ for norm in ("h2", "hinf"):
 # $|\kappa_{\sin}/\kappa_{\cos}-1| < 10^{-3}$.
 
 # %%
-SPARSE_TOL, SAME_TOL = 1e-4, 1e-3
-des_p = {("l1", n): des_all[n] for n in des_all}
-with warnings.catch_warnings():
-    warnings.simplefilter("ignore", UserWarning)  # p = inf, Hinf: status printed below instead
-    for obj in ("l2", "linf"):
-        for n, kw in (("h2", {}), ("hinf", {"pole_radius": R_BW})):
-            des_p[(obj, n)] = lpv.PrecisionLMI.for_cr3bp(model, V, n, objective=obj, **kw).solve(
-                GAMMA, sparsity_tol=SPARSE_TOL)
-
-
-def used_names(d):
-    return ", ".join(nm for nm, u in zip(lpv.SENSOR_NAMES, d.used) if u)
-
-
-def same_th1(d):
-    return abs(d.kappa[0] / d.kappa[1] - 1) < SAME_TOL
-
-
-for (obj, n), d in des_p.items():
-    k_txt = np.array2string(d.kappa, formatter={"float_kind": lambda v: f"{v:.1f}"})
-    print(f"p = {obj[1:]:3s} {n:4s}: {d.status:18s} kappa {k_txt}; used: "
-          f"{used_names(d)}; kappa sin/cos th1 - 1 = {d.kappa[0] / d.kappa[1] - 1:+.1e}")
-table.add_typed("objective norm p in min ||beta||_p", "not stated (Remark: p = 1 gives sparse solutions)", "p = 1",
-          "not in paper", "chosen for the sparse pattern of Fig. 2; p = 2 and p = inf solved for comparison")
-only_th1 = all((des_all[n].used[:2].all() and not des_all[n].used[2:].any()) for n in des_all)
-other_p = "; ".join(f"p = {o[1:]}: {'all six' if all(des_p[(o, n)].used.all() for n in des_all) else 'other'} "
-                    "sensors used" for o in ("l2", "linf"))
-table.add_typed("sensors needed", "sin th1, cos th1 only", ", ".join(
-    n for n, u in zip(lpv.SENSOR_NAMES, des_all["h2"].used & des_all["hinf"].used) if u),
-    "consistent (tuned): only with p = 1" if only_th1 else "differs: other sensors selected with p = 1",
-    f"both theorems; used = beta_i > {SPARSE_TOL:.0e} max beta (fixed before); {other_p}")
-same_p = {o: all(same_th1(des_p[(o, n)]) for n in des_all) for o in ("l1", "l2", "linf")}
-six_equal = all(np.ptp(des_p[("linf", n)].kappa) < SAME_TOL * des_p[("linf", n)].kappa.max() for n in des_all)
-table.add_typed("precision sin th1 = cos th1", "identical",
-          f"H2 {des_all['h2'].kappa[0]:.1f}/{des_all['h2'].kappa[1]:.1f}, "
-          f"Hinf {des_all['hinf'].kappa[0]:.1f}/{des_all['hinf'].kappa[1]:.1f} (p = 1)",
-          "consistent (tuned): only with p = 1 or p = inf" if same_p["l1"] and not same_p["l2"] else
-          ("consistent (tuned): with p = 1" if same_p["l1"] else "differs: sin and cos th1 differ with p = 1"),
-          f"identical = relative difference < {SAME_TOL:.0e} (fixed before); p = 2: H2 "
-          f"{des_p[('l2', 'h2')].kappa[0]:.0f}/{des_p[('l2', 'h2')].kappa[1]:.0f}, Hinf "
-          f"{des_p[('l2', 'hinf')].kappa[0]:.0f}/{des_p[('l2', 'hinf')].kappa[1]:.0f} "
-          f"({'equal' if same_p['l2'] else 'not equal'}); p = inf: six "
-          f"{'equal' if six_equal else 'unequal'}, H2 "
-          f"{des_p[('linf', 'h2')].kappa[0]:.1f}, Hinf {des_p[('linf', 'hinf')].kappa[0]:.1f} "
-          f"({des_p[('linf', 'hinf')].status})")
-_ = table.add_typed("theta1-only = 6-sensor precision", "-", f"rel. diff. H2 "
-              f"{abs(des['h2'].kappa[0] / des_all['h2'].kappa[0] - 1):.0e}, Hinf "
-              f"{abs(des['hinf'].kappa[0] / des_all['hinf'].kappa[0] - 1):.0e}", "derived",
-              "the comparison rows use the theta1-only problems")
+obj = sp.objective_norm_study(sc, D, sparsity_tol=1e-4, same_tol=1e-3)
+for (o, n), d in obj.designs.items():
+    print(f"p = {o[1:]:3s} {n:4s}: {d.status:18s} kappa "
+          f"{np.array2string(d.kappa, formatter={'float_kind': lambda v: f'{v:.1f}'})}; used: "
+          f"{', '.join(nm for nm, u in zip(lpv.SENSOR_NAMES, d.used) if u)}; kappa sin/cos th1 - 1 = "
+          f"{d.kappa[0] / d.kappa[1] - 1:+.1e}")
+k = {key: d.kappa for key, d in obj.designs.items()}
+other_p = "; ".join(f"p = {o[1:]}: {'all six' if obj.all_used(o) else 'other'} sensors used" for o in ("l2", "linf"))
+table.add(CLAIMS["objective"].judge("p = 1"),
+          CLAIMS["sensors"].judge(obj.only_theta1, shown=", ".join(
+              n for n, u in zip(lpv.SENSOR_NAMES, des_all["h2"].used & des_all["hinf"].used) if u),
+              note=f"both theorems; used = beta_i > 1e-04 max beta (fixed before); {other_p}"),
+          CLAIMS["sin_cos_equal"].judge(
+              obj.same_theta1("l1"), shown=f"H2 {k[('l1', 'h2')][0]:.1f}/{k[('l1', 'h2')][1]:.1f}, "
+              f"Hinf {k[('l1', 'hinf')][0]:.1f}/{k[('l1', 'hinf')][1]:.1f} (p = 1)",
+              note=f"p = 2: H2 {k[('l2', 'h2')][0]:.0f}/{k[('l2', 'h2')][1]:.0f}, Hinf {k[('l2', 'hinf')][0]:.0f}/"
+              f"{k[('l2', 'hinf')][1]:.0f} ({'equal' if obj.same_theta1('l2') else 'not equal'}); p = inf: six "
+              f"{'equal' if obj.six_equal_linf else 'unequal'}, H2 {k[('linf', 'h2')][0]:.1f}, Hinf "
+              f"{k[('linf', 'hinf')][0]:.1f} ({obj.designs[('linf', 'hinf')].status})"))
+rel = {n: abs(des[n].kappa[0] / des_all[n].kappa[0] - 1) for n in sp.NORMS}
+_ = table.add(CLAIMS["theta1_only"].judge(max(rel.values()), shown=f"rel. diff. H2 {rel['h2']:.0e}, Hinf "
+                                          f"{rel['hinf']:.0e}", note="the comparison rows use the theta1-only problems"))
 
 # %% [markdown]
 # **Reading the H-infinity result.** Its limit equals $\max r_{13}/\gamma$ in precision: the least precision is the
@@ -386,50 +296,34 @@ _ = table.add_typed("theta1-only = 6-sensor precision", "-", f"rel. diff. H2 "
 # (one significant digit) $[0.05, 0.15)$.
 
 # %%
-TU_MIN = model.system.time_unit_s / 60.0
-noise = {norm: float(np.min(d.noise_deg[:2])) for norm, d in des.items()}
-k2 = float(np.min(des["h2"].kappa[:2]))
-dt_01 = 1.0 / (k2 * np.sin(np.radians(0.1))) ** 2
-dt_eq = 1.0 / (k2 * np.sin(np.radians(noise["hinf"]))) ** 2
-print(f"H2: {noise['h2']:.4f} deg (intensity reading);  Hinf: {noise['hinf']:.4f} deg")
-print(f"H2 per sample = 0.1 deg at dt = {dt_01:.4f} TU ({dt_01 * TU_MIN:.0f} min); H2 > Hinf per sample for "
-      f"dt < {dt_eq:.4f} TU ({dt_eq * TU_MIN:.0f} min)")
-# The paper's own alternatives, printed as they stand: Eq. 8b literally (trace < gamma, not gamma^2) is the H2
-# problem at bound sqrt(gamma); the printed kappa = sqrt(beta / gamma) divides our H-infinity kappa by sqrt(gamma).
-h2_lit = float(lmi1["h2"].solve(np.sqrt(GAMMA)).noise_deg[0])
-hinf_lit = float(np.degrees(np.arcsin(np.sqrt(GAMMA) / des["hinf"].kappa[0])))
-k_paper = {"h2": 1.0 / np.sin(np.radians(0.1)), "hinf": 1.0 / np.sin(np.radians(0.08))}
-print(f"Eq. 8b literal (trace < gamma): H2 {h2_lit:.3f} deg;  printed kappa = sqrt(beta/gamma): Hinf {hinf_lit:.4f} deg")
-print(f"kappa implied by Eq. 24 and the paper's 0.1 / 0.08 deg: H2 {k_paper['h2']:.0f}, Hinf {k_paper['hinf']:.0f}; "
-      f"here H2 {k2:.0f}, Hinf {des['hinf'].kappa[0]:.0f}")
-in_h2 = lambda v: 0.05 <= v < 0.15  # noqa: E731
-in_hinf = lambda v: 0.075 <= v < 0.085  # noqa: E731
-table.add_typed("allowable theta1 noise, H2, intensity read as an angle", "0.1 deg", f"{noise['h2']:.4f} deg",
-          "reproduced" if in_h2(noise["h2"]) else "differs: a white-noise intensity, not a per-sample angle",
-          f"2:1 orbit; criterion [0.05, 0.15) deg fixed before; Section 9 tries other orbits and disturbances; Eq. 8b "
-          f"read literally (trace < gamma) gives {h2_lit:.3f} deg, also outside")
-table.add_typed("allowable theta1 noise, H2, per sample", "0.1 deg", f"0.1 deg at dt = {dt_01 * TU_MIN:.0f} min",
-          "consistent (tuned)", "sampling interval chosen to match the paper's number (paper states none)")
-table.add_typed("allowable theta1 noise, Hinf, gamma = 0.0013", "0.08 deg", f"{noise['hinf']:.4f} deg (R = {R_BW:.0f}/TU; "
-          f"limit {limit:.4f})", "consistent (tuned)" if in_hinf(noise["hinf"]) else "differs: depends on max r13",
-          f"= asin(gamma / max r13) in the limit; max r13 = {r13max:.3f} LU on the 2:1 orbit, an orbit choice not "
-          "independent of the paper's number (Section 9 counts the resonances that fall in [0.075, 0.085))")
-table.add_typed("ordering H2 > Hinf", "H2 0.1 > Hinf 0.08 deg",
-          f"intensity reading: H2 {noise['h2']:.3f} < Hinf {noise['hinf']:.3f}; per sample: H2 > Hinf iff dt < "
-          f"{dt_eq * TU_MIN:.0f} min", "differs: reversed unless the H2 number is read per sample",
-          "the paper compares an intensity with an energy bound without a sampling interval")
-table.add_typed("Hinf precision formula", "kappa = sqrt(beta/gamma)", "kappa = sqrt(beta)",
-          "differs: printed formula does not follow from Eq. 18-19", "verified norm equals gamma with sqrt(beta); "
-          f"the printed formula would give {hinf_lit:.4f} deg, not 0.08")
-k_band = 1.0 / np.sin(np.radians([0.085, 0.075]))  # kappa band implied by the printed digits of 0.08 deg
-_ = table.add_typed("kappa implied by Eq. 24 and the paper's 0.1 / 0.08 deg", f"H2 {k_paper['h2']:.0f}, Hinf {k_paper['hinf']:.0f}",
-              f"H2 {k2:.0f}, Hinf {des['hinf'].kappa[0]:.0f}",
-              (f"differs: H2 {k2 / k_paper['h2']:.1f}x the implied value (intensity reading)" if not in_h2(noise["h2"])
-               else "consistent (tuned): H2 within the printed digits") + (
-                  "; Hinf inside the band of the printed digits (orbit choice, see above)"
-                  if k_band[0] < des["hinf"].kappa[0] <= k_band[1] else "; Hinf outside the band"),
-              f"the paper prints no kappa: 1/sin(0.1 deg), 1/sin(0.08 deg); band for 0.08 deg [0.075, 0.085) is kappa "
-              f"({k_band[0]:.0f}, {k_band[1]:.0f}]")
+al = sp.allowances(D, model.system)
+TU_MIN = al.minutes_per_tu
+print(f"H2: {al.h2_deg:.4f} deg (intensity reading);  Hinf: {al.hinf_deg:.4f} deg")
+print(f"H2 per sample = 0.1 deg at dt = {al.dt_01:.4f} TU ({al.dt_01 * TU_MIN:.0f} min); H2 > Hinf per sample for "
+      f"dt < {al.dt_eq:.4f} TU ({al.dt_eq * TU_MIN:.0f} min)")
+print(f"Eq. 8b literal (trace < gamma): H2 {al.h2_literal_deg:.3f} deg;  printed kappa = sqrt(beta/gamma): Hinf "
+      f"{al.hinf_literal_deg:.4f} deg")
+kp, kb = al.kappa_paper, al.kappa_band_hinf
+print(f"kappa implied by Eq. 24 and the paper's 0.1 / 0.08 deg: H2 {kp['h2']:.0f}, Hinf {kp['hinf']:.0f}; "
+      f"here H2 {al.kappa_h2:.0f}, Hinf {al.kappa_hinf:.0f}")
+table.add(
+    CLAIMS["h2_intensity"].judge(al.h2_deg, shown=f"{al.h2_deg:.4f} deg", note="2:1 orbit; Section 9 tries other "
+                                 f"orbits and disturbances; Eq. 8b read literally (trace < gamma) gives "
+                                 f"{al.h2_literal_deg:.3f} deg, also outside"),
+    CLAIMS["h2_per_sample"].judge(float(des["h2"].noise_per_sample_deg(al.dt_01)[0]),
+                                  shown=f"0.1 deg at dt = {al.dt_01 * TU_MIN:.0f} min"),
+    CLAIMS["hinf_noise"].judge(al.hinf_deg, shown=f"{al.hinf_deg:.4f} deg (R = {POLE_RADIUS:.0f}/TU; limit "
+                               f"{bw.limit_deg:.4f})", note=f"= asin(gamma / max r13) in the limit; max r13 = "
+                               f"{bw.r13_max:.3f} LU on the 2:1 orbit (Section 9 counts the resonances in the band)"),
+    CLAIMS["ordering"].judge(bool(al.h2_deg > al.hinf_deg), shown=f"intensity reading: H2 {al.h2_deg:.3f} < Hinf "
+                             f"{al.hinf_deg:.3f}; per sample: H2 > Hinf iff dt < {al.dt_eq * TU_MIN:.0f} min"),
+    CLAIMS["hinf_formula"].judge("kappa = sqrt(beta)", note="verified norm equals gamma with sqrt(beta); the printed "
+                                 f"formula would give {al.hinf_literal_deg:.4f} deg, not 0.08"),
+    CLAIMS["kappa_implied"].judge(
+        al.kappa_h2, shown=f"H2 {al.kappa_h2:.0f}, Hinf {al.kappa_hinf:.0f}",
+        note=f"H2 {al.kappa_h2 / kp['h2']:.1f}x the implied value; Hinf "
+        f"{'inside' if kb[0] < al.kappa_hinf <= kb[1] else 'outside'} the band ({kb[0]:.0f}, {kb[1]:.0f}] of the "
+        "printed digits of 0.08 deg; the paper prints no kappa: 1/sin(0.1 deg), 1/sin(0.08 deg)"))
 
 # %% [markdown]
 # ## 8 · Beyond the paper: required precision against gamma
@@ -440,32 +334,16 @@ _ = table.add_typed("kappa implied by Eq. 24 and the paper's 0.1 / 0.08 deg", f"
 # $S_d/\gamma$ is largest.
 
 # %%
-gammas = np.geomspace(3e-4, 3e-2, N_GAMMA)
-sweep = {norm: lpv.gamma_sweep(lmi1[norm], gammas) for norm in lmi1}
-fig, ax = plt.subplots(1, 2, figsize=(8.5, 3.8), layout="constrained")
-for norm, label in (("h2", "H2"), ("hinf", r"H$_\infty$")):
-    k = np.array([np.nan if d is None else d.kappa[0] for d in sweep[norm]])
-    nd = np.array([np.nan if d is None else d.noise_deg[0] for d in sweep[norm]])
-    ax[0].loglog(gammas * model.system.length_unit_km, k, "o-", label=label)
-    ax[1].loglog(gammas * model.system.length_unit_km, nd, "o-", label=label)
-for a in ax:
-    a.axvline(GAMMA * model.system.length_unit_km, color="k", lw=0.8, ls=":",
-              label=rf"paper's $\gamma$ = {GAMMA} LU ({GAMMA * model.system.length_unit_km:.0f} km)")
-    a.set_xlabel(r"$\gamma$ [km]")
-fig.legend(*ax[0].get_legend_handles_labels(), loc="outside lower center", ncol=3)
-ax[0].set_ylabel(r"required precision $\kappa_{\sin\theta_1}$" "\n" r"[H$_\infty$: per unit output; H2: TU$^{-1/2}$]")
-ax[1].set_ylabel(r"Eq. 24 allowance $\sin^{-1}(1/\kappa)$" "\n" r"[H$_\infty$: deg RMS; H2: intensity, deg$\sqrt{\rm TU}$]")
-fig.suptitle("trade curve: precision needed for a position-error bound")
-_ = plotting.save_figure(fig, "11_tradecurve", output_dir=out)
-slope = {n: np.polyfit(np.log(gammas), np.log([d.kappa[0] for d in sweep[n]]), 1)[0] for n in sweep}
-print("log-log slope of kappa against gamma: " + ", ".join(f"{n} {s:.3f}" for n, s in slope.items()))
-_ = table.add_typed("trade curve kappa(gamma)", "-", f"slopes H2 {slope['h2']:.2f}, Hinf {slope['hinf']:.2f}",
-              "beyond paper", f"{N_GAMMA} gammas from 115 to 11500 km")
+tc = sp.trade_curve(D, np.geomspace(3e-4, 3e-2, N_GAMMA))
+_ = plotting.save_figure(figures.trade_curve(tc, GAMMA, model.system.length_unit_km), "11_tradecurve", output_dir=out)
+print("log-log slope of kappa against gamma: " + ", ".join(f"{n} {s:.3f}" for n, s in tc.slope.items()))
+_ = table.add(CLAIMS["trade_curve"].judge(tc.slope["h2"], shown=f"slopes H2 {tc.slope['h2']:.2f}, Hinf "
+                                          f"{tc.slope['hinf']:.2f}", note=f"{N_GAMMA} gammas from 115 to 11500 km"))
 
 # %% [markdown]
 # ## 9 · Where do the paper's numbers come from? A sweep over what the paper leaves unstated
 #
-# The paper states neither its orbit, nor its disturbance, nor a sampling interval. `lpv.sensitivity_study` solves
+# The paper states neither its orbit, nor its disturbance, nor a sampling interval. `sp.sensitivity_study` solves
 # both $\theta_1$-only theorems at $\gamma = 0.0013$ for eight planar Earth-Moon resonant orbits (4:1, 3:1, 5:2,
 # 2:1 with several perigee radii), two disturbance structures (accelerations on the velocities; independent
 # perturbations of all four states) and disturbance levels $0$ to $10^{-2}$ (LU/TU² for accelerations); each
@@ -474,62 +352,45 @@ _ = table.add_typed("trade curve kappa(gamma)", "-", f"slopes H2 {slope['h2']:.2
 # $[0.075, 0.085)$ deg, H2 per sample $[0.05, 0.15)$ deg, and H2 more than H-infinity?
 
 # %%
-study = lpv.sensitivity_study(GAMMA, orbits=STUDY_ORBITS or lpv.RESONANT_CANDIDATES, levels=STUDY_LEVELS,
-                              pole_radius=R_BW, n_samples=N_STUDY, progress=True)
-h2i, hinf = study.h2_intensity_deg, study.hinf_deg
-n_opt = int(np.sum(study.h2_status == "optimal") + np.sum(study.hinf_status == "optimal"))
-print(f"{2 * study.h2_kappa.size} solves in {study.seconds:.0f} s; {n_opt} ended optimal")
-names = [f"{p}:{q} guess-rp {rp:.2f}" for p, q, rp in study.orbits]
+study = sp.sensitivity_study(GAMMA, orbits=STUDY_ORBITS or RESONANT_CANDIDATES, levels=STUDY_LEVELS,
+                             pole_radius=POLE_RADIUS, n_samples=N_STUDY, progress=True)
+rd = sp.read_sensitivity(study)
+h2i, hinf, j = study.h2_intensity_deg, study.hinf_deg, rd.level_index
+print(f"{2 * study.h2_kappa.size} solves in {study.seconds:.0f} s; {rd.n_optimal} ended optimal")
 print(f"{'orbit':20s} {'max r13':>8s} {'Hinf deg':>9s} {'H2 int. deg (acc, lvl 1e-3)':>28s} "
       f"{'dt for H2 = 0.1 deg [min]':>26s} {'H2 > Hinf for dt < [min]':>25s}")
-j = int(np.argmin(np.abs(study.levels - 1e-3)))
-dt01 = study.dt_for_h2(0.1)
-dteq = 1.0 / (study.h2_kappa * np.sin(np.radians(hinf))) ** 2
-for i, nm in enumerate(names):
+for i, nm in enumerate(rd.names):
     print(f"{nm:20s} {study.r13_max[i]:8.3f} {hinf[i, 0, j]:9.4f} {h2i[i, 0, j]:28.4f} "
-          f"{dt01[i, 0, j] * TU_MIN:26.0f} {dteq[i, 0, j] * TU_MIN:25.0f}")
+          f"{rd.dt_01[i, 0, j] * TU_MIN:26.0f} {rd.dt_eq[i, 0, j] * TU_MIN:25.0f}")
 
 # %%
 # Where do both of the paper's numbers hold?  Per orbit, structure and level: the dt window in which the H2
 # per-sample allowance lies in [0.05, 0.15) deg and exceeds the H-infinity allowance, given Hinf in [0.075, 0.085).
-lo = 1.0 / (study.h2_kappa * np.sin(np.radians(0.15))) ** 2
-hi = np.minimum(1.0 / (study.h2_kappa * np.sin(np.radians(0.05))) ** 2, dteq)
-ok_hinf = (hinf >= 0.075) & (hinf < 0.085)
-ok_all = ok_hinf & (hi > lo)
-hits = [(names[i], study.structures[s_], study.levels[l_], lo[i, s_, l_] * TU_MIN, hi[i, s_, l_] * TU_MIN)
-        for i, s_, l_ in zip(*np.nonzero(ok_all))]
-print(f"{ok_hinf[:, 0, 0].sum()} of {len(names)} orbits give Hinf in [0.075, 0.085) deg; "
-      f"{len(hits)} of {ok_all.size} (orbit, structure, level) cases admit a sampling interval for the rest:")
-for h in hits:
+print(f"{rd.hinf_in_band[:, 0, 0].sum()} of {len(rd.names)} orbits give Hinf in [0.075, 0.085) deg; "
+      f"{len(rd.hits)} of {rd.all_hold.size} (orbit, structure, level) cases admit a sampling interval for the rest:")
+for h in rd.hits:
     print(f"  {h[0]:20s} {h[1]:13s} level {h[2]:<7g}: dt in [{h[3]:.0f}, {h[4]:.0f}) min")
-never = float(np.nanmax(h2i))
-# Per-sample sampling interval for H2 = 0.1 deg, split by disturbance level (the short intervals need a large one)
-for l_i, lvl in enumerate(study.levels):
-    print(f"dt for H2 = 0.1 deg per sample at level {lvl:g}: {np.nanmin(dt01[:, :, l_i]) * TU_MIN:.0f}-"
-          f"{np.nanmax(dt01[:, :, l_i]) * TU_MIN:.0f} min over orbits and structures")
-table.add_typed("sensitivity study (orbit, disturbance, dt)", "not stated", f"{len(names)} orbits x "
-          f"{len(study.structures)} structures x {len(study.levels)} levels, {study.seconds:.0f} s, "
-          f"{n_opt}/{2 * study.h2_kappa.size} optimal", "beyond paper", "theta1-only LMIs, Clarabel")
-band = (GAMMA / np.sin(np.radians(0.085)), GAMMA / np.sin(np.radians(0.075)))
-spread = float(np.nanmax(np.abs(hinf / hinf[:, :1, :1] - 1)))
-n_hinf_ok = int(ok_hinf[:, 0, 0].sum())
-table.add_typed("where Hinf = 0.08 deg", "0.08 deg", f"{n_hinf_ok} of {len(names)} orbits: "
-          f"{', '.join(names[i] for i in np.nonzero(ok_hinf[:, 0, 0])[0]) or 'none'}",
-          "consistent (tuned): only on the orbits listed" if n_hinf_ok else "differs: on no orbit tried",
-          f"band [0.075, 0.085) fixed before; needs max r13 in [{band[0]:.3f}, {band[1]:.3f}] LU (unbounded-gain "
-          f"limit); disturbance structure and level change it by at most {spread:.0e} (relative)")
-h2_int_ok = bool(np.any((h2i >= 0.05) & (h2i < 0.15)))
-table.add_typed("where H2 = 0.1 deg", "0.1 deg", f"{'in' if h2_int_ok else 'never in'} [0.05, 0.15) deg as an intensity "
-          f"(max {never:.3f} deg); per sample at dt = {np.nanmin(dt01) * TU_MIN:.0f}-{np.nanmax(dt01) * TU_MIN:.0f} min",
-          "differs: never as an intensity; matches only per sample at a chosen dt (consistent (tuned) there)"
-          if not h2_int_ok else "consistent (tuned): as an intensity on some orbits/disturbances",
-          "band [0.05, 0.15) fixed before; range over orbits, structures and levels; the per-sample reading needs a "
-          "sampling interval, which the paper does not state")
-_ = table.add_typed("both numbers and H2 > Hinf together", "yes", f"{len(hits)} of {ok_all.size} cases, e.g. "
-              + (f"{hits[0][0]}, dt {hits[0][3]:.0f}-{hits[0][4]:.0f} min" if hits else "none"),
-              "consistent (tuned): only in the cases listed" if hits else "differs: no tried combination reproduces both",
-              f"only with the per-sample reading of H2, on an orbit with max r13 in [{band[0]:.2f}, {band[1]:.2f}] LU, "
-              "for the dt windows listed")
+for l_i, lvl in enumerate(study.levels):  # the short intervals need a large disturbance
+    print(f"dt for H2 = 0.1 deg per sample at level {lvl:g}: {np.nanmin(rd.dt_01[:, :, l_i]) * TU_MIN:.0f}-"
+          f"{np.nanmax(rd.dt_01[:, :, l_i]) * TU_MIN:.0f} min over orbits and structures")
+b = rd.r13_band
+dt_range = f"{np.nanmin(rd.dt_01) * TU_MIN:.0f}-{np.nanmax(rd.dt_01) * TU_MIN:.0f} min"
+table.add(
+    CLAIMS["study"].judge(rd.n_optimal, shown=f"{len(rd.names)} orbits x {len(study.structures)} structures x "
+                          f"{len(study.levels)} levels, {study.seconds:.0f} s, {rd.n_optimal}/{2 * study.h2_kappa.size}"
+                          " optimal", note="theta1-only LMIs, Clarabel"),
+    CLAIMS["where_hinf"].judge(len(rd.orbits_in_band), shown=f"{len(rd.orbits_in_band)} of {len(rd.names)} orbits: "
+                               f"{', '.join(rd.orbits_in_band) or 'none'}", note=f"band [0.075, 0.085) fixed before; "
+                               f"needs max r13 in [{b[0]:.3f}, {b[1]:.3f}] LU (unbounded-gain limit); disturbance "
+                               f"structure and level change it by at most {rd.hinf_spread:.0e} (relative)"),
+    CLAIMS["where_h2"].judge(rd.h2_intensity_in_band, shown=f"{'in' if rd.h2_intensity_in_band else 'never in'} "
+                             f"[0.05, 0.15) deg as an intensity (max {rd.h2_intensity_max:.3f} deg); per sample at dt "
+                             f"= {dt_range}", note="band [0.05, 0.15) fixed before; range over orbits, structures and "
+                             "levels; the per-sample reading needs a sampling interval, which the paper does not state"),
+    CLAIMS["both"].judge(len(rd.hits), shown=f"{len(rd.hits)} of {rd.all_hold.size} cases, e.g. " + (
+        f"{rd.hits[0][0]}, dt {rd.hits[0][3]:.0f}-{rd.hits[0][4]:.0f} min" if rd.hits else "none"),
+        note=f"only with the per-sample reading of H2, on an orbit with max r13 in [{b[0]:.2f}, {b[1]:.2f}] LU, for the "
+        "dt windows listed"))
 
 # %% [markdown]
 # **The study in one figure.** All three rows share the orbit axis, sorted by the largest Earth distance
@@ -542,69 +403,7 @@ _ = table.add_typed("both numbers and H2 > Hinf together", "yes", f"{len(hits)} 
 # (red dash).
 
 # %%
-order = np.argsort(study.r13_max)
-xo = np.arange(order.size)
-n_s, n_l = len(study.structures), study.levels.size
-fig, ax = plt.subplots(3, 1, figsize=(7.5, 9.0), sharex=True, layout="constrained")
-for a in ax:
-    for x in xo[ok_hinf[order, 0, j]]:
-        a.axvspan(x - 0.45, x + 0.45, color="C7", alpha=0.15, lw=0, zorder=0)
-# (a) H-infinity: optimum against its unbounded-gain limit
-ax[0].axhspan(0.075, 0.085, color="C2", alpha=0.2, lw=0)
-ax[0].plot(xo, hinf[order, 0, j], "o", color="C1", ms=6, zorder=3)
-ax[0].plot(xo, np.degrees(np.arcsin(GAMMA / study.r13_max[order])), "_", color="k", ms=16, mew=1.2, zorder=4)
-ax[0].set_ylabel(r"H$_\infty$ allowable noise [deg]")
-ax[0].set_title(r"(a) H$_\infty$ (energy bound, an angle RMS directly)", fontsize=10, loc="left")
-ax[0].legend(handles=[
-    Line2D([], [], color="C1", marker="o", ls="", label=rf"optimum, R = {R_BW:.0f}/TU"),
-    Line2D([], [], color="k", marker="_", ms=12, mew=1.2, ls="", label=r"limit $\sin^{-1}(\gamma/\max r_{13})$"),
-    Patch(color="C2", alpha=0.2, label="paper's 0.08 deg (printed digits)"),
-    Patch(color="C7", alpha=0.15, label=r"orbit with H$_\infty$ in the paper's band")],
-    loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
-# (b) H2 read directly: every structure and level, side by side within an orbit's slot
-slot = 0.8 / (n_s * n_l)
-colours = plt.cm.viridis(np.linspace(0.0, 0.8, n_l))
-for s_i in range(n_s):
-    for l_i in range(n_l):
-        dx = (s_i * n_l + l_i + 0.5) * slot - 0.4
-        ax[1].plot(xo + dx, h2i[order, s_i, l_i], ["o", "s"][s_i % 2], color=colours[l_i], ms=4.5,
-                   mfc=colours[l_i] if s_i == 0 else "none", mew=1.2, ls="", zorder=3)
-ax[1].axhspan(0.05, 0.15, color="C2", alpha=0.2, lw=0)
-ax[1].set_yscale("log")
-ax[1].set_ylabel("H2 allowance read\nas an angle [deg]")
-ax[1].set_title("(b) H2 read directly (a white-noise intensity, not an angle)", fontsize=10, loc="left")
-key = [Line2D([], [], color="0.3", marker="o", ls="", label="accelerations"),
-       Line2D([], [], color="0.3", marker="s", mfc="none", mew=1.2, ls="", label="all four states")]
-key += [Patch(color=colours[l_i], label=f"level {lvl:g}") for l_i, lvl in enumerate(study.levels)]
-key += [Patch(color="C2", alpha=0.2, label="paper's 0.1 deg (printed digits)")]
-ax[1].legend(handles=key, loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, title="disturbance on",
-             title_fontsize=8)
-# (c) H2 per sample: the sampling intervals that give the paper's number
-k0 = (order, 0, j)
-ax[2].vlines(xo, study.dt_for_h2(0.15)[k0] * TU_MIN, study.dt_for_h2(0.05)[k0] * TU_MIN,
-             color="C0", lw=5, alpha=0.35, zorder=2)
-ax[2].plot(xo, dt01[k0] * TU_MIN, "o", color="C0", ms=6, zorder=3)
-ax[2].plot(xo, dteq[k0] * TU_MIN, "_", color="C1", ms=18, mew=2.0, zorder=2.5)
-ax[2].set_yscale("log")
-ax[2].set_ylabel(r"sampling interval $\Delta t$ [min]")
-ax[2].set_title(f"(c) H2 per sample (accelerations, level {study.levels[j]:g})", fontsize=10, loc="left")
-ax[2].legend(handles=[Line2D([], [], color="C0", lw=5, alpha=0.35, label="per-sample noise 0.05-0.15 deg"),
-                      Line2D([], [], color="C0", marker="o", ls="", label="per-sample noise 0.1 deg"),
-                      Line2D([], [], color="C1", marker="_", ms=14, mew=2.0, ls="",
-                             label=r"H2 > H$_\infty$ for $\Delta t$ below")],
-             loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
-ax[2].set_xticks(xo, [f"{study.orbits[i][0]}:{study.orbits[i][1]}\nrp {study.orbits[i][2]:.2f}\n"
-                      f"{study.r13_max[i]:.2f}" for i in order], fontsize=8)
-ax[2].set_xlim(-0.5, order.size - 0.5)
-ax[2].set_xlabel(r"resonant orbit p:q, perigee $r_p$ of the Keplerian guess [LU], $\max r_{13}$ [LU]; "
-                 r"sorted by $\max r_{13}$")
-fig.suptitle(r"Allowable $\theta_1$ noise at $\gamma$ = 0.0013 LU over the inputs the paper leaves unstated",
-             fontsize=11)
-for a in ax[1:]:  # plain numbers at 1-2-5 steps: readable whether the data span one decade or several
-    a.yaxis.set_major_locator(mticker.LogLocator(subs=(1.0, 2.0, 5.0)))
-    a.yaxis.set_major_formatter(mticker.FuncFormatter(lambda v, _: f"{v:g}"))
-    a.yaxis.set_minor_formatter(mticker.NullFormatter())
-_ = plotting.save_figure(fig, "11_sensitivity", output_dir=out)
+_ = plotting.save_figure(figures.sensitivity(study, rd, GAMMA, POLE_RADIUS), "11_sensitivity", output_dir=out)
 
 # %% [markdown]
 # **Reading it.** The H-infinity allowance sits on or just below its limit for every orbit, so it is a statement

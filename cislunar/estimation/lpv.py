@@ -62,37 +62,31 @@ from cislunar.cr3bp.dynamics import CR3BP, EARTH_MOON, check_system
 from cislunar.cr3bp.orbits import correct_symmetric
 from cislunar.cr3bp.propagation import propagate
 from cislunar.utils import validation
-from cislunar.utils.progress import progress as _progress
 
 __all__ = [
+    "CR3BPLPV",
+    "DISTURBANCE_STRUCTURES",
     "RHO_NAMES",
     "SENSOR_NAMES",
-    "CR3BPLPV",
-    "ParameterBox",
-    "resonant_orbit",
-    "PrecisionLMI",
-    "ObserverDesign",
+    "SIN_THETA3_MIN",
     "InfeasibleLMIError",
+    "ObserverDesign",
+    "ParameterBox",
+    "PrecisionLMI",
+    "ResonantOrbit",
+    "Verification",
+    "default_disturbance",
     "design_observer",
-    "precision_to_noise_deg",
-    "noise_deg_to_precision",
+    "disturbance_model",
+    "error_system",
+    "gamma_sweep",
+    "guaranteed_error_rms",
     "h2_norm",
     "hinf_norm",
-    "Verification",
+    "noise_deg_to_precision",
+    "precision_to_noise_deg",
+    "resonant_orbit",
     "verify_observer",
-    "gamma_sweep",
-    "default_disturbance",
-    "error_system",
-    "ResonantOrbit",
-    "Scenario",
-    "paper_scenario",
-    "SIN_THETA3_MIN",
-    "DISTURBANCE_STRUCTURES",
-    "disturbance_model",
-    "guaranteed_error_rms",
-    "RESONANT_CANDIDATES",
-    "SensitivityStudy",
-    "sensitivity_study",
 ]
 
 #: Names of the scheduling parameters rho_1..rho_6.
@@ -176,6 +170,12 @@ class CR3BPLPV:
         r13, r23 = self._distances(s)
         if np.any(r13 == 0) or np.any(r23 == 0):
             raise ValueError("state coincides with a primary (r13 or r23 is zero)")
+        return self._rho(s, r13, r23)
+
+    def _rho(self, s, r13=None, r23=None):
+        """Kernel of :meth:`rho` (unchecked): ``s`` a float array (..., 2 or 4) off the primaries."""
+        if r13 is None:
+            r13, r23 = self._distances(s)
         return np.stack([r13**-3, r23**-3, 1.0 / r13, 1.0 / r23, s[..., 0], s[..., 1]], axis=-1)
 
     def angles(self, state):
@@ -183,7 +183,10 @@ class CR3BPLPV:
 
         :math:`\theta_1 = \operatorname{atan2}(y, x+\mu)`, :math:`\theta_2 = \operatorname{atan2}(y, 1-\mu-x)`.
         """
-        s = self._planar_input(state)
+        return self._angles(self._planar_input(state))
+
+    def _angles(self, s):
+        """Kernel of :meth:`angles` (unchecked)."""
         mu = self.mu
         return np.arctan2(s[..., 1], s[..., 0] + mu), np.arctan2(s[..., 1], 1.0 - mu - s[..., 0])
 
@@ -203,6 +206,12 @@ class CR3BPLPV:
         if np.any(np.abs(s3) < SIN_THETA3_MIN):
             raise ValueError(f"theta1 + theta2 is a multiple of pi (|sin theta3| < {SIN_THETA3_MIN:g}): the "
                              "triangulation is singular (spacecraft on the Earth-Moon line)")
+        return self._rho_from_angles(t1, t2, s3)
+
+    def _rho_from_angles(self, t1, t2, s3=None):
+        """Kernel of :meth:`rho_from_angles` (unchecked: the caller keeps away from :math:`\\sin\\theta_3 = 0`)."""
+        if s3 is None:
+            s3 = np.sin(t1 + t2)
         r13 = np.sin(t2) / s3
         r23 = np.sin(t1) / s3
         x = -self.mu + r13 * np.cos(t1)
@@ -214,13 +223,14 @@ class CR3BPLPV:
     def f(self, state) -> np.ndarray:
         """Nonlinear planar CR3BP vector field (..., 4), from :meth:`CR3BP.eom` (LU/TU, LU/TU^2)."""
         s = validation.as_array(state, "state", last=4, min_size=1)
-        d = self.system.eom(self.spatial(s))
-        return d[..., [0, 1, 3, 4]]
+        s6 = np.zeros(s.shape[:-1] + (6,))
+        s6[..., [0, 1, 3, 4]] = s
+        return self.system.eom(s6)[..., [0, 1, 3, 4]]
 
     def measure(self, state) -> np.ndarray:
         """Nonlinear sensor model (..., 6): ``[sin th1, cos th1, sin th2, cos th2, r13^2, r23^2]`` from geometry."""
         s = self._planar_input(state)
-        t1, t2 = self.angles(s)
+        t1, t2 = self._angles(s)
         r13, r23 = self._distances(s)
         return np.stack([np.sin(t1), np.cos(t1), np.sin(t2), np.cos(t2), r13**2, r23**2], axis=-1)
 
@@ -257,7 +267,10 @@ class CR3BPLPV:
         return {"A": A, "b": b, "C": C, "d": d}
 
     def _affine(self, key, rho):
-        r = validation.as_array(rho, "rho", last=6, min_size=1)
+        return self._affine_kernel(key, validation.as_array(rho, "rho", last=6, min_size=1))
+
+    def _affine_kernel(self, key, r):
+        """Unchecked :math:`M(\\rho) = M_0 + \\sum_i \\rho_i M_i` for ``r`` a float array (..., 6)."""
         coef = self.affine_coefficients()[key]
         return coef[0] + np.tensordot(r, coef[1:], axes=(-1, 0))
 
@@ -287,14 +300,14 @@ class CR3BPLPV:
     def lpv_rhs(self, state, rho=None) -> np.ndarray:
         """:math:`A(\\rho)x + b(\\rho)` (..., 4) with :math:`\\rho` from ``state`` unless given."""
         s = validation.as_array(state, "state", last=4, min_size=1)
-        r = self.rho(s) if rho is None else rho
-        return np.einsum("...ij,...j->...i", self.A(r), s) + self.b(r)
+        r = self.rho(s) if rho is None else validation.as_array(rho, "rho", last=6, min_size=1)
+        return np.einsum("...ij,...j->...i", self._affine_kernel("A", r), s) + self._affine_kernel("b", r)
 
     def lpv_measure(self, state, rho=None) -> np.ndarray:
         """:math:`C(\\rho)x + d(\\rho)` (..., 6) with :math:`\\rho` from ``state`` unless given."""
         s = validation.as_array(state, "state", last=4, min_size=1)
-        r = self.rho(s) if rho is None else rho
-        return np.einsum("...ij,...j->...i", self.C(r), s) + self.d(r)
+        r = self.rho(s) if rho is None else validation.as_array(rho, "rho", last=6, min_size=1)
+        return np.einsum("...ij,...j->...i", self._affine_kernel("C", r), s) + self._affine_kernel("d", r)
 
 
 # ------------------------------------------------------------------------------------------- polytope
@@ -334,7 +347,7 @@ class ParameterBox:
         object.__setattr__(self, "upper", hi)
 
     @classmethod
-    def from_samples(cls, rho, *, margin: float = 0.0, source: str = "") -> "ParameterBox":
+    def from_samples(cls, rho, *, margin: float = 0.0, source: str = "") -> ParameterBox:
         """Smallest box containing the samples ``rho`` (n, k), widened by ``margin`` times each range."""
         r = validation.as_array(rho, "rho", ndim=(2,))
         if r.shape[0] < 1:
@@ -476,6 +489,11 @@ def precision_to_noise_deg(kappa) -> np.ndarray:
     k = validation.as_array(kappa, "kappa", finite=False)
     if np.any(np.isnan(k)) or np.any(k < 0):
         raise ValueError("kappa must be non-negative")
+    return _precision_to_noise_deg(k)
+
+
+def _precision_to_noise_deg(k):
+    """Kernel of :func:`precision_to_noise_deg` (unchecked: ``k`` a float array >= 0, inf allowed)."""
     with np.errstate(divide="ignore"):
         inv = np.where(k > 0, 1.0 / np.where(k > 0, k, 1.0), np.inf)
     return np.degrees(np.arcsin(np.minimum(inv, 1.0)))
@@ -512,7 +530,11 @@ def disturbance_model(structure: str = "acceleration", level: float = 1e-3):
         ``(Bd (4, nd), Sd (nd, nd), Dd (6, nd))``.
     """
     structure = validation.choice(structure, "structure", DISTURBANCE_STRUCTURES)
-    s = validation.positive(level, "level", allow_zero=True)
+    return _disturbance_model(structure, validation.positive(level, "level", allow_zero=True))
+
+
+def _disturbance_model(structure, s):
+    """Kernel of :func:`disturbance_model` (unchecked)."""
     Bd = np.vstack([np.zeros((2, 2)), np.eye(2)]) if structure == "acceleration" else np.eye(4)
     nd = Bd.shape[1]
     return Bd, s * np.eye(nd), np.zeros((6, nd))
@@ -531,7 +553,7 @@ def default_disturbance(sigma_acc: float = 1e-3):
     tuple of ndarray
         ``(Bd (4, 2), Sd (2, 2), Dd (6, 2))``.
     """
-    return disturbance_model("acceleration", validation.positive(sigma_acc, "sigma_acc", allow_zero=True))
+    return _disturbance_model("acceleration", validation.positive(sigma_acc, "sigma_acc", allow_zero=True))
 
 
 class InfeasibleLMIError(RuntimeError):
@@ -633,7 +655,7 @@ class ObserverDesign:
             raise ValueError("noise_per_sample_deg applies to H2 designs (an intensity); this design is "
                              f"{self.norm!r}")
         dt = validation.positive(dt, "dt")
-        return precision_to_noise_deg(self.kappa * np.sqrt(dt))
+        return _precision_to_noise_deg(self.kappa * np.sqrt(dt))
 
     def gain(self, *, drop_unused: bool = True) -> np.ndarray:
         """Observer gain (4, 6); with ``drop_unused`` the columns of removed sensors are set to zero."""
@@ -746,9 +768,9 @@ class PrecisionLMI:
                  state_scale=None, variable_scale: float | None = None):
         import cvxpy as cp
 
-        self._init = dict(A_vertices=A_vertices, C_vertices=C_vertices, norm=norm, disturbance=disturbance, Cz=Cz,
-                          objective=objective, eps=eps, sensors=sensors, pole_radius=pole_radius,
-                          state_scale=state_scale)
+        self._init = {"A_vertices": A_vertices, "C_vertices": C_vertices, "norm": norm, "disturbance": disturbance, "Cz": Cz,
+                          "objective": objective, "eps": eps, "sensors": sensors, "pole_radius": pole_radius,
+                          "state_scale": state_scale}
         self._rescaled = {}
         A_v = validation.as_array(A_vertices, "A_vertices", ndim=(3,))
         nx = A_v.shape[1]
@@ -844,7 +866,7 @@ class PrecisionLMI:
         self.problem = cp.Problem(cp.Minimize(cp.norm(beta, _OBJECTIVES[objective])), cons)
 
     @classmethod
-    def for_cr3bp(cls, model: CR3BPLPV, vertices, norm: str = "h2", *, disturbance=None, **kwargs) -> "PrecisionLMI":
+    def for_cr3bp(cls, model: CR3BPLPV, vertices, norm: str = "h2", *, disturbance=None, **kwargs) -> PrecisionLMI:
         """The LMI for the planar CR3BP LPV model at the polytope ``vertices`` (n_v, 6) of :math:`\rho`.
 
         ``disturbance`` defaults to :func:`default_disturbance`; other keywords go to the constructor.
@@ -861,11 +883,14 @@ class PrecisionLMI:
         lmi.balanced_state_scale = np.array([1.0, 1.0, v, v])
         return lmi
 
-    def rescaled(self, variable_scale: float, state_scale=None) -> "PrecisionLMI":
+    def rescaled(self, variable_scale: float, state_scale=None) -> PrecisionLMI:
         """The same problem built with another ``variable_scale`` and ``state_scale`` (cached)."""
         xs = validation.positive(variable_scale, "variable_scale")
         ss = self.state_scale if state_scale is None else validation.as_array(state_scale, "state_scale",
                                                                              shape=(self.n_x,))
+        return self._rescaled_kernel(xs, ss)
+
+    def _rescaled_kernel(self, xs, ss):
         if xs == self.variable_scale and np.array_equal(ss, self.state_scale):
             return self
         key = (xs, tuple(ss))
@@ -888,6 +913,8 @@ class PrecisionLMI:
         warning) or, if every attempt failed, :class:`InfeasibleLMIError`.  Parameters: see :meth:`solve_once`.
         """
         retry = validation.boolean(retry, "retry")
+        gamma, solver, disturbance_scale, tol, sparsity_tol, solver_options = self._solve_arguments(
+            gamma, solver, disturbance_scale, tol, sparsity_tol, solver_options)
         balanced = getattr(self, "balanced_state_scale", None)
         configs = [(self.variable_scale, None)]
         if retry:
@@ -897,15 +924,14 @@ class PrecisionLMI:
                 configs.append((xs, balanced if bal else np.ones(self.n_x)))
         first, first_exc, tried = None, None, []
         for xs, ss in configs:
-            lmi = self.rescaled(xs, ss)
+            lmi = self._rescaled_kernel(xs, self.state_scale if ss is None else ss)
             if lmi in tried:
                 continue
             tried.append(lmi)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 try:
-                    d = lmi.solve_once(gamma, solver=solver, disturbance_scale=disturbance_scale, tol=tol,
-                                       sparsity_tol=sparsity_tol, **solver_options)
+                    d = lmi._solve_once(gamma, solver, disturbance_scale, sparsity_tol, solver_options)
                 except InfeasibleLMIError as exc:
                     if exc.status == "infeasible":  # a certificate, not a numerical accident
                         raise
@@ -947,8 +973,13 @@ class PrecisionLMI:
         InfeasibleLMIError
             The solver reports infeasibility or fails; the message names gamma and the status.
         """
-        import cvxpy as cp
+        gamma, solver, dscale, _, sparsity_tol, solver_options = self._solve_arguments(
+            gamma, solver, disturbance_scale, tol, sparsity_tol, solver_options)
+        return self._solve_once(gamma, solver, dscale, sparsity_tol, solver_options)
 
+    @staticmethod
+    def _solve_arguments(gamma, solver, disturbance_scale, tol, sparsity_tol, solver_options):
+        """The checks of :meth:`solve` / :meth:`solve_once`, done once; the tolerance folded into the options."""
         gamma = validation.positive(gamma, "gamma")
         solver = validation.choice(str(solver).upper() if isinstance(solver, str) else solver, "solver", _SOLVERS)
         dscale = validation.positive(disturbance_scale, "disturbance_scale", allow_zero=True)
@@ -961,6 +992,12 @@ class PrecisionLMI:
         elif tol is not None:
             solver_options = {"tol_gap_abs": tol, "tol_gap_rel": tol, "tol_feas": tol, "max_iter": 400,
                               **solver_options}
+        return gamma, solver, dscale, tol, sparsity_tol, solver_options
+
+    def _solve_once(self, gamma, solver, dscale, sparsity_tol, solver_options) -> ObserverDesign:
+        """Kernel of :meth:`solve_once` (arguments already checked by :meth:`_solve_arguments`)."""
+        import cvxpy as cp
+
         self.dist_over_gamma.value = dscale / gamma
         t0 = time.perf_counter()
         try:
@@ -990,7 +1027,7 @@ class PrecisionLMI:
         used[self.sensors] = beta[self.sensors] > sparsity_tol * beta.max()
         Sd = dscale * self.Sd
         return ObserverDesign(norm=self.norm, gamma=gamma, L=L, X=Xv, beta=beta, kappa=kappa,
-                              noise_deg=precision_to_noise_deg(kappa), used=used, status=str(status),
+                              noise_deg=_precision_to_noise_deg(kappa), used=used, status=str(status),
                               solver=solver, solve_time=elapsed, objective=float(self.problem.value) / gamma**2,
                               Bw=self.Bd @ Sd, Dd=self.Dd @ Sd, pole_radius=self.pole_radius,
                               variable_scale=self.variable_scale)
@@ -1040,9 +1077,13 @@ def h2_norm(A, B, C) -> float:
 
     :math:`AP + PA^T + BB^T = 0`, :math:`\|G\|_2 = \sqrt{\mathrm{tr}(CPC^T)}`; ``inf`` if A is not Hurwitz.
     """
+    return _h2_norm(*_check_abc(A, B, C))
+
+
+def _h2_norm(A, B, C) -> float:
+    """Kernel of :func:`h2_norm` (unchecked)."""
     from scipy.linalg import solve_continuous_lyapunov
 
-    A, B, C = _check_abc(A, B, C)
     if np.max(np.linalg.eigvals(A).real) >= 0:
         return np.inf
     P = solve_continuous_lyapunov(A, -B @ B.T)
@@ -1067,6 +1108,11 @@ def hinf_norm(A, B, C, *, rtol: float = 1e-9, max_iter: int = 50) -> float:
     A, B, C = _check_abc(A, B, C)
     rtol = validation.positive(rtol, "rtol")
     max_iter = validation.integer(max_iter, "max_iter", minimum=1)
+    return _hinf_norm(A, B, C, rtol, max_iter)
+
+
+def _hinf_norm(A, B, C, rtol: float = 1e-9, max_iter: int = 50) -> float:
+    """Kernel of :func:`hinf_norm` (unchecked)."""
     eig = np.linalg.eigvals(A)
     if np.max(eig.real) >= 0:
         return np.inf
@@ -1075,7 +1121,7 @@ def hinf_norm(A, B, C, *, rtol: float = 1e-9, max_iter: int = 50) -> float:
     lb = max(_sigma_max(A, B, C, w) for w in freqs)
     if lb == 0:
         return 0.0
-    n = A.shape[0]
+    A.shape[0]
     BB, CC = B @ B.T, C.T @ C
     for _ in range(max_iter):
         g = lb * (1.0 + 2.0 * rtol)
@@ -1152,10 +1198,15 @@ def error_system(model: CR3BPLPV, design: ObserverDesign, rho, *, L=None):
     design = validation.instance(design, "design", ObserverDesign)
     r = validation.as_array(rho, "rho", shape=(model.n_rho,))
     L = design.gain() if L is None else validation.as_array(L, "L", shape=(model.n_x, model.n_y))
+    return _error_system(model, design, r, L)
+
+
+def _error_system(model, design, r, L):
+    """Kernel of :func:`error_system` (unchecked: ``r`` (6,), ``L`` (4, 6) float arrays)."""
     with np.errstate(divide="ignore"):
         sn = np.where(design.kappa > 0, 1.0 / np.where(design.kappa > 0, design.kappa, 1.0), 0.0)
     sn = np.where(np.any(L != 0, axis=0), sn, 0.0)
-    Acl = model.A(r) + L @ model.C(r)
+    Acl = model._affine_kernel("A", r) + L @ model._affine_kernel("C", r)
     B = np.hstack([design.Bw + L @ design.Dd, L * sn[None, :]])
     Cz = np.hstack([np.eye(2), np.zeros((2, 2))])
     return Acl, B, Cz
@@ -1188,70 +1239,23 @@ def verify_observer(model: CR3BPLPV, design: ObserverDesign, box: ParameterBox, 
     rng = validation.rng(rng, "rng")
     if box.dim != model.n_rho:
         raise ValueError(f"box must bound the {model.n_rho} scheduling parameters; got dim {box.dim}")
-    if L is not None:
-        L = validation.as_array(L, "L", shape=(model.n_x, model.n_y))
+    L = design.gain() if L is None else validation.as_array(L, "L", shape=(model.n_x, model.n_y))
     V = box.vertices()
     S = box.sample(n_samples, rng)
     pts = np.vstack([V, S])
     max_eig, worst2, worstinf = -np.inf, -np.inf, -np.inf
     r2 = rinf = pts[0]
     for r in pts:
-        Acl, B, Cz = error_system(model, design, r, L=L)
+        Acl, B, Cz = _error_system(model, design, r, L)
         max_eig = max(max_eig, float(np.max(np.linalg.eigvals(Acl).real)))
-        h2 = h2_norm(Acl, B, Cz)
-        hi = hinf_norm(Acl, B, Cz)
+        h2 = _h2_norm(Acl, B, Cz)
+        hi = _hinf_norm(Acl, B, Cz)
         if h2 > worst2:
             worst2, r2 = h2, r
         if hi > worstinf:
             worstinf, rinf = hi, r
     return Verification(V.shape[0], S.shape[0], max_eig, worst2, worstinf, r2.copy(), rinf.copy(),
                         design.gamma, design.norm)
-
-
-@dataclass(frozen=True)
-class Scenario:
-    """The documented set-up of this reproduction: model, resonant orbit, its samples and the parameter box.
-
-    Attributes
-    ----------
-    model : CR3BPLPV
-    orbit : ResonantOrbit
-    t : ndarray (n,)
-        Sample times over one period, TU.
-    states : ndarray (n, 4)
-        Planar states along the orbit.
-    rho : ndarray (n, 6)
-        Scheduling parameters along the orbit.
-    box : ParameterBox
-        Bounds of ``rho`` along the orbit (the polytope whose vertices carry the LMIs).
-    """
-
-    model: CR3BPLPV
-    orbit: ResonantOrbit
-    t: np.ndarray
-    states: np.ndarray
-    rho: np.ndarray
-    box: ParameterBox
-
-
-def paper_scenario(system: CR3BP = EARTH_MOON, *, p: int = 2, q: int = 1, perigee_radius: float = 0.3,
-                   n_samples: int = 2000, margin: float = 0.0) -> Scenario:
-    """Resonant orbit (default the planar 2:1, perigee 0.3 LU) and the scheduling-parameter box over one period.
-
-    ``n_samples`` points over one period bound :math:`\\rho`; ``margin`` widens the box by that fraction of
-    each range (0 by default: the samples are dense enough that the extrema are resolved to ~1e-5).
-    """
-    model = CR3BPLPV(check_system(system, "system"))
-    n_samples = validation.integer(n_samples, "n_samples", minimum=2)
-    margin = validation.positive(margin, "margin", allow_zero=True)
-    orbit = resonant_orbit(system, p, q, perigee_radius)
-    t, x = orbit.sample(n_samples)
-    s = model.planar(x)
-    rho = model.rho(s)
-    box = ParameterBox.from_samples(rho, margin=margin,
-                                    source=f"planar {p}:{q} resonant orbit, x0 = {orbit.x0[0]:.6f} LU, "
-                                           f"vy0 = {orbit.x0[4]:.6f} LU/TU, T = {orbit.period:.6f} TU")
-    return Scenario(model, orbit, t, s, rho, box)
 
 
 # ------------------------------------------------------------------------------------ Fig. 3 criterion
@@ -1296,185 +1300,3 @@ def guaranteed_error_rms(design: ObserverDesign, noise_rms_deg: float, dt: float
             raise ValueError("dt (the sampling interval, TU) is required for an H2 design")
         return design.gamma * kmax * sig * np.sqrt(dt)
     return design.gamma * kmax * sig
-
-
-# ------------------------------------------------------------------------------- sensitivity study
-#: Planar Earth-Moon resonant orbits tried by the sensitivity study: (p, q, perigee radius in LU).  Each is an
-#: x-axis symmetric orbit that :func:`resonant_orbit` corrects (5:3, 3:2 and 7:4 guesses do not converge with the
-#: Keplerian start and are left out).
-RESONANT_CANDIDATES = ((4, 1, 0.2), (3, 1, 0.2), (3, 1, 0.3), (5, 2, 0.35), (2, 1, 0.2), (2, 1, 0.3),
-                       (2, 1, 0.4), (2, 1, 0.5))
-
-
-@dataclass(frozen=True)
-class SensitivityStudy:
-    r"""Allowable :math:`\theta_1` noise at one gamma over orbits, disturbance structures and levels.
-
-    Array axes are ``(orbit, structure, level)``.  The precisions come from the :math:`\theta_1`-only problems
-    (``sensors=[0, 1]``, the channels Eq. 24 uses and the :math:`\|\beta\|_1` optimum selects), whose LMIs depend
-    only on :math:`\rho_1, \rho_2, \rho_3` (8 distinct vertices).  The sampling interval enters afterwards, through
-    :meth:`h2_per_sample_deg`.
-
-    Attributes
-    ----------
-    orbits : tuple of (p, q, perigee_radius)
-    r13_max, period : ndarray (n_orbit,)
-        Largest Earth distance (LU) and period (TU) of each orbit.
-    structures : tuple of str
-    levels : ndarray (n_level,)
-        Disturbance levels :math:`S_d = \mathrm{level}\,I`.
-    gamma, pole_radius : float
-        Bound (LU) and the H-infinity bandwidth bound R (1/TU).
-    h2_kappa, hinf_kappa : ndarray
-        Precision of the :math:`\theta_1` channels (the smaller of sin and cos; NaN where infeasible).
-    h2_status, hinf_status : ndarray of str
-    h2_gain, hinf_gain : ndarray
-        :math:`\|L\|_2` of each design.
-    seconds : float
-        Wall-clock time of the study.
-    """
-
-    orbits: tuple
-    r13_max: np.ndarray
-    period: np.ndarray
-    structures: tuple
-    levels: np.ndarray
-    gamma: float
-    pole_radius: float
-    h2_kappa: np.ndarray
-    hinf_kappa: np.ndarray
-    h2_status: np.ndarray
-    hinf_status: np.ndarray
-    h2_gain: np.ndarray
-    hinf_gain: np.ndarray
-    seconds: float
-
-    @property
-    def h2_intensity_deg(self) -> np.ndarray:
-        """H2 allowance read directly through Eq. 24 (a white-noise intensity, deg TU^1/2)."""
-        return precision_to_noise_deg(np.nan_to_num(self.h2_kappa, nan=np.inf))
-
-    @property
-    def hinf_deg(self) -> np.ndarray:
-        """H-infinity allowance through Eq. 24, deg."""
-        return precision_to_noise_deg(np.nan_to_num(self.hinf_kappa, nan=np.inf))
-
-    def h2_per_sample_deg(self, dt) -> np.ndarray:
-        """H2 allowance per sample for sampling interval(s) ``dt`` (TU); broadcasts ``dt`` on a new last axis."""
-        dt = validation.as_array(dt, "dt")
-        if np.any(dt <= 0):
-            raise ValueError("dt must be positive (TU)")
-        k = np.nan_to_num(self.h2_kappa, nan=np.inf)[..., None] * np.sqrt(dt)
-        out = precision_to_noise_deg(k)
-        return out[..., 0] if dt.ndim == 0 else out
-
-    def dt_for_h2(self, target_deg: float = 0.1) -> np.ndarray:
-        """Sampling interval (TU) at which the H2 per-sample allowance equals ``target_deg``."""
-        s = np.sin(np.radians(validation.in_range(target_deg, "target_deg", 0.0, 90.0, closed=False)))
-        return 1.0 / (self.h2_kappa * s) ** 2
-
-    @property
-    def all_optimal(self) -> bool:
-        """Every solve ended ``optimal``."""
-        return bool(np.all(self.h2_status == "optimal") and np.all(self.hinf_status == "optimal"))
-
-
-def _study_orbit(task):
-    """One orbit of :func:`sensitivity_study` (module-level so process pools can pickle it)."""
-    system, (p, q, rp), structures, levels, gamma, R, n_samples = task
-    sc = paper_scenario(system, p=p, q=q, perigee_radius=rp, n_samples=n_samples)
-    V = sc.box.vertices()
-    shape = (len(structures), len(levels))
-    res = {f"{n}_{k}": np.full(shape, np.nan) for n in _NORMS for k in ("kappa", "gain")}
-    res.update({f"{n}_status": np.full(shape, "not_run", dtype=object) for n in _NORMS})
-    for i, structure in enumerate(structures):
-        dist = disturbance_model(structure, 1.0)
-        for norm in _NORMS:
-            lmi = PrecisionLMI.for_cr3bp(sc.model, V, norm, disturbance=dist, sensors=[0, 1],
-                                         pole_radius=R if norm == "hinf" else None)
-            for j, level in enumerate(levels):
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    try:
-                        d = lmi.solve(gamma, disturbance_scale=float(level))
-                    except InfeasibleLMIError as exc:
-                        res[f"{norm}_status"][i, j] = exc.status
-                        continue
-                res[f"{norm}_kappa"][i, j] = float(np.min(d.kappa[:2]))
-                res[f"{norm}_gain"][i, j] = d.gain_norm
-                res[f"{norm}_status"][i, j] = d.status
-    res["r13_max"] = float(1.0 / sc.box.lower[2])
-    res["period"] = sc.orbit.period
-    return res
-
-
-def sensitivity_study(gamma: float = 0.0013, *, orbits=RESONANT_CANDIDATES, structures=DISTURBANCE_STRUCTURES,
-                      levels=(0.0, 1e-4, 1e-3, 1e-2), pole_radius: float = 1000.0, n_samples: int = 1000,
-                      system: CR3BP = EARTH_MOON, executor=None, progress: bool = False) -> SensitivityStudy:
-    r"""Where do the paper's 0.1 deg (H2) and 0.08 deg (H-infinity) come from?  Solve both theorems over the inputs
-    the paper leaves unstated.
-
-    For every resonant orbit (its :math:`\rho` box from ``n_samples`` points over one period), disturbance
-    structure (:func:`disturbance_model`) and level, the :math:`\theta_1`-only H2 problem and the
-    bandwidth-bounded H-infinity problem are solved at ``gamma``.  Each (orbit, structure, norm) problem is built
-    once; the level is a ``cp.Parameter``.
-
-    Parameters
-    ----------
-    gamma : float
-        Bound, LU.
-    orbits : sequence of (p, q, perigee_radius)
-        Planar resonances (see :data:`RESONANT_CANDIDATES`).
-    structures : sequence of str
-        Disturbance structures.
-    levels : array_like
-        Disturbance levels (>= 0).
-    pole_radius : float
-        H-infinity bandwidth bound R, 1/TU (makes the minimum attained; see :class:`PrecisionLMI`).
-    n_samples : int
-        Samples per orbit period bounding :math:`\rho`.
-    system : CR3BP
-    executor : concurrent.futures.Executor, optional
-        Runs the orbits (one task each) with ``executor.map``; default serial.  Results do not depend on it.
-    progress : bool
-        Show a progress bar over the orbits.
-
-    Returns
-    -------
-    SensitivityStudy
-    """
-    gamma = validation.positive(gamma, "gamma")
-    system = check_system(system, "system")
-    try:
-        orbits = tuple((validation.integer(o[0], "orbits p"), validation.integer(o[1], "orbits q"),
-                        validation.positive(o[2], "orbits perigee_radius")) for o in orbits)
-    except (TypeError, IndexError) as exc:
-        raise validation.ArgumentTypeError("orbits must be a sequence of (p, q, perigee_radius) tuples") from exc
-    if not orbits:
-        raise ValueError("orbits must hold at least one (p, q, perigee_radius)")
-    structures = tuple(validation.choice(s, "structures", DISTURBANCE_STRUCTURES)
-                       for s in validation.one_or_many(structures, "structures", str, "disturbance structure name"))
-    lv = validation.as_array(levels, "levels", ndim=(1,), min_size=1)
-    if np.any(lv < 0):
-        raise ValueError(f"levels must be >= 0; got {lv}")
-    R = validation.positive(pole_radius, "pole_radius")
-    n_samples = validation.integer(n_samples, "n_samples", minimum=10)
-    progress = validation.boolean(progress, "progress")
-    if executor is not None and not callable(getattr(executor, "map", None)):
-        raise validation.ArgumentTypeError(f"executor must be a concurrent.futures-style executor with a map method "
-                                        f"(or None); got {type(executor).__name__}")
-    tasks = [(system, o, structures, tuple(lv), gamma, R, n_samples) for o in orbits]
-    t0 = time.perf_counter()
-    mapper = map if executor is None else executor.map
-    results = mapper(_study_orbit, tasks)
-    if progress:
-
-        results = _progress(results, total=len(tasks), desc="sensitivity study (orbits)")
-    results = list(results)
-    stack = {k: np.stack([r[k] for r in results]) for k in results[0] if k not in ("r13_max", "period")}
-    return SensitivityStudy(orbits=orbits, r13_max=np.array([r["r13_max"] for r in results]),
-                            period=np.array([r["period"] for r in results]), structures=structures, levels=lv,
-                            gamma=gamma, pole_radius=R, h2_kappa=stack["h2_kappa"], hinf_kappa=stack["hinf_kappa"],
-                            h2_status=stack["h2_status"].astype(str), hinf_status=stack["hinf_status"].astype(str),
-                            h2_gain=stack["h2_gain"], hinf_gain=stack["hinf_gain"],
-                            seconds=time.perf_counter() - t0)

@@ -40,7 +40,7 @@ import numpy as np
 from cislunar.estimation.lpv import CR3BPLPV
 from cislunar.utils import validation
 
-__all__ = ["Measurements", "ObserverRun", "make_measurements", "simulate_lpv_observer", "simulate_ekf"]
+__all__ = ["Measurements", "ObserverRun", "make_measurements", "simulate_ekf", "simulate_lpv_observer"]
 
 
 @dataclass(frozen=True)
@@ -104,7 +104,7 @@ def make_measurements(model: CR3BPLPV, t, truth, sigma_deg: float, rng: np.rando
     t = validation.time_grid(t, "t", increasing=True)
     x = validation.as_array(truth, "truth", shape=(t.size, 4))
     sigma = np.radians(validation.positive(sigma_deg, "sigma_deg", allow_zero=True))
-    t1, t2 = model.angles(x)
+    t1, t2 = model._angles(x)
     n = rng.standard_normal((2, t.size)) * sigma
     return Measurements(t, t1 + n[0], t2 + n[1], float(sigma))
 
@@ -113,7 +113,7 @@ def _measurement_vector(model: CR3BPLPV, th1, th2, singular):
     """Measurement vector and triangulated rho; NaN where ``singular`` (the caller uses the estimate there)."""
     rho = np.full(th1.shape + (6,), np.nan)
     ok = ~singular
-    rho[ok] = model.rho_from_angles(th1[ok], th2[ok])
+    rho[ok] = model._rho_from_angles(th1[ok], th2[ok])
     r13, r23 = 1.0 / rho[..., 2], 1.0 / rho[..., 3]
     y = np.stack([np.sin(th1), np.cos(th1), np.sin(th2), np.cos(th2), r13**2, r23**2], axis=-1)
     return y, rho
@@ -157,18 +157,20 @@ def simulate_lpv_observer(model: CR3BPLPV, L, meas: Measurements, x_hat0, truth,
     thr = validation.in_range(sin3_threshold, "sin3_threshold", 0.0, 1.0)
     exact_rho = validation.boolean(exact_rho, "exact_rho")
     hold = validation.choice(hold, "hold", ("noise", "measurement"))
+    if substeps is not None:
+        substeps = validation.integer(substeps, "substeps", minimum=1)
     singular = np.abs(np.sin(meas.theta1 + meas.theta2)) < max(thr, 1e-9)
     y_all, rho_all = _measurement_vector(model, meas.theta1, meas.theta2, singular)
     y_singular = singular
     if exact_rho:
-        rho_all = model.rho(truth)
+        rho_all = model._rho(truth)
         singular = np.zeros_like(singular)
     if substeps is None:
-        rho_ok = rho_all[~singular] if np.any(~singular) else model.rho(truth)
-        rate = np.linalg.norm(L, 2) * np.max(np.linalg.norm(model.C(rho_ok), 2, axis=(-2, -1))) + 10.0
+        rho_ok = rho_all[~singular] if np.any(~singular) else model._rho(truth)
+        c_max = np.max(np.linalg.norm(model._affine_kernel("C", rho_ok), 2, axis=(-2, -1)))
+        rate = np.linalg.norm(L, 2) * c_max + 10.0
         dt_max = float(np.max(np.diff(meas.t))) if meas.t.size > 1 else 0.0
         substeps = max(4, int(np.ceil(dt_max * rate)))
-    substeps = validation.integer(substeps, "substeps", minimum=1)
     coef = model.affine_coefficients()
     A0, Ai, b0, bi = coef["A"][0], coef["A"][1:], coef["b"][0], coef["b"][1:]
     C0, Ci, d0, di = coef["C"][0], coef["C"][1:], coef["d"][0], coef["d"][1:]
@@ -190,7 +192,7 @@ def simulate_lpv_observer(model: CR3BPLPV, L, meas: Measurements, x_hat0, truth,
     out = np.empty((m, 4))
     out[0] = xh
     if hold == "noise":
-        t1_true, t2_true = model.angles(truth)
+        t1_true, t2_true = model._angles(truth)
         n1 = np.angle(np.exp(1j * (meas.theta1 - t1_true)))
         n2 = np.angle(np.exp(1j * (meas.theta2 - t2_true)))
 
@@ -201,7 +203,7 @@ def simulate_lpv_observer(model: CR3BPLPV, L, meas: Measurements, x_hat0, truth,
             h00, h10, h01, h11 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u, -2 * u**3 + 3 * u**2, u**3 - u**2
             pos = (h00 * truth[k, :2] + h10 * hk * truth[k, 2:] + h01 * truth[k + 1, :2]
                    + h11 * hk * truth[k + 1, 2:])
-            a1, a2 = model.angles(pos)
+            a1, a2 = model._angles(pos)
             th1, th2 = a1 + n1[k], a2 + n2[k]
             sing = abs(np.sin(th1 + th2)) < max(thr, 1e-9)
             if exact_rho:
@@ -209,7 +211,7 @@ def simulate_lpv_observer(model: CR3BPLPV, L, meas: Measurements, x_hat0, truth,
             elif sing:
                 rho = None
             else:
-                rho = model.rho_from_angles(th1, th2)
+                rho = model._rho_from_angles(th1, th2)
             yv = np.zeros(6)
             yv[:4] = np.sin(th1), np.cos(th1), np.sin(th2), np.cos(th2)
             if rho is not None and not exact_rho:
@@ -278,7 +280,8 @@ def simulate_ekf(model: CR3BPLPV, meas: Measurements, x_hat0, P0, truth, *, sigm
     mu = model.mu
 
     def deriv(s, P_):
-        s6 = model.spatial(s)
+        s6 = np.zeros(6)
+        s6[idx] = s
         f = sys.eom(s6)[idx]
         F = sys.jacobian(s6)[np.ix_(idx, idx)]
         return f, F @ P_ + P_ @ F.T + Qc

@@ -10,13 +10,14 @@ from cislunar.estimation.observers import (
     simulate_ekf,
     simulate_lpv_observer,
 )
+from cislunar.papers.nychka_bhattacharya.scenarios import paper_scenario
 
 MODEL = lpv.CR3BPLPV()
 
 
 @pytest.fixture(scope="module")
 def short_run():
-    sc = lpv.paper_scenario(n_samples=400)
+    sc = paper_scenario(n_samples=400)
     t = np.arange(0.0, 0.5, 0.01)
     from cislunar.cr3bp.propagation import propagate
 
@@ -88,7 +89,7 @@ def test_h2_guarantee_holds_with_exact_rho_and_held_noise():
     A wrong noise model (the whole measurement held: lag acts as extra noise) breaks it."""
     from cislunar.cr3bp.propagation import propagate
 
-    sc = lpv.paper_scenario(n_samples=600)
+    sc = paper_scenario(n_samples=600)
     d = lpv.design_observer(MODEL, sc.box.vertices(), 0.0013, "h2", sensors=[0, 1])
     dt = 0.004
     t = np.arange(0.0, sc.orbit.period, dt)

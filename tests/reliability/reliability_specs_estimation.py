@@ -15,6 +15,8 @@ import numpy as np
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.estimation import lpv, observers
 from cislunar.guidance import discretization, scvx
+from cislunar.papers.nychka_bhattacharya import scenarios as nb_scenarios
+from cislunar.papers.nychka_bhattacharya import sensing_precision as nb_sensing
 from cislunar.papers.wolf_jones import reference
 from cislunar.sensing import covariance, information
 from cislunar.sensing.measurements import AZIMUTH_ELEVATION
@@ -123,7 +125,7 @@ def _resonant():
 def _study():
     one = np.ones((1, 1, 1))
     st = np.full((1, 1, 1), "optimal")
-    return lpv.SensitivityStudy(orbits=((2, 1, 0.3),), r13_max=np.ones(1), period=np.ones(1),
+    return nb_sensing.SensitivityStudy(orbits=((2, 1, 0.3),), r13_max=np.ones(1), period=np.ones(1),
                                 structures=("acceleration",), levels=np.array([1e-3]), gamma=0.0013,
                                 pole_radius=1000.0, h2_kappa=one * 500.0, hinf_kappa=one * 600.0, h2_status=st,
                                 hinf_status=st, h2_gain=one, hinf_gain=one, seconds=0.0)
@@ -352,7 +354,7 @@ def specs(Spec, lazy):
     s.append(S("default_disturbance", lpv.default_disturbance, dict(sigma_acc=1e-3), dict(sigma_acc="nonneg")))
     s.append(S("error_system", lpv.error_system, dict(model=MODEL, design=lazy(_design), rho=RHO2[0], L=None),
                dict(model="instance", design="instance", rho="arr", L="arr_opt")))
-    s.append(S("paper_scenario", lpv.paper_scenario,
+    s.append(S("paper_scenario", nb_scenarios.paper_scenario,
                dict(system=em, p=2, q=1, perigee_radius=0.3, n_samples=10, margin=0.0),
                dict(system="system", p="int2", q="int1", perigee_radius="range:0.05:0.9", n_samples="int2",
                     margin="nonneg")))
@@ -365,7 +367,7 @@ def specs(Spec, lazy):
                dict(dt=np.array([0.01, 0.02])), dict(dt="arr_finite")))
     s.append(S("SensitivityStudy.dt_for_h2", lazy(lambda: _study().dt_for_h2), dict(target_deg=0.1),
                dict(target_deg="range:0:90")))
-    s.append(S("sensitivity_study", lpv.sensitivity_study,
+    s.append(S("sensitivity_study", nb_sensing.sensitivity_study,
                dict(gamma=0.0013, orbits=((2, 1, 0.3),), structures=("acceleration",), levels=(1e-3,),
                     pole_radius=1000.0, n_samples=10, system=em, executor=None, progress=False),
                dict(gamma="pos", orbits="iterable", structures="choice", levels="vec", pole_radius="pos",

@@ -1,0 +1,1 @@
+"""Declared claims of Nychka & Bhattacharya (one module per notebook), fixed before comparing."""

@@ -1,0 +1,287 @@
+r"""Notebook 12's set-ups (Nychka & Bhattacharya §IV-B, Fig. 3): the designs of notebook 11 flown on the nonlinear
+CR3BP with noisy angles, the criterion for "converge rapidly and stay accurate", and the re-run at the sampling
+interval where the paper's H2 number holds.
+
+Methods: :mod:`cislunar.estimation.lpv` (designs, guarantees) and :mod:`cislunar.estimation.observers` (the LPV
+observer of Eq. 3a and the EKF).  Units: LU, TU, deg; planar rotating-frame states ``[x, y, vx, vy]``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from cislunar.cr3bp.propagation import propagate
+from cislunar.estimation import lpv
+from cislunar.estimation.observers import (
+    make_measurements,
+    simulate_ekf,
+    simulate_lpv_observer,
+)
+from cislunar.papers.nychka_bhattacharya.scenarios import (
+    GAMMA,
+    POLE_RADIUS,
+    THETA1_SENSORS,
+    Scenario,
+)
+from cislunar.utils import validation
+
+__all__ = ["INITIAL_ERROR", "E0_SCALES", "observer_designs", "ObserverDesigns", "Fig3Runs", "simulate_fig3",
+           "first_and_rms", "Convergence", "convergence_study", "LineCrossings", "line_crossings", "WindowRerun",
+           "window_rerun"]
+
+#: Initial estimate error (LU, LU/TU): 0.02 LU in x and -0.02 LU in y (about 10,900 km), 0.01 LU/TU (10 m/s) in
+#: each velocity.  The paper says only "large initial errors".
+INITIAL_ERROR = np.array([0.02, -0.02, 0.01, 0.01])
+#: Scales of the initial error swept by :func:`convergence_study`.
+E0_SCALES = (0.003, 0.01, 0.03, 0.1, 0.3, 1.0)
+
+
+@dataclass(frozen=True)
+class ObserverDesigns:
+    """The theta1-only H2 and bandwidth-bounded H-infinity gains and their verification (keys ``"h2"``, ``"hinf"``)."""
+
+    designs: dict
+    verification: dict
+
+
+def observer_designs(scenario: Scenario, n_verify: int, rng: np.random.Generator, *, gamma: float = GAMMA,
+                     pole_radius: float = POLE_RADIUS) -> ObserverDesigns:
+    """Solve both theorems on ``scenario``'s polytope and verify each gain at its vertices and ``n_verify`` random
+    interior points (H2 first, drawing from ``rng``)."""
+    scenario = validation.instance(scenario, "scenario", Scenario)
+    n_verify = validation.integer(n_verify, "n_verify", minimum=1)
+    V = scenario.box.vertices()
+    m = scenario.model
+    des = {"h2": lpv.design_observer(m, V, gamma, "h2", sensors=THETA1_SENSORS),
+           "hinf": lpv.design_observer(m, V, gamma, "hinf", sensors=THETA1_SENSORS, pole_radius=pole_radius)}
+    ver = {n: lpv.verify_observer(m, d, scenario.box, n_verify, rng) for n, d in des.items()}
+    return ObserverDesigns(des, ver)
+
+
+@dataclass(frozen=True)
+class Fig3Runs:
+    """Truth, measurements and the observer runs of Fig. 3.
+
+    Attributes
+    ----------
+    t : ndarray (m,)
+        Measurement times, TU.
+    truth : ndarray (m, 4)
+    meas : Measurements
+    x_hat0 : ndarray (4,)
+        Initial estimate.
+    runs : dict of str to ObserverRun
+        ``"h2"``, ``"hinf"`` (triangulated rho), ``"ekf"``.
+    exact : dict of str to ObserverRun
+        The LPV observers scheduled on the true rho (diagnostic).
+    dt, period : float
+        Measurement interval and orbit period, TU.
+    """
+
+    t: np.ndarray
+    truth: np.ndarray
+    meas: object
+    x_hat0: np.ndarray
+    runs: dict
+    exact: dict
+    dt: float
+    period: float
+
+    @property
+    def initial_error(self) -> float:
+        """Initial position error, LU."""
+        return float(self.runs["h2"].position_error[0])
+
+    @property
+    def settled(self) -> np.ndarray:
+        """Samples after the first 10 % of the run."""
+        return self.t > 0.1 * (self.t[-1] - self.t[0])
+
+    def median_settled(self, name: str) -> float:
+        """Median position error of run ``name`` after 10 % of the run, LU."""
+        return float(np.median(self.runs[name].position_error[self.settled]))
+
+
+def simulate_fig3(scenario: Scenario, designs: ObserverDesigns, dt: float, periods: float, sigma_deg: float,
+                  rng: np.random.Generator, *, sigma_acc: float = 1e-3, p0_sigma: float = 0.03) -> Fig3Runs:
+    """Propagate the truth over ``periods`` periods, sample noisy angles every ``dt`` TU (``rng``) and run both LPV
+    observers (triangulated and true rho) and the EKF (``sigma_acc`` LU/TU^2, initial sigma ``p0_sigma``) from
+    ``truth[0] + INITIAL_ERROR``."""
+    scenario = validation.instance(scenario, "scenario", Scenario)
+    designs = validation.instance(designs, "designs", ObserverDesigns)
+    dt = validation.positive(dt, "dt")
+    periods = validation.positive(periods, "periods")
+    m = scenario.model
+    t = np.arange(0.0, periods * scenario.orbit.period, dt)
+    truth = m.planar(propagate(m.system, scenario.orbit.x0, t).x)
+    meas = make_measurements(m, t, truth, sigma_deg, rng)
+    x0 = truth[0] + INITIAL_ERROR
+    runs = {n: simulate_lpv_observer(m, d.gain(), meas, x0, truth) for n, d in designs.designs.items()}
+    exact = {n: simulate_lpv_observer(m, d.gain(), meas, x0, truth, exact_rho=True)
+             for n, d in designs.designs.items()}
+    runs["ekf"] = simulate_ekf(m, meas, x0, np.diag([p0_sigma] * 4) ** 2, truth, sigma_acc=sigma_acc)
+    return Fig3Runs(t, truth, meas, x0, runs, exact, dt, float(scenario.orbit.period))
+
+
+def first_and_rms(t, position_error, bound: float, period: float) -> tuple:
+    """First time (TU) the error falls below ``bound`` and the RMS error (LU) from 2 % of ``period`` after it
+    (``(inf, inf)`` if never)."""
+    t = validation.as_array(t, "t", ndim=(1,))
+    e = validation.as_array(position_error, "position_error", shape=t.shape)
+    below = e < bound
+    if not below.any():
+        return np.inf, np.inf
+    t_first = float(t[np.argmax(below)])
+    after = t > t_first + 0.02 * period
+    return t_first, float(np.sqrt(np.mean(e[after] ** 2))) if after.any() else np.inf
+
+
+@dataclass(frozen=True)
+class Convergence:
+    r"""The Fig. 3 criterion and what sets the convergence time.
+
+    Attributes
+    ----------
+    noise_rms_deg : float
+        RMS of the simulated theta1 noise, deg.
+    bound : dict
+        Guaranteed RMS position error of each design for this noise (LU).
+    first, rms, rms_exact : dict
+        First time below the bound (TU), RMS after it (LU), and the RMS with exact rho (LU).
+    decay : dict
+        Slowest closed-loop decay rate along the orbit, 1/TU.
+    t_pred : dict
+        Predicted time from the initial error to the bound, :math:`\ln(e_0/\mathrm{bound})/\mathrm{decay}`, TU.
+    first_clean : float
+        H2, no noise, exact rho: first time below the bound, TU.
+    e0_scales, first_sweep : ndarray
+        Initial-error scales and the H2 first time below the bound for each, TU.
+    """
+
+    noise_rms_deg: float
+    bound: dict
+    first: dict
+    rms: dict
+    rms_exact: dict
+    decay: dict
+    t_pred: dict
+    first_clean: float
+    e0_scales: np.ndarray
+    first_sweep: np.ndarray
+
+    def converges(self, name: str, period: float) -> bool:
+        """First below the bound within 5 % of ``period``."""
+        return bool(self.first[name] <= 0.05 * period)
+
+    def stays(self, name: str) -> bool:
+        """RMS after convergence below the bound."""
+        return bool(self.rms[name] <= self.bound[name])
+
+    def e0_max_ok(self, initial_error: float, period: float) -> float:
+        """Largest swept initial error (units of ``initial_error``) that still meets the 5 % criterion (NaN if none)."""
+        ok = [f * initial_error for f, tf in zip(self.e0_scales, self.first_sweep) if tf <= 0.05 * period]
+        return max(ok) if ok else float("nan")
+
+
+def convergence_study(scenario: Scenario, designs: ObserverDesigns, sim: Fig3Runs, sigma_deg: float, *,
+                      e0_scales=E0_SCALES, seed: int = 0) -> Convergence:
+    """Judge ``sim`` against the LMI guarantees (``lpv.guaranteed_error_rms``), predict the convergence time from the
+    slowest closed-loop pole, re-run H2 without noise on the true rho and sweep the initial error."""
+    scenario = validation.instance(scenario, "scenario", Scenario)
+    designs = validation.instance(designs, "designs", ObserverDesigns)
+    sim = validation.instance(sim, "sim", Fig3Runs)
+    scales = validation.as_array(e0_scales, "e0_scales", ndim=(1,), min_size=1)
+    m, des, t, P = scenario.model, designs.designs, sim.t, sim.period
+    dth = np.degrees(np.angle(np.exp(1j * (np.stack([sim.meas.theta1, sim.meas.theta2])
+                                           - np.stack(m.angles(sim.truth))))))
+    noise_rms = float(np.sqrt(np.mean(dth[0] ** 2)))
+    bound = {"h2": lpv.guaranteed_error_rms(des["h2"], sigma_deg, sim.dt),
+             "hinf": lpv.guaranteed_error_rms(des["hinf"], noise_rms)}
+    first, rms, rms_exact = {}, {}, {}
+    for n in bound:
+        first[n], rms[n] = first_and_rms(t, sim.runs[n].position_error, bound[n], P)
+        rms_exact[n] = first_and_rms(t, sim.exact[n].position_error, bound[n], P)[1]
+    e0 = sim.initial_error
+    decay, t_pred = {}, {}
+    for n, d in des.items():
+        Lg = d.gain()
+        ev = np.array([np.linalg.eigvals(m.A(r) + Lg @ m.C(r)).real.max() for r in scenario.rho[::10]])
+        decay[n] = float(-ev.max())
+        t_pred[n] = float(np.log(e0 / bound[n]) / decay[n])
+    clean_meas = make_measurements(m, t, sim.truth, 0.0, np.random.default_rng(seed))
+    clean = simulate_lpv_observer(m, des["h2"].gain(), clean_meas, sim.x_hat0, sim.truth, exact_rho=True)
+    first_clean = first_and_rms(t, clean.position_error, bound["h2"], P)[0]
+    sweep = []
+    for f in scales:
+        x0 = sim.truth[0] + f * (sim.x_hat0 - sim.truth[0])
+        run = simulate_lpv_observer(m, des["h2"].gain(), sim.meas, x0, sim.truth)
+        sweep.append(first_and_rms(t, run.position_error, bound["h2"], P)[0])
+    return Convergence(noise_rms, bound, first, rms, rms_exact, decay, t_pred, first_clean, scales, np.array(sweep))
+
+
+@dataclass(frozen=True)
+class LineCrossings:
+    """Where the spacecraft crosses the Earth-Moon line (rho from the estimate) and the running RMS errors.
+
+    Attributes
+    ----------
+    starts : ndarray
+        Times at which a stretch of samples with :math:`|\\sin\\theta_3| < 0.04` begins, TU.
+    near : ndarray of bool (m,)
+        Samples within ``window`` TU of a start.
+    running_rms : dict of str to ndarray (m,)
+        Running RMS of the position error over ``window`` TU, LU.
+    window : float
+    """
+
+    starts: np.ndarray
+    near: np.ndarray
+    running_rms: dict
+    window: float
+
+
+def line_crossings(sim: Fig3Runs, window: float = 0.1) -> LineCrossings:
+    """Earth-Moon line crossings of ``sim`` and the running RMS of each run over ``window`` TU."""
+    sim = validation.instance(sim, "sim", Fig3Runs)
+    window = validation.positive(window, "window")
+    t = sim.t
+    on_line = sim.runs["h2"].rho_from_estimate
+    starts = t[on_line & ~np.r_[False, on_line[:-1]]]
+    near = np.zeros(t.size, dtype=bool)
+    for t0 in starts:
+        near |= np.abs(t - t0) < window
+    w = max(1, int(round(window / sim.dt)))
+    n_win = np.convolve(np.ones(t.size), np.ones(w), mode="same")  # fewer samples in the windows at the ends
+    run_rms = {n: np.sqrt(np.convolve(r.position_error**2, np.ones(w), mode="same") / n_win)
+               for n, r in sim.runs.items()}
+    return LineCrossings(starts, near, run_rms, window)
+
+
+@dataclass(frozen=True)
+class WindowRerun:
+    """Both LPV observers re-run at another sampling interval ``dt`` (TU), with ``n`` samples; ``median``: median
+    position error after 10 % of the run by observer, LU."""
+
+    dt: float
+    n: int
+    median: dict
+
+
+def window_rerun(scenario: Scenario, designs: ObserverDesigns, sim: Fig3Runs, dt: float, periods: float,
+                 sigma_deg: float, rng: np.random.Generator) -> WindowRerun:
+    """Repeat the LPV runs of ``sim`` (same initial error) with measurements every ``dt`` TU drawn from ``rng``."""
+    scenario = validation.instance(scenario, "scenario", Scenario)
+    designs = validation.instance(designs, "designs", ObserverDesigns)
+    sim = validation.instance(sim, "sim", Fig3Runs)
+    dt = validation.positive(dt, "dt")
+    m = scenario.model
+    t = np.arange(0.0, validation.positive(periods, "periods") * scenario.orbit.period, dt)
+    truth = m.planar(propagate(m.system, scenario.orbit.x0, t).x)
+    meas = make_measurements(m, t, truth, sigma_deg, rng)
+    x0 = truth[0] + (sim.x_hat0 - sim.truth[0])
+    settle = t > 0.1 * (t[-1] - t[0])
+    med = {n: float(np.median(simulate_lpv_observer(m, d.gain(), meas, x0, truth).position_error[settle]))
+           for n, d in designs.designs.items()}
+    return WindowRerun(float(dt), int(t.size), med)

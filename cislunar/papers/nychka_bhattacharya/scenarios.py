@@ -1,0 +1,104 @@
+r"""The set-up of this reproduction of Nychka & Bhattacharya (arXiv 2410.02013): bound, sensors, orbit, polytope.
+
+The paper states its bound :math:`\gamma = 0.0013` LU and its 0.1 deg angle noise, but neither its orbit, nor its
+disturbance, nor a sampling interval.  This module holds the constants the paper gives, the choices this
+reproduction makes where it gives none (each named), and :func:`paper_scenario`, the planar resonant orbit whose
+scheduling parameters bound the LPV polytope.
+
+Frame and units: the rotating frame of :mod:`cislunar.estimation.lpv`, non-dimensional (LU, TU); planar states
+``[x, y, vx, vy]``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from cislunar.cr3bp.dynamics import CR3BP, EARTH_MOON, check_system
+from cislunar.estimation.lpv import (
+    CR3BPLPV,
+    ParameterBox,
+    ResonantOrbit,
+    resonant_orbit,
+)
+from cislunar.utils import validation
+
+__all__ = [
+    "GAMMA",
+    "POLE_RADIUS",
+    "RESONANT_CANDIDATES",
+    "SIGMA_DEG",
+    "SIN3_THRESHOLD",
+    "THETA1_SENSORS",
+    "Scenario",
+    "paper_scenario",
+]
+
+#: The paper's bound on the position error, LU (about 500 km), §IV-B.
+GAMMA = 0.0013
+#: The paper's simulated angle noise, deg (Fig. 3).
+SIGMA_DEG = 0.1
+#: H-infinity bandwidth bound R, 1/TU (beyond the paper: makes Theorem 2's minimum attained; about 1 per 6 min).
+POLE_RADIUS = 1000.0
+#: The sensors the comparison rows offer: sin and cos of theta1 (the ones Eq. 24 uses and the l1 optimum keeps).
+THETA1_SENSORS = (0, 1)
+#: Below this :math:`|\sin\theta_3|` the observer takes rho from its estimate (paper, §IV-B).
+SIN3_THRESHOLD = 0.04
+#: Planar Earth-Moon resonant orbits tried by the sensitivity study: (p, q, perigee radius in LU).  Each is an
+#: x-axis symmetric orbit that :func:`cislunar.estimation.lpv.resonant_orbit` corrects (5:3, 3:2 and 7:4 guesses
+#: do not converge with the Keplerian start and are left out).
+RESONANT_CANDIDATES = ((4, 1, 0.2), (3, 1, 0.2), (3, 1, 0.3), (5, 2, 0.35), (2, 1, 0.2), (2, 1, 0.3),
+                       (2, 1, 0.4), (2, 1, 0.5))
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """The documented set-up of this reproduction: model, resonant orbit, its samples and the parameter box.
+
+    Attributes
+    ----------
+    model : CR3BPLPV
+    orbit : ResonantOrbit
+    t : ndarray (n,)
+        Sample times over one period, TU.
+    states : ndarray (n, 4)
+        Planar states along the orbit (LU, LU/TU).
+    rho : ndarray (n, 6)
+        Scheduling parameters along the orbit.
+    box : ParameterBox
+        Bounds of ``rho`` along the orbit (the polytope whose vertices carry the LMIs).
+    """
+
+    model: CR3BPLPV
+    orbit: ResonantOrbit
+    t: np.ndarray
+    states: np.ndarray
+    rho: np.ndarray
+    box: ParameterBox
+
+    @property
+    def r13_range(self) -> tuple:
+        """Smallest and largest Earth distance on the orbit, LU."""
+        r13 = 1.0 / self.rho[:, 2]
+        return float(r13.min()), float(r13.max())
+
+
+def paper_scenario(system: CR3BP = EARTH_MOON, *, p: int = 2, q: int = 1, perigee_radius: float = 0.3,
+                   n_samples: int = 2000, margin: float = 0.0) -> Scenario:
+    """Resonant orbit (default the planar 2:1, perigee 0.3 LU) and the scheduling-parameter box over one period.
+
+    ``n_samples`` points over one period bound :math:`\\rho`; ``margin`` widens the box by that fraction of
+    each range (0 by default: the samples are dense enough that the extrema are resolved to ~1e-5).
+    """
+    model = CR3BPLPV(check_system(system, "system"))
+    n_samples = validation.integer(n_samples, "n_samples", minimum=2)
+    margin = validation.positive(margin, "margin", allow_zero=True)
+    orbit = resonant_orbit(system, p, q, perigee_radius)
+    t, x = orbit.sample(n_samples)
+    s = model.planar(x)
+    rho = model.rho(s)
+    box = ParameterBox.from_samples(rho, margin=margin,
+                                    source=f"planar {p}:{q} resonant orbit, x0 = {orbit.x0[0]:.6f} LU, "
+                                           f"vy0 = {orbit.x0[4]:.6f} LU/TU, T = {orbit.period:.6f} TU")
+    return Scenario(model, orbit, t, s, rho, box)

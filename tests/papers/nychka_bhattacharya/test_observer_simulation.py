@@ -1,0 +1,65 @@
+"""Notebook 12's set-ups (cislunar.papers.nychka_bhattacharya.observer_simulation) on a short run."""
+
+import numpy as np
+import pytest
+
+from cislunar.papers.nychka_bhattacharya import observer_simulation as obs
+from cislunar.papers.nychka_bhattacharya.claims.observer_simulation import CLAIMS
+from cislunar.papers.nychka_bhattacharya.scenarios import paper_scenario
+
+
+@pytest.fixture(scope="module")
+def setup():
+    sc = paper_scenario(n_samples=300)
+    od = obs.observer_designs(sc, 3, np.random.default_rng(0))
+    sim = obs.simulate_fig3(sc, od, 0.01, 0.2, 0.1, np.random.default_rng(1))
+    return sc, od, sim
+
+
+def test_first_and_rms_on_a_known_error_history():
+    t = np.linspace(0.0, 1.0, 11)
+    e = np.array([5.0, 4.0, 3.0, 0.5, 0.5, 2.0, 0.5, 0.5, 0.5, 0.5, 0.5])
+    first, rms = obs.first_and_rms(t, e, 1.0, period=10.0)  # 2 % of the period = 0.2 TU after t = 0.3
+    assert first == pytest.approx(0.3)
+    assert rms == pytest.approx(np.sqrt(np.mean(e[t > 0.5] ** 2)))
+    assert obs.first_and_rms(t, e, 0.1, period=10.0) == (np.inf, np.inf)
+
+
+def test_designs_verified_and_runs_start_from_the_initial_error(setup):
+    sc, od, sim = setup
+    assert all(v.passed for v in od.verification.values())
+    assert sim.initial_error == pytest.approx(0.02 * np.sqrt(2))
+    assert set(sim.runs) == {"h2", "hinf", "ekf"} and set(sim.exact) == {"h2", "hinf"}
+    for r in sim.runs.values():
+        assert r.position_error[-1] < 0.5 * sim.initial_error  # every observer reduces the error
+
+
+def test_convergence_study_and_line_crossings(setup):
+    sc, od, sim = setup
+    cv = obs.convergence_study(sc, od, sim, 0.1, e0_scales=(0.01, 1.0))
+    # the guarantees follow lpv.guaranteed_error_rms: H2 scales with sqrt(dt)
+    assert cv.bound["h2"] > 0 and cv.bound["hinf"] > 0
+    assert cv.noise_rms_deg == pytest.approx(0.1, rel=0.3)
+    assert all(v > 0 for v in cv.decay.values())
+    # a smaller initial error is never slower to reach the bound
+    assert cv.first_sweep[0] <= cv.first_sweep[1]
+    assert cv.converges("h2", sim.period) == (cv.first["h2"] <= 0.05 * sim.period)
+    lc = obs.line_crossings(sim, window=0.05)
+    assert lc.near.shape == sim.t.shape
+    # the running RMS of a constant error is that constant
+    assert set(lc.running_rms) == set(sim.runs)
+    assert np.all(lc.running_rms["h2"] >= 0)
+
+
+def test_window_rerun_keeps_the_initial_error(setup):
+    sc, od, sim = setup
+    ww = obs.window_rerun(sc, od, sim, 0.02, 0.2, 0.1, np.random.default_rng(2))
+    assert ww.n == np.arange(0.0, 0.2 * sc.orbit.period, 0.02).size
+    assert set(ww.median) == {"h2", "hinf"} and all(m < 0.02 for m in ww.median.values())
+
+
+def test_claims_of_the_chapter():
+    assert CLAIMS["h2_converges"].judge(False, reason="slow").status == "differs"
+    assert CLAIMS["hinf_larger"].judge(True).status == "reproduced"
+    assert CLAIMS["ordering_dt"].judge(0.36, reason="x").status == "differs"
+    assert CLAIMS["dt"].judge(0.004).status == "not in paper"
