@@ -14,6 +14,8 @@ import warnings
 def main(max_k: int = 6, gamma: float = 0.0013) -> dict:
     """Run the benchmark and print a table; returns ``{(solver, n_vertices): {...}}`` as a dict of dicts."""
     from cislunar.estimation import lpv
+    from cislunar.papers.nychka_bhattacharya.scenarios import paper_scenario
+
     sc = paper_scenario(n_samples=1000)
     order = [0, 2, 4, 5, 1, 3]  # 1/r13^3, 1/r13, x, y, 1/r23^3, 1/r23
     results = {}

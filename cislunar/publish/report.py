@@ -12,7 +12,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cislunar.publish.claims import STATUS_MEANINGS, STATUSES, Verdict, fmt
-from cislunar.utils import validation
 
 __all__ = ["ComparisonTable", "Row", "REPORT_METADATA_KEY", "STATUSES", "STATUS_MEANINGS", "fmt"]
 

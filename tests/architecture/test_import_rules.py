@@ -185,3 +185,13 @@ def test_relative_imports_resolve_like_python():
     node = ast.parse("from ..cr3bp import dynamics\n").body[0]
     assert _resolve(node, "cislunar.estimation.ocbe", False) == "cislunar.cr3bp"
     assert _resolve(node, "cislunar.estimation", True) == "cislunar.cr3bp"
+
+
+def test_the_code_passes_the_linter():
+    """ruff with the configuration of pyproject.toml (pyflakes, pycodestyle, import order, bugbear)."""
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-m", "ruff", "check", "--no-cache", "--output-format", "concise", "."],
+                          cwd=PACKAGE.parent, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout[-4000:] + proc.stderr[-2000:]

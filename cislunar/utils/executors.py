@@ -1,0 +1,69 @@
+"""The executor a notebook's Monte Carlo and sweeps run on, from two parameters a reader sets.
+
+Every notebook with a sweep or a Monte Carlo has the parameters ``WORKERS`` (processes on this machine; 1 runs
+serially) and ``SCHEDULER`` (the address of a Dask scheduler, e.g. ``"tcp://10.0.0.5:8786"``; empty: none).
+:func:`open_executor` turns them into an executor for :func:`cislunar.utils.montecarlo.run_monte_carlo` and
+:func:`cislunar.utils.montecarlo.map_tasks` (``None`` for serial runs) and closes it afterwards.  Results do not
+depend on the choice: trial *i* always gets child *i* of the root seed.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing
+from concurrent.futures import ProcessPoolExecutor
+
+__all__ = ["open_executor", "describe_executor"]
+
+
+@contextlib.contextmanager
+def open_executor(workers: int = 1, scheduler: str = ""):
+    """An executor for ``workers`` local processes, or a Dask client of ``scheduler``; ``None`` when serial.
+
+    Parameters
+    ----------
+    workers : int
+        Local worker processes (>= 1); 1 means serial (no executor).  Ignored when ``scheduler`` is given.
+    scheduler : str
+        Address of a running Dask scheduler; needs the ``cluster`` extra (``dask[distributed]``).
+
+    Yields
+    ------
+    concurrent.futures.Executor or dask.distributed.Client or None
+    """
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"workers must be an int >= 1 (1 runs serially); got {workers!r}")
+    if not isinstance(scheduler, str):
+        raise TypeError(f"scheduler must be a str (a Dask scheduler address, or '' for none); got "
+                        f"{type(scheduler).__name__}")
+    if scheduler.strip():
+        try:
+            from dask.distributed import Client
+        except ImportError:  # pragma: no cover - the cluster extra is installed by the bootstrap
+            raise ValueError("scheduler: a Dask address needs the cluster extra (pip install 'cislunar[cluster]')"
+                             ) from None
+        client = Client(scheduler.strip())
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    if workers == 1:
+        yield None
+        return
+    # spawn: workers start clean (no copy of the kernel's state, no fork of threads held by heyoka or BLAS)
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+    try:
+        yield pool
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def describe_executor(executor) -> str:
+    """A short description for a notebook's output: ``serial``, ``2 processes`` or ``Dask <address>``."""
+    if executor is None:
+        return "serial"
+    if isinstance(executor, ProcessPoolExecutor):
+        return f"{executor._max_workers} processes"
+    scheduler = getattr(getattr(executor, "scheduler", None), "address", None)
+    return f"Dask {scheduler}" if scheduler else type(executor).__name__
