@@ -295,7 +295,7 @@ def _index_markdown(entries: list[NotebookEntry], build: Path) -> str:
     lines += ["```{toctree}", ":hidden:", ":caption: Notebooks", ""]
     lines += [f"notebooks/{e.name}" for e in entries if e.executed]
     lines += ["```", "", "```{toctree}", ":hidden:", ":caption: Results and references", "", "report", "papers",
-              "api/index", "```", ""]
+              "sources", "api/index", "```", ""]
     return "\n".join(lines)
 
 
@@ -398,6 +398,7 @@ def stage(build: Path) -> Path:
     (src / "index.md").write_text(_index_markdown(entries, build))
     (src / "report.md").write_text(_report_markdown(build, {e.name: e.title for e in entries if e.executed}))
     (src / "papers.md").write_text(_papers_markdown())
+    shutil.copyfile(book_config_dir() / "sources.md", src / "sources.md")
     _write_api_pages(src / "api")
     return src
 

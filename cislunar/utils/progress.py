@@ -3,11 +3,11 @@
 Long loops (continuation, Monte Carlo, SCvx iterations, sweeps) call :func:`progress`.  What it draws depends on the
 environment variable ``CISLUNAR_PROGRESS``:
 
-``auto`` (default)
-    ``tqdm.auto``: a widget in a live Jupyter front end, text in a terminal.
-``plain``
-    plain-text ``tqdm`` on standard error, updated at most every 10 s.  The notebook runner sets this for headless
-    (papermill) execution, so executed notebooks and the book hold text, never widget state.
+``plain`` (default)
+    plain-text ``tqdm`` on standard error, updated at most every 10 s: readable in a terminal, a live notebook, a
+    papermill run by hand and the notebook runner's logs alike, and no widget state in an executed notebook.
+``widget``
+    ``tqdm.auto``: a widget in a live Jupyter front end (text elsewhere), for readers who prefer it.
 ``off``
     no bar at all.
 
@@ -21,18 +21,20 @@ import sys
 
 __all__ = ["progress", "progress_mode", "MODES"]
 
-MODES = ("auto", "plain", "off")
+MODES = ("plain", "widget", "off")
 
 
 def progress_mode() -> str:
-    """The active mode from ``CISLUNAR_PROGRESS`` (``auto`` when unset).
+    """The active mode from ``CISLUNAR_PROGRESS`` (``plain`` when unset; ``auto``, the old default, reads as
+    ``plain``).
 
     Raises
     ------
     ValueError
-        If the variable holds anything but ``auto``, ``plain`` or ``off``.
+        If the variable holds anything but ``plain``, ``widget`` or ``off``.
     """
-    mode = os.environ.get("CISLUNAR_PROGRESS", "auto").strip().lower() or "auto"
+    mode = os.environ.get("CISLUNAR_PROGRESS", "plain").strip().lower() or "plain"
+    mode = "plain" if mode == "auto" else mode
     if mode not in MODES:
         raise ValueError(f"CISLUNAR_PROGRESS must be one of {MODES}, got {mode!r}")
     return mode
