@@ -24,31 +24,63 @@
 #
 # **Paper sections followed.** Greaves & Scheeres (AMOS 2023), Secs. 4 (informed station keeping, Eq. 25,
 # Figs. 2-3) and 5 (simulation and results, Figs. 4-5). SSAT, $J_\rho$ and MMD are built in notebook 07; the
-# invariant-torus solver is :mod:`cislunar.cr3bp.torus`.
+# invariant-torus solver is `cislunar.cr3bp.torus`.
 
 # %% tags=["parameters"]
-QUICK = False
-SEED = 0
-OUTPUT_DIR = ""
+QUICK = False  # quick mode: coarser surface, fewer sweep points, fewer Monte Carlo trials (the default sizes below)
+SEED = 0  # root seed of the Monte Carlo (streams [SEED, k]) and of the offset directions (stream [SEED, 8])
+OUTPUT_DIR = ""  # where figures are written ("" = the build's default)
+N_SURF = None  # ring angles = arrival times of the station-keeping surface (None: 14 quick, 40 full; paper: not given)
+N_SWEEP = None  # arrival times in the sweep over the unstated scenario inputs (None: 10 quick, 16 full)
+N_GRID = None  # ring-angle counts of the resolution study of section 5b (None: 10, 20, 40 quick; 16 ... 640 full)
+N_GRID_SLICES = None  # arrival times in the resolution study (None: 3 quick, 5 full)
+N_TRIALS = None  # Monte Carlo trials per policy and execution-error level (None: 6 quick, 40 full)
+WORKERS = None  # local processes for the sweeps and the Monte Carlo, 1 = serial (None: 1 quick, 2 full)
+SCHEDULER = ""  # address of a Dask scheduler to run them on ("" = none; then WORKERS applies)
+MEAN_RANGE_KM = None  # mean agent-target range that selects the torus member, km (None: 215.0, the paper's number)
+T_BURN_H = None  # first burn, hours from the target's apoapsis (None: -24.0)
+T_ARRIVAL_H = None  # window of arrival times (second burn), hours from apoapsis (None: (-12.0, 12.0))
+T_FINAL_H = None  # end of the covariance analysis, where sqrt(J_rho) is read, hours from apoapsis (None: 24.0)
+AGENT_THETA = None  # the agent starts on the torus trajectory of this ring angle, rad (None: 0.0)
+PRE_ARC_H = None  # alternative reading: tracking starts this long before the first burn, hours (None: 24.0)
+SWEEP_LEADS_H = None  # first-burn leads before the arrival window swept in section 6, hours (None: 12, 24, 48)
+SWEEP_AGENT_PHASES = None  # agent ring angles swept in section 6, fractions of a turn (None: 0, 0.25, 0.5, 0.75)
+OFFSET_KM = None  # distances of the agent off the torus in section 6, km (None: 0, 1, 10, 50)
+EXEC_ABS_M_S = None  # execution error, absolute part, m/s 1 sigma per axis (None: 1e-3)
+EXEC_REL = None  # execution error, part proportional to the burn, fraction 1 sigma per axis (None: 0.01)
+
+# %% [markdown]
+# **Changing the chapter.** Every size and every scenario choice the paper leaves open is a parameter of the cell
+# above. A parameter left at `None` is chosen in the next cell, from `QUICK` for the sizes (quick mode: a 14 x 14
+# surface, 6 Monte Carlo trials) and from our stated baseline for the scenario (first burn 24 h before apoapsis,
+# arrivals within 12 h of it, read-out 24 h after it, agent at ring angle 0); a value you give, in Jupyter or with
+# `-p NAME=VALUE` on the command line, is used as given in either mode. The sweeps of sections 5b and 6 (one
+# surface per task) and the Monte Carlo of section 7 (one filter run per trial, trial streams `[SEED, k]`) run on
+# the executor that `WORKERS` local processes or a Dask `SCHEDULER` provide; the numbers do not depend on it. The
+# exercises at the end of the chapter start from here.
 
 # %%
-# Sizes derived from QUICK: a coarser surface, fewer sweep points and fewer Monte Carlo trials in quick mode.
-N_SURF = 14 if QUICK else 40  # ring angles x arrival times of the station-keeping surface (paper: not given)
-N_SWEEP = 10 if QUICK else 16  # arrival times in the sweep over the unstated scenario inputs (ring angles: N_SURF)
-N_GRID = (10, 20, 40) if QUICK else (16, 40, 80, 160, 320, 640)  # ring angles in the resolution study (5b)
-N_GRID_SLICES = 3 if QUICK else 5  # arrival times in the resolution study
-N_TRIALS = 6 if QUICK else 40  # Monte Carlo trials per policy and execution-error level
-N_WORKERS = 1 if QUICK else 2  # process pool for the Monte Carlo (1 = serial)
+# Every parameter left at None is picked here (sizes from QUICK); a value the reader gave is used as given.
+N_SURF = N_SURF if N_SURF is not None else (14 if QUICK else 40)
+N_SWEEP = N_SWEEP if N_SWEEP is not None else (10 if QUICK else 16)
+N_GRID = tuple(N_GRID if N_GRID is not None else ((10, 20, 40) if QUICK else (16, 40, 80, 160, 320, 640)))
+N_GRID_SLICES = N_GRID_SLICES if N_GRID_SLICES is not None else (3 if QUICK else 5)
+N_TRIALS = N_TRIALS if N_TRIALS is not None else (6 if QUICK else 40)
+WORKERS = WORKERS if WORKERS is not None else (1 if QUICK else 2)
 # Scenario choices the paper leaves open (stated, then swept in section 6):
-T_BURN_H = -24.0  # first burn, hours from the target's apoapsis
-T_ARRIVAL_H = (-12.0, 12.0)  # window of arrival times (second burn), hours from apoapsis
-T_FINAL_H = 24.0  # end of the covariance analysis, where sqrt(J_rho) is read, hours from apoapsis
-AGENT_THETA = 0.0  # the agent starts on the torus trajectory of this ring angle (rad)
-PRE_ARC_H = 24.0  # alternative reading: tracking starts this long before the first burn (baseline: at the burn)
-EXEC_ABS_M_S, EXEC_REL = 1e-3, 0.01  # execution errors (1 sigma per axis): 1 mm/s plus 1 % of the burn
+MEAN_RANGE_KM = MEAN_RANGE_KM if MEAN_RANGE_KM is not None else 215.0
+T_BURN_H = T_BURN_H if T_BURN_H is not None else -24.0
+T_ARRIVAL_H = tuple(T_ARRIVAL_H if T_ARRIVAL_H is not None else (-12.0, 12.0))
+T_FINAL_H = T_FINAL_H if T_FINAL_H is not None else 24.0
+AGENT_THETA = AGENT_THETA if AGENT_THETA is not None else 0.0
+PRE_ARC_H = PRE_ARC_H if PRE_ARC_H is not None else 24.0
+SWEEP_LEADS_H = tuple(SWEEP_LEADS_H if SWEEP_LEADS_H is not None else (12.0, 24.0, 48.0))
+SWEEP_AGENT_PHASES = tuple(SWEEP_AGENT_PHASES if SWEEP_AGENT_PHASES is not None else (0.0, 0.25, 0.5, 0.75))
+OFFSET_KM = tuple(OFFSET_KM if OFFSET_KM is not None else (0.0, 1.0, 10.0, 50.0))
+EXEC_ABS_M_S = EXEC_ABS_M_S if EXEC_ABS_M_S is not None else 1e-3
+EXEC_REL = EXEC_REL if EXEC_REL is not None else 0.01
 
 import time
-from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
@@ -61,6 +93,7 @@ from cislunar.papers.greaves_scheeres_2023 import station_keeping_study as study
 from cislunar.papers.greaves_scheeres_2023.claims.informed_station_keeping import CLAIMS
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
+from cislunar.utils.executors import open_executor
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -72,7 +105,7 @@ t_start = time.perf_counter()
 # ## 1 · The QPO about the 9:2 NRHO and the 215 km member
 #
 # The target flies the 9:2 southern L2 NRHO; the agent flies a quasi-periodic orbit about it "with the same base
-# frequency" (Sec. 4). We compute 2-D invariant tori by the invariant-circle method (:mod:`cislunar.cr3bp.torus`): the
+# frequency" (Sec. 4). We compute 2-D invariant tori by the invariant-circle method (`cislunar.cr3bp.torus`): the
 # ring $u(\theta)$ at the NRHO's apolune is mapped onto itself by the flow over one NRHO period $T$, rotated by the
 # rotation number $\rho$, $\varphi_T(u(\theta)) = u(\theta+\rho)$; the stroboscopic time is fixed to $T$, which is
 # what "same base frequency" means. The paper gives one number for its member: "the average range between the
@@ -94,7 +127,7 @@ t_start = time.perf_counter()
 
 # %%
 nrho = nrho_9_2(em)
-torus, stats = qpo_for_mean_range(nrho, 215.0)
+torus, stats = qpo_for_mean_range(nrho, MEAN_RANGE_KM)
 print(f"9:2 NRHO: period {nrho.period_days:.4f} d, apolune radius {nrho.apolune_radius_km:.0f} km")
 print(f"QPO member: ring size (RMS about its centre) {torus.size_km:.2f} km and {torus.velocity_size_mps:.3f} m/s; "
       f"largest offset from the NRHO apolune state {torus.max_offset_km:.1f} km, {torus.max_velocity_offset_mps:.2f} m/s")
@@ -315,7 +348,8 @@ print(f"tracking from {T_BURN_H - PRE_ARC_H:.0f} h: sqrt(J_rho) of u* with both 
 
 # %%
 t_grid = np.linspace(*T_ARRIVAL_H, N_GRID_SLICES) * HR
-grid = study.grid_resolution_study(em, torus, N_GRID, t_grid, T_BURN_H * HR, T_FINAL_H * HR)
+with open_executor(WORKERS, SCHEDULER) as executor:
+    grid = study.grid_resolution_study(em, torus, N_GRID, t_grid, T_BURN_H * HR, T_FINAL_H * HR, executor=executor)
 print(f"{N_GRID_SLICES} arrival slices from {T_ARRIVAL_H[0]:+.0f} h to {T_ARRIVAL_H[1]:+.0f} h; medians over the slices")
 print(grid.format())
 _ = plotting.save_figure(figures.grid_resolution(grid, S.range_sigma_km[0, 0] * 1e3), "08_eq25_readings_vs_grid",
@@ -381,7 +415,13 @@ _ = plotting.save_figure(fig, "08_projection_reading", output_dir=out)
 
 # %%
 t_arr_s = np.linspace(*T_ARRIVAL_H, N_SWEEP) * HR
-sweep = study.scenario_sweep(em, torus, theta, t_arr_s, T_ARRIVAL_H[0], T_FINAL_H * HR, pre_arcs_h=(0.0, PRE_ARC_H))
+with open_executor(WORKERS, SCHEDULER) as executor:
+    sweep = study.scenario_sweep(em, torus, theta, t_arr_s, T_ARRIVAL_H[0], T_FINAL_H * HR, pre_arcs_h=(0.0, PRE_ARC_H),
+                                 leads_h=SWEEP_LEADS_H, agent_thetas=tuple(2 * np.pi * p for p in SWEEP_AGENT_PHASES),
+                                 executor=executor)
+    offsets = study.offset_study(em, torus, theta, t_arr_s, T_BURN_H * HR, T_FINAL_H * HR,
+                                 np.random.default_rng([SEED, 8]), distances_km=OFFSET_KM, agent_theta=AGENT_THETA,
+                                 executor=executor)
 print(study.format_sweep(sweep))
 n_valley_angle, n_valley_proj = sum(r.pct_tf < 25 for r in sweep), sum(r.pct_proj < 25 for r in sweep)
 print(f"settings with the median percentile below 25 % (the valley tolerance): angle reading {n_valley_angle} of "
@@ -391,8 +431,6 @@ s_h = sk.station_keeping_surface(em, torus, theta, t_arr_s, T_BURN_H * HR, T_FIN
 pct_horizon = np.median(s_h.informed_percentile)
 print(f"\nMMD coast to t_f instead of the arrival (baseline otherwise): median percentile {pct_horizon:.1f} %, best "
       f"quartile in {np.mean(s_h.informed_percentile < 25) * 100:.0f} % of slices")
-offsets = study.offset_study(em, torus, theta, t_arr_s, T_BURN_H * HR, T_FINAL_H * HR, np.random.default_rng([SEED, 8]),
-                             agent_theta=AGENT_THETA)
 for d_km, vals in offsets.items():
     print(f"agent {d_km:4.0f} km / {d_km * torus.velocity_size_mps / torus.size_km * 1e3:4.0f} mm/s off the torus: median "
           f"percentile of u* {', '.join(f'{v:.0f}' for v in vals)} % (3 random offset directions)")
@@ -408,9 +446,10 @@ print(f"\nmost favourable setting for the angle reading: pre-arc {best_setting.p
 # and a different RMS (section 1). Members chosen so that those two readings equal 215 km instead:
 
 # %%
-member_check = study.member_study(em, nrho, theta, t_arr, T_BURN_H * HR, T_FINAL_H * HR, agent_theta=AGENT_THETA)
+member_check = study.member_study(em, nrho, theta, t_arr, T_BURN_H * HR, T_FINAL_H * HR, target_km=MEAN_RANGE_KM,
+                                  agent_theta=AGENT_THETA)
 for stat, row in member_check.items():
-    print(f"member with {stat[:-3]} = 215 km: torus mean {row['mean_km']:.0f} km, ring size {row['size_km']:.0f} km; "
+    print(f"member with {stat[:-3]} = {MEAN_RANGE_KM:g} km: torus mean {row['mean_km']:.0f} km, ring size {row['size_km']:.0f} km; "
           f"u* median percentile angle {row['angle'][0]:.1f} % / projection {row['projection'][0]:.1f} %; "
           f"at or below median fuel in {row['angle'][1]:.0f} % / {row['projection'][1]:.0f} % of slices")
 
@@ -431,7 +470,7 @@ for stat, row in member_check.items():
 # ## 7 · Beyond the paper: a full-filter Monte Carlo with execution errors
 #
 # The paper's covariance analysis assumes perfectly executed burns and a filter that does not diverge; its
-# conclusions list both as future work. Here an iterated EKF (:func:`cislunar.papers.greaves_scheeres_2023.station_keeping.filter_trial`;
+# conclusions list both as future work. Here an iterated EKF (`cislunar.papers.greaves_scheeres_2023.station_keeping.filter_trial`;
 # 10 relinearisations per update, because a single-linearisation EKF is inconsistent at the start of an
 # angles-only track with 20 km of position uncertainty at a few hundred km range) processes simulated measurements
 # of the true trajectories, including execution errors of **1 mm/s plus 1 % of the burn (1 sigma per axis)** that
@@ -459,11 +498,9 @@ for name, idx in (("informed u*, angle reading", S.informed[j_mc]), ("informed u
     d1, d2 = S.dv1_m_s[j_mc, idx], S.dv2_m_s[j_mc, idx]
     e1, e2 = (1e3 * sk.execution_sigma(np.array([d, 0.0, 0.0]), EXEC_ABS_M_S, EXEC_REL) for d in (d1, d2))
     print(f"{name}: burns {d1:.3f} + {d2:.3f} m/s; nominal execution error (1 sigma per axis) {e1:.1f} and {e2:.1f} mm/s")
-executor = ProcessPoolExecutor(max_workers=N_WORKERS) if N_WORKERS > 1 else None
-mcs = study.filter_monte_carlo(em, S, S_proj, nrho.x0, n_trials=N_TRIALS, seed=SEED, exec_abs_m_s=EXEC_ABS_M_S,
-                               exec_rel=EXEC_REL, executor=executor)
-if executor is not None:
-    executor.shutdown()
+with open_executor(WORKERS, SCHEDULER) as executor:
+    mcs = study.filter_monte_carlo(em, S, S_proj, nrho.x0, n_trials=N_TRIALS, seed=SEED, exec_abs_m_s=EXEC_ABS_M_S,
+                                   exec_rel=EXEC_REL, executor=executor)
 summary, (lo, hi) = mcs.summary, mcs.band
 print(mcs.format())
 
@@ -533,7 +570,7 @@ none_km = S.range_sigma_km[0, 0]
 sweep_range = lambda key: f"{min(getattr(r, key) for r in sweep):.0f}-{max(getattr(r, key) for r in sweep):.0f}"
 table.add(
     CLAIMS["mean_range"].judge(stats.mean_km, shown=f"{stats.mean_km:.2f} km",
-        note="the 215 km was used to SELECT the member (torus average over ring angle and one period); an input, not a "
+        note=f"the {MEAN_RANGE_KM:g} km was used to SELECT the member (torus average over ring angle and one period); an input, not a "
              f"prediction. Same member read as apolune-ring mean: {stats.ring_mean_km:.1f} km, RMS {stats.rms_km:.1f} km"),
     CLAIMS["ring_size"].judge(torus.size_km, shown=f"{torus.size_km:.2f} km / {torus.velocity_size_mps:.3f} m/s"),
     CLAIMS["rotation_number"].judge(torus.rho, shown=f"{torus.rho:.6f}"),
@@ -552,7 +589,7 @@ table.add(
              f"(next to the agent's own phase 0, the smallest burns); rank correlation of fuel and sqrt(J_rho) within "
              f"slices {st.rank_correlation:.2f}. MMD coast to t_f instead of the arrival: {pct_horizon:.0f} %. Agent "
              f"drifted 1-50 km off the torus (3 directions each): {pct_offset_all.min():.0f}-{pct_offset_all.max():.0f} %. "
-             f"Tolerance met in {n_valley_angle} of {len(sweep)} sweep settings. Members matching 215 km as ring mean / "
+             f"Tolerance met in {n_valley_angle} of {len(sweep)} sweep settings. Members matching {MEAN_RANGE_KM:g} km as ring mean / "
              f"RMS: {member_check['ring_mean_km']['angle'][0]:.0f} / {member_check['rms_km']['angle'][0]:.0f} %. "
              f"Grid-dependent: with {grids} ring angles (section 5b) {series('angle', 'percentile', '{:.1f}')} %, "
              "tending to 100 % (u* tends to no maneuver)"),
@@ -560,7 +597,7 @@ table.add(
         shown=f"{st_proj.median_percentile:.0f} % (best quartile in {st_proj.best_quartile_share:.0f} % of slices)",
         note=f"Grid-independent: with {grids} ring angles {series('projection', 'percentile', '{:.0f}')} %. Sweep "
              f"(section 6): {sweep_range('pct_proj')} %, tolerance met in {n_valley_proj} of {len(sweep)} settings; "
-             f"members matching 215 km as ring mean / RMS: {member_check['ring_mean_km']['projection'][0]:.0f} / "
+             f"members matching {MEAN_RANGE_KM:g} km as ring mean / RMS: {member_check['ring_mean_km']['projection'][0]:.0f} / "
              f"{member_check['rms_km']['projection'][0]:.0f} %"),
     CLAIMS["fuel_angle"].judge(st.below_median_fuel * 100,
         shown=f"u* below the slice median fuel in {st.below_median_fuel * 100:.0f} % of slices; median "
@@ -604,3 +641,22 @@ table.add(
 )
 print(f"notebook run time so far: {time.perf_counter() - t_start:.0f} s")
 table.display()
+
+# %% [markdown]
+# ## Exercises
+#
+# Each exercise changes one parameter of the `parameters` cell at the top; rerun the notebook (in Jupyter, or with
+# `python -m cislunar.publish.notebooks --quick 08 -p NAME=VALUE`), write down your prediction first, then compare.
+# The worked solutions are functions of `cislunar.papers.greaves_scheeres_2023.exercises` that answer each question at
+# a small size in a few seconds and return the numbers with a one-paragraph answer.
+#
+# 1. **Sample the set more finely.** Double `N_SURF` (28 in quick mode). Before running: which reading of Eq. 25
+#    moves, the angle or the projection? Predict the direction in which the angle reading's $\mathbf u^*$ moves in
+#    phase, in fuel and in $\sqrt{J_\rho}$, and what happens to its percentile in the valley row of the closing table.
+#    Compare with the resolution study of section 5b. Worked solution: `exercise_08_ring_grid`.
+# 2. **Better or worse thrusters.** Multiply both `EXEC_ABS_M_S` and `EXEC_REL` by 10, then divide them by 10.
+#    Predict how the RMS range error of the informed maneuvers in the Monte Carlo of section 7 scales, and whether
+#    the filter stays consistent (mean NEES inside its band). Worked solution: `exercise_08_execution_errors`.
+# 3. **Where the agent starts.** Set `AGENT_THETA = 1.5708` (a quarter turn, $\pi/2$ rad). Predict whether the
+#    projection reading still puts $\mathbf u^*$ in the valley (best quartile), and compare with the rows of the
+#    sweep of section 6 at agent phase 0.25. Worked solution: `exercise_08_agent_phase`.

@@ -446,17 +446,20 @@ def assemble_report(output_dir=None, *, expected=None) -> Path:
 _DEFAULT_SECONDS = {"quick": 20.0, "full": 60.0}
 
 
-def _workers_asked(source: Path, parameters: dict) -> int:
-    """Processes a notebook asks for: its ``WORKERS`` parameter (as given, else its default), 1 without one."""
+def _workers_asked(source: Path, parameters: dict, quick: bool = False) -> int:
+    """Processes a notebook asks for: its ``WORKERS`` parameter as given, else its default; a default of ``None``
+    ("QUICK picks") counts as 1 in quick mode and 2 in full mode; 1 for a notebook without the parameter."""
     value = parameters.get("WORKERS")
     if value is None:
-        default = parameter_names(source).get("WORKERS")
-        if default is None:
+        names = parameter_names(source)
+        if "WORKERS" not in names:
             return 1
         try:
-            value = ast.literal_eval(default)
+            value = ast.literal_eval(names["WORKERS"])
         except (ValueError, SyntaxError):
             return 2  # an expression (e.g. from os.cpu_count()): assume it wants the machine
+        if value is None:
+            return 1 if quick else 2
     return int(value) if isinstance(value, int) and not isinstance(value, bool) else 1
 
 
@@ -622,7 +625,7 @@ def run_all(sources, *, quick: bool, seed: int = 0, output_dir=None, parameters:
             proc = subprocess.Popen([sys.executable, "-m", "cislunar.publish.notebooks", "--child",
                                      str(tmp / "spec.json")], stdout=f, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                                     env=env, start_new_session=True, cwd=str(root))
-        w = _workers_asked(src, parameters)
+        w = _workers_asked(src, parameters, quick)
         running.append(_Child(src, proc, tmp, log, tmp / "result.json", time.monotonic(),
                               expected_seconds(src.stem), w))
         est = f", last run {expected_seconds(src.stem):.0f} s" if src.stem in previous else ""
@@ -653,7 +656,7 @@ def run_all(sources, *, quick: bool, seed: int = 0, output_dir=None, parameters:
             exclusive_running = any(c.workers > 1 for c in running)
             while queue and not exclusive_running and len(running) < jobs:
                 head = queue[0]
-                if _workers_asked(head, parameters) > 1:
+                if _workers_asked(head, parameters, quick) > 1:
                     if running:
                         break  # wait until the machine is free for it
                     start(queue.pop(0))

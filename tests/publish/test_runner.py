@@ -42,6 +42,10 @@ def test_parameters_are_parsed_and_checked(tmp_path):
     src = source(tmp_path, "90_a", extra="N_NODES = 12\nWORKERS = 2")
     assert set(notebooks.parameter_names(src)) == {"QUICK", "SEED", "OUTPUT_DIR", "N_NODES", "WORKERS"}
     assert notebooks._workers_asked(src, {}) == 2 and notebooks._workers_asked(src, {"WORKERS": 1}) == 1
+    picks = source(tmp_path, "90_b", extra="WORKERS = None")
+    assert notebooks._workers_asked(picks, {}, quick=True) == 1
+    assert notebooks._workers_asked(picks, {}, quick=False) == 2
+    assert notebooks._workers_asked(source(tmp_path, "90_c"), {}, quick=False) == 1
     with pytest.raises(ValueError, match="has no parameter N_NODE"):
         notebooks.run_notebook(src, quick=True, output_dir=tmp_path / "b", parameters={"N_NODE": 3})
 

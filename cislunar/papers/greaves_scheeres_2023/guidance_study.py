@@ -12,6 +12,11 @@ Each function runs one study of the chapter and returns a frozen result object:
 * :func:`tracking_arc_study`: the same comparison with a tracking arc before the burn, over arc lengths;
 * :func:`qpo_pair_study`: the comparison with the agent on the 215-km quasi-periodic torus.
 
+The three sweeps (:func:`policy_study`, :func:`tracking_arc_study`, :func:`qpo_pair_study`) take ``executor=`` (from
+:func:`cislunar.utils.executors.open_executor`; ``None`` runs serially) and run one task per burn size, arc length or
+ring angle through :func:`cislunar.utils.montecarlo.map_tasks`; every task is deterministic, so the results do not
+depend on the executor.
+
 Units: times in hours where named ``*_hours``/``*_h``, otherwise CR3BP time units (TU); :math:`\sqrt{J_\rho}` in
 km; burn magnitudes in m/s where named ``*_m_s``; all states in the Earth-Moon rotating frame (LU, LU/TU).
 """
@@ -29,6 +34,7 @@ from cislunar.cr3bp.propagation import propagate
 from cislunar.guidance import ssat
 from cislunar.sensing.measurements import AZIMUTH_ELEVATION
 from cislunar.utils import validation
+from cislunar.utils.montecarlo import map_tasks
 
 __all__ = [
     "CoordinateChecks",
@@ -321,24 +327,44 @@ class PolicyStudy:
         r = self.results[dv_m_s]
         return 100 * (r.mmd_other / r.mmd - 1)
 
+    def optimum_at(self, dv_m_s: float, coast_hours: float) -> float:
+        """:math:`\\sqrt{J_\\rho}` (km) of the true minimiser for one burn and coast; NaN if that coast was not run."""
+        r = self.results[dv_m_s]
+        hit = np.flatnonzero(np.isclose(r.coast_hours, coast_hours, rtol=0.0, atol=1e-6))
+        return float(r.optimum[hit[0]]) if hit.size else float("nan")
+
     def perpendicular_hours(self, dv_m_s: float, tol: float = 0.02) -> float:
         """Longest coast (h) up to which the best perpendicular direction is within ``tol`` of the optimum."""
         r = self.results[dv_m_s]
         return leading_hours(r.coast_hours, r.perp_best <= (1 + tol) * r.optimum)
 
 
+def _compare_task(task):
+    """One :func:`cislunar.guidance.ssat.compare_burn_policies` call from a picklable tuple (sweep task)."""
+    system, xa, xt, t, coast_idx, dv, P0, kwargs = task
+    return ssat.compare_burn_policies(system, xa, xt, t, coast_idx, dv, P0, **kwargs)
+
+
+def _sweep(tasks, executor, desc):
+    return map_tasks(_compare_task, tasks, executor=executor, progress=False, desc=desc)
+
+
 def policy_study(system: CR3BP, pair: DemonstrationPair, coast_hours, dv_m_s, *, n_grid: int = 3000,
-                 n_perp: int = 120) -> PolicyStudy:
+                 n_perp: int = 120, executor=None) -> PolicyStudy:
     """MMD vs the true minimiser and the perpendicular circle, burn at the start of tracking, for each burn
-    magnitude in ``dv_m_s`` (m/s) and coast in ``coast_hours`` (whole hours)."""
+    magnitude in ``dv_m_s`` (m/s) and coast in ``coast_hours`` (whole hours, within the pair's grid); one task per
+    burn magnitude on ``executor`` (``None``: serial)."""
     check_system(system)
     validation.instance(pair, "pair", DemonstrationPair)
     coast_idx = tuple(int(np.rint(h)) for h in validation.as_array(coast_hours, "coast_hours", ndim=(1,), min_size=1))
+    if min(coast_idx) < 1 or max(coast_idx) > pair.t.size - 1:
+        raise ValueError(f"coast_hours must lie in [1, {pair.t.size - 1}] h (the pair's grid); got {coast_hours}")
     dvs = [float(d) for d in validation.as_array(dv_m_s, "dv_m_s", ndim=(1,), min_size=1)]
     V = system.velocity_unit_km_s
-    res = {dv: ssat.compare_burn_policies(system, pair.agent_x0, pair.target_x0, pair.t, list(coast_idx),
-                                          dv * 1e-3 / V, pair.P0, n_grid=n_grid, n_perp=n_perp) for dv in dvs}
-    return PolicyStudy(res, coast_idx)
+    kw = {"n_grid": n_grid, "n_perp": n_perp}
+    tasks = [(system, pair.agent_x0, pair.target_x0, pair.t, list(coast_idx), dv * 1e-3 / V, pair.P0, kw)
+             for dv in dvs]
+    return PolicyStudy(dict(zip(dvs, _sweep(tasks, executor, "burn sizes"))), coast_idx)
 
 
 @dataclass(frozen=True)
@@ -496,9 +522,11 @@ class TrackingArcStudy:
 
 
 def tracking_arc_study(system: CR3BP, pair: DemonstrationPair, arc_hours, coast_hours, dv_m_s: float = 1.0, *,
-                       n_grid: int = 3000, n_perp: int = 120, tolerance_percent: float = 5.0) -> TrackingArcStudy:
+                       n_grid: int = 3000, n_perp: int = 120, tolerance_percent: float = 5.0,
+                       executor=None) -> TrackingArcStudy:
     """The 1-burn comparison with a tracking arc of each length in ``arc_hours`` (whole hours) before the burn
-    (``P0`` at the start of the arc; the pair propagated back from the burn epoch)."""
+    (``P0`` at the start of the arc; the pair propagated back from the burn epoch); one task per arc length on
+    ``executor`` (``None``: serial)."""
     check_system(system)
     validation.instance(pair, "pair", DemonstrationPair)
     arcs = [int(np.rint(h)) for h in validation.as_array(arc_hours, "arc_hours", ndim=(1,), min_size=1)]
@@ -506,14 +534,14 @@ def tracking_arc_study(system: CR3BP, pair: DemonstrationPair, arc_hours, coast_
     dv = validation.positive(dv_m_s, "dv_m_s") * 1e-3 / system.velocity_unit_km_s
     tol = validation.positive(tolerance_percent, "tolerance_percent")
     HR = _hour(system)
-    out = {}
+    tasks = []
     for h in arcs:
         xa = propagate(system, pair.agent_x0, np.array([0.0, -h * HR])).x[-1]
         xt = propagate(system, pair.target_x0, np.array([0.0, -h * HR])).x[-1]
         t = np.arange(0, h + max(coast_idx) + 1) * HR
-        out[h] = ssat.compare_burn_policies(system, xa, xt, t, [h + k for k in coast_idx], dv, pair.P0,
-                                            burn_index=h, n_grid=n_grid, n_perp=n_perp)
-    return TrackingArcStudy(out, tol)
+        tasks.append((system, xa, xt, t, [h + k for k in coast_idx], dv, pair.P0,
+                      {"burn_index": h, "n_grid": n_grid, "n_perp": n_perp}))
+    return TrackingArcStudy(dict(zip(arcs, _sweep(tasks, executor, "tracking arcs"))), tol)
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -567,9 +595,10 @@ class QpoPairStudy:
 
 
 def qpo_pair_study(system: CR3BP, torus, pair: DemonstrationPair, ring_angles_deg, coast_hours,
-                   dv_m_s: float = 1.0, *, n_grid: int = 3000, n_perp: int = 120) -> QpoPairStudy:
+                   dv_m_s: float = 1.0, *, n_grid: int = 3000, n_perp: int = 120, executor=None) -> QpoPairStudy:
     """Agent on ``torus`` (its trajectory through ring angle ``a``, ``pair.lead_hours`` before apolune), target as
-    in ``pair``; the comparison for each ring angle (deg, must include 0) and for 180 deg."""
+    in ``pair``; the comparison for each ring angle (deg, must include 0) and for 180 deg, one task per ring angle
+    on ``executor`` (``None``: serial)."""
     check_system(system)
     validation.instance(pair, "pair", DemonstrationPair)
     angles = [float(a) for a in validation.as_array(ring_angles_deg, "ring_angles_deg", ndim=(1,), min_size=1)]
@@ -579,13 +608,11 @@ def qpo_pair_study(system: CR3BP, torus, pair: DemonstrationPair, ring_angles_de
     dv = validation.positive(dv_m_s, "dv_m_s") * 1e-3 / system.velocity_unit_km_s
     t_lead = -pair.lead_hours * _hour(system)
 
-    def run(rad):
-        xa = torus.states([rad], [t_lead])[0, 0]
-        return ssat.compare_burn_policies(system, xa, pair.target_x0, pair.t, coast_idx, dv, pair.P0,
-                                          n_grid=n_grid, n_perp=n_perp)
-
-    res = {a: run(np.radians(a)) for a in angles}
-    anti = run(np.pi)
+    kw = {"n_grid": n_grid, "n_perp": n_perp}
+    tasks = [(system, torus.states([rad], [t_lead])[0, 0], pair.target_x0, pair.t, coast_idx, dv, pair.P0, kw)
+             for rad in [np.radians(a) for a in angles] + [np.pi]]
+    *runs, anti = _sweep(tasks, executor, "ring angles")
+    res = dict(zip(angles, runs))
     d0, d180 = ((torus.states([a], [t_lead])[0, 0, :3] - pair.target_x0[:3]) * system.length_unit_km
                 for a in (0.0, np.pi))
     return QpoPairStudy(res, anti, d0, d180)

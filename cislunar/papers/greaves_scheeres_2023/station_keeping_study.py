@@ -10,6 +10,12 @@ and returns a frozen result object:
 * :func:`member_study`: torus members matching 215 km under other readings of "average range";
 * :func:`filter_monte_carlo`: the iterated-EKF Monte Carlo with execution errors (beyond the paper).
 
+The sweeps (:func:`grid_resolution_study`, :func:`scenario_sweep`, :func:`offset_study`) and the Monte Carlo take
+``executor=`` (from :func:`cislunar.utils.executors.open_executor`; ``None`` runs serially): one task per surface
+through :func:`cislunar.utils.montecarlo.map_tasks`, one trial per filter run through
+:func:`cislunar.utils.montecarlo.run_monte_carlo`.  Surfaces are deterministic and trials seeded by index, so the
+results do not depend on the executor.
+
 Units: times in hours where named ``*_h``/``*_hours``, otherwise CR3BP time units (TU); :math:`\sqrt{J_\rho}` in
 km (``*_km``) or m (``*_m``); fuel in m/s; percentiles in percent of the maneuvers of a slice.
 """
@@ -28,7 +34,7 @@ from cislunar.cr3bp.torus import qpo_for_mean_range
 from cislunar.guidance import ssat
 from cislunar.papers.greaves_scheeres_2023 import station_keeping as sk
 from cislunar.utils import validation
-from cislunar.utils.montecarlo import run_monte_carlo
+from cislunar.utils.montecarlo import map_tasks, run_monte_carlo
 
 __all__ = [
     "POLICIES",
@@ -157,25 +163,32 @@ class GridStudy:
         return np.array([getattr(g, key) for g in self.rows if g.agent_phase == agent_phase and g.reading == reading])
 
 
+def _grid_task(task):
+    """The two :class:`GridRow` (angle, projection) of one surface (sweep task)."""
+    system, torus, n, phase, t_arrival, t_burn, t_final = task
+    s = sk.station_keeping_surface(system, torus, 2 * np.pi * np.arange(n) / n, t_arrival, t_burn, t_final,
+                                   agent_theta=2 * np.pi * phase, progress=False)
+    rows = []
+    for crit in ("angle", "projection"):
+        r = s.reselect(crit)
+        rows.append(GridRow(float(phase), n, crit, float(np.median(r.informed_percentile)),
+                            float(np.median(r.informed_range_sigma_km) * 1e3),
+                            float(np.median(r.informed_fuel_m_s)),
+                            float(np.median(r.informed_fuel_percentile)),
+                            float(np.median(r.best_range_sigma_km) * 1e3)))
+    return rows
+
+
 def grid_resolution_study(system: CR3BP, torus, n_grid, t_arrival, t_burn: float, t_final: float, *,
-                          agent_phases=(0.0, 0.75)) -> GridStudy:
+                          agent_phases=(0.0, 0.75), executor=None) -> GridStudy:
     """Both readings of Eq. 25 on surfaces with ``n`` equally spaced ring angles for each ``n`` in ``n_grid``, for
-    each agent phase (fraction of a turn); arrival times ``t_arrival`` and burn/read-out times in TU."""
+    each agent phase (fraction of a turn); arrival times ``t_arrival`` and burn/read-out times in TU; one task per
+    surface on ``executor`` (``None``: serial)."""
     check_system(system)
     ns = tuple(validation.integer(n, "n_grid entry", minimum=2) for n in n_grid)
-    rows = []
-    for phase in agent_phases:
-        for n in ns:
-            s = sk.station_keeping_surface(system, torus, 2 * np.pi * np.arange(n) / n, t_arrival, t_burn, t_final,
-                                           agent_theta=2 * np.pi * phase, progress=False)
-            for crit in ("angle", "projection"):
-                r = s.reselect(crit)
-                rows.append(GridRow(float(phase), n, crit, float(np.median(r.informed_percentile)),
-                                    float(np.median(r.informed_range_sigma_km) * 1e3),
-                                    float(np.median(r.informed_fuel_m_s)),
-                                    float(np.median(r.informed_fuel_percentile)),
-                                    float(np.median(r.best_range_sigma_km) * 1e3)))
-    return GridStudy(tuple(rows), ns)
+    tasks = [(system, torus, n, float(phase), t_arrival, t_burn, t_final) for phase in agent_phases for n in ns]
+    rows = map_tasks(_grid_task, tasks, executor=executor, progress=False, desc="ring-angle grids")
+    return GridStudy(tuple(r for pair in rows for r in pair), ns)
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -202,30 +215,34 @@ class SweepRow:
     fuel_pct_proj: float
 
 
+def _sweep_task(task):
+    """The :class:`SweepRow` of one setting (sweep task)."""
+    system, torus, theta, t_arrival, t_final, pre_h, lead_h, ang, t_b, t_track = task
+    s = sk.station_keeping_surface(system, torus, theta, t_arrival, t_b, t_final, agent_theta=ang,
+                                   t_track_start=t_track, progress=False)
+    sig_a = s.range_sigma_at_arrival_km
+    arr_pct = 100 * np.mean(sig_a < sig_a[np.arange(s.t_arrival.size), s.informed][:, None], axis=1)
+    sp = s.reselect("projection")
+    return SweepRow(float(pre_h), float(lead_h), float(ang / (2 * np.pi)), float(np.median(s.informed_percentile)),
+                    float(np.mean(s.informed_percentile < 25) * 100), float(np.median(arr_pct)),
+                    float(np.mean(arr_pct < 25) * 100), float(np.median(s.informed_fuel_percentile)),
+                    float(np.median(sp.informed_percentile)), float(np.median(sp.informed_fuel_percentile)))
+
+
 def scenario_sweep(system: CR3BP, torus, theta, t_arrival, arrival_start_h: float, t_final: float, *,
                    pre_arcs_h=(0.0, 24.0), leads_h=(12.0, 24.0, 48.0),
-                   agent_thetas=(0.0, np.pi / 2, np.pi, 3 * np.pi / 2)) -> tuple:
+                   agent_thetas=(0.0, np.pi / 2, np.pi, 3 * np.pi / 2), executor=None) -> tuple:
     """One surface per (tracking arc before the first burn, burn lead before ``arrival_start_h``, agent ring angle);
-    returns a tuple of :class:`SweepRow`."""
+    returns a tuple of :class:`SweepRow`; one task per setting on ``executor`` (``None``: serial)."""
     check_system(system)
     HR = 3600.0 / system.time_unit_s
-    rows = []
+    tasks = []
     for pre_h in pre_arcs_h:
         for lead_h in leads_h:
             for ang in agent_thetas:
                 t_b = (arrival_start_h - lead_h) * HR
-                s = sk.station_keeping_surface(system, torus, theta, t_arrival, t_b, t_final, agent_theta=ang,
-                                               t_track_start=t_b - pre_h * HR, progress=False)
-                sig_a = s.range_sigma_at_arrival_km
-                arr_pct = 100 * np.mean(sig_a < sig_a[np.arange(s.t_arrival.size), s.informed][:, None], axis=1)
-                sp = s.reselect("projection")
-                rows.append(SweepRow(float(pre_h), float(lead_h), float(ang / (2 * np.pi)),
-                                     float(np.median(s.informed_percentile)),
-                                     float(np.mean(s.informed_percentile < 25) * 100), float(np.median(arr_pct)),
-                                     float(np.mean(arr_pct < 25) * 100), float(np.median(s.informed_fuel_percentile)),
-                                     float(np.median(sp.informed_percentile)),
-                                     float(np.median(sp.informed_fuel_percentile))))
-    return tuple(rows)
+                tasks.append((system, torus, theta, t_arrival, t_final, pre_h, lead_h, ang, t_b, t_b - pre_h * HR))
+    return tuple(map_tasks(_sweep_task, tasks, executor=executor, progress=False, desc="scenario sweep"))
 
 
 def format_sweep(rows) -> str:
@@ -240,29 +257,35 @@ def format_sweep(rows) -> str:
 
 
 def offset_study(system: CR3BP, torus, theta, t_arrival, t_burn: float, t_final: float, rng: np.random.Generator,
-                 *, distances_km=(0.0, 1.0, 10.0, 50.0), n_directions: int = 3, agent_theta: float = 0.0) -> dict:
+                 *, distances_km=(0.0, 1.0, 10.0, 50.0), n_directions: int = 3, agent_theta: float = 0.0,
+                 executor=None) -> dict:
     """Median percentile of :math:`\\mathbf u^*` (angle reading) for an agent off the torus at the first burn.
 
     For each distance ``d`` (km) and each of ``n_directions`` random directions drawn from ``rng``: position offset
     ``d`` km and velocity offset ``d`` times the ring's velocity-to-position size ratio.  Returns ``{d: [percentile,
-    ...]}`` (percent).
+    ...]}`` (percent); one task per surface on ``executor`` (``None``: serial).
     """
     check_system(system)
     validation.rng(rng)
     n_directions = validation.integer(n_directions, "n_directions", minimum=1)
     L, V = system.length_unit_km, system.velocity_unit_km_s
     vel_per_km = torus.velocity_size_mps / torus.size_km  # m/s per km
-    out = {}
+    tasks = []  # offsets drawn in order first, surfaces computed after: same numbers on any executor
     for d_km in distances_km:
-        vals = []
         for _ in range(n_directions):
             dr, dv = rng.standard_normal(3), rng.standard_normal(3)
             off = np.r_[d_km * dr / np.linalg.norm(dr) / L, d_km * vel_per_km * 1e-3 * dv / np.linalg.norm(dv) / V]
-            s = sk.station_keeping_surface(system, torus, theta, t_arrival, t_burn, t_final, agent_theta=agent_theta,
-                                           agent_offset=off, progress=False)
-            vals.append(float(np.median(s.informed_percentile)))
-        out[float(d_km)] = vals
-    return out
+            tasks.append((system, torus, theta, t_arrival, t_burn, t_final, agent_theta, off))
+    vals = map_tasks(_offset_task, tasks, executor=executor, progress=False, desc="offsets")
+    return {float(d): vals[i * n_directions:(i + 1) * n_directions] for i, d in enumerate(distances_km)}
+
+
+def _offset_task(task):
+    """Median percentile of u* (angle reading) for one offset agent (sweep task)."""
+    system, torus, theta, t_arrival, t_burn, t_final, agent_theta, off = task
+    s = sk.station_keeping_surface(system, torus, theta, t_arrival, t_burn, t_final, agent_theta=agent_theta,
+                                   agent_offset=off, progress=False)
+    return float(np.median(s.informed_percentile))
 
 
 def member_study(system: CR3BP, orbit, theta, t_arrival, t_burn: float, t_final: float, *, target_km: float = 215.0,

@@ -94,3 +94,41 @@ def test_qpo_pair_study_needs_ring_angle_zero(pair):
     assert q.excess_percent.shape == (1,) and q.percentile.shape == (1,)
     opt, mmd, pct = q.antipode_differences()
     assert opt >= 0 and mmd >= 0 and pct >= 0 and q.mirror_ratio >= 0
+
+
+def test_optimum_at_and_coast_range(pair, study):
+    r = study.results[1.0]
+    assert study.optimum_at(1.0, 3) == pytest.approx(r.optimum[1])
+    assert np.isnan(study.optimum_at(1.0, 2))
+    with pytest.raises(ValueError, match="coast_hours"):
+        gs.policy_study(em, pair, [1, 30], [1.0], n_grid=20, n_perp=4)  # the 1-day pair has 24 h of grid
+
+
+def _same_comparison(a, b):
+    for f in ("none", "mmd", "mmd_other", "optimum", "perp_best", "perp_worst", "mmd_percentile", "coast_hours"):
+        np.testing.assert_array_equal(getattr(a, f), getattr(b, f), err_msg=f)
+
+
+def test_sweeps_on_an_executor_match_the_serial_run(pair):
+    from concurrent.futures import ThreadPoolExecutor
+
+    torus = torus_from_orbit(nrho_9_2(em), N=15, size_km=100.0)
+    kw = {"n_grid": 20, "n_perp": 4}
+    serial = gs.policy_study(em, pair, [1, 2], [0.5, 1.0], **kw)
+    arcs = gs.tracking_arc_study(em, pair, [1, 2], [1], 1.0, **kw)
+    qpo = gs.qpo_pair_study(em, torus, pair, [0.0, 90.0], [1], **kw)
+    with ThreadPoolExecutor(2) as ex:
+        par = gs.policy_study(em, pair, [1, 2], [0.5, 1.0], executor=ex, **kw)
+        arcs_p = gs.tracking_arc_study(em, pair, [1, 2], [1], 1.0, executor=ex, **kw)
+        qpo_p = gs.qpo_pair_study(em, torus, pair, [0.0, 90.0], [1], executor=ex, **kw)
+    assert list(par.results) == [0.5, 1.0] and list(arcs_p.results) == [1, 2] and list(qpo_p.results) == [0.0, 90.0]
+    for dv in (0.5, 1.0):
+        _same_comparison(serial.results[dv], par.results[dv])
+    for h in (1, 2):
+        _same_comparison(arcs.results[h], arcs_p.results[h])
+    for a in (0.0, 90.0):
+        _same_comparison(qpo.results[a], qpo_p.results[a])
+    _same_comparison(qpo.antipode, qpo_p.antipode)
+    # the burn sizes are not mixed up: a bigger burn moves the cost further from doing nothing
+    r0, r1 = par.results[0.5], par.results[1.0]
+    assert np.all(np.abs(r1.optimum - r1.none) > np.abs(r0.optimum - r0.none))

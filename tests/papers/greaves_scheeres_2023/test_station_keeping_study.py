@@ -93,3 +93,28 @@ def test_filter_monte_carlo_structure(surface):
     assert mcs.prior_range_m == pytest.approx(20e3 * np.sqrt(2), rel=1e-9)
     assert mcs.ratio(uni) == pytest.approx(1.0)
     assert "filter runs" in mcs.format()
+
+
+def test_sweeps_on_an_executor_match_the_serial_run(torus, surface):
+    from concurrent.futures import ThreadPoolExecutor
+
+    t_arr = surface.t_arrival
+    sweep_kw = {"pre_arcs_h": (0.0,), "leads_h": (12.0, 18.0), "agent_thetas": (0.0, np.pi)}
+    grid_args = (em, torus, (4, 6), np.array([-6.0, 7.0]) * HR, -18 * HR, 12 * HR)
+    off_args = (em, torus, surface.theta, t_arr, -18 * HR, 12 * HR)
+    serial = (study.scenario_sweep(em, torus, surface.theta, t_arr, -6.0, 12 * HR, **sweep_kw),
+              study.grid_resolution_study(*grid_args, agent_phases=(0.0, 0.5)),
+              study.offset_study(*off_args, np.random.default_rng(4), distances_km=(0.0, 5.0), n_directions=2))
+    with ThreadPoolExecutor(2) as ex:
+        par = (study.scenario_sweep(em, torus, surface.theta, t_arr, -6.0, 12 * HR, executor=ex, **sweep_kw),
+               study.grid_resolution_study(*grid_args, agent_phases=(0.0, 0.5), executor=ex),
+               study.offset_study(*off_args, np.random.default_rng(4), distances_km=(0.0, 5.0), n_directions=2,
+                                  executor=ex))
+    assert serial == par
+    rows = par[0]
+    assert [(r.lead_h, r.agent_phase) for r in rows] == [(12.0, 0.0), (12.0, 0.5), (18.0, 0.0), (18.0, 0.5)]
+    assert [(g.agent_phase, g.n, g.reading) for g in par[1].rows][:3] == [(0.0, 4, "angle"), (0.0, 4, "projection"),
+                                                                          (0.0, 6, "angle")]
+    assert list(par[2]) == [0.0, 5.0] and all(len(v) == 2 for v in par[2].values())
+    # zero offset: both directions give the baseline surface
+    assert par[2][0.0] == [pytest.approx(np.median(surface.informed_percentile))] * 2
