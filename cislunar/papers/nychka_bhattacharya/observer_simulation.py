@@ -26,8 +26,10 @@ from cislunar.papers.nychka_bhattacharya.scenarios import (
     Scenario,
 )
 from cislunar.utils import validation
+from cislunar.utils.montecarlo import map_tasks
 
-__all__ = ["INITIAL_ERROR", "E0_SCALES", "observer_designs", "ObserverDesigns", "Fig3Runs", "simulate_fig3",
+__all__ = ["INITIAL_ERROR", "E0_SCALES", "observer_designs", "ObserverDesigns", "AllowanceAtDt", "allowance_at",
+           "Fig3Runs", "simulate_fig3",
            "first_and_rms", "Convergence", "convergence_study", "LineCrossings", "line_crossings", "WindowRerun",
            "window_rerun"]
 
@@ -58,6 +60,28 @@ def observer_designs(scenario: Scenario, n_verify: int, rng: np.random.Generator
            "hinf": lpv.design_observer(m, V, gamma, "hinf", sensors=THETA1_SENSORS, pole_radius=pole_radius)}
     ver = {n: lpv.verify_observer(m, d, scenario.box, n_verify, rng) for n, d in des.items()}
     return ObserverDesigns(des, ver)
+
+
+@dataclass(frozen=True)
+class AllowanceAtDt:
+    r"""What each design allows at the sampling interval ``dt`` (TU): the H2 allowance per sample and read as an
+    intensity, the H-infinity allowance (an RMS), deg; ``dt_01``: the interval (TU) at which H2 allows exactly
+    0.1 deg per sample, :math:`1/(\kappa_{H2}\sin 0.1°)^2`."""
+
+    dt: float
+    h2_per_sample_deg: float
+    h2_intensity_deg: float
+    hinf_deg: float
+    dt_01: float
+
+
+def allowance_at(designs: ObserverDesigns, dt: float) -> AllowanceAtDt:
+    """Eq. 24 allowances of ``designs`` for a sensor sampled every ``dt`` TU (noise held over each interval)."""
+    designs = validation.instance(designs, "designs", ObserverDesigns)
+    dt = validation.positive(dt, "dt")
+    h2, hinf = designs.designs["h2"], designs.designs["hinf"]
+    return AllowanceAtDt(dt, float(h2.noise_per_sample_deg(dt)[0]), float(h2.noise_deg[0]), float(hinf.noise_deg[0]),
+                         float(1.0 / (h2.kappa[0] * np.sin(np.radians(0.1))) ** 2))
 
 
 @dataclass(frozen=True)
@@ -105,19 +129,21 @@ class Fig3Runs:
 
 
 def simulate_fig3(scenario: Scenario, designs: ObserverDesigns, dt: float, periods: float, sigma_deg: float,
-                  rng: np.random.Generator, *, sigma_acc: float = 1e-3, p0_sigma: float = 0.03) -> Fig3Runs:
+                  rng: np.random.Generator, *, sigma_acc: float = 1e-3, p0_sigma: float = 0.03,
+                  initial_error=INITIAL_ERROR) -> Fig3Runs:
     """Propagate the truth over ``periods`` periods, sample noisy angles every ``dt`` TU (``rng``) and run both LPV
     observers (triangulated and true rho) and the EKF (``sigma_acc`` LU/TU^2, initial sigma ``p0_sigma``) from
-    ``truth[0] + INITIAL_ERROR``."""
+    ``truth[0] + initial_error`` (LU, LU/TU; default :data:`INITIAL_ERROR`)."""
     scenario = validation.instance(scenario, "scenario", Scenario)
     designs = validation.instance(designs, "designs", ObserverDesigns)
     dt = validation.positive(dt, "dt")
     periods = validation.positive(periods, "periods")
+    initial_error = validation.as_array(initial_error, "initial_error", shape=(4,))
     m = scenario.model
     t = np.arange(0.0, periods * scenario.orbit.period, dt)
     truth = m.planar(propagate(m.system, scenario.orbit.x0, t).x)
     meas = make_measurements(m, t, truth, sigma_deg, rng)
-    x0 = truth[0] + INITIAL_ERROR
+    x0 = truth[0] + initial_error
     runs = {n: simulate_lpv_observer(m, d.gain(), meas, x0, truth) for n, d in designs.designs.items()}
     exact = {n: simulate_lpv_observer(m, d.gain(), meas, x0, truth, exact_rho=True)
              for n, d in designs.designs.items()}
@@ -185,10 +211,19 @@ class Convergence:
         return max(ok) if ok else float("nan")
 
 
+def _first_below(task):
+    """One run of the initial-error sweep of :func:`convergence_study` (module level: process pools pickle it)."""
+    m, gain, meas, x0, truth, bound, period = task
+    run = simulate_lpv_observer(m, gain, meas, x0, truth)
+    return first_and_rms(meas.t, run.position_error, bound, period)[0]
+
+
 def convergence_study(scenario: Scenario, designs: ObserverDesigns, sim: Fig3Runs, sigma_deg: float, *,
-                      e0_scales=E0_SCALES, seed: int = 0) -> Convergence:
+                      e0_scales=E0_SCALES, seed: int = 0, executor=None) -> Convergence:
     """Judge ``sim`` against the LMI guarantees (``lpv.guaranteed_error_rms``), predict the convergence time from the
-    slowest closed-loop pole, re-run H2 without noise on the true rho and sweep the initial error."""
+    slowest closed-loop pole, re-run H2 without noise on the true rho and sweep the initial error (one task per
+    scale through :func:`cislunar.utils.montecarlo.map_tasks` on ``executor``, default serial; the result does not
+    depend on it)."""
     scenario = validation.instance(scenario, "scenario", Scenario)
     designs = validation.instance(designs, "designs", ObserverDesigns)
     sim = validation.instance(sim, "sim", Fig3Runs)
@@ -213,11 +248,9 @@ def convergence_study(scenario: Scenario, designs: ObserverDesigns, sim: Fig3Run
     clean_meas = make_measurements(m, t, sim.truth, 0.0, np.random.default_rng(seed))
     clean = simulate_lpv_observer(m, des["h2"].gain(), clean_meas, sim.x_hat0, sim.truth, exact_rho=True)
     first_clean = first_and_rms(t, clean.position_error, bound["h2"], P)[0]
-    sweep = []
-    for f in scales:
-        x0 = sim.truth[0] + f * (sim.x_hat0 - sim.truth[0])
-        run = simulate_lpv_observer(m, des["h2"].gain(), sim.meas, x0, sim.truth)
-        sweep.append(first_and_rms(t, run.position_error, bound["h2"], P)[0])
+    tasks = [(m, des["h2"].gain(), sim.meas, sim.truth[0] + f * (sim.x_hat0 - sim.truth[0]), sim.truth, bound["h2"], P)
+             for f in scales]
+    sweep = map_tasks(_first_below, tasks, executor=executor, progress=False, desc="initial-error sweep")
     return Convergence(noise_rms, bound, first, rms, rms_exact, decay, t_pred, first_clean, scales, np.array(sweep))
 
 

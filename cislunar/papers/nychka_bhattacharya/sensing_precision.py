@@ -31,7 +31,7 @@ from cislunar.papers.nychka_bhattacharya.scenarios import (
     paper_scenario,
 )
 from cislunar.utils import validation
-from cislunar.utils.progress import progress as _progress
+from cislunar.utils.montecarlo import map_tasks
 
 __all__ = [
     "H2_BAND_DEG",
@@ -525,8 +525,10 @@ def sensitivity_study(gamma: float = 0.0013, *, orbits=RESONANT_CANDIDATES, stru
     n_samples : int
         Samples per orbit period bounding :math:`\rho`.
     system : CR3BP
-    executor : concurrent.futures.Executor, optional
-        Runs the orbits (one task each) with ``executor.map``; default serial.  Results do not depend on it.
+    executor : concurrent.futures.Executor or dask.distributed.Client, optional
+        Runs the orbits (one task each) through :func:`cislunar.utils.montecarlo.map_tasks`; default serial
+        (:func:`cislunar.utils.executors.open_executor` builds one from a notebook's ``WORKERS`` and ``SCHEDULER``).
+        Results do not depend on it.
     progress : bool
         Show a progress bar over the orbits.
 
@@ -551,16 +553,9 @@ def sensitivity_study(gamma: float = 0.0013, *, orbits=RESONANT_CANDIDATES, stru
     R = validation.positive(pole_radius, "pole_radius")
     n_samples = validation.integer(n_samples, "n_samples", minimum=10)
     progress = validation.boolean(progress, "progress")
-    if executor is not None and not callable(getattr(executor, "map", None)):
-        raise validation.ArgumentTypeError(f"executor must be a concurrent.futures-style executor with a map method "
-                                        f"(or None); got {type(executor).__name__}")
     tasks = [(system, o, structures, tuple(lv), gamma, R, n_samples) for o in orbits]
     t0 = time.perf_counter()
-    mapper = map if executor is None else executor.map
-    results = mapper(_study_orbit, tasks)
-    if progress:
-        results = _progress(results, total=len(tasks), desc="sensitivity study (orbits)")
-    results = list(results)
+    results = map_tasks(_study_orbit, tasks, executor=executor, progress=progress, desc="sensitivity study (orbits)")
     stack = {k: np.stack([r[k] for r in results]) for k in results[0] if k not in ("r13_max", "period")}
     return SensitivityStudy(orbits=orbits, r13_max=np.array([r["r13_max"] for r in results]),
                             period=np.array([r["period"] for r in results]), structures=structures, levels=lv,

@@ -63,3 +63,34 @@ def test_claims_of_the_chapter():
     assert CLAIMS["hinf_larger"].judge(True).status == "reproduced"
     assert CLAIMS["ordering_dt"].judge(0.36, reason="x").status == "differs"
     assert CLAIMS["dt"].judge(0.004).status == "not in paper"
+
+
+def test_convergence_sweep_same_result_through_an_executor(setup):
+    from concurrent.futures import ThreadPoolExecutor
+
+    sc, od, sim = setup
+    serial = obs.convergence_study(sc, od, sim, 0.1, e0_scales=(0.1, 1.0))
+    with ThreadPoolExecutor(2) as executor:
+        threaded = obs.convergence_study(sc, od, sim, 0.1, e0_scales=(0.1, 1.0), executor=executor)
+    assert np.array_equal(serial.first_sweep, threaded.first_sweep)
+    # the sweep's full-scale run is the noisy H2 run of the simulation itself
+    assert serial.first_sweep[1] == serial.first["h2"]
+
+
+def test_simulate_fig3_honours_the_initial_error(setup):
+    sc, od, _ = setup
+    sim = obs.simulate_fig3(sc, od, 0.01, 0.05, 0.1, np.random.default_rng(1), initial_error=0.5 * obs.INITIAL_ERROR)
+    assert sim.initial_error == pytest.approx(0.01 * np.sqrt(2))
+    with pytest.raises(ValueError):
+        obs.simulate_fig3(sc, od, 0.01, 0.05, 0.1, np.random.default_rng(1), initial_error=[0.1, 0.1])
+
+
+def test_allowance_at_follows_eq24_per_sample(setup):
+    _, od, _ = setup
+    a1, a4 = obs.allowance_at(od, 0.001), obs.allowance_at(od, 0.004)
+    k = od.designs["h2"].kappa[0]
+    assert a1.h2_per_sample_deg == pytest.approx(np.degrees(np.arcsin(1.0 / (k * np.sqrt(0.001)))))
+    assert a1.h2_per_sample_deg > a4.h2_per_sample_deg  # a longer interval allows less per sample
+    assert a1.hinf_deg == a4.hinf_deg and a1.dt_01 == a4.dt_01
+    # at dt_01 the H2 design allows exactly 0.1 deg per sample
+    assert obs.allowance_at(od, a1.dt_01).h2_per_sample_deg == pytest.approx(0.1, rel=1e-9)
