@@ -34,6 +34,7 @@ from cislunar.sensing import information as info
 from cislunar.sensing import measurements as meas
 from cislunar.sensing.covariance import AugmentedLinearization
 from cislunar.utils import validation
+from cislunar.utils.montecarlo import map_tasks
 
 __all__ = [
     "OBSERVER_TF_X0",
@@ -186,17 +187,22 @@ class Case2Window:
         return np.asarray(self.system.tu_to_days(self.t))
 
 
-def case_2_window(system: CR3BP = EARTH_MOON, t: np.ndarray | None = None) -> Case2Window:
+def case_2_window(system: CR3BP = EARTH_MOON, t: np.ndarray | None = None, *,
+                  range_sigma_km: float = meas.WOLF_JONES_RANGE_SIGMA_KM,
+                  range_rate_sigma_km_s: float = meas.WOLF_JONES_RANGE_RATE_SIGMA_KM_S) -> Case2Window:
     """Linearise test case 2's window ``[P_ref, 2 P_ref]`` (daily measurements unless ``t`` is given, TU) about the
-    coasting observer and the Table 4 targets; range and range rate (Table 5 noise), Table 5 priors, process noise
-    of the normalised reading (1e-11 LU^2/TU^3)."""
+    coasting observer and the Table 4 targets; range and range rate (noise standard deviations ``range_sigma_km``,
+    km, and ``range_rate_sigma_km_s``, km/s; default Table 5's 100 m and 10 m/s), Table 5 priors, process noise of
+    the normalised reading (1e-11 LU^2/TU^3)."""
     check_system(system)
+    range_sigma_km = validation.positive(range_sigma_km, "range_sigma_km")
+    range_rate_sigma_km_s = validation.positive(range_rate_sigma_km_s, "range_rate_sigma_km_s")
     P_ref = _period(system, OBSERVER_TF_X0)
     start = propagate(system, np.vstack([OBSERVER_TF_X0, TARGETS_X0]), [0.0, P_ref]).x[:, -1]
     day = float(system.days_to_tu(1.0))
     t_win = P_ref + np.arange(0.0, P_ref + 1e-12, day) if t is None else np.asarray(t, dtype=float)
     P_obj = cov.state_covariance(cov.WOLF_JONES_SIGMA_POS_KM, cov.WOLF_JONES_SIGMA_VEL_KM_S, system)
-    R_rr = meas.range_range_rate_noise(meas.WOLF_JONES_RANGE_SIGMA_KM, meas.WOLF_JONES_RANGE_RATE_SIGMA_KM_S, system)
+    R_rr = meas.range_range_rate_noise(range_sigma_km, range_rate_sigma_km_s, system)
     q_nd = cov.psd_to_nondimensional(cov.WOLF_JONES_PSD_KM2_S3, system)
     lin = cov.linearize_augmented(system, start[0], start[1:], t_win, meas.RANGE_RANGE_RATE, R_rr,
                                   cov.block_diag([P_obj] * 4), q=q_nd, derivatives=True)
@@ -412,13 +418,32 @@ class BaselineCurve:
         return self.gain > 0 and self.rms_drop > min_drop and self.rebound < max_rebound
 
 
+def _baseline_row(task) -> tuple:
+    """One (measurement type, observer start) cell of the baseline study, for
+    :func:`cislunar.utils.montecarlo.map_tasks`: mean baseline (LU), MI (nats) and five terminal RMS (km)."""
+    em, model, noise, xo, tgt, t_base, P0_pair, q = task
+    lb = cov.linearize_augmented(em, xo, tgt[None], t_base, model, noise, P0_pair, q=q)
+    P_end = cov.covariance_analysis(*lb.arrays).posterior[-1]
+    return tuple(float(v) for v in (
+        np.mean(np.linalg.norm(lb.targets[0, :, :3] - lb.observer[:, :3], axis=1)),
+        info.mutual_information(*lb.arrays), cov.position_sigma_km(P_end, 0, em),
+        cov.position_sigma_km(P_end, 1, em), cov.position_sigma_km(P_end, 0, em, axes=(2,)),
+        cov.position_sigma_km(P_end, 0, em, axes=(0, 1)), cov.position_sigma_km(P_end, 1, em, axes=(0, 1))))
+
+
 def baseline_study(window: Case2Window, n_baselines: int, *, min_phase: float = 0.002,
-                   max_phase: float = 0.5) -> tuple:
+                   max_phase: float = 0.5, executor=None) -> tuple:
     """Observer on the first Table 4 target's DRO, ahead by a phase (fraction of the period, geometric from
     ``min_phase`` to ``max_phase``); one period of daily measurements, relative position (100 m per axis) and
-    range + range rate.  Returns one :class:`BaselineCurve` per measurement type."""
+    range + range rate (the window's noise).  Returns one :class:`BaselineCurve` per measurement type.
+
+    The ``2 n_baselines`` covariance analyses are independent; they run through ``executor``
+    (:func:`cislunar.utils.montecarlo.map_tasks`; ``None``: serially) with the same result either way.
+    """
     validation.instance(window, "window", Case2Window)
     n = validation.integer(n_baselines, "n_baselines", minimum=2)
+    min_phase = validation.in_range(min_phase, "min_phase", 0.0, 1.0, closed=False)
+    max_phase = validation.in_range(max_phase, "max_phase", min_phase, 1.0, closed=False)
     em = window.system
     tgt = TARGETS_X0[0]
     P_tgt = _period(em, tgt)
@@ -428,18 +453,13 @@ def baseline_study(window: Case2Window, n_baselines: int, *, min_phase: float = 
     P0_pair = cov.block_diag([window.P_obj] * 2)
     models = {"relative position (100 m)": (meas.RELATIVE_POSITION, meas.relative_position_noise(0.1, em)),
               "range + range rate": (meas.RANGE_RANGE_RATE, window.R)}
+    tasks = [(em, model, noise, xo, tgt, t_base, P0_pair, window.q)
+             for model, noise in models.values() for xo in obs_starts]
+    rows = map_tasks(_baseline_row, tasks, executor=executor, progress=False, desc="baseline study")
     curves = []
-    for name, (model, noise) in models.items():
-        rows = []
-        for xo in obs_starts:
-            lb = cov.linearize_augmented(em, xo, tgt[None], t_base, model, noise, P0_pair, q=window.q)
-            P_end = cov.covariance_analysis(*lb.arrays).posterior[-1]
-            rows.append((np.mean(np.linalg.norm(lb.targets[0, :, :3] - lb.observer[:, :3], axis=1)),
-                         info.mutual_information(*lb.arrays), cov.position_sigma_km(P_end, 0, em),
-                         cov.position_sigma_km(P_end, 1, em), cov.position_sigma_km(P_end, 0, em, axes=(2,)),
-                         cov.position_sigma_km(P_end, 0, em, axes=(0, 1)),
-                         cov.position_sigma_km(P_end, 1, em, axes=(0, 1))))
-        cols = [np.array([float(r[j]) for r in rows]) for j in range(7)]
+    for k, name in enumerate(models):
+        block = rows[k * n:(k + 1) * n]
+        cols = [np.array([r[j] for r in block]) for j in range(7)]
         curves.append(BaselineCurve(name, *cols, em.length_unit_km))
     return tuple(curves)
 

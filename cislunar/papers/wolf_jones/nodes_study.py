@@ -28,6 +28,7 @@ from cislunar.guidance import discretization as D
 from cislunar.papers.wolf_jones import reference
 from cislunar.publish import plotting
 from cislunar.utils import validation
+from cislunar.utils.montecarlo import map_tasks
 
 __all__ = [
     "A_MAX_KM_S2",
@@ -84,6 +85,30 @@ def node_sweep(system: CR3BP, arcs: dict, sigmas, n_nodes: int) -> NodeSweep:
     return NodeSweep(dict(arcs), sigmas, n, nodes)
 
 
+def _draw_profiles(rng: np.random.Generator, draws: int) -> list:
+    """``draws`` random control profiles ``(phase (3,), cycles)``, drawn from ``rng`` in a fixed order (phases, then
+    the number of cycles, per draw)."""
+    return [(rng.uniform(0, 2 * np.pi, 3), rng.integers(1, 4)) for _ in range(draws)]
+
+
+def _error_of_profiles(system: CR3BP, x0, t_nodes, profiles, a_max: float) -> float:
+    """Median over ``profiles`` of the largest one-interval affine-model position error, km (unchecked kernel)."""
+    t_nodes = np.asarray(t_nodes, dtype=float)
+    x_ref = propagation.propagate(system, x0, t_nodes).x
+    model = D.foh_discretize(system, t_nodes, x_ref, np.zeros((t_nodes.size, 3)))
+    worst = []
+    for phase, cycles in profiles:
+        du = a_max * np.sin(2 * np.pi * t_nodes[:, None] / t_nodes[-1] * cycles + phase)
+        nonlinear = D.foh_discretize(system, t_nodes, x_ref, du).x_next
+        worst.append(np.max(np.linalg.norm((model.predict(x_ref, du) - nonlinear)[:, :3], axis=1)))  # position
+    return float(np.median(worst) * system.length_unit_km)
+
+
+def _error_task(task) -> float:
+    """One (arc, sigma) cell of the sweep, for :func:`cislunar.utils.montecarlo.map_tasks` (module level: picklable)."""
+    return _error_of_profiles(*task)
+
+
 def linearisation_error(system: CR3BP, x0, t_nodes, draws: int, rng: np.random.Generator, a_max: float) -> float:
     """Median over ``draws`` random control profiles of the largest one-interval affine-model position error, km.
 
@@ -93,16 +118,7 @@ def linearisation_error(system: CR3BP, x0, t_nodes, draws: int, rng: np.random.G
     """
     n = validation.integer(draws, "draws", minimum=1)
     validation.instance(rng, "rng", np.random.Generator)
-    t_nodes = np.asarray(t_nodes, dtype=float)
-    x_ref = propagation.propagate(system, x0, t_nodes).x
-    model = D.foh_discretize(system, t_nodes, x_ref, np.zeros((t_nodes.size, 3)))
-    worst = []
-    for _ in range(n):
-        phase = rng.uniform(0, 2 * np.pi, 3)
-        du = a_max * np.sin(2 * np.pi * t_nodes[:, None] / t_nodes[-1] * rng.integers(1, 4) + phase)
-        nonlinear = D.foh_discretize(system, t_nodes, x_ref, du).x_next
-        worst.append(np.max(np.linalg.norm((model.predict(x_ref, du) - nonlinear)[:, :3], axis=1)))  # position
-    return float(np.median(worst) * system.length_unit_km)
+    return _error_of_profiles(system, x0, t_nodes, _draw_profiles(rng, n), float(a_max))
 
 
 @dataclass(frozen=True)
@@ -129,17 +145,32 @@ class LinearisationSweep:
 
 
 def linearisation_sweep(system: CR3BP, sweep: NodeSweep, draws: int, rng: np.random.Generator, extra_seeds,
-                        a_max: float) -> LinearisationSweep:
+                        a_max: float, *, executor=None) -> LinearisationSweep:
     """:func:`linearisation_error` for every (arc, sigma) of ``sweep`` (drawing from ``rng`` in that order), then on
-    the DRO arc for every sigma with a fresh generator per seed of ``extra_seeds``.  Needs sigma = 0 in the sweep."""
+    the DRO arc for every sigma with a fresh generator per seed of ``extra_seeds``.  Needs sigma = 0 in the sweep.
+
+    The random control profiles are all drawn here, in that order, before any cell is computed; the cells then run
+    through ``executor`` (:func:`cislunar.utils.montecarlo.map_tasks`; ``None``: serially), so the result does not
+    depend on the executor.
+    """
     validation.instance(sweep, "sweep", NodeSweep)
     if 0.0 not in sweep.sigmas:
         raise ValueError("the sweep must contain sigma = 0 (uniform nodes), the reference of every gain")
-    errors = {(name, s): linearisation_error(system, sweep.arcs[name][0], sweep.nodes[name, s], draws, rng, a_max)
-              for name, s in sweep.nodes}
+    n = validation.integer(draws, "draws", minimum=1)
+    validation.instance(rng, "rng", np.random.Generator)
+    a_max = float(validation.positive(a_max, "a_max", allow_zero=True))
+    extra_seeds = [validation.integer(seed, "extra seed", minimum=0) for seed in extra_seeds]
+    keys = list(sweep.nodes)
+    tasks = [(system, sweep.arcs[name][0], sweep.nodes[name, s], _draw_profiles(rng, n), a_max) for name, s in keys]
     x0 = sweep.arcs[DRO_ARC][0]
-    extra = {seed: {s: linearisation_error(system, x0, sweep.nodes[DRO_ARC, s], draws, np.random.default_rng(seed),
-                                           a_max) for s in sweep.sigmas} for seed in extra_seeds}
+    extra_keys = [(seed, s) for seed in extra_seeds for s in sweep.sigmas]
+    tasks += [(system, x0, sweep.nodes[DRO_ARC, s], _draw_profiles(np.random.default_rng(seed), n), a_max)
+              for seed, s in extra_keys]
+    values = map_tasks(_error_task, tasks, executor=executor, progress=False, desc="linearisation sweep")
+    errors = dict(zip(keys, values[:len(keys)]))
+    extra = {seed: {} for seed in extra_seeds}
+    for (seed, s), v in zip(extra_keys, values[len(keys):]):
+        extra[seed][s] = v
     return LinearisationSweep(errors, extra)
 
 

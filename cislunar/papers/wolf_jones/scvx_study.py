@@ -9,7 +9,7 @@ What is here
 * :func:`iteration_summary`: what the iteration history says (accepted steps, the noise rule, multiplier updates,
   the largest-defect ratios that a superlinear rate would drive to zero).
 * :func:`single_shooting`: the converged first-order-hold control re-flown from the initial state alone.
-* :func:`guess_study`: the same problem from random initial guesses.
+* :func:`blended_guess`, :func:`guess_study`: the same problem from random initial guesses.
 * ``figure_*``: the chapter's figures.
 
 Units: non-dimensional (LU, TU, LU/TU, LU/TU^2) unless a name says ``_km``, ``_mm_s`` or ``_d``; Earth-Moon
@@ -30,12 +30,14 @@ from cislunar.guidance import scvx
 from cislunar.papers.wolf_jones import scenarios
 from cislunar.publish import plotting
 from cislunar.utils import validation
+from cislunar.utils.montecarlo import map_tasks
 
 __all__ = [
     "GuessStudy",
     "IterationSummary",
     "ShootingCheck",
     "TransferProblem",
+    "blended_guess",
     "figure_converged_control",
     "figure_iterations",
     "guess_study",
@@ -88,11 +90,12 @@ class TransferProblem:
         return float(np.linalg.norm(propagate(self.system, self.x0, self.scenario.duration).x[-1] - self.x_final))
 
 
-def transfer_problem(n_nodes: int, sigma: float = 1.0) -> TransferProblem:
-    """Test case 1's transfer on ``n_nodes`` Sundman nodes of exponent ``sigma`` (window ends moved onto nodes)."""
+def transfer_problem(n_nodes: int, sigma: float = 1.0, *, a_max_km_s2: float | None = None) -> TransferProblem:
+    """Test case 1's transfer on ``n_nodes`` Sundman nodes of exponent ``sigma`` (window ends moved onto nodes), with
+    the thrust-acceleration bound ``a_max_km_s2`` (km/s^2; ``None``: Table 3's value)."""
     n = validation.integer(n_nodes, "n_nodes", minimum=4)
     sigma = validation.positive(sigma, "sigma", allow_zero=True)
-    sc = scenarios.test_case_1()
+    sc = scenarios.test_case_1() if a_max_km_s2 is None else scenarios.test_case_1(a_max_km_s2=a_max_km_s2)
     dro = sc.row_checks["observer_t0"].corrected
     t, k_ws, k_we = sc.node_times(n, sigma)
     x_guess = propagate(sc.system, dro.x0, t).x
@@ -176,25 +179,44 @@ class GuessStudy:
     spread: float
 
 
+def _solve_guess(task) -> tuple:
+    """One SCvx run from a given guess, for :func:`cislunar.utils.montecarlo.map_tasks`: (impulse, iterations)."""
+    problem, x_guess, u_guess, max_iter = task
+    r = solve(problem, scvx.SCvxSettings(max_iter=max_iter), x_guess=x_guess, u_guess=u_guess)
+    return float(r.impulse), len(r.history)
+
+
+def blended_guess(problem: TransferProblem) -> np.ndarray:
+    """The straight blend ``(1 - s) x_fwd + s x_bwd``, ``s = t / t_f``, of the forward ballistic arc from ``x0`` and
+    the backward ballistic arc from ``x_final``, at the nodes (LU, LU/TU)."""
+    validation.instance(problem, "problem", TransferProblem)
+    t = problem.t
+    back = propagate(problem.system, problem.x_final, t[::-1]).x[::-1]
+    s = (t / t[-1])[:, None]
+    return (1 - s) * problem.x_guess + s * back
+
+
 def guess_study(problem: TransferProblem, n_guesses: int, rng: np.random.Generator, reference_impulse: float, *,
-                control_scale: float = 0.05, max_iter: int = 200) -> GuessStudy:
-    """Solve from ``n_guesses`` guesses: the straight blend of the forward and backward ballistic arcs, with random
-    node controls of ``control_scale * a_max`` per axis (zero in the window)."""
+                control_scale: float = 0.05, max_iter: int = 200, executor=None) -> GuessStudy:
+    """Solve from ``n_guesses`` guesses: the straight blend of the forward and backward ballistic arcs
+    (:func:`blended_guess`), with random node controls of ``control_scale * a_max`` per axis (zero in the window).
+
+    The random controls are drawn from ``rng`` here, guess after guess; the runs then go through ``executor``
+    (:func:`cislunar.utils.montecarlo.map_tasks`; ``None``: serially), so the result does not depend on it.
+    """
     n = validation.integer(n_guesses, "n_guesses", minimum=1)
     validation.instance(rng, "rng", np.random.Generator)
     ref = validation.positive(reference_impulse, "reference_impulse")
-    t, em = problem.t, problem.system
-    impulses, iterations = [], []
-    for _ in range(n):
-        back = propagate(em, problem.x_final, t[::-1]).x[::-1]
-        s = (t / t[-1])[:, None]
-        guess = (1 - s) * problem.x_guess + s * back
-        u0 = control_scale * problem.scenario.a_max * rng.standard_normal((t.size, 3)) * (problem.u_max > 0)[:, None]
-        r = solve(problem, scvx.SCvxSettings(max_iter=max_iter), x_guess=guess, u_guess=u0)
-        impulses.append(r.impulse)
-        iterations.append(len(r.history))
-    impulses = np.array(impulses)
-    return GuessStudy(impulses, tuple(iterations), float((impulses.max() - impulses.min()) / ref))
+    scale = validation.positive(control_scale, "control_scale", allow_zero=True)
+    max_iter = validation.integer(max_iter, "max_iter", minimum=1)
+    t = problem.t
+    guess = blended_guess(problem)
+    tasks = [(problem, guess,
+              scale * problem.scenario.a_max * rng.standard_normal((t.size, 3)) * (problem.u_max > 0)[:, None],
+              max_iter) for _ in range(n)]
+    runs = map_tasks(_solve_guess, tasks, executor=executor, progress=False, desc="initial guesses")
+    impulses = np.array([r[0] for r in runs])
+    return GuessStudy(impulses, tuple(r[1] for r in runs), float((impulses.max() - impulses.min()) / ref))
 
 
 # ---------------------------------------------------------------------------------------------------------------

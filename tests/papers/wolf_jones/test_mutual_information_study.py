@@ -77,3 +77,27 @@ def test_crossover_interpolates_on_log_axes():
     t = S.TimingStudy((4, 16), (info.TimingResult(1.0, 2.0, 1.0, 1.0), info.TimingResult(4.0, 2.0, 3.0, 1.0)))
     assert t.at(16).ratio_value == 2.0 and t.crossover_value == "N = 8 (between 4 and 16)"
     assert t.crossover_gradient == "at or below N = 4"
+
+
+def test_range_noise_enters_the_window(short_window):
+    w = S.case_2_window(em, t=short_window.t, range_sigma_km=0.05)
+    assert w.R[0, 0] == pytest.approx(0.25 * short_window.R[0, 0]) and w.R[1, 1] == short_window.R[1, 1]
+    assert info.window_information(w.lin) > info.window_information(short_window.lin)  # less noise, more MI
+    with pytest.raises(ValueError):
+        S.case_2_window(em, t=short_window.t, range_sigma_km=0.0)
+
+
+def test_baseline_study_is_the_same_through_an_executor(short_window):
+    from concurrent.futures import ThreadPoolExecutor
+
+    serial = S.baseline_study(short_window, 2, min_phase=0.01, max_phase=0.1)
+    with ThreadPoolExecutor(2) as pool:
+        pooled = S.baseline_study(short_window, 2, min_phase=0.01, max_phase=0.1, executor=pool)
+    assert [c.name for c in serial] == ["relative position (100 m)", "range + range rate"]
+    for a, b in zip(serial, pooled):
+        assert np.array_equal(a.mi, b.mi) and np.array_equal(a.obs_xy, b.obs_xy)
+        assert a.baseline[1] > a.baseline[0] > 0  # a longer lead, a longer baseline
+        # the in-plane and out-of-plane parts make up the observer's total terminal RMS
+        assert np.all(a.obs_xy <= a.obs * (1 + 1e-12)) and np.all(a.obs_z <= a.obs * (1 + 1e-12))
+    with pytest.raises(ValueError):
+        S.baseline_study(short_window, 2, min_phase=0.2, max_phase=0.1)

@@ -46,3 +46,23 @@ def test_sweep_gains_and_seeds():
 def test_eq40_residual_of_minimum_norm_bounds():
     t = np.array([0.0, 0.1, 0.4, 0.5, 1.2])
     assert S.eq40_residual(t, 2.0) < 1e-12
+
+
+def test_linearisation_sweep_is_the_same_through_an_executor(sweep):
+    """The profiles are drawn before any cell runs: an executor gives the serial result, and each cell equals
+    linearisation_error drawing from the same generator state."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    a = S.A_MAX_KM_S2 / em.acceleration_unit_km_s2
+    serial = S.linearisation_sweep(em, sweep, 1, np.random.default_rng(7), [11], a)
+    with ThreadPoolExecutor(2) as pool:
+        pooled = S.linearisation_sweep(em, sweep, 1, np.random.default_rng(7), [11], a, executor=pool)
+    assert serial == pooled
+    assert list(serial.errors) == list(sweep.nodes) and list(serial.extra[11]) == [0.0, 1.0]
+    rng = np.random.default_rng(7)
+    first = S.linearisation_error(em, sweep.arcs[S.DRO_ARC][0], sweep.nodes[S.DRO_ARC, 0.0], 1, rng, a)
+    assert serial.errors[S.DRO_ARC, 0.0] == first
+    # every extra seed restarts its generator for each sigma
+    again = S.linearisation_error(em, sweep.arcs[S.DRO_ARC][0], sweep.nodes[S.DRO_ARC, 1.0], 1,
+                                  np.random.default_rng(11), a)
+    assert serial.extra[11][1.0] == again

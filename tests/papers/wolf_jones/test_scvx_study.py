@@ -54,3 +54,23 @@ def test_iteration_summary_applies_the_noise_rule():
     assert np.allclose(s.defect_ratio, [0.1, 1.0])
     with pytest.raises(ValueError):
         S.iteration_summary(SimpleNamespace(history=[]), settings)
+
+
+def test_guess_study_draws_first_and_matches_through_an_executor(problem):
+    from concurrent.futures import ThreadPoolExecutor
+
+    guess = S.blended_guess(problem)
+    assert np.allclose(guess[0], problem.x0) and np.allclose(guess[-1], problem.x_final)  # ends of the blend
+    ref = S.solve(problem).impulse
+    serial = S.guess_study(problem, 2, np.random.default_rng(5), ref, max_iter=60)
+    with ThreadPoolExecutor(2) as pool:
+        pooled = S.guess_study(problem, 2, np.random.default_rng(5), ref, max_iter=60, executor=pool)
+    assert np.array_equal(serial.impulses, pooled.impulses) and serial.iterations == pooled.iterations
+    assert serial.spread == pytest.approx((serial.impulses.max() - serial.impulses.min()) / ref)
+    assert serial.spread < 1e-6  # the same optimum from both guesses
+
+
+def test_a_tighter_thrust_bound_reaches_the_problem(problem):
+    tight = S.transfer_problem(16, 1.0, a_max_km_s2=1e-8)
+    assert tight.scenario.a_max == pytest.approx(0.01 * problem.scenario.a_max)
+    assert np.allclose(tight.u_max, 0.01 * problem.u_max) and np.array_equal(tight.t, problem.t)

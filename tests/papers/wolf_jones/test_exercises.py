@@ -1,0 +1,66 @@
+"""The worked solutions of the Wolf & Jones exercises (cislunar.papers.wolf_jones.exercises): each test checks the
+claim its answer makes (the predicted direction and size of the change), so a wrong solution fails."""
+
+import numpy as np
+import pytest
+
+from cislunar.papers.wolf_jones import exercises as X
+
+# ===============================================================================================================
+# Notebooks 02-04
+# ===============================================================================================================
+
+
+def test_02_standard_error_falls_as_one_over_sqrt_n():
+    a = X.exercise_02_monte_carlo_samples(n_samples=4000, factor=4, seed=0)
+    assert a.predicted_ratio == pytest.approx(2.0)
+    assert a.ratio == pytest.approx(2.0, rel=0.15)  # standard errors of 4000 and 16000 samples
+    assert max(a.misses) < 4.0  # both estimates agree with the closed form
+    assert a.closed == pytest.approx(0.5 * np.log(5.0)) and "1/sqrt(n)" in a.answer
+    with pytest.raises(ValueError):
+        X.exercise_02_monte_carlo_samples(factor=1)
+
+
+def test_02_less_range_noise_gains_at_most_ln_one_over_factor_per_measurement():
+    a = X.exercise_02_range_noise(factor=0.5)  # the whole window: 17 daily times
+    assert a.n_days == 17 and a.n_range == 51 and a.bound == pytest.approx(51 * np.log(2.0))
+    assert a.mi_scaled > a.mi_table5 and a.gain == pytest.approx(a.mi_scaled - a.mi_table5)
+    assert a.gain <= a.bound * (1 + 1e-9)  # the determinant bound ...
+    assert np.all(a.daily_gain > 0) and np.all(a.daily_gain <= 1 + 1e-6)  # ... holds day by day
+    assert a.daily_gain[0] > 0.99  # the first day is high signal-to-noise: the full bound
+    assert a.daily_gain[-8:].mean() < 0.8 and a.gain < 0.8 * a.bound  # later days gain less, as the answer says
+    assert np.sum(a.daily_gain) * 3 * np.log(2.0) == pytest.approx(a.gain)
+    short = X.exercise_02_range_noise(factor=0.5, n_days=2)
+    assert short.n_range == 6 and short.gain > 0.99 * short.bound
+    with pytest.raises(ValueError):
+        X.exercise_02_range_noise(factor=2.0)
+
+
+def test_03_fewer_nodes_cost_more_impulse():
+    a = X.exercise_03_node_count(n_nodes=(24, 12))
+    assert a.n_nodes == (12, 24)
+    assert a.impulses_mps[0] > 1.1 * a.impulses_mps[1] > 0
+    assert max(a.max_defects) < 1e-9
+
+
+def test_03_an_inactive_thrust_bound_does_not_move_the_optimum():
+    a = X.exercise_03_thrust_bound(scale=0.01, n_nodes=12)
+    assert a.thrust_fraction < a.scale  # the tightened bound is still not reached ...
+    assert a.relative_difference < 1e-6  # ... so the optimum is unchanged
+    assert a.impulse_table3_mps > 0
+
+
+def test_04_linearisation_error_is_quadratic_in_the_control_size():
+    a = X.exercise_04_control_size(factor=2.0, n_nodes=24, draws=2)
+    assert a.error_km > a.error_reduced_km > 0
+    assert a.ratio == pytest.approx(4.0, rel=0.1)
+
+
+def test_04_halving_the_intervals_divides_the_error_by_about_two_to_the_sixth():
+    a = X.exercise_04_node_count(n_nodes=24, draws=2)
+    assert a.error_km > a.error_doubled_km > 0
+    assert 5.0 < a.order < 7.0 and a.ratio == pytest.approx(2**a.order)
+
+# ===============================================================================================================
+# End of notebooks 02-04
+# ===============================================================================================================
