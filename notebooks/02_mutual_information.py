@@ -31,16 +31,27 @@
 # of the closing table are claims declared in `cislunar.papers.wolf_jones.claims.mutual_information`.
 
 # %% tags=["parameters"]
-QUICK = False
-SEED = 0
-OUTPUT_DIR = ""
+QUICK = False  # quick mode: every None below picks its smaller quick-mode value; the same experiments run
+SEED = 0  # seed of the notebook's random generator (the Monte Carlo check of section 1)
+OUTPUT_DIR = ""  # folder for the figures ("": the build's default)
+MC_SAMPLES = None  # Monte Carlo samples for the Eq. 11 check [-] (None: 20000 quick, 200000 full)
+RANGE_SIGMA_KM = None  # range noise standard deviation [km] (None: Table 5's 0.1 km = 100 m)
+N_BASELINES = None  # observer phase offsets in the baseline study of section 6 [-] (None: 5 quick, 10 full)
+BASELINE_MAX_PHASE = None  # longest observer lead in section 6, fraction of the DRO period [-] (None: 0.5)
+TIMING_SIZES = None  # measurement times per window in section 7 [-] (None: [5, 9, 17] quick, up to 65 full)
+TIMING_MIN_TIME = None  # seconds per timing run in section 7 [s] (None: 0.02 quick, 0.1 full)
+WORKERS = None  # processes for the baseline study [-] (None: 1, serial); the timing study always runs serially
+SCHEDULER = ""  # address of a Dask scheduler for the baseline study, e.g. "tcp://10.0.0.5:8786" ("": none)
 
 # %%
-# Sizes derived from QUICK: quick mode uses fewer samples, baselines and timing sizes; every step still runs.
-MC_SAMPLES = 20000 if QUICK else 200000  # Monte Carlo samples for the KL check (Eq. 11)
-N_BASELINES = 5 if QUICK else 10  # observer phase offsets in the baseline study
-TIMING_SIZES = [5, 9, 17] if QUICK else [5, 9, 17, 33, 65]  # measurement times per window in the timing study
-TIMING_MIN_TIME = 0.02 if QUICK else 0.1  # seconds per timing run
+# Every None above is resolved here; a value the reader gave is used as given, in quick and in full mode.
+mc_samples = MC_SAMPLES if MC_SAMPLES is not None else (20000 if QUICK else 200000)
+range_sigma_km = RANGE_SIGMA_KM if RANGE_SIGMA_KM is not None else 0.1
+n_baselines = N_BASELINES if N_BASELINES is not None else (5 if QUICK else 10)
+baseline_max_phase = BASELINE_MAX_PHASE if BASELINE_MAX_PHASE is not None else 0.5
+timing_sizes = TIMING_SIZES if TIMING_SIZES is not None else ([5, 9, 17] if QUICK else [5, 9, 17, 33, 65])
+timing_min_time = TIMING_MIN_TIME if TIMING_MIN_TIME is not None else (0.02 if QUICK else 0.1)
+workers = WORKERS if WORKERS is not None else 1
 
 import numpy as np
 
@@ -53,6 +64,7 @@ from cislunar.publish.report import ComparisonTable
 from cislunar.sensing import covariance as cov
 from cislunar.sensing import information as info
 from cislunar.sensing import measurements as meas
+from cislunar.utils.executors import open_executor
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -76,9 +88,9 @@ table = ComparisonTable("02 Mutual information (Wolf & Jones Eqs. 9-23, 44-52, P
 # Monte Carlo average of $\ln p(y|x) - \ln p(y)$ from `monte_carlo_mutual_information`.
 
 # %%
-ex = study.scalar_worked_example(MC_SAMPLES, rng, p=4.0, h=1.0, r=1.0)
+ex = study.scalar_worked_example(mc_samples, rng, p=4.0, h=1.0, r=1.0)
 print(f"closed form 0.5 ln(1 + h^2 p / r)  = {ex.closed:.5f} nats")
-print(f"E_x[KL] over {MC_SAMPLES} samples    = {ex.kl_mean:.5f} +- {ex.kl_se:.5f}")
+print(f"E_x[KL] over {mc_samples} samples    = {ex.kl_mean:.5f} +- {ex.kl_se:.5f}")
 print(f"joint Monte Carlo of log ratio       = {ex.monte_carlo:.5f} +- {ex.monte_carlo_se:.5f}")
 print(f"posterior/prior std ratio: {ex.std_ratio:.4f} = exp(-I) = {np.exp(-ex.closed):.4f}")
 
@@ -125,6 +137,8 @@ print(f"Eq. 18 dense: {dense_toy:.12f} nats; chain rule: {total_toy:.12f} nats =
 # is the negative (Eq. 21 puts both in $H_{\mathcal A}$). Optical angles (G&S 2021 Eqs. 7-8, AMOS Eqs. 15-18) use
 # the RMS model $\sigma_\theta = \sqrt{\sigma_{min}^2 + D^2/\rho^2}$ (AMOS Eq. 20, $\sigma_{min}$ = 10 µrad,
 # $D$ = 4 m = 0.004 km): resolution dominates below $D/\sigma_{min}$ = 0.004 km / 10 µrad = 400 km, pointing above.
+# The range noise of the test-case-2 window below is the parameter `RANGE_SIGMA_KM` (Table 5's 100 m unless the
+# reader sets it); the range-rate noise stays at Table 5's 10 m/s.
 
 # %%
 fig = study.figure_angular_noise(mean_range_km=215.0)
@@ -157,7 +171,7 @@ print(f"sigma_theta at 215 km: "
 # out-of-plane position RMS, together with Eq. 18 evaluated both ways and the chain-rule gains.
 
 # %%
-win = study.case_2_window(em)
+win = study.case_2_window(em, range_sigma_km=range_sigma_km)
 lin, days = win.lin, win.days
 print(f"P_ref = {em.tu_to_days(win.P_ref):.3f} d; window {days[0]:.2f}-{days[-1]:.2f} d, "
       f"{win.t.size} measurement times, state dim {lin.P0.shape[0]}")
@@ -268,9 +282,16 @@ print(f"package SCvx defaults: information_model = {scvx_defaults.information_mo
 # vector, while in-plane range and range rate leave the out-of-plane errors unobserved — the paper notes that
 # range needs out-of-plane observer motion (test case 2, Fig. 6) — so for them only the in-plane CRLB can respond
 # to the baseline.
+#
+# The $2\times$`N_BASELINES` covariance analyses (two measurement types, one per observer phase) do not depend
+# on each other: `baseline_study` hands them to the executor opened from `WORKERS` and `SCHEDULER` (serial unless
+# the reader asks for processes or a Dask cluster), and the curves are the same whichever runs them. The phases
+# are spaced geometrically from 0.002 of the period up to `BASELINE_MAX_PHASE` (half a period by default, the
+# longest baseline a DRO offers).
 
 # %%
-curves = study.baseline_study(win, N_BASELINES)  # relative position, then range + range rate
+with open_executor(workers, SCHEDULER) as executor:  # relative position, then range + range rate
+    curves = study.baseline_study(win, n_baselines, max_phase=baseline_max_phase, executor=executor)
 fig = study.figure_baseline(curves)
 _ = plotting.save_figure(fig, "02_baseline_study", output_dir=out)
 for c in curves:
@@ -311,18 +332,21 @@ print("baselines [km] where the observer's total RMS exceeds the target's by > 5
 # tens of percent, and the crossover moves with them).
 #
 # `timing_study` re-linearises the window for each size and times the four evaluations in interleaved rounds, so
-# that a change of load on the machine affects the dense and the structured times alike.
+# that a change of load on the machine affects the dense and the structured times alike. It runs serially
+# whatever `WORKERS` says: times measured beside other work would not compare the two forms fairly. The table row
+# is read at $N$ = 17 (or at the size of `TIMING_SIZES` nearest to it, when the reader leaves 17 out).
 
 # %%
-timing = study.timing_study(win, TIMING_SIZES, min_time=TIMING_MIN_TIME, repeat=3)
+timing = study.timing_study(win, timing_sizes, min_time=timing_min_time, repeat=3)
 fig = study.figure_timing(timing)
 _ = plotting.save_figure(fig, "02_timing_dense_vs_structured", output_dir=out)
 for N, r in zip(timing.sizes, timing.results):
     print(f"N = {N:3d}: MI {r.ratio_value:5.1f}x, MI + gradient {r.ratio_gradient:5.1f}x faster structured "
           f"(dense {1e3 * r.dense_gradient:.2f} ms, structured {1e3 * r.structured_gradient:.2f} ms)")
-r17 = timing.at(17)
+n_ref = min(timing.sizes, key=lambda n: abs(n - 17))  # 17, or the size run nearest to it
+r17 = timing.at(n_ref)
 print(f"chain rule faster than dense from {timing.crossover_value} for the MI, from {timing.crossover_gradient} for "
-      f"MI + gradient; at N = 17: {r17.ratio_value:.1f}x and {r17.ratio_gradient:.1f}x")
+      f"MI + gradient; at N = {n_ref}: {r17.ratio_value:.1f}x and {r17.ratio_gradient:.1f}x")
 
 # %% [markdown]
 # ## 8 · Paper versus reproduction
@@ -390,7 +414,28 @@ for key, c in zip(("baseline_relative_position", "baseline_range_rate"), curves)
         note=f"MI peak and in-plane CRLB minimum at {'the same' if c.same_peak else 'different'} baselines; out-of-"
              f"plane share of the observer's terminal variance {c.out_of_plane_share:.0%} (mean over baselines)"))
 table.add(claims.CLAIMS["timing"].judge(
-    r17.ratio_value, shown=f"MI {r17.ratio_value:.1f}x, MI + gradient {r17.ratio_gradient:.1f}x",
+    r17.ratio_value, shown=(f"at N = {n_ref}: " if n_ref != 17 else "") + f"MI {r17.ratio_value:.1f}x, MI + gradient {r17.ratio_gradient:.1f}x",
     note=f"crossover from this run's times: {timing.crossover_value} (MI), {timing.crossover_gradient} (MI + "
          "gradient); O(N) against O(N^3) shows at larger N (timing figure)"))
 table.display()
+
+# %% [markdown]
+# ## Exercises
+#
+# Change one parameter in the `parameters` cell at the top (or pass it to the runner, e.g.
+# `python -m cislunar.publish.notebooks --quick 02 -p MC_SAMPLES=80000`), write down a prediction, then rerun and
+# compare. The worked solutions are functions of `cislunar.papers.wolf_jones.exercises` that run the same
+# computation at a small size and explain the answer.
+#
+# 1. **Samples and the standard error.** Multiply `MC_SAMPLES` by four. How should the "+-" of the joint Monte
+#    Carlo estimate of section 1 change, and can the first row of the table change its verdict? Worked solution:
+#    `exercise_02_monte_carlo_samples` (the estimate is a mean of independent samples, so its standard error
+#    falls as $1/\sqrt n$: by 2x; the tolerance of 3 standard errors tightens with it and the verdict stays).
+# 2. **Halve the range noise.** Set `RANGE_SIGMA_KM = 0.05`. Before running, bound the change of
+#    $\mathcal I(X;Y)$ in section 4: write Eq. 18 with whitened measurements, $\tfrac12\ln|I + W|$, and ask what
+#    halving the noise does to the range rows of $W$ and how much one measurement can gain at most. Compare
+#    (3 targets) x (17 days) x $\ln 2$ = 35.4 nats with the printed change, and use the chain-rule gains of the
+#    figure in section 4 to say which days reach the bound. Worked solution: `exercise_02_range_noise` (the MI
+#    rises by at most $\ln 2$ nats per range measurement; the first four days gain exactly that, 100 m against a
+#    100 km prior, the later days about half of it, because the filter has by then pinned down much of what a
+#    range measurement sees: 22.7 of the 35.4 nats in all).

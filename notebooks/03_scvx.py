@@ -28,15 +28,26 @@
 # `cislunar.papers.wolf_jones.claims.scvx`, judged at the end.
 
 # %% tags=["parameters"]
-QUICK = False
-SEED = 0
-OUTPUT_DIR = ""
+QUICK = False  # quick mode: every None below picks its smaller quick-mode value; the same experiments run
+SEED = 0  # seed of the notebook's random generator (the random initial guesses of section 4)
+OUTPUT_DIR = ""  # folder for the figures ("": the build's default)
+N_NODES = None  # time nodes of the transfer [-] (None: 24 quick, 60 full)
+SIGMA = None  # Sundman exponent of the nodes, notebook 04 [-] (None: 1.0; the DRO is benign, it matters little)
+A_MAX_KM_S2 = None  # thrust-acceleration bound outside the window [km/s^2] (None: Table 3's 1e-6)
+N_GUESSES = None  # random initial guesses in section 4 [-] (None: 2 quick, 6 full)
+GUESS_CONTROL_SCALE = None  # size of the guesses' random controls, fraction of a_max [-] (None: 0.05)
+GUESS_MAX_ITER = None  # SCvx iteration limit of each run from a random guess [-] (None: 200)
+WORKERS = None  # processes for the runs of section 4 [-] (None: 1, serial)
+SCHEDULER = ""  # address of a Dask scheduler for section 4, e.g. "tcp://10.0.0.5:8786" ("": none)
 
 # %%
-# Sizes derived from QUICK: fewer nodes and fewer random initial guesses in quick mode; the same experiments.
-N_NODES = 24 if QUICK else 60
-N_GUESSES = 2 if QUICK else 6
-SIGMA = 1.0  # Sundman exponent (notebook 04); the DRO is benign, so its value matters little here
+# Every None above is resolved here; a value the reader gave is used as given, in quick and in full mode.
+n_nodes = N_NODES if N_NODES is not None else (24 if QUICK else 60)
+sigma = SIGMA if SIGMA is not None else 1.0
+n_guesses = N_GUESSES if N_GUESSES is not None else (2 if QUICK else 6)
+guess_control_scale = GUESS_CONTROL_SCALE if GUESS_CONTROL_SCALE is not None else 0.05
+guess_max_iter = GUESS_MAX_ITER if GUESS_MAX_ITER is not None else 200
+workers = WORKERS if WORKERS is not None else 1
 
 import numpy as np
 
@@ -46,6 +57,7 @@ from cislunar.papers.wolf_jones import scvx_study as study
 from cislunar.papers.wolf_jones.claims.scvx import CLAIMS
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
+from cislunar.utils.executors import open_executor
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -57,7 +69,7 @@ table = ComparisonTable("03 SCvx with first-order hold (Wolf & Jones Eqs. 24-36,
 #
 # Test case 1's observer starts on the DRO of Table 2 (its printed $\dot y_0$ is corrected in notebook 01) and must
 # reach the printed final state $x_{\mathcal S}(t_f)$ on a neighbouring DRO after two periods, with a thrust
-# acceleration of at most $a_{max} = 10^{-6}$ km/s² (Table 3) **and none at all inside the observation window
+# acceleration of at most $a_{max} = 10^{-6}$ km/s² (Table 3; the parameter `A_MAX_KM_S2` changes it) **and none at all inside the observation window
 # $[3P/4, 3P/2]$** (12.1-24.3 d): the window ends are moved onto nodes and every node of the window gets the bound
 # zero, so the first-order-hold thrust vanishes on the whole window. With $\alpha_h = 0$ the objective of Eq. 42 is
 # the total impulse plus the defect penalty.
@@ -69,9 +81,9 @@ table = ComparisonTable("03 SCvx with first-order hold (Wolf & Jones Eqs. 24-36,
 # %%
 # The node controls are accelerations (first-order hold, Eq. 27), so the bound is a_max at every node outside the
 # window (the acceleration reading of Eqs. 40-41, notebook 04) and zero at the window's nodes.
-prob = study.transfer_problem(N_NODES, SIGMA)  # Sundman nodes, window ends moved onto nodes
+prob = study.transfer_problem(n_nodes, sigma, a_max_km_s2=A_MAX_KM_S2)  # Sundman nodes, window ends on nodes
 t, (k_ws, k_we), A_MAX = prob.t, prob.k_window, prob.scenario.a_max
-print(f"transfer time {em.tu_to_days(prob.scenario.duration):.2f} d, {N_NODES} Sundman nodes (sigma = {SIGMA}), "
+print(f"transfer time {em.tu_to_days(prob.scenario.duration):.2f} d, {n_nodes} Sundman nodes (sigma = {sigma}), "
       f"a_max = {A_MAX:.4f} LU/TU^2, zero on nodes {k_ws}..{k_we} "
       f"({em.tu_to_days(t[k_ws]):.2f}-{em.tu_to_days(t[k_we]):.2f} d); |x_f - x(T) ballistic| = "
       f"{prob.ballistic_miss:.2e}")
@@ -183,9 +195,16 @@ _ = plotting.save_figure(fig, "03_converged_control", output_dir=out)
 # With $s = t/t_f$, the guess is $x^{(0)}(t) = (1-s)\,x_{fwd}(t) + s\,x_{bwd}(t)$, where $x_{fwd}$ coasts from
 # $x_{\mathcal S}(t_0)$ and $x_{bwd}$ coasts backwards from $x_{\mathcal S}(t_f)$; the spread of the converged
 # impulses is measured relative to the run of section 2.
+#
+# `guess_study` draws every guess's random controls from the notebook's generator first, guess after guess, and
+# only then solves: the `N_GUESSES` SCvx runs are independent and go to the executor opened from `WORKERS` and
+# `SCHEDULER` (serial by default), with the same impulses whichever runs them. `GUESS_CONTROL_SCALE` sets how
+# rough the guesses are and `GUESS_MAX_ITER` how long each run may take to recover.
 
 # %%
-guesses = study.guess_study(prob, N_GUESSES, rng, res.impulse, control_scale=0.05, max_iter=200)
+with open_executor(workers, SCHEDULER) as executor:
+    guesses = study.guess_study(prob, n_guesses, rng, res.impulse, control_scale=guess_control_scale,
+                                max_iter=guess_max_iter, executor=executor)
 print("impulses from random guesses [m/s]:", np.round(guesses.impulses * em.velocity_unit_km_s * 1e3, 6),
       f"relative spread {guesses.spread:.1e}; iterations {list(guesses.iterations)}")
 
@@ -216,7 +235,7 @@ table.add(CLAIMS["trust_region_parameters"].judge(
 table.add(CLAIMS["minimum_impulse"].judge(res.impulse * em.velocity_unit_km_s * 1e3,
                                           shown=f"{res.impulse * em.velocity_unit_km_s * 1e3:.4f} m/s"))
 table.add(CLAIMS["initial_guess"].judge(guesses.spread, shown=f"relative impulse spread {guesses.spread:.0e}",
-                                        note=f"{N_GUESSES} random guesses"))
+                                        note=f"{n_guesses} random guesses"))
 table.add(CLAIMS["window_thrust"].judge(window_thrust, shown=f"largest window thrust {window_thrust:.0e}"))
 table.add(CLAIMS["defect_handling"].judge(
     "augmented Lagrangian (SCvx*); exact penalty kept as an option",
@@ -228,3 +247,20 @@ table.add(CLAIMS["trust_region_update"].judge(
          f"with a negative prediction that Eq. 36 would reject; steps with a real predicted decrease had rho in "
          f"[{it.rho_range[0]:.3f}, {it.rho_range[1]:.3f}]"))
 table.display()
+
+# %% [markdown]
+# ## Exercises
+#
+# Change one parameter in the `parameters` cell (or pass it to the runner, e.g.
+# `python -m cislunar.publish.notebooks --quick 03 -p N_NODES=12`), predict, then rerun and compare. The worked
+# solutions are functions of `cislunar.papers.wolf_jones.exercises`, run at small sizes.
+#
+# 1. **Halve the node count.** Set `N_NODES` to half its value. The node controls are the only freedom of the
+#    first-order-hold control: will the converged minimum impulse of section 2 rise, fall or stay? Does the
+#    single-shooting check of section 3 still pass? Worked solution: `exercise_03_node_count` (fewer nodes, a
+#    coarser piecewise-linear thrust and a costlier transfer: about 0.56 m/s on 12 nodes against 0.42 m/s on 24,
+#    every run closing its defects).
+# 2. **Tighten the thrust bound.** Set `A_MAX_KM_S2 = 1e-8`, a hundredth of Table 3's value. Look first at the
+#    converged control of section 3: how close does it come to the bound? Predict the impulse, then check.
+#    Worked solution: `exercise_03_thrust_bound` (the largest converged thrust is about 0.1 % of Table 3's
+#    bound, so a bound 100x tighter is still inactive and the optimum does not move).

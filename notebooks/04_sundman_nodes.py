@@ -27,16 +27,25 @@
 # `cislunar.papers.wolf_jones.claims.sundman_nodes`, judged at the end.
 
 # %% tags=["parameters"]
-QUICK = False
-SEED = 0
-OUTPUT_DIR = ""
+QUICK = False  # quick mode: every None below picks its smaller quick-mode value; the same experiments run
+SEED = 0  # seed of the random control draws (further draw seeds are SEED + 1, SEED + 2, ...)
+OUTPUT_DIR = ""  # folder for the figures ("": the build's default)
+SIGMAS = None  # Sundman exponents swept [-], must hold 0 and 1 (None: [0, 1, 2] quick, [0, 0.5, ..., 2] full)
+N_NODES = None  # nodes over each reference arc [-] (None: 24 quick, 48 full)
+N_DRAWS = None  # random control profiles per (arc, sigma) [-] (None: 2 quick, 8 full)
+N_EXTRA_SEEDS = None  # further draw seeds for the DRO robustness check [-] (None: 1 quick, 3 full)
+CONTROL_SIZE_KM_S2 = None  # amplitude of the random control profiles [km/s^2] (None: Table 3's a_max, 1e-6)
+WORKERS = None  # processes for the linearisation sweep [-] (None: 1, serial)
+SCHEDULER = ""  # address of a Dask scheduler for the sweep, e.g. "tcp://10.0.0.5:8786" ("": none)
 
 # %%
-# Sizes derived from QUICK: fewer exponents, nodes and perturbation draws in quick mode; the same experiments.
-SIGMAS = [0.0, 1.0, 2.0] if QUICK else [0.0, 0.5, 1.0, 1.5, 2.0]
-N_NODES = 24 if QUICK else 48  # nodes over each reference arc
-N_DRAWS = 2 if QUICK else 8  # random control perturbations per (orbit, sigma)
-N_EXTRA_SEEDS = 1 if QUICK else 3  # further random-draw seeds for the DRO robustness check
+# Every None above is resolved here; a value the reader gave is used as given, in quick and in full mode.
+sigmas = SIGMAS if SIGMAS is not None else ([0.0, 1.0, 2.0] if QUICK else [0.0, 0.5, 1.0, 1.5, 2.0])
+n_nodes = N_NODES if N_NODES is not None else (24 if QUICK else 48)
+n_draws = N_DRAWS if N_DRAWS is not None else (2 if QUICK else 8)
+n_extra_seeds = N_EXTRA_SEEDS if N_EXTRA_SEEDS is not None else (1 if QUICK else 3)
+control_size_km_s2 = CONTROL_SIZE_KM_S2 if CONTROL_SIZE_KM_S2 is not None else 1e-6
+workers = WORKERS if WORKERS is not None else 1
 
 import numpy as np
 
@@ -45,6 +54,7 @@ from cislunar.papers.wolf_jones import nodes_study as study
 from cislunar.papers.wolf_jones.claims.sundman_nodes import CLAIMS, DRO_SIGMA
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
+from cislunar.utils.executors import open_executor
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -56,6 +66,7 @@ table = ComparisonTable("04 Sundman nodes and FOH discretisation (Wolf & Jones E
 ARCS = study.reference_arcs(em)
 dro_name, nrho_name = list(ARCS)
 A_MAX = study.A_MAX_KM_S2 / em.acceleration_unit_km_s2  # Wolf & Jones Table 3: 1e-6 km/s^2, in LU/TU^2
+CONTROL_SIZE = control_size_km_s2 / em.acceleration_unit_km_s2  # random control amplitude, LU/TU^2
 
 # %% [markdown]
 # ## 1 · The Sundman transformation (Eqs. 37-39)
@@ -73,7 +84,7 @@ A_MAX = study.A_MAX_KM_S2 / em.acceleration_unit_km_s2  # Wolf & Jones Table 3: 
 # \min\Delta t_k$, which is 1 for $\sigma = 0$ and grows with $\sigma$ as fast as $r_m$ varies along the arc.
 
 # %%
-sweep = study.node_sweep(em, ARCS, SIGMAS, N_NODES)
+sweep = study.node_sweep(em, ARCS, sigmas, n_nodes)
 fig = study.figure_node_spacing(em, sweep)
 _ = plotting.save_figure(fig, "04_node_spacing", output_dir=out)
 for key, v in sweep.spread.items():
@@ -120,17 +131,22 @@ _ = plotting.save_figure(fig, "04_nodes_on_orbits", output_dir=out)
 # $\bar x_k$; the error of a draw is the largest position difference over the intervals, and
 # `linearisation_error` returns the median over the draws, in km. `linearisation_sweep` draws from the notebook's
 # generator in a fixed order (arc by arc, $\sigma$ by $\sigma$), then repeats the DRO with one fresh generator per
-# extra seed.
+# extra seed. All the random profiles are drawn first, in that order; the cells of the sweep then go to the
+# executor opened from `WORKERS` and `SCHEDULER` (serial by default), so the errors do not depend on who computes
+# them. The amplitude of the profiles is `CONTROL_SIZE_KM_S2` (Table 3's $a_{max}$ unless the reader changes it);
+# the node bounds of section 3 keep Table 3's $a_{max}$.
 
 # %%
-lin = study.linearisation_sweep(em, sweep, N_DRAWS, rng, range(SEED + 1, SEED + 1 + N_EXTRA_SEEDS), A_MAX)
+with open_executor(workers, SCHEDULER) as executor:
+    lin = study.linearisation_sweep(em, sweep, n_draws, rng, range(SEED + 1, SEED + 1 + n_extra_seeds), CONTROL_SIZE,
+                                    executor=executor)
 fig = study.figure_linearisation_error(sweep, lin)
 _ = plotting.save_figure(fig, "04_linearisation_error_vs_sigma", output_dir=out)
 for key, v in lin.errors.items():
     print(f"{key[0]:30s} sigma = {key[1]:3.1f}: {v:.3e} km (uniform / this = {lin.errors[key[0], 0.0] / v:.2f})")
 for seed, errs in lin.extra.items():
     print(f"DRO, draw seed {seed}: uniform / sigma error ratio",
-          {f"{s:g}": round(errs[0.0] / errs[s], 2) for s in SIGMAS})
+          {f"{s:g}": round(errs[0.0] / errs[s], 2) for s in sigmas})
 
 # %% [markdown]
 # The error is not monotonic in $\sigma$: crowding the nodes into perilune leaves long intervals elsewhere, where
@@ -155,7 +171,7 @@ for seed, errs in lin.extra.items():
 # %%
 fig = study.figure_node_bounds(em, sweep, nrho_name, A_MAX)
 _ = plotting.save_figure(fig, "04_umax_per_node", output_dir=out)
-residual_40 = study.eq40_residual(sweep.nodes[nrho_name, max(SIGMAS)], A_MAX)
+residual_40 = study.eq40_residual(sweep.nodes[nrho_name, max(sigmas)], A_MAX)
 print(f"Eq. 40 relative residual of the minimum-norm solution: {residual_40:.1e}")
 
 # %% [markdown]
@@ -170,20 +186,20 @@ print(f"Eq. 40 relative residual of the minimum-norm solution: {residual_40:.1e}
 # %%
 gains_dro = lin.dro_gains(DRO_SIGMA)
 best_nrho_gain, best_nrho = lin.best_gain(nrho_name)
-spread_nrho = sweep.spread[nrho_name, max(SIGMAS)]
+spread_nrho = sweep.spread[nrho_name, max(sigmas)]
 table.add(CLAIMS["sigma0_identity"].judge(
     "uniform nodes, tau = t (tested)", note="an identity of Eq. 37 at sigma = 0 (dt = d tau), checked to atol 1e-12 "
                                             "in tests/guidance/test_discretization.py"))
 table.add(CLAIMS["dilation"].judge(spread_nrho, shown=f"NRHO shortest interval at perilune; spacing ratio "
-                                                      f"{spread_nrho:.0f} at sigma = {max(SIGMAS):g}"))
+                                                      f"{spread_nrho:.0f} at sigma = {max(sigmas):g}"))
 table.add(CLAIMS["exponent_symbol"].judge("sigma", shown="sigma used throughout"))
-table.add(CLAIMS["nodes_and_sigma"].judge(f"N = {N_NODES}; sigma in {SIGMAS}"))
+table.add(CLAIMS["nodes_and_sigma"].judge(f"N = {n_nodes}; sigma in {sigmas}"))
 table.add(CLAIMS["dro_gain"].judge(
     min(gains_dro), shown=f"sigma = {DRO_SIGMA:g} reduces the worst one-step position error {min(gains_dro):.2f}-"
                           f"{max(gains_dro):.2f}x vs uniform ({len(gains_dro)} draw seeds; {gains_dro[0]:.2f}x for "
                           f"seed {SEED})",
     note=f"smallest gain over the draw seeds; uniform {lin.errors[dro_name, 0.0]:.2e} km; best of the sweep {lin.best_gain(dro_name)[0]:.2f}x; "
-         f"sigma = {max(SIGMAS):g} gives {lin.gain(dro_name, max(SIGMAS)):.2f}x (below 1: worse than uniform)"))
+         f"sigma = {max(sigmas):g} gives {lin.gain(dro_name, max(sigmas)):.2f}x (below 1: worse than uniform)"))
 table.add(CLAIMS["nrho_gain"].judge(best_nrho_gain, shown=f"{best_nrho_gain:.1f}x at sigma = {best_nrho:g} vs uniform",
                                     note=f"uniform {lin.errors[nrho_name, 0.0]:.2e} km"))
 table.add(CLAIMS["eq41_bounds"].judge(
@@ -196,3 +212,20 @@ table.add(CLAIMS["foh_matrices"].judge(
     "heyoka state/parameter sensitivities", note="same matrices without inverting the STM; tests vs STM and finite "
                                                  "differences"))
 table.display()
+
+# %% [markdown]
+# ## Exercises
+#
+# Change one parameter in the `parameters` cell (or pass it to the runner, e.g.
+# `python -m cislunar.publish.notebooks --quick 04 -p CONTROL_SIZE_KM_S2=5e-7`), predict, then rerun and compare.
+# The worked solutions are functions of `cislunar.papers.wolf_jones.exercises`, run at small sizes.
+#
+# 1. **Halve the control size.** Set `CONTROL_SIZE_KM_S2 = 5e-7`. The affine model of Eq. 28 is the first-order
+#    expansion of the flow in the controls: by how much should every linearisation error of section 2 fall? Do
+#    the uniform-over-Sundman ratios change? Worked solution: `exercise_04_control_size` (what the model misses
+#    is second order, so the errors fall 4x, and the ratios between node spacings barely move).
+# 2. **Double the node count.** Set `N_NODES` to twice its value. Over an interval of length $h$ a control of
+#    size $a$ moves the state by about $ah^2$; the model misses a term quadratic in that, accumulated over the
+#    interval into velocity and then position. Predict the factor by which the errors fall, then compare it with
+#    what the Sundman exponent achieves at a fixed node count. Worked solution: `exercise_04_node_count` (the
+#    error decays as about $h^6$: halving the intervals divides it by about 64, far more than any $\sigma$ does).
