@@ -15,12 +15,11 @@ Pieces, in the order of the paper:
   window around apoapsis, and the test statistic :math:`z = \int\|\hat{\mathbf u}\|dt` (Eq. 33) of the *smoothed*
   control (the spike "appears only in the smoothed system", Figs. 10-13).
 * **Batched OCBE** (:func:`ocbe_batch`): the same filter and smoother for ``B`` trials in lockstep, heyoka batch
-  integrators for the transitions and stacked numpy QR/Cholesky for the square-root-information algebra.  The
-  default engine integrates only the three non-zero 6x6 blocks of the transition
-  (:func:`cislunar.estimation.ocbe.block_integrator`, about four times cheaper than the full 12x12 variational system, which
-  the ``engine="reference"`` path keeps).  Both equal the single-trial filter to round-off
-  (``tests/papers/greaves_scheeres_2021/test_detection.py``); :func:`run_detection_monte_carlo` runs several batches per lockstep call.  The
-  Monte Carlo is about six times faster than with the first batched OCBE (``benchmarks/bench_detection.py``).
+  integrators for the transitions and stacked numpy QR/Cholesky for the square-root-information algebra.  It
+  integrates only the three non-zero 6x6 blocks of the transition (:func:`cislunar.estimation.ocbe.block_integrator`,
+  about four times cheaper than the full 12x12 variational system) and equals the single-trial filter to round-off
+  (``tests/estimation/test_batched_ocbe.py``, ``tests/papers/greaves_scheeres_2021/test_detection.py``);
+  :func:`run_detection_monte_carlo` runs several batches per lockstep call (``benchmarks/bench_detection.py``).
   Every Monte Carlo trial also records the NEES of its forward and smoothed estimates against its truth, so each
   training or test set doubles as a consistency check of the tuning (:attr:`MonteCarloSample.inconsistent_runs`).
 * **Hypothesis test** (Eqs. 34-35): Gaussian kernel density estimates of :math:`z` under :math:`\mathcal H_0`

@@ -1,0 +1,306 @@
+"""Figures of notebooks 09b and 10 (Greaves & Scheeres 2021) drawn from the study results.
+
+Each function takes a result object of :mod:`cislunar.papers.greaves_scheeres_2021.adaptive_studies` or
+:mod:`cislunar.papers.greaves_scheeres_2021.detection_studies` and returns a ``matplotlib.figure.Figure`` (through
+pyplot, so that a notebook shows it inline); saving is the caller's (``plotting.save_figure``).  Units as on the axes.
+"""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+from scipy import stats
+
+from cislunar.estimation import adaptive_ocbe as ad
+from cislunar.papers.greaves_scheeres_2021 import adaptive_studies as ads
+from cislunar.papers.greaves_scheeres_2021 import detection as det
+from cislunar.papers.greaves_scheeres_2021 import panels as ocbe_panels
+
+__all__ = ["metric_law", "adaptive_errors", "adaptive_control_metric", "delays", "reset_rules", "station_keeping_policy",
+           "control_integral_pdfs", "z_vs_maneuver", "pm_j_search", "health_lead", "health_metric", "tuning_map"]
+
+_OUTCOME_COLORS = {"prompt": "C0", "late": "C3", "nearly periapsis": "C1", "not detected": "0.6"}
+
+
+def metric_law(null: ads.NullMetricStudy):
+    """Histogram and Q-Q plot of the pooled no-maneuver metric against its chi-square law (notebook 09b, Sec. 1)."""
+    pooled, law, lim = null.metric, ad.metric_law(null.dof), ad.metric_limit(null.dof)
+    fig, ax = plt.subplots(1, 2, figsize=(11, 3.8))
+    xx = np.linspace(0, 20, 300)
+    ax[0].hist(pooled, bins=40, range=(0, 20), density=True, alpha=0.6, histtype="stepfilled",
+               label=f"{pooled.size} epochs, {null.n_runs} runs")
+    ax[0].plot(xx, law.pdf(xx), "k", lw=1.2, label=rf"$\chi^2_{null.dof}$ (derived)")
+    ax[0].axvline(lim, color="C3", ls="--", label=f"99 % limit {lim:.2f}")
+    ax[0].set(xlabel="OCBE metric $M$ [-]", ylabel="probability density [-]",
+              title=f"no maneuver: KS p = {null.ks_p:.2f}")
+    ax[0].legend()
+    srt = np.sort(pooled)
+    ax[1].plot(law.ppf((np.arange(srt.size) + 0.5) / srt.size), srt, ".", ms=3)
+    ax[1].plot([0, 20], [0, 20], "k", lw=0.8)
+    ax[1].set(xlabel=rf"$\chi^2_{null.dof}$ quantile [-]", ylabel="metric quantile [-]", xlim=(0, 20), ylim=(0, 20),
+              title="Q-Q plot against the derived law")
+    return fig
+
+
+def _days(setup: det.DetectionSetup, t) -> float:
+    return t * setup.system.time_unit_s / 86400.0
+
+
+def adaptive_errors(setup: det.DetectionSetup, run: ads.AdaptiveRun, title: str):
+    """Fig. 6/8 layout of an adaptive run: position and velocity error norms with 3-sigma, forward and smoothed."""
+    return ocbe_panels.figure_errors(run.panels, title, burn_days=_days(setup, setup.t_maneuver),
+                                     detection_days=[_days(setup, d.time) for d in run.detections])
+
+
+def adaptive_control_metric(setup: det.DetectionSetup, run: ads.AdaptiveRun, title: str):
+    """Fig. 7/9 layout of an adaptive run: control norm and normalised metric, forward and smoothed; crosses: what
+    the online filter saw before the first reset (its three strikes)."""
+    dets = run.detections
+    return ocbe_panels.figure_control_metric(run.panels, title, burn_days=_days(setup, setup.t_maneuver),
+                                             detection_days=[_days(setup, d.time) for d in dets],
+                                             first_pass_metric=run.run.metric_first_pass if dets else None,
+                                             first_pass_until=dets[0].declared_epoch if dets else None)
+
+
+def delays(study: ads.DelayStudy):
+    """Delay after the burn per size, and stacked outcome bars per size and per angle noise (notebook 09b, Sec. 5)."""
+    mags = list(study.by_size)
+    mm = np.array(mags) * 1e3
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    q = np.array([study.by_size[m].quartiles_h for m in mags])
+    ax[0].fill_between(mm, q[:, 0], q[:, 1], color="C0", alpha=0.2, label="25-75 % of detected runs")
+    ax[0].plot(mm, [study.by_size[m].median_h for m in mags], "C0o-", label="median of detected runs")
+    ax[0].axhline(study.late_from_h, color="C1", ls="--", lw=1, label="'nearly periapsis' above this line")
+    ax[0].set(xscale="log", xlabel="burn size [mm/s]", ylabel="detection delay [h]",
+              title=f"delay after the burn ({study.n_runs} runs per size)")
+    ax[0].legend(loc="center right", fontsize=8)
+    for j, (groups, labels, title, xlabel) in enumerate((
+            (list(study.by_size.values()), [f"{m:g}" for m in mm], "outcome versus burn size (10 urad)",
+             "burn size [mm/s]"),
+            (list(study.by_noise.values()), [f"{s:g}" for s in study.by_noise],
+             "50 mm/s burn: outcome versus angle noise", "angle noise (1 sigma) [urad]"))):
+        bottom = np.zeros(len(groups))
+        for name in ads.OUTCOMES:
+            frac = 100 * np.array([g.fraction(name) for g in groups])
+            ax[j + 1].bar(labels, frac, bottom=bottom, color=_OUTCOME_COLORS[name], label=name, width=0.6)
+            bottom += frac
+        ax[j + 1].set(ylabel="runs [%]", ylim=(0, 100), title=title, xlabel=xlabel)
+    handles, labels = ax[1].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=4, bbox_to_anchor=(0.5, 0.0))
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    return fig
+
+
+def reset_rules(study: ads.ResetRuleStudy):
+    """Inconsistent-after-the-burn and re-converged fractions per burn size for each reset rule (notebook 09b)."""
+    mm = np.array(study.magnitudes_m_s) * 1e3
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
+    for j, rule in enumerate(study.rules):
+        S = [study.summary(m, rule) for m in study.magnitudes_m_s]
+        sty = dict(color=f"C{j}", ls="-" if j == 0 else "--", marker="o" if j == 0 else "s", ms=8 if j == 0 else 5,
+                   mfc="none" if j else None, label=f"{rule} rule")
+        ax[0].plot(mm, [100 * s["inconsistent"] for s in S], **sty)
+        ax[1].plot(mm, [100 * s["final_ok"] for s in S], **sty)
+    ax[0].set(xscale="log", xlabel="burn size [mm/s]", ylabel="runs [%]", ylim=(-5, 105),
+              title="inconsistent after the burn (NEES)")
+    ax[1].set(xscale="log", xlabel="burn size [mm/s]", ylabel="detected runs [%]", ylim=(-5, 105),
+              title="final estimate consistent (re-converged)")
+    handles, labels = ax[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=2, bbox_to_anchor=(0.5, 0.0))
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Notebook 10
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def station_keeping_policy(magnitudes: dict, policies: dict, uz):
+    """Eq. 5 magnitude draws against the truncated-Gaussian PDF per policy, and the k component of Eqs. 3-4 pointing
+    against the arcsine law and a uniform sphere.  ``magnitudes``: policy name -> draws [m/s]."""
+    fig, ax = plt.subplots(1, 3, figsize=(14, 3.8))
+    for name, pol in policies.items():
+        m, d = magnitudes[name], pol.magnitude_distribution
+        a = ax[0 if name == "active" else 1]
+        a.hist(m * 1e3, bins=60, density=True, alpha=0.6, histtype="stepfilled", label="draws")
+        zz = np.linspace(d.ppf(0), d.ppf(1), 300)
+        a.plot(zz * 1e3, d.pdf(zz) / 1e3, "k", lw=1, label="truncnorm PDF")
+        a.set(title=f"{name}: mean {m.mean() * 1e3:.1f}, sd {m.std() * 1e3:.2f} mm/s",
+              ylim=(0, 1.35 * d.pdf(d.mean()) / 1e3),  # headroom for the legend
+              xlabel="impulse magnitude [mm/s]", ylabel="probability density [1/(mm/s)]")
+    ax[2].hist(uz, bins=50, density=True, alpha=0.6, histtype="stepfilled", label="Eqs. 3-4 (paper)")
+    ax[2].plot(np.linspace(-0.999, 0.999, 200), stats.arcsine(-1, 2).pdf(np.linspace(-0.999, 0.999, 200)), "k",
+               lw=1, label="arcsine PDF")
+    ax[2].axhline(0.5, color="C3", ls="--", label="uniform sphere")
+    ax[2].set(xlabel=r"$\hat k$ component of the impulse direction [-]", ylabel="probability density [-]",
+              ylim=(0, 3), title="pointing")
+    ax[0].legend(loc="upper left")
+    ax[2].legend(fontsize=8, loc="upper center")
+    return fig
+
+
+def control_integral_pdfs(studies: dict, orbit_names, policy_names):
+    """Figs. 14-15 and 18-19 analogues: histograms and KDEs of z under H0 and H1, with z_lim, per orbit (rows) and
+    policy (column pairs; active in m/s, quiet in mm/s).  ``studies``: (orbit, policy) -> detection.PolicyStudy."""
+    fig, ax = plt.subplots(len(orbit_names), 4, figsize=(16, 3.3 * len(orbit_names)))
+    for row, o in enumerate(orbit_names):
+        for k, p in enumerate(policy_names):
+            st = studies[o, p]
+            unit, ulab = (1.0, "m/s") if p == "active" else (1e3, "mm/s")
+            lo, hi = 0.0, max(st.h0.z.max(), st.h1.z.max()) * unit * 1.05
+            bins = np.linspace(lo, hi, 50)
+            a_h, a_p = ax[row, 2 * k], ax[row, 2 * k + 1]
+            a_h.hist(st.h0.z * unit, bins=bins, alpha=0.6, histtype="stepfilled", label="no maneuver (H0)")
+            a_h.hist(st.h1.z * unit, bins=bins, alpha=0.6, histtype="stepfilled", label="maneuver (H1)")
+            zz = np.linspace(lo, hi, 600)
+            a_p.plot(zz, st.threshold.pdf0(zz / unit) / unit, label=r"$PDF_{H0}$")
+            a_p.plot(zz, st.threshold.pdf1(zz / unit) / unit, label=r"$PDF_{H1}$")
+            for a in (a_h, a_p):
+                a.axvline(st.threshold.z_lim * unit, color="k", ls=":", lw=1)
+                a.set(xlabel=f"z [{ulab}]")
+            a_h.set(title=f"{o}, {p}: {len(st.h0)} H0 + {len(st.h1)} H1 runs", ylabel="runs [-]")
+            a_p.set(title=f"z_lim = {st.threshold.z_lim * unit:.4g} {ulab}",
+                    ylabel=f"probability density [1/({ulab})]")
+    h0h, h0l = ax[0, 0].get_legend_handles_labels()
+    h1h, h1l = ax[0, 1].get_legend_handles_labels()
+    fig.legend(h0h + h1h + [plt.Line2D([], [], color="k", ls=":", lw=1)], h0l + h1l + ["z_lim"], loc="lower center",
+               ncol=5, bbox_to_anchor=(0.5, 0.0))
+    fig.tight_layout(rect=(0, 0.04, 1, 1))
+    return fig
+
+
+def z_vs_maneuver(studies: dict, orbit_names, policy_names):
+    """Figs. 16-17, 20-21 analogues on the 9:2 NRHO's training runs: z over the pointing, z/|dv| over the azimuth,
+    z against the magnitude (the first two orbits of ``orbit_names`` overlaid)."""
+    fig, ax = plt.subplots(2, 3, figsize=(15, 8))
+    for row, p in enumerate(policy_names):
+        h1 = studies["9:2 NRHO", p].h1
+        unit, ulab = (1.0, "m/s") if p == "active" else (1e3, "mm/s")
+        sc = ax[row, 0].scatter(np.degrees(h1.azimuth), np.degrees(h1.elevation), c=h1.z * unit, s=6,
+                                cmap="viridis")
+        fig.colorbar(sc, ax=ax[row, 0], label=f"z [{ulab}]")
+        ax[row, 0].set(xlabel="azimuth [deg]", ylabel="elevation [deg]", title=f"9:2 NRHO, {p}")
+        ax[row, 1].scatter(np.degrees(h1.azimuth), h1.z / h1.magnitude, s=4, alpha=0.5)
+        ax[row, 1].set(xlabel="azimuth [deg]", ylabel="z / impulse magnitude [-]", title=f"9:2 NRHO, {p}")
+        for o, mk in zip(orbit_names, ("o", "x")):
+            s1 = studies[o, p].h1
+            ax[row, 2].scatter(s1.magnitude * unit, s1.z * unit, s=4, alpha=0.4, marker=mk, label=o)
+        mm = np.array([0, h1.magnitude.max() * unit])
+        ax[row, 2].plot(mm, mm, "k--", lw=1, label="z = magnitude")
+        ax[row, 2].set(xlabel=f"impulse magnitude [{ulab}]", ylabel=f"z [{ulab}]",
+                       title=f"{p}: z against the magnitude")
+        ax[row, 2].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0), markerscale=3)
+    fig.tight_layout()
+    return fig
+
+
+def pm_j_search(pmj: dict, f_values, noise_urad, offsets_h, f_pm: float, sig_pm: float, active_sample):
+    """The +-j search: paired contrast against the angle noise per window factor (burn at apoapsis), per burn time
+    at ``f_pm``, and the random-burn runs of the regime ``(f_pm, sig_pm)`` coloured by z/|dv|.
+    ``pmj``: (f, noise, offset) -> (z per direction, contrast)."""
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    for f, mk in zip(f_values, "osD^"):
+        ax[0].plot(noise_urad, [pmj[f, s, 0.0][1] for s in noise_urad], marker=mk, label=f"f = {f:g}")
+    ax[0].axhline(1.0, color="0.5", lw=0.8)
+    ax[0].set(xscale="log", xlabel="angle noise [micro-rad]", ylabel="z(+-j) / z(+-i, +-k) [-]",
+              title="burn at apoapsis")
+    ax[0].legend(fontsize=8, loc="upper left")
+    for off, mk in zip(offsets_h, "osD"):
+        ax[1].plot(noise_urad, [pmj[f_pm, s, off][1] for s in noise_urad], marker=mk,
+                   label=f"burn {off:+g} h from apoapsis")
+    ax[1].axhline(1.0, color="0.5", lw=0.8)
+    ax[1].set(xscale="log", xlabel="angle noise [micro-rad]", ylabel="z(+-j) / z(+-i, +-k) [-]",
+              title=f"f = {f_pm:g}: burn time in the window")
+    ax[1].legend(fontsize=8, loc="upper left")
+    h = active_sample
+    sc = ax[2].scatter(np.degrees(h.azimuth), np.degrees(h.elevation), c=h.z / h.magnitude, s=8, cmap="viridis")
+    fig.colorbar(sc, ax=ax[2], label="z / impulse magnitude [-]")
+    ax[2].set(xlabel="azimuth [deg]", ylabel="elevation [deg]", title=f"active, f = {f_pm:g}, {sig_pm:g} urad")
+    fig.tight_layout()
+    return fig
+
+
+def health_lead(lead: dict):
+    """Fig. 22 race: per burn size, the share of runs where the control or the residual test fires first, both at
+    the same epoch, or neither within 24 h.  ``lead``: label -> detection.HealthLeadStudy."""
+    fig, ax = plt.subplots(1, len(lead), figsize=(5 * len(lead), 3.8), sharey=True)
+    for a, (tag, h) in zip(ax, lead.items()):
+        fr = h.outcome_fractions()
+        x = np.arange(h.magnitudes_m_s.size)
+        bottom = np.zeros(x.size)
+        for (name, v), col in zip(fr.items(), ("C2", "0.6", "C1", "0.85")):
+            a.bar(x, 100 * v, bottom=bottom, color=col, label=name, width=0.7)
+            bottom += 100 * v
+        a.set(xticks=x, xticklabels=[f"{m:g}" for m in h.magnitudes_m_s], xlabel="burn size [m/s]", title=tag)
+    ax[0].set(ylabel="runs [%]")
+    h_, l_ = ax[0].get_legend_handles_labels()
+    fig.legend(h_, l_, loc="lower center", ncol=4, bbox_to_anchor=(0.5, -0.02))
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    return fig
+
+
+def health_metric(setup: det.DetectionSetup, inputs: det.TrialInputs, result, reference, z_m_s: float):
+    """Fig. 22 analogue of one run: smoothed position error and 3-sigma, whitened residual norms against the 99 %
+    level of a 4-dof residual, and z against the quiet training runs (``reference``: a detection.PolicyStudy)."""
+    em = setup.system
+    fig, ax = plt.subplots(1, 3, figsize=(15, 3.8))
+    hours = setup.scenario.t * em.time_unit_s / 3600
+    err = np.linalg.norm(result.x_smooth[:, :3] - inputs.truth[:, :3], axis=1) * em.length_unit_km
+    sig = 3 * np.sqrt(np.trace(result.P_smooth[:, :3, :3], axis1=1, axis2=2)) * em.length_unit_km
+    ax[0].plot(hours, err, label="smoothed error")
+    ax[0].plot(hours, sig, "--", label="3-sigma")
+    ax[0].set(xlabel="time from periapsis [h]", ylabel="position error [km]", title="0.5 m/s burn, quiet tuning")
+    ax[0].legend(loc="upper right")
+    ax[1].plot(hours, result.residual_norms, ".", label="this run")
+    ax[1].axhline(np.sqrt(stats.chi2.ppf(0.99, 4)), color="k", ls=":", label="99 % of a 4-dof residual")
+    ax[1].set(xlabel="time from periapsis [h]", ylabel="whitened residual norm [-]", title="measurement residuals")
+    ax[1].legend(loc="center left")
+    ax[2].hist(reference.h0.z, bins=40, alpha=0.6, histtype="stepfilled", label="quiet H0")
+    ax[2].hist(reference.h1.z, bins=40, alpha=0.6, histtype="stepfilled", label="quiet H1")
+    ax[2].axvline(z_m_s, color="k", label=f"this run: z = {z_m_s:.3f} m/s")
+    ax[2].set(xscale="log", xlabel="z [m/s]", ylabel="runs [-]", title="z against the training runs")
+    ax[2].legend(fontsize=8, loc="upper left")
+    return fig
+
+
+def tuning_map(tmap: dict, orbit_names, policy_names, variants, base_variant: str, f_grid, f_side, f_c: float,
+               f_tune: float, paper_zlim: dict, worst):
+    """The tuning map (notebook 10, Section 2): top row all orbits at the paper's window (H1 forward and smoothed
+    inconsistent runs, FP + MD); bottom row the 9:2 NRHO per setting (worst cell, z_lim over the paper's, FP + MD).
+    ``tmap``: (orbit, policy, f, variant) -> cell dict; ``worst(o, p, f, v)``: worst inconsistent fraction."""
+    fig, ax = plt.subplots(2, 3, figsize=(15, 8.4))
+    for o, col in zip(orbit_names, ("C0", "C1", "C2")):
+        for p, ls in zip(policy_names, ("-", "--")):
+            c = [tmap[o, p, f, base_variant] for f in f_grid]
+            lab = f"{o}, {p}"
+            ax[0, 0].plot(f_grid, [100 * x["h1"][0] for x in c], ls, color=col, marker="o", ms=3, label=lab)
+            ax[0, 1].plot(f_grid, [100 * x["h1"][1] for x in c], ls, color=col, marker="o", ms=3, label=lab)
+            ax[0, 2].plot(f_grid, [x["err"] for x in c], ls, color=col, marker="o", ms=3, label=lab)
+    for v, col in zip(variants, ("k", "C3", "C4", "C5", "C6", "C7")):
+        for p, ls in zip(policy_names, ("-", "--")):
+            fs = f_grid if v == base_variant else f_side
+            kw = {"color": col, "marker": "o", "ms": 3}
+            ax[1, 0].plot(fs, [100 * worst("9:2 NRHO", p, f, v) for f in fs], ls, label=f"{v}, {p}", **kw)
+            ax[1, 1].plot(fs, [tmap["9:2 NRHO", p, f, v]["z_lim"] / paper_zlim[p] for f in fs], ls, **kw)
+            ax[1, 2].plot(fs, [tmap["9:2 NRHO", p, f, v]["err"] for f in fs], ls, **kw)
+    for a in (ax[0, 0], ax[0, 1], ax[1, 0]):
+        a.axhline(10, color="0.5", lw=0.8, ls=":")
+    ax[1, 1].axhspan(0.75, 1.25, color="0.85", zorder=0)
+    ax[1, 1].axhline(1.0, color="0.4", lw=0.8)
+    titles = (("burn runs (H1): forward inconsistent", "inconsistent runs [%]"),
+              ("burn runs (H1): smoothed inconsistent", "inconsistent runs [%]"),
+              ("expected error of the test", "FP + MD [-]"),
+              ("9:2 NRHO: worst cell (H0/H1, fwd/smo)", "inconsistent runs [%]"),
+              ("9:2 NRHO: threshold over the paper's", "z_lim / paper z_lim [-]"),
+              ("9:2 NRHO: expected error of the test", "FP + MD [-]"))
+    for a, (t, yl) in zip(ax.ravel(), titles):
+        a.set(xscale="log", xlabel="window weight factor f [-]", ylabel=yl, title=t)
+        a.axvline(f_c, color="C2", lw=2, alpha=0.3)
+        a.axvline(f_tune, color="C1", lw=2, alpha=0.3)
+    h, lab = ax[0, 0].get_legend_handles_labels()
+    fig.legend(h, lab, loc="upper center", bbox_to_anchor=(0.5, 0.515), ncol=6, fontsize=8)
+    h, lab = ax[1, 0].get_legend_handles_labels()
+    fig.legend(h, lab, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=4, fontsize=8)
+    fig.tight_layout(h_pad=5.0)
+    return fig

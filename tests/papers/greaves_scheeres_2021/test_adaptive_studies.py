@@ -1,0 +1,100 @@
+"""Studies of notebook 09b on small sizes: outcome bookkeeping, the reset-rule summaries, the null metric law and
+the closing rows judged by the declared claims."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cislunar.cr3bp import orbits
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.estimation import adaptive_ocbe as ad
+from cislunar.papers.greaves_scheeres_2021 import adaptive_studies as ads
+from cislunar.papers.greaves_scheeres_2021 import detection as det
+from cislunar.papers.greaves_scheeres_2021.claims.adaptive_ocbe import CLAIMS
+
+
+@pytest.fixture(scope="module")
+def nrho():
+    return orbits.nrho_9_2(em)
+
+
+@pytest.fixture(scope="module")
+def setup(nrho):
+    return det.make_setup(em, nrho, 1e-18, 1e-18)
+
+
+def test_first_seen_epoch_is_the_first_epoch_after_the_burn(setup):
+    k = ads.first_seen_epoch(setup)
+    t = setup.scenario.t
+    assert t[k - 1] <= setup.t_maneuver < t[k]
+
+
+def test_delay_outcomes_partition_the_runs(setup, nrho):
+    k = ads.first_seen_epoch(setup)
+    t = setup.scenario.t
+    late_from = setup.t_maneuver + 0.75 * (nrho.period - setup.t_maneuver)
+    k_late = int(np.searchsorted(t, late_from))
+    # prompt (on time, one early, two late), late, nearly periapsis, not detected, false alarm
+    epochs = [k, k - 1, k + 2, k + 5, k_late, -1, 3]
+    o = ads.delay_outcome(setup, epochs, late_from)
+    assert o.n == 7
+    assert o.prompt == pytest.approx(3 / 7) and o.late == pytest.approx(1 / 7)
+    assert o.near == pytest.approx(1 / 7) and o.undetected == pytest.approx(1 / 7)
+    assert o.false_alarms == 1 and o.early_by_chance == 1
+    # every run is in exactly one outcome or a false alarm
+    assert o.prompt + o.late + o.near + o.undetected + o.false_alarms / o.n == pytest.approx(1.0)
+    assert sorted(o.delays_h) == sorted(np.array([0, -1, 2, 5, k_late - k]) * setup.scenario.cadence_hours)
+    assert o.median_h == pytest.approx(2 * setup.scenario.cadence_hours)
+    assert [o.fraction(x) for x in ads.OUTCOMES] == [o.prompt, o.late, o.near, o.undetected]
+
+
+def test_reset_rule_summary_counts_chains_and_reconvergence():
+    runs = ((0.05, "mean", True, 0.5, True, 3, False), (0.05, "mean", False, 1.0, True, 0, False),
+            (0.05, "likelihood", True, 0.0, False, 1, True), (0.05, "likelihood", False, 1.0, True, 0, False),
+            (3.0, "mean", True, 0.0, False, 1, True), (3.0, "likelihood", True, 0.0, False, 1, True))
+    study = ads.ResetRuleStudy(runs, (0.05, 3.0), ("mean", "likelihood"))
+    s = study.summary(0.05, "mean")
+    assert s["n"] == 2 and s["n_detected"] == 1 and s["inconsistent"] == 1.0 and s["chains"] == 1
+    assert s["final_ok"] == 0.0 and s["resets"] == 1.5
+    assert study.summary(0.05, "likelihood")["final_ok"] == 1.0
+    assert study.chains("mean") == (1, 2) and study.chains("likelihood") == (0, 2)
+    assert study.pooled_inconsistent((0.05, 3.0), "mean") == (pytest.approx(2 / 3), 3)
+    assert "agree at 3000 mm/s" in study.report()
+    with pytest.raises(ValueError, match="no runs"):
+        study.summary(1.0, "mean")
+
+
+def test_null_metric_has_the_chi2_mean_and_no_false_resets(setup):
+    null = ads.null_metric_study(setup, 2, np.random.default_rng(0))
+    assert null.dof == 4 and null.n_runs == 2 and null.n_resets == 0
+    # chi2_4: mean 4, within 4 standard errors
+    assert abs(null.metric.mean() - 4.0) < 4 * null.standard_error
+    assert null.exceed_fraction < 0.05
+    spread = ads.measurement_spread(setup, null.first.P0)
+    assert spread.shape == (4,) and np.all(spread > 0)
+    assert spread[2:].max() < 1e-2 < spread[:2].min()  # rates carry almost no state information here
+
+
+def test_large_burn_run_and_closing_rows_are_judged_by_every_claim(setup, nrho):
+    rng = np.random.default_rng(1)
+    big = ads.adaptive_run(setup, det.draw_trial(rng, setup, magnitude_m_s=3.0))
+    assert big.detections and big.delay_epochs is not None and abs(big.delay_epochs) <= ad.CONSECUTIVE_EPOCHS - 1
+    assert big.panels is not None and 0.0 <= big.nees_f_after <= 1.0
+    null = ads.NullMetricStudy(np.full(10, 4.0), 4, 0.5, 0.0, 0, np.full((1, 5), 6.0), big.inputs)
+    k = ads.first_seen_epoch(setup)
+    delays = ads.DelayStudy({0.05: ads.delay_outcome(setup, [-1, k + 20], 0.0),
+                             3.0: ads.delay_outcome(setup, [k, k], 0.0)},
+                            {10: ads.delay_outcome(setup, [-1, k + 20], 0.0)}, 90.0, 70.0, 2)
+    rules = ads.ResetRuleStudy(((0.05, "mean", False, 1.0, True, 0, False), (0.05, "likelihood", False, 1.0, True, 0,
+                                                                             False),
+                                (3.0, "mean", True, 0.0, False, 1, True), (3.0, "likelihood", True, 0.0, False, 1, True)),
+                               (0.05, 3.0), ("mean", "likelihood"))
+    rows = ads.closing_rows(null, big, delays, rules, 1e-18)
+    assert set(rows) == set(CLAIMS)
+    status = {key: CLAIMS[key].judge(**row).status for key, row in rows.items()}
+    assert status["3 m/s prompt"] == "reproduced" and status["large prompt"] == "reproduced"
+    assert status["large consistent"] == "reproduced" and status["no false resets"] == "derived"
+    assert status["small late"] == "reproduced"  # no prompt run
+    assert status["small re-converges"] == "differs"  # no detected run counts as 0
+    assert status["base weight"] == "not in paper"
