@@ -22,23 +22,46 @@
 # objective of Eqs. 42-44 and the SCvx of Eqs. 24-36 (notebook 03); the mutual information and its gradient are
 # notebook 02, the node placement notebook 04.
 
+# %% [markdown]
+# **How to use this chapter.** The next cell (tagged `parameters`) holds everything you might change: the node
+# grids, the homotopy weights, the iteration limits and penalty weights granted to the paper's exact-penalty SCvx,
+# and the impulse budgets of Section 8. Leave an entry at `None` and the notebook picks it (the values in brackets
+# in the comments: a shorter, coarser run when `QUICK = True`, then the full run); give a value (edit the cell, or
+# pass `-p NAME=VALUE` to the runner) and it is used as given in both modes. The exact-penalty runs of Section 4
+# are independent of one another and run on `WORKERS` local processes or on a Dask cluster (`SCHEDULER`); every
+# run is deterministic, so the numbers do not depend on where they run.
+
 # %% tags=["parameters"]
 QUICK = False
-SEED = 0
+SEED = 0  # no random draws in this chapter: every computation is deterministic
 OUTPUT_DIR = ""
+N_NODES = None  # Sundman-spaced nodes over the two periods; the paper does not give its N (None: 18 quick, 40 full)
+N_NODES_ALT = None  # node count of the second grid of the mesh check, Section 5 (None: 24 quick, 28 full)
+SIGMA = 1.0  # Sundman exponent of the node spacing dt = r_m^sigma dtau (notebook 04)
+ALPHAS = None  # homotopy weights alpha_h, increasing in [0, 1], must contain 5e-3 (None: [0, 5e-3, 1e-2] quick, 9 full)
+PENALTY_ITER = None  # iterations granted to the paper's exact-penalty SCvx in Section 4 (None: 10 quick, 80 full)
+PENALTY_ITER_LONG = None  # the same at gamma = 1e3 with a larger limit (None: 20 quick, 300 full)
+PENALTY_GAMMAS = None  # exact-penalty weights gamma swept, unstated in the paper (None: [1e1, 1e3, 1e5] quick, 1e1-1e5 full)
+BUDGETS_EXTRA_MPS = None  # impulse budgets above the baseline's, Section 8, m/s (None: [5] quick, [1, 5, 20] full)
+BUDGET_RTOL = 0.02  # a budget counts as met within this relative tolerance (fixed before solving)
+FORWARD_HESSIAN = None  # forward (True) or central (False) differences for the MI Hessian (None: True quick, False full)
+WORKERS = None  # local processes for the exact-penalty runs of Section 4, 1 = serial (None: 1 quick, 2 full)
+SCHEDULER = ""  # address of a Dask scheduler to run them on, e.g. "tcp://10.0.0.5:8786" ("": none; WORKERS applies)
 
 # %%
-# Sizes derived from QUICK: fewer nodes and a coarser alpha_h grid in quick mode; the same experiments.
-N_NODES = 18 if QUICK else 40  # Sundman-spaced nodes over the two periods (the paper does not give its N)
-N_NODES_ALT = 24 if QUICK else 28  # second grid of the mesh check (section 5)
-SIGMA = 1.0  # Sundman exponent (notebook 04)
-ALPHAS = ([0.0, 5e-3, 1e-2] if QUICK else  # quick: the right panels of Figs. 1 and 3 show the grid's top
-          [0.0, 1e-3, 2e-3, 3e-3, 5e-3, 7e-3, 1e-2, 1.5e-2, 2e-2])
-PENALTY_ITER = 10 if QUICK else 80  # iterations granted to the paper's exact-penalty SCvx in section 4
-PENALTY_ITER_LONG = 20 if QUICK else 300  # the same at gamma = 1e3 with a larger iteration limit
-PENALTY_GAMMAS = [1e1, 1e3, 1e5] if QUICK else [1e1, 1e2, 1e3, 1e4, 1e5]  # exact-penalty weights swept (unstated)
-BUDGETS_EXTRA_MPS = [5.0] if QUICK else [1.0, 5.0, 20.0]  # impulse budgets above the baseline's (section 8)
-BUDGET_RTOL = 0.02  # a budget counts as met within 2 % (fixed before solving)
+n_nodes = N_NODES if N_NODES is not None else (18 if QUICK else 40)
+n_nodes_alt = N_NODES_ALT if N_NODES_ALT is not None else (24 if QUICK else 28)
+alphas = ALPHAS if ALPHAS is not None else ([0.0, 5e-3, 1e-2] if QUICK else  # quick: the grid's top as right panels
+                                            [0.0, 1e-3, 2e-3, 3e-3, 5e-3, 7e-3, 1e-2, 1.5e-2, 2e-2])
+penalty_iter = PENALTY_ITER if PENALTY_ITER is not None else (10 if QUICK else 80)
+penalty_iter_long = PENALTY_ITER_LONG if PENALTY_ITER_LONG is not None else (20 if QUICK else 300)
+penalty_gammas = PENALTY_GAMMAS if PENALTY_GAMMAS is not None else ([1e1, 1e3, 1e5] if QUICK else
+                                                                     [1e1, 1e2, 1e3, 1e4, 1e5])
+budgets_extra_mps = BUDGETS_EXTRA_MPS if BUDGETS_EXTRA_MPS is not None else ([5.0] if QUICK else [1.0, 5.0, 20.0])
+forward_hessian = FORWARD_HESSIAN if FORWARD_HESSIAN is not None else QUICK
+workers = WORKERS if WORKERS is not None else (1 if QUICK else 2)
+if 5e-3 not in alphas:
+    raise ValueError(f"ALPHAS must contain 5e-3 (Figs. 1 and 3, Section 4, the mesh check); got {alphas}")
 
 import numpy as np
 
@@ -49,6 +72,7 @@ from cislunar.papers.wolf_jones import test_case_studies as studies
 from cislunar.papers.wolf_jones.claims.test_case_1 import CLAIMS
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
+from cislunar.utils.executors import open_executor
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -92,7 +116,7 @@ MPS = em.velocity_unit_km_s * 1e3
 sc = wolf_jones.test_case_1()
 P, chk = sc.period, sc.row_checks["observer_t0"]
 print(studies.case1_scenario_summary(sc))
-slip = studies.table2_slip(sc, wolf_jones.test_case_2(), N_NODES, SIGMA)
+slip = studies.table2_slip(sc, wolf_jones.test_case_2(), n_nodes, SIGMA)
 print(slip.summary(em))
 
 # %% [markdown]
@@ -117,7 +141,7 @@ print(slip.summary(em))
 # miss.
 
 # %%
-case = studies.sweep_test_case_1(sc, N_NODES, ALPHAS, sigma=SIGMA, forward_hessian=QUICK, progress=True)
+case = studies.sweep_test_case_1(sc, n_nodes, alphas, sigma=SIGMA, forward_hessian=forward_hessian, progress=True)
 
 # %% [markdown]
 # ## 3 · The homotopy sweep, both ways
@@ -150,8 +174,9 @@ best, impulse_mps, mi = case.best, case.impulse_mps, case.mi
 # information model, $\gamma = 10^3$) separates the effect of the penalty from that of the information model.
 
 # %%
-i5 = ALPHAS.index(5e-3)
-pen = studies.penalty_study(case, PENALTY_GAMMAS, PENALTY_ITER, PENALTY_ITER_LONG, alpha=5e-3)
+i5 = alphas.index(5e-3)
+with open_executor(workers, SCHEDULER) as executor:
+    pen = studies.penalty_study(case, penalty_gammas, penalty_iter, penalty_iter_long, alpha=5e-3, executor=executor)
 print(pen.summary(best[i5].cost))
 _ = plotting.save_figure(figures.convergence(pen), "05_convergence", output_dir=out)
 
@@ -181,7 +206,7 @@ _ = plotting.save_figure(figures.convergence(pen), "05_convergence", output_dir=
 # %%
 fl = studies.reflight(case)
 print(fl.summary(case))
-mesh = studies.mesh_check(case, N_NODES_ALT, 5e-3, sigma=SIGMA)
+mesh = studies.mesh_check(case, n_nodes_alt, 5e-3, sigma=SIGMA)
 print(mesh.summary())
 
 # %% [markdown]
@@ -193,13 +218,13 @@ print(mesh.summary())
 # $a_z$ stays at zero here too (its largest value is printed below the figure).
 
 # %%
-show = [ALPHAS.index(5e-3), len(ALPHAS) - 1]  # the paper's 5e-3 and 2e-2 (quick mode: the grid's largest)
+show = [alphas.index(5e-3), len(alphas) - 1]  # the paper's 5e-3 and 2e-2 (quick mode: the grid's largest)
 _ = plotting.save_figure(figures.trajectories(case, show), "05_fig1_trajectories", output_dir=out)
 rel_km, departure_km = studies.departures_km(case)
-_ = plotting.save_figure(figures.relative_motion(ALPHAS, rel_km), "05_fig2_relative_motion", output_dir=out)
+_ = plotting.save_figure(figures.relative_motion(alphas, rel_km), "05_fig2_relative_motion", output_dir=out)
 departure_monotone = bool(np.all(np.diff(departure_km) >= 0))
 print("largest departure from the reference DRO [km]:", ", ".join(f"{a:g}: {d:.0f}" for a, d in
-                                                                   zip(ALPHAS, departure_km)))
+                                                                   zip(alphas, departure_km)))
 _ = plotting.save_figure(figures.thrust(case, show), "05_fig3_thrust", output_dir=out)
 az_share = max(float(np.max(np.abs(r.u[:, 2])) / np.max(np.linalg.norm(r.u, axis=1))) for r in best)
 print(f"largest |a_z| / largest |a| over the grid: {az_share:.1e} (planar problem: the paper plots a_x, a_y only)")
@@ -221,17 +246,17 @@ print(f"largest |a_z| / largest |a| over the grid: {az_share:.1e} (planar proble
 # %%
 cr = studies.crlb_study(case)
 crlb, term_obs, term_tgt, lit = cr.crlb, cr.term_obs, cr.term_tgt, cr.literal
-_ = plotting.save_figure(figures.crlb_axes(em, ALPHAS, crlb), "05_fig4_crlb", output_dir=out)
-_ = plotting.save_figure(figures.pareto(ALPHAS, impulse_mps, term_obs, term_tgt), "05_fig5_pareto", output_dir=out)
-for a, imp, mo, mt, m1, m2 in zip(ALPHAS, impulse_mps, term_obs, term_tgt, mi, cr.mi_eval):
+_ = plotting.save_figure(figures.crlb_axes(em, alphas, crlb), "05_fig4_crlb", output_dir=out)
+_ = plotting.save_figure(figures.pareto(alphas, impulse_mps, term_obs, term_tgt), "05_fig5_pareto", output_dir=out)
+for a, imp, mo, mt, m1, m2 in zip(alphas, impulse_mps, term_obs, term_tgt, mi, cr.mi_eval):
     print(f"alpha_h {a:7.4f}: {imp:8.3f} m/s  terminal RMS observer {mo:7.3f} km, target {mt:7.3f} km;  "
           f"MI {m1:.3f} (planning Q) / {m2:.3f} nats (Q along the trajectory)")
 print(f"with q = 1e-11 km^2/s^3 = {cr.q_literal:.3g} LU^2/TU^3 instead of {sc.q:g}: terminal RMS "
-      f"alpha_h = 0: {lit[0].terminal_rms_km[0]:.0f} / {lit[0].terminal_rms_km[1]:.0f} km, alpha_h = {ALPHAS[-1]:g}: "
+      f"alpha_h = 0: {lit[0].terminal_rms_km[0]:.0f} / {lit[0].terminal_rms_km[1]:.0f} km, alpha_h = {alphas[-1]:g}: "
       f"{lit[1].terminal_rms_km[0]:.0f} / {lit[1].terminal_rms_km[1]:.0f} km (observer / target); growth over the "
       f"window after the transient: {cr.literal_growth[1]:.1f} x")
-lit_text = "; ".join(f"alpha_h = {ALPHAS[i]:g}: {c.rms_km[0, 1]:.0f} -> {c.rms_km[0, -1]:.0f} km ({g_:.3f} x)"
-                     for i, c, g_ in zip((0, len(ALPHAS) - 1), lit, cr.literal_growth))
+lit_text = "; ".join(f"alpha_h = {alphas[i]:g}: {c.rms_km[0, 1]:.0f} -> {c.rms_km[0, -1]:.0f} km ({g_:.3f} x)"
+                     for i, c, g_ in zip((0, len(alphas) - 1), lit, cr.literal_growth))
 print("literal Q, observer RMS at the 2nd measurement -> window end: " + lit_text)
 
 # %% [markdown]
@@ -258,9 +283,9 @@ print(f"Spearman rank correlation of MI with terminal RMS: observer {rho_obs:+.3
 i_best = int(np.argmax(mi))
 print(f"baseline alpha_h = 0: {impulse_mps[0]:.3f} m/s, terminal RMS observer {term_obs[0]:.2f} km, target "
       f"{term_tgt[0]:.2f} km, I = {mi[0]:.2f} nats")
-print(f"best information plan alpha_h = {ALPHAS[i_best]:g}: {impulse_mps[i_best]:.2f} m/s, observer "
+print(f"best information plan alpha_h = {alphas[i_best]:g}: {impulse_mps[i_best]:.2f} m/s, observer "
       f"{term_obs[i_best]:.2f} km, target {term_tgt[i_best]:.2f} km, I = {mi[i_best]:.2f} nats")
-budget_rows, budget_msgs = studies.budget_study(case, term_obs, BUDGETS_EXTRA_MPS, rtol=BUDGET_RTOL)
+budget_rows, budget_msgs = studies.budget_study(case, term_obs, budgets_extra_mps, rtol=BUDGET_RTOL)
 print("\n".join(budget_msgs))
 _ = plotting.save_figure(figures.equal_impulse(impulse_mps, term_obs, budget_rows), "05_equal_impulse",
                          output_dir=out)
@@ -322,7 +347,7 @@ table.add(CLAIMS["window"].judge(max(abs(w_start - 12.0), abs(w_end - 23.0)), sh
                                  f"of the adopted reading; the rejected reading misses 23 d by "
                                  f"{slip.miss23_days[rj]:.2f} d; last daily measurement at "
                                  f"{em.tu_to_days(sc.measurement_times[-1]):.2f} d"))
-table.add(CLAIMS["fig3_alpha"].judge(ALPHAS[show[0]], shown="5e-3 shown"))
+table.add(CLAIMS["fig3_alpha"].judge(alphas[show[0]], shown="5e-3 shown"))
 table.add(CLAIMS["process_noise"].judge(cr.bounded, shown=f"q = {sc.q:g} LU^2/TU^3 (acceleration PSD)", note=(
     "notebook 06, section 9; the SI reading 1e-11 m^2/s^3 would pass the same test")))
 table.add(CLAIMS["literal_q_bounded"].judge(
@@ -377,7 +402,7 @@ table.add(CLAIMS["modified_scvx"].judge(
 
 # %%
 table.add(CLAIMS["departure"].judge(departure_monotone, shown="largest distance from the DRO " + ", ".join(
-    f"{a:g}: {d / 1e3:.1f}" for a, d in zip(ALPHAS, departure_km)) + " (10^3 km)",
+    f"{a:g}: {d / 1e3:.1f}" for a, d in zip(alphas, departure_km)) + " (10^3 km)",
     note="best of upward and downward sweeps of the modified solver"))
 table.add(CLAIMS["front_monotone"].judge(case.monotone, shown=f"impulse {impulse_mps[0]:.2f} -> {impulse_mps[-1]:.1f}"
                                          f" m/s, MI {mi[0]:.1f} -> {mi[-1]:.1f} nats"))
@@ -389,11 +414,11 @@ table.add(CLAIMS["bounded"].judge(cr.bounded, shown=f"window end <= 2nd-measurem
 table.add(CLAIMS["information_gain"].judge(
     bool(term_obs[-1] < term_obs[0] and term_tgt[-1] < term_tgt[0]), shown=f"observer {term_obs[0]:.1f} -> "
     f"{term_obs[-1]:.1f} km, target {term_tgt[0]:.1f} -> {term_tgt[-1]:.1f} km", note=(
-        f"alpha_h = 0 vs {ALPHAS[-1]:g}; holds under the literal Q too ({lit[0].terminal_rms_km[0]:.0f} -> "
+        f"alpha_h = 0 vs {alphas[-1]:g}; holds under the literal Q too ({lit[0].terminal_rms_km[0]:.0f} -> "
         f"{lit[1].terminal_rms_km[0]:.0f} km)")))
 table.add(CLAIMS["mi_correlation"].judge(max(rho_obs, rho_tgt), shown=f"Spearman(MI, terminal RMS): observer "
                                          f"{rho_obs:+.2f}, target {rho_tgt:+.2f}", note=f"as in notebook 06, over "
-                                         f"the {len(ALPHAS)} alpha_h of the grid"))
+                                         f"the {len(alphas)} alpha_h of the grid"))
 
 # %% [markdown]
 # ### Beyond the paper
@@ -408,7 +433,7 @@ table.add(CLAIMS["mi_correlation"].judge(max(rho_obs, rho_tgt), shown=f"Spearman
 table.add(CLAIMS["reflight"].judge(max(fl.miss_km), shown=f"largest terminal miss {max(fl.miss_km):.1e} km",
                                    note="FOH control alone from x_S(t0), nonlinear CR3BP"))
 table.add(CLAIMS["mesh"].judge(mesh.impulse_change, shown=(
-    f"{N_NODES} nodes: {mesh.impulse_mps[0]:.2f} m/s, RMS {mesh.rms_km[0]:.2f} km; {N_NODES_ALT} nodes: "
+    f"{n_nodes} nodes: {mesh.impulse_mps[0]:.2f} m/s, RMS {mesh.rms_km[0]:.2f} km; {n_nodes_alt} nodes: "
     f"{mesh.impulse_mps[1]:.2f} m/s, RMS {mesh.rms_km[1]:.2f} km"), note=(
     f"impulse changes by {100 * mesh.impulse_change:.1f} %, RMS by {100 * mesh.rms_change:.0f} %: near-impulsive "
     f"plans (|u|/a_max <= {max(fl.max_ratio):.2f})")))
@@ -419,8 +444,26 @@ for r in budget_rows:
         f"budget met within {100 * BUDGET_RTOL:g} %; log-interpolation on the grid at the spent impulse said "
         f"{r.interp:.1f} km")))
 table.add(CLAIMS["pareto_values"].judge(term_tgt[-1], shown=f"{impulse_mps[-1]:.1f} m/s -> target "
-                                        f"{term_tgt[-1]:.2f} km at alpha_h = {ALPHAS[-1]:g}"))
+                                        f"{term_tgt[-1]:.2f} km at alpha_h = {alphas[-1]:g}"))
 table.add(CLAIMS["local_optima"].judge(case.cost_gap, shown=f"largest cost difference {case.cost_gap:.0e}: " + (
     "distinct local optima found" if case.distinct_optima else "both sweeps reach the same optimum on this grid"),
     note="best cost per alpha_h kept; differences below 1e-8 relative are solver round-off"))
 table.display()
+
+# %% [markdown]
+# ## Exercises
+#
+# Each exercise asks you to change one entry of the parameters cell, to predict what will happen before running,
+# and then to check. The worked solutions are functions of `cislunar.papers.wolf_jones.exercises`, run at small
+# sizes (a few seconds each); each returns the numbers that answer the exercise and an `answer` paragraph.
+#
+# 1. **Fewer nodes.** Set `N_NODES = 10` (quick mode uses 18, full mode 40) and rerun. Before you do: will the
+#    minimum-impulse plan ($\alpha_h = 0$, the first row of the table in Section 3 and the left end of Fig. 5) cost
+#    more or less impulse, and will its terminal RMS move as much? Think of what a first-order-hold control can
+#    represent on a coarser grid. Worked solution: `exercises.exercise_05_node_count`, which solves
+#    $\alpha_h = 0$ on 10, 14 and 18 nodes.
+# 2. **Patience for the printed method.** Raise `PENALTY_ITER_LONG` (20 in quick mode) to 60. Does the paper's
+#    exact-penalty SCvx converge if it is only given more iterations? Predict what happens to its largest defect,
+#    its best accepted cost and its trust-region radius (the long-run line of Section 4 and the row "printed SCvx
+#    at gamma 1e3 with a larger iteration limit"). Worked solution: `exercises.exercise_05_penalty_iterations`
+#    (10 and 30 iterations on a 10-node grid).

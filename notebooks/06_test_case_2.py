@@ -28,33 +28,51 @@
 # `cislunar.papers.wolf_jones.test_case_studies` (the studies of this chapter, each returning a frozen result),
 # `cislunar.papers.wolf_jones.figures` (the figures) and `cislunar.guidance.scvx` (the solver).
 
+# %% [markdown]
+# **How to use this chapter.** The next cell (tagged `parameters`) holds everything you might change: the node
+# grid and the homotopy weights, the iteration limits, the keep-out radii and the scan of Section 3, the budget of
+# Section 11. Leave an entry at `None` and the notebook picks it (the values in brackets in the comments: a
+# shorter, coarser run when `QUICK = True`, then the full run); give a value (edit the cell, or pass `-p NAME=VALUE`
+# to the runner) and it is used as given in both modes. The independent SCvx runs (the two sweep directions, the
+# seeded runs, the other node grids, the keep-out radii and the $a_{max}$ readings) run on `WORKERS` local processes
+# or on a Dask cluster (`SCHEDULER`); every run is deterministic, so the numbers do not depend on where they run.
+
 # %% tags=["parameters"]
 QUICK = False
-SEED = 0
+SEED = 0  # no random draws in this chapter; kept for the common parameter interface
 OUTPUT_DIR = ""
+N_NODES = None  # Sundman nodes over the three periods, window ends moved onto nodes (None: 16 quick, 30 full)
+MAX_ITER = None  # SCvx iteration limit per run (None: 100 quick, 150 full)
+N_NODES_ALT = None  # other node grids on which the whole sweep is solved again (None: [14] quick, [24, 27] full)
+FREE_ITER = None  # iterations granted to the run without keep-out, which does not converge (None: 10 quick, 75 full)
+SIGMA = 1.0  # Sundman exponent of the node spacing dt = r_m^sigma dtau (notebook 04)
+ALPHAS = None  # homotopy weights alpha_h, increasing in [0, 1] (None: [0, 5e-3, 1e-2] quick; 8 values full)
+SEED_ALPHAS = None  # weights solved from +z and -z seeds, Fig. 7's pair (None: [] quick, [5e-3, 7e-3] full)
+MIRROR_ALPHA = 5e-3  # weight whose sweep optimum is mirrored in z and solved again (both modes)
+D_MIN_KM = None  # keep-out radii solved besides the adopted 424 km, km (None: [1500] quick, 5 radii 10-2500 full)
+RADIUS_WARM = None  # radius solves start from the adopted plan (True) or the ballistic guess (None: True quick, False full)
+SCAN_POINTS = None  # pass distances of the closest-approach scan of Section 3 (None: 8 quick, 20 full)
+SCAN_RANGE_KM = [1e-6, 3000.0]  # closest and farthest pass distance of that scan, km
+BUDGET_EXTRA_MPS = 5.0  # impulse budget above the baseline's for the equal-impulse solve of Section 11, m/s
+BUDGET_RTOL = 0.02  # a budget counts as met within this relative tolerance (fixed before solving)
+SAME_PLAN_KM = 100.0  # two plans are the same if their node positions are never farther apart, km (fixed in advance)
+WORKERS = None  # local processes for the independent SCvx runs, 1 = serial (None: 1 quick, 2 full)
+SCHEDULER = ""  # address of a Dask scheduler to run them on, e.g. "tcp://10.0.0.5:8786" ("": none; WORKERS applies)
 
 # %%
-# Sizes derived from QUICK: quick mode uses fewer SCvx nodes and alphas; the seeds and every study still run.
-N_NODES = 16 if QUICK else 30  # Sundman nodes over the three periods (window ends moved onto nodes)
-MAX_ITER = 100 if QUICK else 150  # SCvx iteration limit per run
-N_NODES_ALT = [14] if QUICK else [24, 27]  # other node grids: the whole sweep again (Fig. 7 robustness, mesh check)
-FREE_ITER = 10 if QUICK else 75  # iterations granted to the run without keep-out (it does not converge)
-SIGMA = 1.0  # Sundman exponent (notebook 04)
-# homotopy grid: 8 values including 0 and the weights of Figs. 6-8 (quick mode: 3; figures asking for an alpha_h
-# outside the grid show the nearest one and say so)
-ALPHAS = [0.0, 5e-3, 1e-2] if QUICK else [0.0, 5e-4, 1e-3, 2e-3, 5e-3, 7e-3, 1e-2, 2e-2]
-SEED_ALPHAS = [] if QUICK else [5e-3, 7e-3]  # Fig. 7's pair, solved from +z and -z seeds (full mode)
-MIRROR_ALPHA = 5e-3  # the sweep's optimum there, mirrored and solved again (both modes)
-D_MIN_KM = [1500.0] if QUICK else [10.0, 141.0, 1000.0, 1500.0, 2500.0]  # keep-out radii swept (besides 424 km)
-SCAN_POINTS = 8 if QUICK else 20  # closest-approach scan of section 3
-BUDGET_EXTRA_MPS = 5.0  # impulse budget above the baseline's for the equal-impulse solve (section 11)
-BUDGET_RTOL = 0.02  # a budget counts as met within 2 % (fixed before solving)
-WORKERS = 2  # processes for the independent upward/downward sweeps and the other independent runs
-SAME_PLAN_KM = 100.0  # two plans count as the same if their node positions are never farther apart (fixed in advance)
+n_nodes = N_NODES if N_NODES is not None else (16 if QUICK else 30)
+max_iter = MAX_ITER if MAX_ITER is not None else (100 if QUICK else 150)
+n_nodes_alt = N_NODES_ALT if N_NODES_ALT is not None else ([14] if QUICK else [24, 27])
+free_iter = FREE_ITER if FREE_ITER is not None else (10 if QUICK else 75)
+alphas = ALPHAS if ALPHAS is not None else ([0.0, 5e-3, 1e-2] if QUICK else [0.0, 5e-4, 1e-3, 2e-3, 5e-3, 7e-3, 1e-2,
+                                                                              2e-2])
+seed_alphas = SEED_ALPHAS if SEED_ALPHAS is not None else ([] if QUICK else [5e-3, 7e-3])
+d_min_km = D_MIN_KM if D_MIN_KM is not None else ([1500.0] if QUICK else [10.0, 141.0, 1000.0, 1500.0, 2500.0])
+radius_warm = RADIUS_WARM if RADIUS_WARM is not None else QUICK
+scan_points = SCAN_POINTS if SCAN_POINTS is not None else (8 if QUICK else 20)
+workers = WORKERS if WORKERS is not None else (1 if QUICK else 2)
 
-import multiprocessing
 import time
-from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
 import numpy as np
 from scipy.stats import spearmanr
@@ -67,21 +85,13 @@ from cislunar.papers.wolf_jones import test_case_studies as studies
 from cislunar.papers.wolf_jones.claims.test_case_2 import CLAIMS
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
+from cislunar.utils.executors import open_executor
 
 plotting.use_style()
 out = OUTPUT_DIR or None
 rng = np.random.default_rng(SEED)  # no random draws below; kept for the common parameter interface
 table = ComparisonTable("06 Test case 2 (Wolf & Jones Tables 4-5, Figs. 6-10)")
 t_start = time.perf_counter()
-executor = ProcessPoolExecutor(max_workers=WORKERS, mp_context=multiprocessing.get_context("spawn"))
-
-
-def outcome(fut):
-    """The result of a queued SCvx run, or its SCvxError."""
-    try:
-        return fut.result()
-    except scvx.SCvxError as exc:
-        return exc
 
 # %% [markdown]
 # ## 1 · The scenario (Tables 4 and 5)
@@ -104,7 +114,7 @@ print(f"P_ref = {em.tu_to_days(sc.period):.3f} d, scenario {em.tu_to_days(sc.dur
       f"[{ws_d:.2f}, {we_d:.2f}] d with {sc.measurement_times.size} daily range/range-rate pairs per target")
 print(f"a_max = {sc.a_max * em.acceleration_unit_km_s2:.1e} km/s^2 = {sc.a_max:.4f} LU/TU^2; "
       f"process-noise PSD q = {sc.q:.0e} LU^2/TU^3 = {sc.q * em.length_unit_km**2 / em.time_unit_s**3:.2e} km^2/s^3")
-t, k_ws, k_we = sc.node_times(N_NODES, SIGMA)
+t, k_ws, k_we = sc.node_times(n_nodes, SIGMA)
 print(f"{t.size} Sundman nodes (sigma = {SIGMA}); window nodes {k_ws}-{k_we}: "
       f"thrust bound a_max outside, 0 inside (the observer coasts through the window)")
 x_ball, u_ball = sc.ballistic_guess(t)
@@ -165,7 +175,7 @@ print(f"Hessian diagonal (z, vz): {gc.hessian[2, 2]:.3e}, {gc.hessian[5, 5]:.3e}
 # plans of the sweep (section 4 counts them), so the keep-out shapes the optima, and section 11 sweeps its radius.
 
 # %%
-scan = studies.keep_out_scan(sc, info, x_ws_ball, SCAN_POINTS)
+scan = studies.keep_out_scan(sc, info, x_ws_ball, scan_points, d_range_km=SCAN_RANGE_KM)
 _ = plotting.save_figure(figures.keep_out_motivation(scan, sc.keep_out_km), "06_keep_out_motivation", output_dir=out)
 for d_show in (1000.0, 424.0, 1.0, 0.1, 1e-3, 1e-6):
     print(f"pass at {d_show:8.0e} km: MI gain {scan.gain_at(d_show):+.2f} nats")
@@ -177,20 +187,17 @@ for d_show in (1000.0, 424.0, 1.0, 0.1, 1e-3, 1e-6):
 # quadratic MI model from the concave part of the Hessian, the keep-out as a linearised constraint) starts from a
 # warm start. The problem has several local optima, so we sweep the grid upward (from the ballistic guess at
 # $\alpha_h = 0$) and downward (from the ballistic guess at the largest $\alpha_h$) and keep the lower cost per
-# $\alpha_h$; the two sweeps are independent and run in two processes.
+# $\alpha_h$. The two sweeps are independent: with `WORKERS = 2` they run side by side, together with the
+# seeded runs of section 7 and the sweeps on other node grids of section 6 (`test_case_studies.case2_runs`
+# queues them all on one executor and collects them).
 
 # %%
 solver = wj.ScenarioSolver(sc, t, k_ws, information=info, keep_out=True,
-                           settings=scvx.SCvxSettings(max_iter=MAX_ITER))
-# the seeded runs of section 7 do not depend on the sweep: queue them behind its two chains
-seed_jobs = {(a, s): executor.submit(solver, a, *sc.seeded_guess(t, s)) for a in SEED_ALPHAS for s in (+1, -1)}
-t0 = time.perf_counter()
-sweep = wj.sweep_both_ways(solver, ALPHAS, x_ball, u_ball, executor=executor)
-case = studies.case2_rows(sc, solver, k_ws, k_we, sweep, time.perf_counter() - t0)
-# the same two-way sweep on other Sundman grids, queued behind the seeded runs; collected in section 6
-waiter = ThreadPoolExecutor(max_workers=len(N_NODES_ALT))  # a thread only waits on the process pool
-alt_jobs = {n_: waiter.submit(studies.alt_grid_sweep, sc, info, n_, ALPHAS, solver.settings, sigma=SIGMA,
-                              executor=executor) for n_ in N_NODES_ALT}
+                           settings=scvx.SCvxSettings(max_iter=max_iter))
+with open_executor(workers, SCHEDULER) as executor:  # seeded runs (section 7), this sweep, other grids (section 6)
+    runs = studies.case2_runs(sc, solver, alphas, x_ball, u_ball, seed_alphas=seed_alphas, alt_nodes=n_nodes_alt,
+                              sigma=SIGMA, executor=executor)
+case = studies.case2_rows(sc, solver, k_ws, k_we, runs.sweep, runs.seconds)
 print(case.summary())
 ok, by_alpha = case.ok, case.by_alpha
 
@@ -237,16 +244,15 @@ print("largest departure from the reference [km]:", ", ".join(f"{r.alpha:g}: {d_
 drops = [(ok[n_].alpha, ok[n_ + 1].alpha) for n_ in range(len(ok) - 1) if dep_max[n_ + 1] < dep_max[n_]]
 print(f"Spearman rank correlation of alpha_h and the largest departure: {rho_dep:.2f}; departure drops between "
       f"consecutive weights: " + (", ".join(f"{a_:g} -> {b_:g}" for a_, b_ in drops) or "none"))
-rho_grids, mesh_rows = {N_NODES: float(rho_dep)}, []  # robustness on other node grids; mesh check at a6
-for n_alt, job in alt_jobs.items():
-    gd = studies.grid_departures(sc, *job.result(), a6)
+rho_grids, mesh_rows = {n_nodes: float(rho_dep)}, []  # robustness on other node grids; mesh check at a6
+for n_alt, alt in runs.alt.items():
+    gd = studies.grid_departures(sc, *alt, a6)
     rho_grids[n_alt] = gd.spearman
     mesh_rows += [(n_alt, *gd.at_weight)] if gd.at_weight else []
-    print(f"{n_alt} nodes: {len(gd.alphas)}/{len(ALPHAS)} weights converged; largest departure [km] "
+    print(f"{n_alt} nodes: {len(gd.alphas)}/{len(alphas)} weights converged; largest departure [km] "
           + ", ".join(f"{a:g}: {d_:.0f}" for a, d_ in zip(gd.alphas, gd.departure_km)) + f"; Spearman {gd.spearman:.2f}")
 dep = closing.Departures(dep_max, float(rho_dep), rho_grids, mesh_rows)
 dep_pass = dep.dep_pass
-waiter.shutdown()
 print(f"Spearman(alpha_h, departure) above 0.8 on {dep_pass} of {len(rho_grids)} node grids: "
       + ", ".join(f"{n_} nodes {v:.2f}" for n_, v in rho_grids.items()))
 
@@ -260,6 +266,7 @@ print(f"Spearman(alpha_h, departure) above 0.8 on {dep_pass} of {len(rho_grids)}
 # choice of local optima). More weight on information also shows
 # in larger out-of-plane excursions and more impulse (table of section 4).
 
+# %% [markdown]
 # ## 7 · The z-mirror question of Fig. 7
 #
 # The paper sees near-mirror images for $\alpha_h = 5\times10^{-3}$ and $7\times10^{-3}$ ("symmetry across the z
@@ -278,7 +285,7 @@ print(f"Spearman(alpha_h, departure) above 0.8 on {dep_pass} of {len(rho_grids)}
 
 # %%
 ms = studies.mirror_study(case, [pick(a) for a in (5e-3, 7e-3)], pick(MIRROR_ALPHA),
-                          {key: outcome(fut) for key, fut in seed_jobs.items()})
+                          runs.seeded)
 print(ms.summary())
 _ = plotting.save_figure(figures.z_mirror(sc, t, ms.curves(), (ws_d, we_d)), "06_z_mirror", output_dir=out)
 
@@ -312,7 +319,7 @@ _ = plotting.save_figure(figures.thrust_profiles(sc, t, plans8, (ws_d, we_d)), "
 # unobserved).
 
 # %%
-fig9_alphas = [pick(a).alpha for a in (0.0, 5e-3, 2e-2)]
+fig9_alphas = [float(pick(a).alpha) for a in (0.0, 5e-3, 2e-2)]
 _ = plotting.save_figure(figures.crlb_objects(em, {a: by_alpha[a].crlb for a in fig9_alphas}), "06_fig9_crlb",
                          output_dir=out)
 obs_mean = {a: float(np.mean(by_alpha[a].crlb.rms_km[0])) for a in fig9_alphas[1:]}
@@ -419,21 +426,14 @@ if base and cheap:
           f"{cheap.dv:.2f} m/s (+{cheap.dv - base.dv:.2f}), RMS {cheap.crlb.terminal_rms_km[0]:.0f} km "
           f"({rms0 / cheap.crlb.terminal_rms_km[0]:.0f}x better); best alpha {best.alpha:g}: dV {best.dv:.2f} m/s, "
           f"RMS {best.crlb.terminal_rms_km[0]:.1f} km")
-# queue the independent runs (other radii, a_max readings); the budget search and the free run run meanwhile here
-d_guess = (row6.res.x, row6.res.u) if QUICK else (x_ball, u_ball)  # quick mode: warm from the adopted solution
-radius_jobs = {d: executor.submit(wj.ScenarioSolver(sc, t, k_ws, information=info, keep_out=True, d_min_km=d,
-                                                    settings=solver.settings), a6, *d_guess) for d in D_MIN_KM}
-amax_solvers = {label: wj.ScenarioSolver(wj.test_case_2(a_max_km_s2=a_km), t, k_ws, information=info, keep_out=True,
-                                         settings=solver.settings)
-                for label, a_km in wj.A_MAX_READINGS_CASE2_KM_S2.items() if a_km != wj.A_MAX_CASE2_KM_S2}
-amax_jobs = {label: executor.submit(s_, a6, row6.res.x, row6.res.u) for label, s_ in amax_solvers.items()}
-budget_row, budget_msg = studies.case2_budget(case, BUDGET_EXTRA_MPS, rtol=BUDGET_RTOL)
+with open_executor(workers, SCHEDULER) as executor:  # other radii and a_max readings queued; the rest runs here
+    jobs = studies.queue_keep_out_runs(case, row6, d_min_km, warm=radius_warm, x_guess=x_ball, u_guess=u_ball,
+                                       executor=executor)
+    budget_row, budget_msg = studies.case2_budget(case, BUDGET_EXTRA_MPS, rtol=BUDGET_RTOL)
+    free = studies.free_run(sc, t, k_ws, info, a6, x_ball, u_ball, free_iter)  # no keep-out, references recorded
+    ko = jobs.collect(free)
 print(budget_msg)
-free = studies.free_run(sc, t, k_ws, info, a6, x_ball, u_ball, FREE_ITER)  # no keep-out, references recorded
-ko = studies.keep_out_study(case, row6, free, {d: outcome(f) for d, f in radius_jobs.items()},
-                            {lab: (amax_solvers[lab], outcome(f)) for lab, f in amax_jobs.items()},
-                            radius_start="warm" if QUICK else "cold")
-print(ko.summary(row6, D_MIN_KM, sc.keep_out_km, SAME_PLAN_KM))
+print(ko.summary(row6, d_min_km, sc.keep_out_km, SAME_PLAN_KM))
 radius_rows, amax_rows = ko.radius_rows, ko.amax_rows
 i6 = next(n_ for n_, r in enumerate(ok) if r.alpha == a6)
 neighbours = [ok[n_] for n_ in (i6 - 1, i6 + 1) if 0 <= n_ < len(ok)]  # the sweep's optima at the adjacent weights
@@ -441,7 +441,6 @@ _ = plotting.save_figure(figures.keep_out_sweep(radius_rows, neighbours, sc.keep
                          output_dir=out)
 dominated_note = studies.dominated_note(case, dominated, row6, radius_rows, amax_rows)
 print("front:", dominated_note)
-executor.shutdown()
 print(f"notebook compute time {time.perf_counter() - t_start:.0f} s")
 
 # %% [markdown]
@@ -470,7 +469,7 @@ print(f"notebook compute time {time.perf_counter() - t_start:.0f} s")
 # text's "roughly 17 and 32 days" (largest miss measured).
 
 # %%
-rows = closing.measurements(case, row6, n_nodes=N_NODES, sigma=SIGMA, gc=gc, ms=ms, ko=ko, nr=nr, fr=fr,
+rows = closing.measurements(case, row6, n_nodes=n_nodes, sigma=SIGMA, gc=gc, ms=ms, ko=ko, nr=nr, fr=fr,
                             departures=dep, obs_mean=obs_mean, tgt_mean=tgt_mean, common=common,
                             budget_row=budget_row, extra_mps=BUDGET_EXTRA_MPS, rtol=BUDGET_RTOL)
 
@@ -535,3 +534,19 @@ judge("weakly_observable", "observer_below_targets", "mi_correlation", "front_gr
 # %%
 judge("values", "mesh", "budget", "cheap", "keep_out_radius", "gradient")
 table.display()
+
+# %% [markdown]
+# ## Exercises
+#
+# Each exercise asks you to change one entry of the parameters cell, to predict what will happen before running,
+# and then to check. The worked solutions are functions of `cislunar.papers.wolf_jones.exercises`, run at small
+# sizes (a few seconds each); each returns the numbers that answer the exercise and an `answer` paragraph.
+#
+# 1. **How fast does the reward blow up?** Set `SCAN_RANGE_KM = [1e-6, 1e-2]` (passes between a millimetre and
+#    ten metres) and `SCAN_POINTS = 7`. Before running, use the range-rate Jacobian of Section 3, which grows like
+#    $1/\rho$, to predict how many nats each factor of 10 closer adds to the MI of the window; then read the
+#    figure `06_keep_out_motivation`. Worked solution: `exercises.exercise_06_close_pass_scan`.
+# 2. **No keep-out, more patience.** Raise `FREE_ITER` (10 in quick mode) to 30. Will SCvx without a keep-out
+#    converge if it is given more iterations? Predict its best accepted cost and its largest defect (the
+#    "without the keep-out" lines of Section 11 and the row "SCvx converges for every alpha_h without a
+#    keep-out"). Worked solution: `exercises.exercise_06_free_run_iterations` (10 and 30 iterations on 12 nodes).

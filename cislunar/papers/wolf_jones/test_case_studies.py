@@ -12,6 +12,8 @@ barycentric CR3BP states in LU and LU/TU.
 
 from __future__ import annotations
 
+import concurrent.futures
+import functools
 import time
 from dataclasses import dataclass
 
@@ -24,7 +26,7 @@ from cislunar.guidance import discretization as D
 from cislunar.guidance import scvx
 from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.sensing import covariance as cov
-from cislunar.utils import validation
+from cislunar.utils import montecarlo, validation
 
 __all__ = ["case1_scenario_summary", "SlipStudy", "table2_slip", "Case1Sweep", "sweep_test_case_1", "PenaltyStudy", "penalty_study",
            "Reflight", "reflight", "MeshCheck", "mesh_check", "departures_km", "CrlbStudy", "crlb_study",
@@ -33,7 +35,8 @@ __all__ = ["case1_scenario_summary", "SlipStudy", "table2_slip", "Case1Sweep", "
            "grid_departures", "MirrorPair", "mirror_pair", "mirrored", "relative_rms_km", "NoiseReadings",
            "noise_readings", "Front", "front", "RecordingInformation", "FreeRun", "free_run", "RadiusRow", "radius_row",
            "alt_grid_sweep", "MirrorStudy", "mirror_study", "case2_budget", "radius_summary", "dominated_note",
-           "KeepOutStudy", "keep_out_study"]
+           "KeepOutStudy", "keep_out_study", "Case2Runs", "case2_runs", "KeepOutJobs",
+           "queue_keep_out_runs"]
 
 
 def _mps(system) -> float:
@@ -353,12 +356,20 @@ class PenaltyStudy:
         return "\n".join(lines)
 
 
-def _penalty_run(case: Case1Sweep, alpha, gamma, max_iter, model):
+def _penalty_problem(case: Case1Sweep, alpha: float) -> tuple:
+    """What one exact-penalty run needs, picklable (it may run in another process)."""
     sc = case.scenario
+    return (sc.system, case.t, case.x_ball, case.u_ball, case.u_max, sc.observer_xf, case.info, case.k_ws, alpha)
+
+
+def _penalty_task(problem: tuple, task: tuple) -> dict:
+    """One exact-penalty run of :func:`penalty_study`: ``task = (gamma, max_iter, model)``."""
+    system, t, x_ball, u_ball, u_max, x_final, info, k_ws, alpha = problem
+    gamma, max_iter, model = task
     st = scvx.SCvxSettings(method="penalty", information_model=model, defect_weight=gamma, max_iter=max_iter)
     try:
-        r = scvx.solve_scvx(sc.system, case.t, case.x_ball, case.u_ball, case.u_max, x_final=sc.observer_xf,
-                            info=case.info, info_node=case.k_ws, alpha=alpha, settings=st)
+        r = scvx.solve_scvx(system, t, x_ball, u_ball, u_max, x_final=x_final, info=info, info_node=k_ws, alpha=alpha,
+                            settings=st)
         hist, outcome, ok = r.history, f"converged in {r.iterations} iterations (largest defect {r.max_defect:.1e})", True
     except scvx.SCvxError as exc:
         hist, outcome, ok = exc.history, exc.reason, False
@@ -367,19 +378,33 @@ def _penalty_run(case: Case1Sweep, alpha, gamma, max_iter, model):
                 best=min(acc) if acc else np.nan, eta=hist[-1]["eta"] if hist else np.nan)
 
 
-def penalty_study(case: Case1Sweep, gammas, n_iter: int, n_iter_long: int, *, alpha: float = 5e-3) -> PenaltyStudy:
+def penalty_study(case: Case1Sweep, gammas, n_iter: int, n_iter_long: int, *, alpha: float = 5e-3,
+                  executor=None) -> PenaltyStudy:
     """Our solver cold from the ballistic DRO, and the printed exact-penalty SCvx over penalty weights ``gammas``
     (``n_iter`` iterations each), at gamma = 1e3 with ``n_iter_long`` iterations, and the hybrid (exact penalty,
-    quadratic MI model) at gamma = 1e3 (notebook 05, section 4)."""
+    quadratic MI model) at gamma = 1e3 (notebook 05, section 4).
+
+    The exact-penalty runs are independent: with an ``executor`` (``submit``, e.g. from
+    :func:`cislunar.utils.executors.open_executor`) they run side by side through
+    :func:`cislunar.utils.montecarlo.map_tasks`, the cold run of our solver here meanwhile; results do not depend
+    on it.
+    """
     validation.instance(case, "case", Case1Sweep)
     n_iter = validation.integer(n_iter, "n_iter", minimum=1)
     n_iter_long = validation.integer(n_iter_long, "n_iter_long", minimum=1)
-    cold = case.solver(alpha, case.x_ball, case.u_ball)
-    t0 = time.perf_counter()
-    runs = [_penalty_run(case, alpha, g, n_iter, "linear") for g in gammas]
-    runs.append(_penalty_run(case, alpha, 1e3, n_iter_long, "linear"))
-    hybrid = _penalty_run(case, alpha, 1e3, n_iter, "quadratic")
-    return PenaltyStudy(alpha, cold, runs, hybrid, n_iter, time.perf_counter() - t0)
+    tasks = [(float(g), n_iter, "linear") for g in gammas] + [(1e3, n_iter_long, "linear"), (1e3, n_iter, "quadratic")]
+    run = functools.partial(_penalty_task, _penalty_problem(case, alpha))
+    if executor is None:
+        cold = case.solver(alpha, case.x_ball, case.u_ball)
+        t0 = time.perf_counter()
+        out = montecarlo.map_tasks(run, tasks, progress=False)
+    else:
+        t0 = time.perf_counter()
+        with concurrent.futures.ThreadPoolExecutor(max_workers=1) as waiter:  # a thread only waits on the executor
+            fut = waiter.submit(montecarlo.map_tasks, run, tasks, executor=executor, progress=False)
+            cold = case.solver(alpha, case.x_ball, case.u_ball)
+            out = fut.result()
+    return PenaltyStudy(alpha, cold, out[:-1], out[-1], n_iter, time.perf_counter() - t0)
 
 
 # --------------------------------------------------------------------------------------------------------------
@@ -1014,6 +1039,130 @@ def alt_grid_sweep(sc: wj.Scenario, info, n_nodes: int, alphas, settings, *, sig
     t, k, _ = sc.node_times(validation.integer(n_nodes, "n_nodes", minimum=4), sigma)
     solver = wj.ScenarioSolver(sc, t, k, information=info, keep_out=True, settings=settings)
     return t, k, wj.sweep_both_ways(solver, alphas, *sc.ballistic_guess(t), executor=executor)
+
+
+
+class _Deferred:
+    """A serial stand-in for a future: the call runs when its result is asked for."""
+
+    def __init__(self, fn, args):
+        self._fn, self._args = fn, args
+
+    def result(self):
+        return self._fn(*self._args)
+
+
+def _submit(executor, fn, *args):
+    """``executor.submit(fn, *args)``, or a :class:`_Deferred` call when ``executor`` is None (serial)."""
+    return _Deferred(fn, args) if executor is None else executor.submit(fn, *args)
+
+
+def _outcome(future):
+    """The result of a queued SCvx run, or its :class:`~cislunar.guidance.scvx.SCvxError`."""
+    try:
+        return future.result()
+    except scvx.SCvxError as exc:
+        return exc
+
+
+@dataclass(frozen=True)
+class Case2Runs:
+    """The SCvx runs of test case 2 that do not depend on one another (notebook 06, sections 4, 6 and 7).
+
+    Attributes
+    ----------
+    sweep : SweepResult
+        The two-way sweep on the main grid.
+    seconds : float
+        Wall time until the main sweep was done (s).
+    seeded : dict
+        ``(alpha, sign) -> SCvxResult or SCvxError`` of the +z/-z seeded runs.
+    alt : dict
+        ``n_nodes -> (t, k_ws, SweepResult)``: the same two-way sweep on other Sundman grids.
+    """
+
+    sweep: object
+    seconds: float
+    seeded: dict
+    alt: dict
+
+
+def case2_runs(sc: wj.Scenario, solver, alphas, x_guess, u_guess, *, seed_alphas=(), alt_nodes=(),
+               sigma: float = 1.0, executor=None) -> Case2Runs:
+    """Queue the independent runs of test case 2 on ``executor`` and collect them.
+
+    The +z/-z seeded runs at ``seed_alphas`` (:meth:`Scenario.seeded_guess`), the two-way sweep of ``solver`` over
+    ``alphas`` from ``(x_guess, u_guess)`` (:func:`~cislunar.papers.wolf_jones.scenarios.sweep_both_ways`) and the
+    same sweep on each Sundman grid of ``alt_nodes`` nodes (:func:`alt_grid_sweep`, same settings).  With an
+    executor (``submit``: a process pool or a Dask client from :func:`cislunar.utils.executors.open_executor`)
+    every chain and seeded run is one task, queued in that order; without one they run here, one after the other.
+    Every run is deterministic, so the results do not depend on the executor.
+    """
+    validation.instance(sc, "sc", wj.Scenario)
+    validation.callable_(solver, "solver")
+    seed_alphas = tuple(float(a) for a in seed_alphas)
+    alt_nodes = tuple(validation.integer(n, "alt_nodes", minimum=4) for n in alt_nodes)
+    seed_jobs = {(a, z): _submit(executor, solver, a, *sc.seeded_guess(solver.t, z))
+                 for a in seed_alphas for z in (+1, -1)}
+    t0 = time.perf_counter()
+
+    def alt(n):
+        return alt_grid_sweep(sc, solver.information, n, alphas, solver.settings, sigma=sigma, executor=executor)
+
+    if executor is None:
+        sweep = wj.sweep_both_ways(solver, alphas, x_guess, u_guess)
+        seconds = time.perf_counter() - t0
+        alt_sweeps = {n: alt(n) for n in alt_nodes}
+    else:
+        # threads only wait on the executor: each two-way sweep blocks on its two chains
+        with concurrent.futures.ThreadPoolExecutor(max_workers=1 + len(alt_nodes)) as waiter:
+            main = waiter.submit(wj.sweep_both_ways, solver, alphas, x_guess, u_guess, executor=executor)
+            sweep = main.result()
+            seconds = time.perf_counter() - t0
+            alt_jobs = {n: waiter.submit(alt, n) for n in alt_nodes}
+            alt_sweeps = {n: job.result() for n, job in alt_jobs.items()}
+    return Case2Runs(sweep, seconds, {key: _outcome(f) for key, f in seed_jobs.items()}, alt_sweeps)
+
+
+class KeepOutJobs:
+    """The keep-out radius and a_max solves of notebook 06, section 11, queued on an executor (a job handle, not a
+    result: :meth:`collect` waits for them and returns the frozen :class:`KeepOutStudy`)."""
+
+    def __init__(self, case, row6, radius_jobs: dict, amax_solvers: dict, amax_jobs: dict, radius_start: str):
+        self.case, self.row6, self.radius_start = case, row6, radius_start
+        self.radius_jobs, self.amax_solvers, self.amax_jobs = radius_jobs, amax_solvers, amax_jobs
+
+    def collect(self, free: FreeRun) -> KeepOutStudy:
+        """Wait for the queued solves and compare them, with the run without keep-out ``free``, against ``row6``."""
+        return keep_out_study(self.case, self.row6, free, {d: _outcome(f) for d, f in self.radius_jobs.items()},
+                              {lab: (self.amax_solvers[lab], _outcome(f)) for lab, f in self.amax_jobs.items()},
+                              radius_start=self.radius_start)
+
+
+def queue_keep_out_runs(case: Case2Sweep, row6, d_min_km, *, warm: bool, x_guess=None, u_guess=None,
+                        executor=None) -> KeepOutJobs:
+    """Queue, at ``row6``'s weight, one solve per keep-out radius of ``d_min_km`` (km) and one per other reading
+    of Table 5's a_max (:data:`~cislunar.papers.wolf_jones.scenarios.A_MAX_READINGS_CASE2_KM_S2`).
+
+    The radius solves start from ``row6``'s plan when ``warm``, else from ``(x_guess, u_guess)`` (the ballistic
+    guess); the a_max solves always start from ``row6``'s plan.  Without an executor the solves run when
+    :meth:`KeepOutJobs.collect` is called.
+    """
+    validation.instance(case, "case", Case2Sweep)
+    validation.boolean(warm, "warm")
+    sc, t, k_ws, info, settings, a6 = (case.scenario, case.t, case.k_ws, case.solver.information,
+                                       case.solver.settings, row6.alpha)
+    guess = (row6.res.x, row6.res.u) if warm else (x_guess, u_guess)
+    if not warm and (x_guess is None or u_guess is None):
+        raise ValueError("x_guess and u_guess are needed for cold radius solves (warm=False)")
+    radius_jobs = {float(d): _submit(executor, wj.ScenarioSolver(sc, t, k_ws, information=info, keep_out=True,
+                                                                 d_min_km=float(d), settings=settings), a6, *guess)
+                   for d in d_min_km}
+    amax_solvers = {label: wj.ScenarioSolver(wj.test_case_2(a_max_km_s2=a_km), t, k_ws, information=info,
+                                             keep_out=True, settings=settings)
+                    for label, a_km in wj.A_MAX_READINGS_CASE2_KM_S2.items() if a_km != wj.A_MAX_CASE2_KM_S2}
+    amax_jobs = {label: _submit(executor, s_, a6, row6.res.x, row6.res.u) for label, s_ in amax_solvers.items()}
+    return KeepOutJobs(case, row6, radius_jobs, amax_solvers, amax_jobs, "warm" if warm else "cold")
 
 
 @dataclass(frozen=True)

@@ -64,3 +64,55 @@ def test_04_halving_the_intervals_divides_the_error_by_about_two_to_the_sixth():
 # ===============================================================================================================
 # End of notebooks 02-04
 # ===============================================================================================================
+
+
+# ===============================================================================================================
+# Notebooks 05-06
+# ===============================================================================================================
+
+
+def test_05_fewer_nodes_raise_the_minimum_impulse():
+    a = X.exercise_05_node_count(n_nodes=(10, 14, 18))
+    imp = a.impulse_mps
+    assert imp[0] > imp[1] > imp[2] > 0  # fewer nodes, more impulse
+    assert imp[0] - imp[1] > imp[1] - imp[2]  # diminishing returns towards the continuous optimum
+    assert max(imp) < 1.0  # the DRO transfer stays cheap (well under 1 m/s) on every grid
+    # the alpha_h = 0 plan's RMS moves much less with the grid than its impulse
+    assert max(a.rms_km) / min(a.rms_km) - 1 < 0.5 * (max(imp) / min(imp) - 1)
+    assert "Fewer nodes, more impulse" in a.answer
+    with pytest.raises(ValueError):
+        X.exercise_05_node_count(n_nodes=(14, 10))
+
+
+def test_05_more_iterations_do_not_make_the_printed_method_converge():
+    a = X.exercise_05_penalty_iterations(max_iter=(10, 30))
+    assert not any(a.converged)
+    assert a.last_defect[1] < a.last_defect[0]  # the defects close slowly ...
+    assert a.best_cost[1] < a.best_cost[0]  # ... the cost creeps down ...
+    assert a.last_eta[1] < a.last_eta[0]  # ... while the trust region keeps shrinking
+    assert "do not make the printed method converge" in a.answer
+    with pytest.raises(ValueError):
+        X.exercise_05_penalty_iterations(max_iter=(30, 10))
+
+
+def test_06_each_decade_closer_adds_ln10_nats():
+    a = X.exercise_06_close_pass_scan(d_range_km=(1e-6, 1e-2), n_points=7)
+    assert a.slope == pytest.approx(1.0, rel=0.02)  # one nat per e-fold: the ln(1/rho) of one range-rate term
+    assert a.per_decade == pytest.approx(np.log(10.0), rel=0.02)
+    assert np.all(np.diff(a.gain) < 0) and a.gain[0] > 0  # closer passes gain more, without bound
+    with pytest.raises(ValueError):
+        X.exercise_06_close_pass_scan(d_range_km=(1e-2, 1e-6))
+
+
+def test_06_without_keep_out_more_iterations_do_not_converge():
+    a = X.exercise_06_free_run_iterations(max_iter=(10, 30))
+    assert not any(a.converged)
+    assert a.best_cost[1] < a.best_cost[0]  # the cost keeps sinking ...
+    assert a.last_defect[1] > 1e-6  # ... with the defects still open
+    assert "more iterations do not bring convergence" in a.answer
+    with pytest.raises(ValueError):
+        X.exercise_06_free_run_iterations(max_iter=(10, 10))
+
+# ===============================================================================================================
+# End of notebooks 05-06
+# ===============================================================================================================

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+from cislunar.guidance import scvx
 from cislunar.guidance.scvx import SCvxError
 from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.papers.wolf_jones import test_case_studies as S
@@ -140,3 +142,78 @@ def test_mirror_study_flags_seeds_that_are_mirror_images():
 
 def test_departures_count_the_grids_above_the_threshold():
     assert Departures([1.0], 0.5, {16: 0.5, 14: 1.0, 24: 0.81}, []).dep_pass == 2
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The executor paths (round 2): queued runs give the serial results, whatever runs them
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def test_penalty_study_is_the_same_with_an_executor(case1):
+    serial = S.penalty_study(case1, [1e1, 1e3], 2, 3)
+    with ThreadPoolExecutor(max_workers=2) as ex:
+        queued = S.penalty_study(case1, [1e1, 1e3], 2, 3, executor=ex)
+    # the gamma sweep, then gamma 1e3 with the long limit; the hybrid apart with the quadratic model
+    assert [(r["gamma"], r["max_iter"], r["model"]) for r in serial.runs] == [(1e1, 2, "linear"), (1e3, 2, "linear"),
+                                                                              (1e3, 3, "linear")]
+    assert serial.hybrid["model"] == "quadratic" and serial.long_run["max_iter"] == 3
+    assert serial.printed is serial.runs[1]
+    for a, b in zip(serial.runs + [serial.hybrid], queued.runs + [queued.hybrid]):
+        assert a["converged"] == b["converged"] and a["outcome"] == b["outcome"]
+        assert np.array_equal(a["best"], b["best"], equal_nan=True)  # NaN: no step accepted yet
+        assert len(a["history"]) == len(b["history"]) <= a["max_iter"]
+    assert serial.cold.cost == queued.cold.cost and serial.cold.max_defect <= 1e-9  # our solver converges
+
+
+@pytest.fixture(scope="module")
+def case2_small():
+    sc = wj.test_case_2()
+    t, k_ws, k_we = sc.node_times(10)
+    solver = wj.ScenarioSolver(sc, t, k_ws, keep_out=True, settings=scvx.SCvxSettings(max_iter=60))
+    x_ball, u_ball = sc.ballistic_guess(t)
+    return sc, solver, k_ws, k_we, x_ball, u_ball
+
+
+def test_case2_runs_serial_and_queued_agree_and_an_alt_grid_equal_to_the_main_one_repeats_it(case2_small):
+    sc, solver, k_ws, k_we, x_ball, u_ball = case2_small
+    serial = S.case2_runs(sc, solver, [0.0], x_ball, u_ball, seed_alphas=[0.0], alt_nodes=[10])
+    with ThreadPoolExecutor(max_workers=2) as ex:
+        queued = S.case2_runs(sc, solver, [0.0], x_ball, u_ball, seed_alphas=[0.0], alt_nodes=[10], executor=ex)
+    for r in (serial, queued):
+        assert set(r.seeded) == {(0.0, 1), (0.0, -1)} and set(r.alt) == {10}
+        t_alt, k_alt, sw = r.alt[10]
+        assert np.array_equal(t_alt, solver.t) and k_alt == k_ws  # the same grid: the same sweep
+        assert sw.best[0].cost == r.sweep.best[0].cost
+    assert queued.sweep.best[0].cost == serial.sweep.best[0].cost
+    for key, res in serial.seeded.items():
+        other = queued.seeded[key]
+        assert type(res) is type(other)
+        if not isinstance(res, SCvxError):
+            assert res.cost == other.cost
+    # the +z and -z seeds are mirror images and so is the problem (z -> -z): equal costs when both converge
+    p, m = serial.seeded[(0.0, 1)], serial.seeded[(0.0, -1)]
+    if not isinstance(p, SCvxError) and not isinstance(m, SCvxError):
+        assert p.cost == pytest.approx(m.cost, rel=1e-6)
+    with pytest.raises(ValueError):
+        S.case2_runs(sc, solver, [0.0], x_ball, u_ball, alt_nodes=[2])
+
+
+def test_queued_keep_out_runs_respect_their_radius(case2_small):
+    sc, solver, k_ws, k_we, x_ball, u_ball = case2_small
+    sweep = wj.sweep_both_ways(solver, [0.0], x_ball, u_ball)
+    case = S.case2_rows(sc, solver, k_ws, k_we, sweep)
+    row = case.ok[0]
+    with pytest.raises(ValueError):
+        S.queue_keep_out_runs(case, row, [1500.0], warm=False)
+    with ThreadPoolExecutor(max_workers=2) as ex:
+        jobs = S.queue_keep_out_runs(case, row, [1500.0], warm=True, executor=ex)
+        free = S.free_run(sc, solver.t, k_ws, solver.information, 0.0, x_ball, u_ball, 2)
+        ko = jobs.collect(free)
+    serial = S.queue_keep_out_runs(case, row, [1500.0], warm=True).collect(free)
+    assert [r.d for r in ko.radius_rows] == [sc.keep_out_km, 1500.0] and ko.radius_rows[1].src == "warm"
+    r15 = ko.radius_rows[1]
+    assert r15.closest >= 1500.0 * (1 - 1e-3)  # the keep-out holds at every measurement
+    assert r15.dv == serial.radius_rows[1].dv
+    # one solve per other a_max reading of Table 5, same labels serial or queued
+    assert len(ko.amax_rows) + len(ko.amax_failed) == len(wj.A_MAX_READINGS_CASE2_KM_S2) - 1
+    assert [a[0] for a in ko.amax_rows] == [a[0] for a in serial.amax_rows]
