@@ -4,8 +4,9 @@ Each trial is one detection run of notebook 10 at the paper's setting: one perio
 2-hour cadence (79 epochs), L2 angles and rates, quiet-policy maneuver at apoapsis, window tuning f = 0.1, full
 OCBE filter and smoother, z from the smoothed control.
 
-* ``reference``: the Monte Carlo as it ran before (batches of 8 trials: draws, then
-  ``ocbe_batch(..., engine="reference")``, the full 12x12 variational system, one batch per call).
+* ``reference``: the Monte Carlo as it ran before (batches of 8 trials: draws, then the first batched OCBE on the
+  full 12x12 variational system, one batch per call; kept as the test oracle
+  ``tests/estimation/reference_batched_ocbe.py``, imported from there).
 * ``fast``: :func:`cislunar.papers.greaves_scheeres_2021.detection.run_detection_monte_carlo` with ``batch_size=8`` as notebook 10 calls it
   (same seeds and trials; the block integrator, several batches per lockstep call).
 
@@ -18,7 +19,9 @@ Ratios come from one run (the machine may be shared); no timed assertion.
 Run with ``OMP_NUM_THREADS=1 python -m benchmarks detection``.
 """
 
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -27,6 +30,9 @@ from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.estimation import batched_ocbe
 from cislunar.papers.greaves_scheeres_2021 import detection as det
 from cislunar.utils.montecarlo import trial_rng
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "estimation"))
+from reference_batched_ocbe import ocbe_batch_reference  # the test oracle, not part of the package
 
 
 def _best(fn, repeats):
@@ -53,7 +59,7 @@ def main(n_trials: int = 128, batch: int = 8, lockstep=(8, 16, 32, 64, 128), n_s
         z = []
         for k in range(n_batches):
             inputs = [det.draw_trial(c, setup, pol) for c in trial_rng(seed, k).spawn(batch)]
-            res = batched_ocbe.ocbe_batch(*filter_args(inputs), n_sub=setup.n_sub, tol=setup.tol, engine="reference")
+            res = ocbe_batch_reference(*filter_args(inputs), n_sub=setup.n_sub, tol=setup.tol)
             z.extend(res.z_smooth * em.velocity_unit_km_s * 1e3)
         return np.array(z[:n_trials])
 
@@ -63,10 +69,9 @@ def main(n_trials: int = 128, batch: int = 8, lockstep=(8, 16, 32, 64, 128), n_s
     # compile every integrator outside the timings
     warm = [det.draw_trial(c, setup, pol) for c in np.random.default_rng(seed + 1).spawn(max(lockstep))]
     for B in sorted({batch, *lockstep}):
-        for engine in ("reference", "fast"):
-            if engine == "reference" and B != batch:
-                continue
-            batched_ocbe.ocbe_batch(*filter_args(warm[:B]), engine=engine)
+        if B == batch:
+            ocbe_batch_reference(*filter_args(warm[:B]))
+        batched_ocbe.ocbe_batch(*filter_args(warm[:B]))
     det.run_detection_monte_carlo(setup, pol, 2 * batch, seed + 1, batch_size=batch, progress=False)
 
     result = {"n_trials": n_trials, "batch_size": batch, "lockstep_trials": det.LOCKSTEP_TRIALS,
@@ -97,7 +102,7 @@ def main(n_trials: int = 128, batch: int = 8, lockstep=(8, 16, 32, 64, 128), n_s
                                     for k in range(n_batches) for c in trial_rng(seed, k).spawn(batch)], 1)
     result["draw_s_per_trial"] = t_draw / len(inputs)
     print(f"drawing (truth, measurements, hand-off error): {t_draw / len(inputs) * 1e3:.1f} ms/trial")
-    t_f, _ = _best(lambda: [batched_ocbe.ocbe_batch(*filter_args(inputs[k:k + batch]), engine="reference")
+    t_f, _ = _best(lambda: [ocbe_batch_reference(*filter_args(inputs[k:k + batch]))
                             for k in range(0, len(inputs), batch)], 1)
     result[f"filter_reference_B{batch}_s_per_trial"] = t_f / len(inputs)
     print(f"filter, reference engine, lockstep {batch:3d}: {t_f / len(inputs) * 1e3:.1f} ms/trial")

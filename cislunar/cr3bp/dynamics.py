@@ -59,6 +59,12 @@ MOON_RADIUS_KM = 1737.4
 EARTH_RADIUS_KM = 6371.0
 
 
+#: Smallest mass parameter: ``1 - mu`` must differ from 1 in double precision (the Moon sits at ``1 - mu``).
+_MU_MIN = np.finfo(float).eps / 2.0
+#: Allowed range of the length and time units (km, s): their ratios (LU/TU, LU/TU^2) stay finite and non-zero.
+_UNIT_RANGE = (1e-6, 1e15)
+
+
 @dataclass(frozen=True)
 class CR3BP:
     """A circular restricted three-body system with its units.
@@ -66,11 +72,12 @@ class CR3BP:
     Parameters
     ----------
     mu : float
-        Mass parameter :math:`m_2/(m_1+m_2)`, in (0, 0.5].
+        Mass parameter :math:`m_2/(m_1+m_2)`, in (0, 0.5] and at least ``eps/2`` (1.1e-16) so that ``1 - mu``
+        differs from 1.
     length_unit_km : float
-        Length unit (distance between the primaries), km.
+        Length unit (distance between the primaries), km, in [1e-6, 1e15].
     time_unit_s : float
-        Time unit (inverse mean motion of the primaries), s.
+        Time unit (inverse mean motion of the primaries), s, in [1e-6, 1e15].
     primary_radius_km, secondary_radius_km : float
         Mean radii of the primaries, km (used for plots, visibility and impact checks).
     name : str
@@ -91,10 +98,15 @@ class CR3BP:
 
     def __post_init__(self):
         validation.in_range(self.mu, "mu", 0.0, 0.5, closed=True)
-        if self.mu == 0.0:
-            raise ValueError("mu must lie in (0, 0.5]; got 0.0")
+        if not float(self.mu) >= _MU_MIN:  # also 0: the primaries at -mu and 1 - mu would not resolve a smaller mu
+            raise ValueError(f"mu must lie in (0, 0.5] and be resolvable next to 1 (mu >= {_MU_MIN:.1e}); got "
+                             f"{self.mu!r}")
         validation.positive(self.length_unit_km, "length_unit_km")
         validation.positive(self.time_unit_s, "time_unit_s")
+        for attr in ("length_unit_km", "time_unit_s"):
+            if not _UNIT_RANGE[0] <= float(getattr(self, attr)) <= _UNIT_RANGE[1]:
+                raise ValueError(f"{attr} must lie in [{_UNIT_RANGE[0]:g}, {_UNIT_RANGE[1]:g}] (derived velocity "
+                                 f"and acceleration units must stay finite and non-zero); got {getattr(self, attr)!r}")
         # radii drive impact detection: NaN, negative or non-numeric radii would silently switch it off
         validation.positive(self.primary_radius_km, "primary_radius_km")
         validation.positive(self.secondary_radius_km, "secondary_radius_km")

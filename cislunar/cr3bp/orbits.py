@@ -41,6 +41,7 @@ from cislunar.cr3bp.propagation import (
     DEFAULT_TOL,
     ImpactError,
     PropagationError,
+    check_outside_primaries,
     find_events,
     propagate,
     propagate_stm,
@@ -159,6 +160,17 @@ class PeriodicOrbit:
     closure: float
     residuals: tuple = field(default=(), repr=False)
     label: str = ""
+
+    def __post_init__(self):
+        """Validate on construction: a finite state outside both primaries, a positive period, a 6x6 monodromy."""
+        check_system(self.system, "system")
+        x0 = validation.as_state(self.x0, "x0", batch=False)
+        check_outside_primaries(self.system, x0, "x0")
+        object.__setattr__(self, "x0", x0)
+        validation.positive(self.period, "period")
+        object.__setattr__(self, "monodromy", validation.square(self.monodromy, "monodromy", n=6))
+        if not isinstance(self.label, str):
+            raise validation.ArgumentTypeError(f"label must be a str; got {type(self.label).__name__}")
 
     @property
     def jacobi(self) -> float:

@@ -139,6 +139,40 @@ def check_outside_primaries(system: CR3BP, states, name: str = "states", *, t0: 
                                      f"radius {radius * system.length_unit_km:.6g} km")
 
 
+def _check_arcs_outside_primaries(system: CR3BP, t, states, tol: float = DEFAULT_TOL, *, first: int = 0) -> None:
+    """Raise :class:`ImpactError` if an arc sampled at ``states`` dips below a primary's surface between samples.
+
+    For integrators without impact events (the OCBE transitions, whose steps the events would change at round-off
+    level).  ``t`` (m,) is the grid (TU), ``states`` (m, 6) or (m, B, 6) the ballistic states on it (B arcs).  On
+    every grid interval the cubic Hermite interpolant of the end positions and velocities is sampled at 17
+    points; an interval whose interpolant comes within ``R + h v_max / 2`` of a primary's centre (``h`` the
+    interval, ``v_max`` the larger end speed, ``R`` the radius) is re-propagated from its start with the impact
+    events of :func:`propagate`, which decide.  The results are discarded: this only checks.  Unchecked inputs
+    (inner kernel); ``first`` offsets the arc index reported as ``member``.
+    """
+    X = states if states.ndim == 3 else states[:, None, :]
+    if t.size < 2:
+        return
+    h = np.diff(t)[:, None, None]  # (m-1, 1, 1)
+    r0, r1, v0, v1 = X[:-1, :, :3], X[1:, :, :3], X[:-1, :, 3:], X[1:, :, 3:]
+    s = np.linspace(0.0, 1.0, 17)[:, None, None, None]
+    h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
+    p = h00 * r0 + h10 * h * v0 + h01 * r1 + h11 * h * v1  # (17, m-1, B, 3)
+    reach = 0.5 * h[..., 0] * np.maximum(np.linalg.norm(v0, axis=-1), np.linalg.norm(v1, axis=-1))  # (m-1, B)
+    near = np.zeros(reach.shape, dtype=bool)
+    for centre, radius in ((system.secondary_position, system.secondary_radius),
+                           (system.primary_position, system.primary_radius)):
+        d = np.min(np.linalg.norm(p - centre, axis=-1), axis=0)
+        near |= d <= radius + reach
+    for k, b in zip(*np.nonzero(near)):
+        grid = np.array([t[k], t[k + 1]])
+        try:
+            _propagate_chunk(system, X[k, b][None], grid, 0, tol, 1, True, None)
+        except ImpactError as exc:
+            raise ImpactError(exc.body, exc.time, None if states.ndim == 2 else first + int(b), exc.state,
+                              detail="between grid points") from None
+
+
 def _heyoka():
     import heyoka as hy  # imported lazily: importing heyoka costs about a second
 

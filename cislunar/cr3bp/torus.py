@@ -165,12 +165,20 @@ def _check_circle_outside_primaries(system: CR3BP, circle: np.ndarray, name: str
 # ----------------------------------------------------------------------------------------------------------
 # Fourier interpolation on the circle
 # ----------------------------------------------------------------------------------------------------------
+#: Largest number of points on the invariant circle (the Newton systems are dense, 6N x 6N).
+_MAX_N = 1001
+#: Largest number of continuation steps or of grid samples a single call may request.
+_MAX_STEPS = 1_000
+_MAX_SAMPLES = 5e6
+
+
 def _check_n(n, name: str = "N") -> int:
     if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)):
         raise validation.ArgumentTypeError(f"{name} must be an odd integer >= 5; got {type(n).__name__} {n!r:.60}")
     n = int(n)
     if n < 5 or n % 2 == 0:
         raise ValueError(f"{name} must be an odd integer >= 5 (odd: no ambiguous Nyquist mode); got {n}")
+    validation.work_size(n, name, _MAX_N, "points on the invariant circle (dense 6N x 6N Newton systems)")
     return n
 
 
@@ -849,7 +857,8 @@ def torus_from_orbit(orbit: PeriodicOrbit, N: int = 25, size_km: float = 10.0, *
                         **solve_kw)
     if size_km == start_km:
         return torus
-    n_steps = int(np.ceil((size_km - start_km) / step_km))
+    n_steps = validation.work_size(np.ceil((size_km - start_km) / step_km), "step_km", _MAX_STEPS,
+                                   "continuation steps")
     values = np.linspace(start_km, size_km, n_steps + 1)[1:]
     return continue_tori(torus, values, parameter="size_km", progress=progress, **solve_kw)[-1]
 
@@ -1037,6 +1046,7 @@ def mean_range(torus: InvariantTorus, *, n_theta: int = 48, n_t: int = 1201, per
     n_theta = validation.integer(n_theta, "n_theta", minimum=4)
     n_t = validation.integer(n_t, "n_t", minimum=11)
     periods = validation.integer(periods, "periods", minimum=1)
+    validation.work_size(float(n_theta) * periods * n_t, "n_theta * n_t * periods", _MAX_SAMPLES, "torus samples")
     tol = _heyoka_tol(tol)
     T = torus.period
     th = 2.0 * np.pi * np.arange(n_theta) / n_theta

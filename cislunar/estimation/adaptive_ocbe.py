@@ -599,7 +599,7 @@ def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0,
 def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *,
                         probability: float = DETECTION_PROBABILITY, consecutive: int = CONSECUTIVE_EPOCHS,
                         reset: str = "mean", n_sub: int = 9, tol: float = DEFAULT_TOL, max_resets: int = 50):
-    """The adaptive OCBE for B trials in lockstep on :func:`cislunar.papers.greaves_scheeres_2021.batched_ocbe.ocbe_batch` (one observer).
+    """The adaptive OCBE for B trials in lockstep on :func:`cislunar.estimation.batched_ocbe.ocbe_batch` (one observer).
 
     Same rule and reset as :func:`adaptive_ocbe`, trial by trial; each pass re-runs the whole batch with the
     updated per-trial weights (trials without a new detection reproduce their previous pass).
@@ -610,7 +610,7 @@ def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x
     x0 : array_like, shape (B, 6)
     P0 : array_like, shape (6, 6) or (B, 6, 6)
     control_weight : scalar or array_like, shape (N-1,) or (B, N-1)
-    Others as in :func:`cislunar.papers.greaves_scheeres_2021.batched_ocbe.ocbe_batch`.
+    Others as in :func:`cislunar.estimation.batched_ocbe.ocbe_batch`.
 
     Returns
     -------
@@ -671,7 +671,7 @@ def first_pass_detections(system: CR3BP, t, y, observer_states, model, meas_cov,
 
     Until its first reset the adaptive filter is the plain OCBE with the starting tuning, so its first detection
     (and with it the detection delay of a single maneuver) does not depend on the reset rule: one pass of
-    :func:`cislunar.papers.greaves_scheeres_2021.batched_ocbe.ocbe_batch` and the three-epoch rule (:func:`first_detection`, from epoch 1) give it
+    :func:`cislunar.estimation.batched_ocbe.ocbe_batch` and the three-epoch rule (:func:`first_detection`, from epoch 1) give it
     for every trial.  Arguments as in :func:`adaptive_ocbe_batch` (one observer).
 
     Returns

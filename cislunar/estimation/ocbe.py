@@ -37,6 +37,7 @@ import numpy as np
 from cislunar.cr3bp.dynamics import CR3BP, check_system
 from cislunar.cr3bp.propagation import (
     DEFAULT_TOL,
+    _check_arcs_outside_primaries,
     _check_outcome,
     _check_tol,
     _grid_from,
@@ -141,10 +142,11 @@ def _ocbe_template(tol: float):
 def variational_system(tol: float = DEFAULT_TOL):
     """The OCBE variational ODE system (heyoka expressions) and the state index of each 12x12 STM entry.
 
-    For callers that build their own integrators from it (e.g. a heyoka batch integrator running several filters
-    in lockstep, :mod:`cislunar.papers.greaves_scheeres_2021.detection`).  Returns ``(sys, index)``: ``sys`` is the list of (variable,
-    expression) pairs, ``index[i, j]`` the position of entry (i, j) of the 12x12 STM in the integrator state; parameters are
-    ``[mu, q]``.
+    For callers that build their own integrators from it (e.g. the heyoka batch integrator of the full-12x12 test
+    oracle of the batched OCBE, ``tests/estimation/reference_batched_ocbe.py``; the package's batched OCBE integrates
+    the three non-zero blocks, :func:`block_integrator`).  Returns ``(sys, index)``: ``sys`` is the list of
+    (variable, expression) pairs, ``index[i, j]`` the position of entry (i, j) of the 12x12 STM in the integrator
+    state; parameters are ``[mu, q]``.
     """
     ta, index = _ocbe_template(_check_tol(tol))
     return ta.sys, index.copy()
@@ -211,7 +213,7 @@ def block_integrator(batch_size: int, tol: float = DEFAULT_TOL):
     vanishes exactly and :math:`\\Phi_{px}` stays exactly zero.  Dropping the zero block and the vanishing
     third-derivative terms cuts the Taylor decomposition about six-fold (114 instead of 156 states, 836 instead of
     5260 elementary operations); the kept entries obey the same differential equations, so the two integrators
-    agree to round-off (``tests/estimation/test_ocbe.py``).  Used by the batched OCBE of :mod:`cislunar.papers.greaves_scheeres_2021.detection`.
+    agree to round-off (``tests/estimation/test_ocbe.py``).  Used by the batched OCBE of :mod:`cislunar.estimation.batched_ocbe`.
 
     Parameters
     ----------
@@ -294,10 +296,11 @@ def ocbe_transition(system: CR3BP, x0, t, control_weight: float, *, tol: float =
     Notes
     -----
     The OCBE integrator carries no impact events (its reference is the filter's current estimate of a spacecraft
-    in orbit, re-linearised every interval).  Instead a start inside a primary raises
-    :class:`cislunar.cr3bp.propagation.ImpactError`, and so does any grid state inside a primary; a reference that
-    passes through a primary entirely between two grid points would not be seen, so keep the grid finer than a
-    perilune passage (the filters use several sub-steps per measurement interval).
+    in orbit, re-linearised every interval): impact events change its steps at round-off level.  A start inside a
+    primary raises :class:`cislunar.cr3bp.propagation.ImpactError`, and so does any grid state inside a primary or
+    an arc between two grid points that dips below a surface: every grid interval that the cubic Hermite
+    interpolant of its end states brings near a primary is re-propagated with the impact events of
+    :func:`cislunar.cr3bp.propagation.propagate`.
     """
     check_system(system)
     x0 = validation.as_state(x0, "x0", batch=False)
@@ -321,6 +324,7 @@ def _transition(system, x0, grid, q, tol) -> OCBETransition:
     out = res[-1]
     if _inside_primaries(system, out[:, :3]):
         check_outside_primaries(system, out[:, :6], "reference trajectory", t0=grid[0])
+    _check_arcs_outside_primaries(system, grid, out[:, :6], tol)
     return OCBETransition(t=grid, x=out[:, :6], phi=out[:, index], control_weight=q)
 
 
@@ -460,10 +464,14 @@ class OCBEResult:
     residual_norms: np.ndarray
 
 
-def _control_integral(t_sub, control) -> float:
-    """:math:`\\sum_n\\int_{t_n}^{t_{n+1}}\\|u\\|dt` by the trapezoid rule on each interval's sub-grid."""
+def _control_integral(t_sub, control) -> np.ndarray:
+    """Eq. 33, :math:`\\sum_n\\int_{t_n}^{t_{n+1}}\\|u\\|dt`, by the trapezoid rule on each interval's sub-grid.
+
+    ``t_sub`` (N-1, n_sub) in TU, ``control`` (..., N-1, n_sub, 3) in LU/TU^2 with optional leading trial axes (the
+    batched filter of :mod:`cislunar.estimation.batched_ocbe`); returns shape (...), LU/TU.
+    """
     mag = np.linalg.norm(control, axis=-1)
-    return float(np.sum(np.trapezoid(mag, t_sub, axis=-1)))
+    return np.sum(np.trapezoid(mag, t_sub, axis=-1), axis=-1)
 
 
 def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *,
@@ -535,7 +543,7 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
         raise ValueError(f"meas_cov must have shape ({model.dim}, {model.dim}) or ({N}, {model.dim}, {model.dim})")
     validation.spd(R, "meas_cov", batch=True)
     qs = control_weights(control_weight, N - 1)
-    n_sub = validation.integer(n_sub, "n_sub", minimum=2)
+    n_sub = validation.integer(n_sub, "n_sub", minimum=2, maximum=10_000)
     smooth = validation.boolean(smooth, "smooth")
     tol = _check_tol(tol)
     x = validation.as_state(x0, "x0", batch=False).copy()
@@ -595,7 +603,7 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
         t_sub = np.array(t_sub)
         phi_pp_sub = np.array(phi_pp_sub)
         control_step = -qs[:, None, None] * np.einsum("nkij,nj->nki", phi_pp_sub, p_step)[..., 3:6]
-        z_step = _control_integral(t_sub, control_step)
+        z_step = float(_control_integral(t_sub, control_step))
         x_s = P_s = p_s = control_s = z_s = None
         if smooth:
             xs, Ps = [None] * N, [None] * N
@@ -614,7 +622,7 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
                 w = (x_s[n + 1] - x_pred[n + 1]) - Phi_xx @ (x_s[n] - x_filt[n])
                 p_s[n] = np.linalg.solve(Phi_xp, w)
             control_s = -qs[:, None, None] * np.einsum("nkij,nj->nki", phi_pp_sub, p_s)[..., 3:6]
-            z_s = _control_integral(t_sub, control_s)
+            z_s = float(_control_integral(t_sub, control_s))
         return OCBEResult(t, np.array(x_pred), np.array(P_pred), np.array(x_filt), np.array(P_filt), x_s, P_s, p_step,
                           p_s, t_sub, control_step, control_s, z_step, z_s, np.array(resid))
 

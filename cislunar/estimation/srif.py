@@ -19,7 +19,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import solve_triangular
 
 from cislunar.utils import validation
 
@@ -44,49 +43,71 @@ def householder_triangularize(A) -> np.ndarray:
     return _triangularize(validation.as_array(A, "A", ndim=(2,)))
 
 
-# Unchecked kernels: the public functions below validate their arguments and call these; filters built on this
-# module (cislunar.estimation.ocbe) validate once at their own boundary and call the kernels in their inner loops.
+# Unchecked kernels, written once in stacked form: every array may carry leading batch axes (B, ...) that broadcast
+# against each other, and a single matrix is the case without them.  The public functions below validate their
+# arguments and call these; the filters built on this module (the single-trial OCBE of cislunar.estimation.ocbe and
+# the B-trial lockstep OCBE of cislunar.estimation.batched_ocbe) validate once at their own boundary and call the
+# kernels in their inner loops.
 def _triangularize(A):
+    """Householder QR of A (..., m, n): the min(m, n) rows of U, with non-negative diagonal."""
     r = np.linalg.qr(A, mode="r")
-    d = np.sign(np.diag(r))
+    d = np.sign(np.diagonal(r, axis1=-2, axis2=-1)).copy()
     d[d == 0] = 1.0
-    return r * d[:, None]
+    return r * d[..., :, None]
+
+
+def _blocks(rows):
+    """:func:`numpy.block` for stacks: a list of block rows whose blocks share (broadcast) leading axes."""
+    lead = np.broadcast_shapes(*(b.shape[:-2] for row in rows for b in row))
+    return np.concatenate([np.concatenate([np.broadcast_to(b, lead + b.shape[-2:]) for b in row], axis=-1)
+                           for row in rows], axis=-2)
 
 
 def _sri_of_cov(C):
-    """W upper triangular with W^T W = C^{-1}; raises LinAlgError if C is not positive definite."""
-    L = np.linalg.cholesky(0.5 * (C + C.T))
-    return _triangularize(solve_triangular(L, np.eye(C.shape[0]), lower=True))
+    """W upper triangular with W^T W = C^{-1} (..., n, n); raises LinAlgError if C is not positive definite."""
+    L = np.linalg.cholesky(0.5 * (C + np.swapaxes(C, -1, -2)))
+    return _triangularize(np.linalg.inv(L))  # C = L L^T -> C^{-1} = L^{-T} L^{-1}; W = L^{-1} re-triangularised
+
+
+def _solve_upper(R, b):
+    """x with R x = b for stacks of upper-triangular R (..., n, n) and b (..., n)."""
+    return np.linalg.solve(R, b[..., None])[..., 0]
 
 
 def _cov_of_sri(R, z=None):
-    Rinv = solve_triangular(R, np.eye(R.shape[0]), lower=False)
-    P = Rinv @ Rinv.T
-    return P if z is None else (Rinv @ z, P)
+    """Covariance R^{-1}R^{-T} (..., n, n), and the mean R^{-1}z first if ``z`` (..., n) is given."""
+    Rinv = np.linalg.inv(R)
+    P = Rinv @ np.swapaxes(Rinv, -1, -2)
+    return P if z is None else ((Rinv @ z[..., None])[..., 0], P)
 
 
 def _measurement_update(R, z, H, y, meas_cov):
-    n = R.shape[0]
+    """Stacked :func:`measurement_update`: R (..., n, n), z (..., n), H (..., m, n), y (..., m), meas_cov (..., m, m).
+
+    Returns ``R_new, z_new, residual_norm`` (the last of shape (...)).
+    """
+    n = R.shape[-1]
     W = _sri_of_cov(meas_cov)
-    U = _triangularize(np.block([[R, z[:, None]], [W @ H, (W @ y)[:, None]]]))
-    return U[:n, :n], U[:n, n], float(abs(U[n, n]))
+    U = _triangularize(_blocks([[R, z[..., None]], [W @ H, W @ y[..., None]]]))
+    return U[..., :n, :n], U[..., :n, n], np.abs(U[..., n, n])
 
 
 def _time_update(R, z, Phi, Gamma, Q):
-    n = R.shape[0]
-    Rt = np.linalg.solve(Phi.T, R.T).T  # R Phi^{-1}
-    r = Gamma.shape[1]
-    A = np.block([[_sri_of_cov(Q), np.zeros((r, n)), np.zeros((r, 1))], [-Rt @ Gamma, Rt, z[:, None]]])
+    """Stacked :func:`time_update` with process noise (Gamma (..., n, r), Q (..., r, r))."""
+    n, r = R.shape[-1], Gamma.shape[-1]
+    Rt = np.swapaxes(np.linalg.solve(np.swapaxes(Phi, -1, -2), np.swapaxes(R, -1, -2)), -1, -2)  # R Phi^{-1}
+    A = _blocks([[_sri_of_cov(Q), np.zeros((r, n)), np.zeros((r, 1))], [-Rt @ Gamma, Rt, z[..., None]]])
     U = _triangularize(A)
-    return U[r:, r:r + n], U[r:, r + n], (U[:r, :r], U[:r, r:r + n], U[:r, r + n])
+    return U[..., r:, r:r + n], U[..., r:, r + n], (U[..., :r, :r], U[..., :r, r:r + n], U[..., :r, r + n])
 
 
 def _smoother_step(Rs_next, zs_next, Phi, Gamma, smoother_terms):
+    """Stacked :func:`smoother_step`; ``smoother_terms`` is the (Rw, Rwx, zw) triple of :func:`_time_update`."""
     Rw, Rwx, zw = smoother_terms
-    r, n = Rw.shape[0], Rs_next.shape[0]
-    A = np.block([[Rw + Rwx @ Gamma, Rwx @ Phi, zw[:, None]], [Rs_next @ Gamma, Rs_next @ Phi, zs_next[:, None]]])
+    r, n = Rw.shape[-2], Rs_next.shape[-1]
+    A = _blocks([[Rw + Rwx @ Gamma, Rwx @ Phi, zw[..., None]], [Rs_next @ Gamma, Rs_next @ Phi, zs_next[..., None]]])
     U = _triangularize(A)
-    return U[r:r + n, r:r + n], U[r:r + n, r + n]
+    return U[..., r:r + n, r:r + n], U[..., r:r + n, r + n]
 
 
 def _chol_upper_inverse(C, name):
@@ -96,13 +117,11 @@ def _chol_upper_inverse(C, name):
         raise ValueError(f"{name} must not be empty")
     if not np.allclose(C, C.T, rtol=1e-10, atol=1e-14 * max(1.0, np.max(np.abs(C)))):
         raise ValueError(f"{name} must be symmetric")
+    validation.spd(C, name)  # also refuses numerically singular covariances (validation.SPD_RCOND)
     try:
-        L = np.linalg.cholesky(0.5 * (C + C.T))
+        return _sri_of_cov(C)
     except np.linalg.LinAlgError:
         raise ValueError(f"{name} must be symmetric positive definite") from None
-    # C = L L^T  ->  C^{-1} = L^{-T} L^{-1}; W = L^{-1} is lower; use QR to make it upper triangular
-    W = solve_triangular(L, np.eye(C.shape[0]), lower=True)
-    return _triangularize(W)
 
 
 def sri_from_covariance(x, P, *, name: str = "P") -> tuple[np.ndarray, np.ndarray]:
@@ -148,9 +167,8 @@ def measurement_update(R, z, H, y, meas_cov):
     W = _chol_upper_inverse(meas_cov, "meas_cov")
     if W.shape[0] != H.shape[0]:
         raise ValueError(f"meas_cov must be {H.shape[0]}x{H.shape[0]}; got {np.shape(meas_cov)}")
-    A = np.block([[R, z[:, None]], [W @ H, (W @ y)[:, None]]])
-    U = _triangularize(A)  # (n + 1, n + 1): [R_new z_new; 0 e]
-    return U[:n, :n], U[:n, n], float(abs(U[n, n]))
+    R_new, z_new, e = _measurement_update(R, z, H, y, meas_cov)  # triangularised [R_new z_new; 0 e]
+    return R_new, z_new, float(e)
 
 
 def factor_process_noise(Q, *, rtol: float = 1e-12):
@@ -197,7 +215,7 @@ def time_update(R, z, Phi, Gamma=None, Q=None):
     if not np.all(np.isfinite(Rt)):
         raise ValueError("Phi must be an invertible transition matrix; it is numerically singular")
     if Gamma is None and Q is None:
-        U = householder_triangularize(np.hstack([Rt, z[:, None]]))
+        U = _triangularize(np.hstack([Rt, z[:, None]]))
         return U[:, :n], U[:, n], None
     if Gamma is None or Q is None:
         raise ValueError("Gamma and Q must be given together (or both omitted for no process noise)")
@@ -205,12 +223,9 @@ def time_update(R, z, Phi, Gamma=None, Q=None):
     if Gamma.shape[0] != n:
         raise ValueError(f"Gamma must have {n} rows; got shape {Gamma.shape}")
     r = Gamma.shape[1]
-    Rw = _chol_upper_inverse(Q, "Q")
-    if Rw.shape[0] != r:
+    if _chol_upper_inverse(Q, "Q").shape[0] != r:
         raise ValueError(f"Q must be {r}x{r} to match Gamma; got {np.shape(Q)}")
-    A = np.block([[Rw, np.zeros((r, n)), np.zeros((r, 1))], [-Rt @ Gamma, Rt, z[:, None]]])
-    U = _triangularize(A)
-    return U[r:, r:r + n], U[r:, r + n], (U[:r, :r], U[:r, r:r + n], U[:r, r + n])
+    return _time_update(R, z, Phi, Gamma, np.asarray(Q, dtype=float))
 
 
 def smoother_step(Rs_next, zs_next, Phi, Gamma, smoother_terms):

@@ -90,6 +90,8 @@ def chapter_statistics(source: str | os.PathLike) -> ChapterStatistics:
 
 def statistics_table(sources) -> str:
     """A Markdown table of :func:`chapter_statistics` for several sources, with a total row."""
+    if isinstance(sources, (str, bytes, os.PathLike)) or not hasattr(sources, "__iter__"):
+        raise TypeError(f"sources must be an iterable of notebook source paths; got {type(sources).__name__}")
     rows = [chapter_statistics(s) for s in sources]
     out = ["| notebook | prose lines | code lines | code comments | prose / code |", "|---|---:|---:|---:|---:|"]
     for r in rows:

@@ -17,6 +17,8 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from cislunar.utils import validation
+
 __all__ = ["RunInfo", "IncompleteBuildError", "new_run", "git_commit", "write_record", "read_records",
            "provenance_line", "parse_provenance_line", "audit_build", "METADATA_KEY"]
 
@@ -63,8 +65,17 @@ class IncompleteBuildError(RuntimeError):
         return (type(self), (self.build, self.problems))
 
 
+def _folder(value, name: str) -> Path:
+    if not isinstance(value, (str, os.PathLike)):
+        raise TypeError(f"{name} must be a path (str or os.PathLike); got {type(value).__name__}")
+    if not str(value).strip():
+        raise ValueError(f"{name} must be a non-empty path")
+    return Path(value)
+
+
 def git_commit(root) -> str:
     """Short commit of the checkout at ``root`` (``+dirty`` with uncommitted changes), or ``unknown``."""
+    root = _folder(root, "root")
     try:
         head = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], cwd=root, capture_output=True, text=True,
                               timeout=10)
@@ -79,6 +90,8 @@ def git_commit(root) -> str:
 
 def new_run(*, quick: bool, seed: int, root) -> RunInfo:
     """A fresh :class:`RunInfo` for a run from the checkout at ``root``."""
+    quick = validation.boolean(quick, "quick")
+    seed = validation.integer(seed, "seed", minimum=0)
     now = time.gmtime()
     run_id = time.strftime("%Y%m%dT%H%M%SZ", now) + "-" + os.urandom(2).hex()
     return RunInfo(run_id, git_commit(root), "quick" if quick else "full", int(seed),
@@ -87,12 +100,15 @@ def new_run(*, quick: bool, seed: int, root) -> RunInfo:
 
 def provenance_line(run: RunInfo, seconds: float) -> str:
     """The line under a report section's heading: mode, time, run, commit and start."""
+    validation.instance(run, "run", RunInfo)
+    seconds = validation.positive(seconds, "seconds", allow_zero=True)
     return (f"*{run.mode} mode · {seconds:.0f} s · run {run.run_id} · commit {run.commit} · "
             f"started {run.started}*")
 
 
 def parse_provenance_line(text: str) -> dict | None:
     """``{"mode", "run_id", "commit"}`` from the first provenance line of a report section, else ``None``."""
+    validation.instance(text, "text", str)
     for line in text.splitlines():
         if line.startswith("*") and " mode · " in line and " · run " in line:
             parts = line.strip("*").split(" · ")
@@ -108,9 +124,16 @@ def parse_provenance_line(text: str) -> dict | None:
 
 def write_record(build, name: str, run: RunInfo, *, status: str, seconds: float, error: str = "") -> Path:
     """Write ``<build>/runs/<name>.json`` atomically: this notebook's outcome in ``run``."""
+    build = _folder(build, "build")
+    validation.instance(name, "name", str)
+    if not name or "/" in name or name.startswith("."):
+        raise ValueError(f"name must be a notebook name (no path); got {name!r}")
+    validation.instance(run, "run", RunInfo)
+    seconds = validation.positive(seconds, "seconds", allow_zero=True)
+    validation.instance(error, "error", str)
     if status not in ("ok", "failed", "interrupted"):
         raise ValueError(f"status must be 'ok', 'failed' or 'interrupted'; got {status!r}")
-    folder = Path(build) / "runs"
+    folder = build / "runs"
     folder.mkdir(parents=True, exist_ok=True)
     data = dict(asdict(run), notebook=name, status=status, seconds=round(float(seconds), 1), error=error,
                 finished=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()))
@@ -123,7 +146,7 @@ def write_record(build, name: str, run: RunInfo, *, status: str, seconds: float,
 
 def read_records(build) -> dict:
     """``{notebook name: record dict}`` of ``<build>/runs/*.json``."""
-    folder = Path(build) / "runs"
+    folder = _folder(build, "build") / "runs"
     if not folder.is_dir():
         return {}
     return {p.stem: json.loads(p.read_text()) for p in sorted(folder.glob("*.json"))}
@@ -139,7 +162,12 @@ def audit_build(build, expected) -> list[str]:
     expected : iterable of str
         Names of every notebook the build must hold.
     """
-    build = Path(build)
+    build = _folder(build, "build")
+    if isinstance(expected, (str, bytes)) or not hasattr(expected, "__iter__"):
+        raise TypeError(f"expected must be an iterable of notebook names; got {type(expected).__name__}")
+    expected = list(expected)
+    if not all(isinstance(n, str) for n in expected):
+        raise TypeError("expected must hold notebook names (str)")
     records = read_records(build)
     problems = []
     runs = {}

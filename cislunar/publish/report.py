@@ -56,7 +56,7 @@ class ComparisonTable:
         """
         for v in (verdict, *more):
             if not isinstance(v, Verdict):
-                raise TypeError("add takes Verdicts from Claim.judge (a status word is computed, not typed); got "
+                raise TypeError("verdict must be a Verdict from Claim.judge (a status word is computed, not typed); got "
                                 f"{type(v).__name__}")
             self.rows.append(Row(v.quantity, v.paper, v.reproduced, v.status, v.note))
         return self

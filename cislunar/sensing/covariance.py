@@ -162,9 +162,12 @@ def cholesky_spd(P, name: str = "P", *, rtol: float = 1e-8) -> np.ndarray:
 def check_spd(P, name: str = "P", *, rtol: float = 1e-8) -> np.ndarray:
     """Check that ``P`` (..., n, n) is symmetric positive definite; return its symmetric part.
 
-    Raises ``ValueError`` naming ``name`` otherwise (see :func:`cholesky_spd`).
+    Raises ``ValueError`` naming ``name`` otherwise (see :func:`cholesky_spd`), also for a numerically singular
+    matrix (correlation-matrix eigenvalue ratio at most :data:`cislunar.utils.validation.SPD_RCOND`, see
+    :func:`cislunar.utils.validation.spd`).
     """
     cholesky_spd(P, name, rtol=rtol)
+    validation.spd(P, name, batch=True, rtol=max(rtol, 1e-8))
     return symmetrize(P)
 
 
@@ -421,7 +424,17 @@ def ekf_predict(P, F, Q) -> np.ndarray:
     n = P.shape[-1]
     if F.ndim < 2 or F.shape[-2:] != (n, n) or Q.shape[-1] != n:
         raise ValueError(f"F and Q must be ({n}, {n}) to match P; got F {F.shape}, Q {Q.shape}")
-    return symmetrize(F @ P @ np.swapaxes(F, -1, -2) + Q)
+    return _ekf_predict(P, F, Q)
+
+
+def _sym(A):
+    """Symmetric part of (..., n, n) arrays (unchecked :func:`symmetrize`)."""
+    return 0.5 * (A + np.swapaxes(A, -1, -2))
+
+
+def _ekf_predict(P, F, Q):
+    """:func:`ekf_predict` on checked arrays (the recursion's inner loop)."""
+    return _sym(F @ P @ np.swapaxes(F, -1, -2) + Q)
 
 
 def ekf_update(P, H, R):
@@ -455,15 +468,21 @@ def ekf_update(P, H, R):
     if R.shape[-1] != m:
         raise ValueError(f"R must be ({m}, {m}) to match H; got {R.shape}")
     cholesky_spd(R, "R")
+    return _ekf_update(P, H, R)
+
+
+def _ekf_update(P, H, R):
+    """:func:`ekf_update` on checked arrays (the recursion's inner loop); raises ValueError if S is not SPD."""
+    n = P.shape[-1]
     HT = np.swapaxes(H, -1, -2)
-    S = symmetrize(H @ P @ HT + R)
+    S = _sym(H @ P @ HT + R)
     L = cholesky_spd(S, "S (innovation covariance)")
     # K^T = S^{-1} H P via two triangular solves
     HP = H @ P
     KT = np.linalg.solve(np.swapaxes(L, -1, -2), np.linalg.solve(L, HP))
     K = np.swapaxes(KT, -1, -2)
     IKH = np.eye(n) - K @ H
-    P_post = symmetrize(IKH @ P @ np.swapaxes(IKH, -1, -2) + K @ R @ np.swapaxes(K, -1, -2))
+    P_post = _sym(IKH @ P @ np.swapaxes(IKH, -1, -2) + K @ R @ np.swapaxes(K, -1, -2))
     return P_post, K, S
 
 
@@ -515,7 +534,7 @@ def covariance_analysis(P0, F, Q, H, R) -> CovarianceHistory:
     -------
     CovarianceHistory
     """
-    P0, F, Q, H, R = _check_linear_system(P0, F, Q, H, R)
+    P0, F, Q, H, R = _check_linear_system(P0, F, Q, H, R)  # checked once here; the loop calls the kernels
     N = H.shape[0]
     prior = np.empty((N,) + P0.shape)
     post = np.empty_like(prior)
@@ -523,9 +542,9 @@ def covariance_analysis(P0, F, Q, H, R) -> CovarianceHistory:
     P = P0
     for k in range(N):
         if k > 0:
-            P = ekf_predict(P, F[k - 1], Q[k - 1])
+            P = _ekf_predict(P, F[k - 1], Q[k - 1])
         prior[k] = P
-        P, _, S[k] = ekf_update(P, H[k], R[k])
+        P, _, S[k] = _ekf_update(P, H[k], R[k])
         post[k] = P
     return CovarianceHistory(prior, post, S)
 

@@ -195,6 +195,7 @@ def site_grid(lat_step_deg: float, lon_step_deg: float) -> tuple:
             raise ValueError(f"{name} must be at most {total:g} deg; got {v!r}")
         if abs(k - round(k)) > 1e-9:
             raise ValueError(f"{name} must divide {total:g} deg exactly; got {v!r}")
+    validation.work_size((180.0 / dlat + 1.0) * (360.0 / dlon), "lat_step_deg, lon_step_deg", 1e6, "sites")
     lats = np.linspace(-90.0, 90.0, int(round(180.0 / dlat)) + 1)
     lons = np.linspace(-180.0, 180.0, int(round(360.0 / dlon)) + 1)[:-1]
     out = []
@@ -386,9 +387,8 @@ def occultation_outages(system: CR3BP, observer, target, span_days: float, step_
         raise ValueError(f"step_s must not exceed the span ({span * 86400.0:g} s); got {step_s!r}")
     validation.choice(body, "body", ("moon", "earth"))
     n_table = validation.integer(table_points, "table_points", minimum=16)
+    validation.work_size(span * 86400.0 / step + 1.0, "step_s", 5e6, "samples over span_days")
     tq = np.arange(0.0, span * 86400.0 + 0.5 * step, step) / system.time_unit_s  # TU
-    if tq.size > 50_000_000:
-        raise ValueError(f"span_days / step_s gives {tq.size} samples; at most 5e7")
 
     def positions(value, name):
         if isinstance(value, PeriodicOrbit):

@@ -16,7 +16,6 @@ from concurrent.futures import ProcessPoolExecutor
 __all__ = ["open_executor", "describe_executor"]
 
 
-@contextlib.contextmanager
 def open_executor(workers: int = 1, scheduler: str = ""):
     """An executor for ``workers`` local processes, or a Dask client of ``scheduler``; ``None`` when serial.
 
@@ -27,15 +26,22 @@ def open_executor(workers: int = 1, scheduler: str = ""):
     scheduler : str
         Address of a running Dask scheduler; needs the ``cluster`` extra (``dask[distributed]``).
 
-    Yields
-    ------
-    concurrent.futures.Executor or dask.distributed.Client or None
+    Returns
+    -------
+    context manager
+        Entering it gives a ``concurrent.futures.Executor``, a ``dask.distributed.Client`` or ``None``; leaving it
+        shuts the pool down or closes the client.  Arguments are checked when it is called.
     """
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ValueError(f"workers must be an int >= 1 (1 runs serially); got {workers!r}")
     if not isinstance(scheduler, str):
         raise TypeError(f"scheduler must be a str (a Dask scheduler address, or '' for none); got "
                         f"{type(scheduler).__name__}")
+    return _executor(workers, scheduler)
+
+
+@contextlib.contextmanager
+def _executor(workers: int, scheduler: str):
     if scheduler.strip():
         try:
             from dask.distributed import Client

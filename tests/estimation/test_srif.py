@@ -97,3 +97,56 @@ def test_sri_round_trip_and_errors():
         srif.measurement_update(R, z, np.ones((2, 5)), np.ones(2), np.eye(3))
     with pytest.raises(ValueError, match="Q must be positive semi-definite"):
         srif.factor_process_noise(-np.eye(3))
+
+
+def test_stacked_kernels_equal_one_matrix_at_a_time_and_keep_the_information():
+    """The private SRI kernels take leading batch axes: each slice equals the unbatched call, and the algebra holds.
+
+    The batched OCBE (cislunar.estimation.batched_ocbe) and the single-trial filters share these kernels.
+    """
+    rng = np.random.default_rng(11)
+    B, n, m, r = 4, 5, 3, 2
+
+    def spd(k):
+        A = rng.standard_normal((B, k, k))
+        return A @ np.swapaxes(A, -1, -2) + k * np.eye(k)
+
+    P, Rv, Q = spd(n), spd(m), spd(r)
+    R = srif._sri_of_cov(P)
+    assert np.allclose(R, np.triu(R)) and np.all(np.diagonal(R, axis1=-2, axis2=-1) > 0)
+    assert np.allclose(np.swapaxes(R, -1, -2) @ R, np.linalg.inv(P), rtol=1e-10, atol=1e-12)
+    z, H, y = rng.standard_normal((B, n)), rng.standard_normal((B, m, n)), rng.standard_normal((B, m))
+    Phi, Gamma = np.eye(n) + 0.2 * rng.standard_normal((B, n, n)), rng.standard_normal((B, n, r))
+    Rm, zm, e = srif._measurement_update(R, z, H, y, Rv)
+    Rt, zt, terms = srif._time_update(R, z, Phi, Gamma, Q)
+    Rs, zs = srif._smoother_step(Rm, zm, Phi, Gamma, terms)
+    mean, cov = srif._cov_of_sri(Rm, zm)
+    for b in range(B):
+        one = srif._measurement_update(R[b], z[b], H[b], y[b], Rv[b])
+        assert np.allclose(Rm[b], one[0], rtol=1e-13, atol=1e-13) and np.allclose(zm[b], one[1], rtol=1e-13)
+        assert np.isclose(e[b], one[2], rtol=1e-12)
+        one = srif._time_update(R[b], z[b], Phi[b], Gamma[b], Q[b])
+        assert np.allclose(Rt[b], one[0], rtol=1e-13, atol=1e-13) and np.allclose(zt[b], one[1], rtol=1e-13)
+        assert all(np.allclose(a[b], c, rtol=1e-13, atol=1e-13) for a, c in zip(terms, one[2]))
+        one = srif._smoother_step(Rm[b], zm[b], Phi[b], Gamma[b], tuple(a[b] for a in terms))
+        assert np.allclose(Rs[b], one[0], rtol=1e-13, atol=1e-13) and np.allclose(zs[b], one[1], rtol=1e-12)
+        # the algebra: information adds in the measurement update, covariance propagates in the time update
+        info = np.linalg.inv(P[b]) + H[b].T @ np.linalg.solve(Rv[b], H[b])
+        assert np.allclose(Rm[b].T @ Rm[b], info, rtol=1e-10)
+        assert np.allclose(cov[b], np.linalg.inv(info), rtol=1e-10)
+        assert np.allclose(mean[b], np.linalg.solve(Rm[b], zm[b]), rtol=1e-10)
+        assert np.allclose(srif._solve_upper(Rm, zm)[b], mean[b], rtol=1e-10)
+        P_next = Phi[b] @ P[b] @ Phi[b].T + Gamma[b] @ Q[b] @ Gamma[b].T
+        assert np.allclose(srif._cov_of_sri(Rt[b]), P_next, rtol=1e-10)
+        # the whitened residual norm is the increase of the least-squares cost
+        prior_mean = np.linalg.solve(R[b], z[b])
+        x_hat = np.linalg.solve(info, np.linalg.solve(P[b], prior_mean) + H[b].T @ np.linalg.solve(Rv[b], y[b]))
+        d = R[b] @ x_hat - z[b]
+        w = np.linalg.cholesky(np.linalg.inv(Rv[b])).T @ (H[b] @ x_hat - y[b])
+        assert np.isclose(e[b] ** 2, d @ d + w @ w, rtol=1e-9)
+    # one prior broadcast against a stack of measurements (as the batched OCBE's zero prior deviation)
+    Rb = srif._measurement_update(R, np.zeros(n), H, y, Rv[0])[0]
+    one = srif._measurement_update(R[2], np.zeros(n), H[2], y[2], Rv[0])[0]
+    assert np.allclose(Rb[2], one, rtol=1e-13, atol=1e-13)
+    with pytest.raises(np.linalg.LinAlgError):
+        srif._sri_of_cov(-P)

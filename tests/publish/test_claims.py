@@ -73,7 +73,7 @@ def test_a_claim_is_judged_not_typed():
     assert v.status == "consistent (tuned)" and "window weight" in v.note
     table = ComparisonTable("t").add(v, claim.judge(6.5624))
     assert [r.status for r in table.rows] == ["consistent (tuned)", "reproduced"]
-    with pytest.raises(TypeError, match="Verdict"):
+    with pytest.raises(TypeError, match="verdict must be a Verdict"):
         ComparisonTable("t").add("x", 1, 2, "reproduced")
 
 

@@ -38,6 +38,7 @@ from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.estimation import batched_ocbe, consistency, ocbe, srif
 from cislunar.papers.greaves_scheeres_2021 import detection, tracking
 from cislunar.publish import plotting, report
+from cislunar.publish.claims import Claim, Within
 from cislunar.sensing import measurements, sites
 from cislunar.utils import montecarlo
 
@@ -144,6 +145,12 @@ def bad_values(kind, valid):
         return [None, 3.0, object(), b"x"]
     if kind == "iterable":
         return [None, 3.0, object(), "abc"]
+    if kind == "path":  # a folder or file path
+        return [None, 3.0, object(), "", b"x"]
+    if kind == "names":  # an iterable of str
+        return [None, 3.0, "01_a", [1, 2], object()]
+    if kind == "criterion":
+        return [None, "within 5 %", 0.05, object()]
     if kind == "cell":  # a table cell
         return [NAN, INF, -INF, True, np.float64("nan")]
     if kind == "cell_required":
@@ -486,10 +493,9 @@ def _specs():
                dict(system=em, t=np.array([0.0, 0.05, 0.1]), y=np.zeros((2, 3, 4)),
                     observer_states=np.tile(OBS, (3, 1)), model=measurements.ANGLES_AND_RATES,
                     meas_cov=np.eye(4) * 1e-8, x0=np.tile(TGT, (2, 1)), P0=SPD6, control_weight=1e-8, n_sub=2,
-                    tol=1e-13, engine="fast"),
+                    tol=1e-13),
                dict(system="system", t="grid", y="arr", observer_states="arr", model="instance", meas_cov="spd",
-                    x0="arr", P0="spd", control_weight="weights", n_sub="int2", tol="range:1e-16:1e-3",
-                    engine="choice"),
+                    x0="arr", P0="spd", control_weight="weights", n_sub="int2", tol="range:1e-16:1e-3"),
                baseline=False))
     # montecarlo
     s.append(S("run_monte_carlo", montecarlo.run_monte_carlo,
@@ -506,9 +512,7 @@ def _specs():
     # report and plotting
     s.append(S("ComparisonTable", report.ComparisonTable, dict(title="t"), dict(title="instance_str")))
     s.append(S("ComparisonTable.add", lazy(lambda: report.ComparisonTable("t").add),
-               dict(quantity="q", paper=1.0, reproduced=1.0, status="reproduced", note=""),
-               dict(quantity="instance_str", paper="cell", reproduced="cell_required", status="instance_str",
-                    note="instance_str")))
+               dict(verdict=Claim("q", 1.0, Within(1.0, 0.1)).judge(1.0)), dict(verdict="instance")))
     s.append(S("fmt", report.fmt, dict(value=1.0, digits=6), dict(digits="int1")))
     s.append(S("save_figure", plotting.save_figure, dict(fig=lazy(lambda: _fig()[0]), name="x", output_dir="/tmp",
                                                          formats=("png",)),
@@ -787,7 +791,7 @@ def test_the_audits_examples():
         (lambda: montecarlo.run_monte_carlo(None, 3, 0), "trial"),
         (lambda: montecarlo.run_monte_carlo(_unit_trial, 2.9, 0), "n_trials"),
         (lambda: montecarlo.run_monte_carlo(_unit_trial, 3, None), "seed"),
-        (lambda: report.ComparisonTable("t").add("x", 1, 2, None), "status"),
+        (lambda: report.ComparisonTable("t").add("x"), "Verdict"),
         (lambda: CR3BP(0.01, 1.0, 1.0, secondary_radius_km=np.nan), "secondary_radius_km"),
         (lambda: CR3BP(0.01, 1.0, 1.0, primary_radius_km=-1.0), "primary_radius_km"),
         (lambda: CR3BP(0.01, 1.0, 1.0, secondary_radius_km="0.001"), "secondary_radius_km"),
