@@ -1,7 +1,6 @@
 """Tests of the LPV model, the precision LMIs (Theorems 1-2) and the observer simulation (cislunar.estimation.lpv, .observers)."""
 
 import os
-import warnings
 
 import numpy as np
 import pytest

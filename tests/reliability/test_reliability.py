@@ -640,6 +640,12 @@ def test_every_plugin_covers_every_public_function_of_its_modules():
     assert not missing, f"public functions without a malformed-argument spec: {missing}"
 
 
+def _public_functions(module_name):
+    mod = importlib.import_module(module_name)
+    return [n for n, o in vars(mod).items() if inspect.isfunction(o) and o.__module__ == module_name
+            and not n.startswith("_")]
+
+
 def test_every_module_is_swept_or_listed():
     """New modules cannot slip past the sweep: each is core, covered by a plugin, or listed with a reason."""
     covered = {m.__name__ for m in CORE_MODULES}
@@ -647,6 +653,8 @@ def test_every_module_is_swept_or_listed():
     # every module of every subpackage, however deep (packages themselves hold no code)
     names = {m.name for m in pkgutil.walk_packages(cislunar.__path__, "cislunar.")
              if not m.ispkg and not m.name.endswith("__main__")}
+    # a paper's claims modules hold declarations only (no function); tests/publish/test_claims.py probes each claim
+    names = {n for n in names if ".claims." not in n or _public_functions(n)}
     unlisted = sorted(names - covered - NOT_SWEPT_YET - NOT_SWEPT)
     assert not unlisted, f"modules neither swept nor listed: {unlisted}"
     stale = sorted(covered & (NOT_SWEPT_YET | NOT_SWEPT))
@@ -820,9 +828,10 @@ def test_a_start_inside_a_primary_raises_on_every_path():
     inside_moon = np.r_[em.secondary_position + [0.001, 0, 0], 0, 0.1, 0]
     inside_earth = np.r_[em.primary_position + [0.01, 0, 0], 0, 0.1, 0]
     for x0, body in ((inside_moon, "Moon"), (inside_earth, "Earth")):
-        for call in (lambda: propagation.propagate(em, x0, 0.1), lambda: propagation.propagate_stm(em, x0, 0.1),
-                     lambda: propagation.propagate_scipy(em, x0, 0.1),
-                     lambda: propagation.find_events(em, x0, 0.1, "apse")):
+        for call in (lambda x0=x0: propagation.propagate(em, x0, 0.1),
+                     lambda x0=x0: propagation.propagate_stm(em, x0, 0.1),
+                     lambda x0=x0: propagation.propagate_scipy(em, x0, 0.1),
+                     lambda x0=x0: propagation.find_events(em, x0, 0.1, "apse")):
             with pytest.raises(propagation.ImpactError, match=body) as info:
                 call()
             assert info.value.started_inside and info.value.body == body
@@ -845,7 +854,6 @@ def test_scipy_path_detects_impacts():
     falling = np.r_[em.secondary_position + [0.008, 0, 0], 0, 0, 0]
     with pytest.raises(propagation.ImpactError, match="Moon") as info:
         propagation.propagate_scipy(em, falling, 1.0)
-    hy = None
     with pytest.raises(propagation.ImpactError) as hy:
         propagation.propagate(em, falling, 1.0)
     assert abs(info.value.time - hy.value.time) < 1e-8  # both paths find the same impact time
