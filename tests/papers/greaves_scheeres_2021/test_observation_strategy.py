@@ -1,0 +1,106 @@
+"""Chapter 09 studies: Monte Carlo aggregation, seeding, the regime-map analysis and the stable-candidate
+comparison (small sizes and synthetic cells; invariants, not snapshots)."""
+
+import numpy as np
+import pytest
+
+from cislunar.cr3bp import orbits
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.papers.greaves_scheeres_2021 import observation_strategy as obs
+from cislunar.papers.greaves_scheeres_2021 import tracking
+from cislunar.papers.greaves_scheeres_2021.claims.observation_strategy import CLAIMS
+from cislunar.utils.montecarlo import trial_rng
+
+Q = 1e-20 * em.time_unit_s**3 / em.length_unit_km**2
+
+
+def _summary(diverged, sigma_pos=1.0, nees=6.0):
+    return tracking.TrialSummary(sigma_pos, 1e-3, 0.1, 1e-4, 1.0, nees, 0.2 if diverged else 0.0, diverged)
+
+
+@pytest.fixture(scope="module")
+def nrho():
+    return orbits.nrho_9_2(em)
+
+
+def test_labels_and_flags():
+    assert obs.cadence_label(1 / 60) == "1 min" and obs.cadence_label(10 / 60) == "10 min"
+    assert obs.cadence_label(12.0) == "12 h"
+    assert obs.pct_span([0.1, 0.1]) == "10 %" and obs.pct_span([0.0, 0.5]) == "0-50 %"
+    rows = [("a", 2.0, 0.1, 0, 0, 0, 10), ("b", 2.0, 0.15, 0, 0, 0, 10)]
+    assert obs.flagged_cells(rows) == [("b", 2.0, 0.15)]  # the 10 % flag is "more than"
+
+
+def test_study_rows_are_fractions_and_medians():
+    runs = {("x", 2.0): (_summary(True, 1.0, 50.0), _summary(False, 3.0, 5.0), _summary(False, 2.0, 6.0), _summary(
+        False, 4.0, 7.0)), ("x", 12.0): (_summary(True, 5.0), _summary(True, 7.0))}
+    st = obs.StrategyStudy(runs, rates=True)
+    r2, r12 = st.by_cadence("x")[2.0], st.by_cadence("x")[12.0]
+    assert r2[2] == 0.25 and r2[3] == pytest.approx(6.5) and r2[4] == pytest.approx(3 * 2.5) and r2[6] == 4
+    assert r12[2] == 1.0 and st.diverged_cells() == [("x", 12.0)]
+    assert st.diverged_fraction("x", [2.0, 12.0]) == pytest.approx(3 / 6)
+    assert "cadence [h]" in st.report("label")
+
+
+def test_strategy_study_seeds_each_cell_independently_of_the_executor(nrho):
+    st = obs.strategy_study(em, {"9:2 NRHO": nrho}, [12.0], Q, rates=True, n_runs=2, seed=3)
+    scn = tracking.make_scenario(em, nrho, 12.0, start="apoapsis", rates=True)
+    direct = tracking.filter_trial(trial_rng((3, 0, 0, 1), 1), scn, Q)
+    assert st.runs["9:2 NRHO", 12.0][1] == direct
+    assert len(st.rows) == 1 and st.rows[0][6] == 2
+    with pytest.raises(ValueError, match="n_runs"):
+        obs.strategy_study(em, {"9:2 NRHO": nrho}, [12.0], Q, rates=True, n_runs=0, seed=3)
+
+
+def _synthetic_map():
+    models = ("angles", "angles + rates (1 s)", "angles + rates (dt = 1 TU)")
+    orbit_names, handoffs = ("9:2 NRHO", "other"), (1.0, 10.0, 100.0)
+    cells = {}
+    for o in orbit_names:
+        for h in handoffs:
+            cells[o, 12.0, 1e-5, "angles", h] = 0.0 if h < 100 else 0.8
+            cells[o, 12.0, 1e-5, models[1], h] = 0.0 if h < 100 else 0.7
+            cells[o, 12.0, 1e-5, models[2], h] = 0.0 if (h < 100 or o == "other") else 0.9
+    cells["other", 12.0, 1e-5, "angles", 1.0] = 0.6  # diverges at the paper's hand-off
+    onsets = {k: ["first update"] * int(10 * v) for k, v in cells.items()}
+    return obs.RegimeMap(cells, onsets, models, orbit_names, (12.0,), (1e-5,), handoffs, 10)
+
+
+def test_regime_map_analysis_on_synthetic_cells():
+    rm = _synthetic_map()
+    assert len(rm.map_cells) == 6 and rm.rates_paper == "angles + rates (1 s)"
+    # contrast: angles > 50 % and rates <= 10 %: only "other" at 100 with the dt = 1 TU model, and "other" at 1.0
+    # with both models (its rates fractions there are 0)
+    assert rm.contrast["angles + rates (dt = 1 TU)"] == [("other", 12.0, 1e-5, 1.0), ("other", 12.0, 1e-5, 100.0)]
+    assert rm.contrast["angles + rates (1 s)"] == [("other", 12.0, 1e-5, 1.0)]
+    assert rm.onset_km("9:2 NRHO") == 1000.0 and rm.onset_km("other") == 10.0
+    assert rm.at_paper_handoff("other") == [0.6]
+    cell_92, cell_paper = rm.divergence_cells()
+    assert cell_92 == ("9:2 NRHO", 12.0, 1e-5, "angles", 100.0)
+    assert cell_paper == ("other", 12.0, 1e-5, "angles", 1.0)
+    text = rm.analysis_report()
+    assert "verdict: the paper's contrast appears in 3" in text and rm.table_report().count("\n") == 6
+
+
+def test_stable_candidates_compare_medians_and_long_cadence_fractions():
+    runs = {}
+    for name, pos, div in (("ref", 2.0, False), ("a", 1.0, False), ("b", 3.0, True)):
+        for c in (2.0, 12.0):
+            runs[name, c] = (_summary(div, pos), _summary(False, pos))
+    cand = obs.compare_stable_candidates(obs.StrategyStudy(runs, True), "ref", ("a", "b"), (2.0, 12.0))
+    assert cand.better == {"a": 1.0, "b": 0.0} and cand.ratio["a"] == [0.5, 0.5]
+    assert cand.long_cadences == (12.0,) and cand.inconsistent == {"ref": 0.0, "a": 0.0, "b": 0.5}
+    assert cand.supports("a") and not cand.supports("b")
+
+
+def test_measurement_demo_rate_noise_is_eq_13(nrho):
+    demo = obs.measurement_demo(em, nrho, 12.0)
+    assert demo.sigma_rate_urad_s == pytest.approx(np.sqrt(2) * 10.0)
+    assert demo.y.shape == (demo.days.size, 4) and demo.days[0] == 0.0
+
+
+def test_claims_read_diverges_and_consistent_as_declared():
+    assert CLAIMS["inner_consistent_long"].judge(0.10).status == "reproduced"
+    assert CLAIMS["inner_consistent_long"].judge(0.15).status == "differs"
+    assert CLAIMS["outer_better"].judge(1.0).status == "consistent (tuned)"
+    assert CLAIMS["table4_2 h"].judge(1.0, note="median").status == "not in paper"
