@@ -61,32 +61,6 @@ class ComparisonTable:
             self.rows.append(Row(v.quantity, v.paper, v.reproduced, v.status, v.note))
         return self
 
-    def add_typed(self, quantity: str, paper, reproduced, status: str, note: str = "") -> "ComparisonTable":
-        """Transitional: a row whose status word is typed by hand.  Being removed as each notebook's rows become
-        claims declared in its paper's package (issue 18); no new caller."""
-        for name, v in (("quantity", quantity), ("status", status), ("note", note)):
-            if not isinstance(v, str):
-                raise TypeError(f"{name} must be a str; got {type(v).__name__} {v!r:.40}")
-        if not quantity.strip():
-            raise ValueError("quantity must be a non-empty str")
-        for name, v in (("paper", paper), ("reproduced", reproduced)):
-            if isinstance(v, (bool, np.bool_)):
-                raise TypeError(f"{name} must be a number, a str or None; got {type(v).__name__}")
-            if isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "iuf":
-                v = v.reshape(())[()]
-            if isinstance(v, (int, float, np.number)) and not np.isfinite(float(v)):
-                raise ValueError(f"{name} must be finite (a table may not hold NaN or inf); got {v!r}; use a str "
-                                 "such as 'not computed' with a note instead")
-        if reproduced is None:
-            raise ValueError("reproduced must be given (a number or a str); None would print as '-'")
-        head = status.split(":")[0].strip()
-        if head not in STATUSES:
-            raise ValueError(f"status must start with one of {STATUSES}; got {status!r}")
-        if head in ("differs", "not in paper") and not note and ":" not in status:
-            raise ValueError(f"a {head!r} row needs a note saying why (quantity {quantity!r})")
-        self.rows.append(Row(quantity, fmt(paper), fmt(reproduced), status, note))
-        return self
-
     def to_markdown(self) -> str:
         """The table as GitHub-flavoured Markdown."""
         lines = [f"**{self.title}**", "", "| quantity | paper | reproduced | status | note |",

@@ -147,8 +147,8 @@ def test_runner_shuts_kernels_down_without_sigint(tmp_path):
         '# %% tags=["parameters"]\nQUICK = False\nSEED = 0\nOUTPUT_DIR = ""\n\n'
         f"# %%\nimport subprocess, sys, time, pathlib\nproc = subprocess.Popen([sys.executable, '-c', {child!r}])\n"
         f"while not pathlib.Path({str(ready)!r}).exists():\n    time.sleep(0.05)\n\n"
-        "# %%\nfrom cislunar.publish.report import ComparisonTable\n"
-        "ComparisonTable('t').add_typed('x [-]', 1, 1, 'derived').display()\n"
+        "# %%\nfrom cislunar.publish.claims import Claim\nfrom cislunar.publish.report import ComparisonTable\n"
+        "ComparisonTable('t').add(Claim('x [-]', kind='derived').judge(1)).display()\n"
     )
     notebooks.run_notebook(src, quick=True, output_dir=tmp_path / "build")
     time.sleep(1.0)  # a signal sent during shutdown would have been handled by now

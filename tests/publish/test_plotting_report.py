@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from cislunar.publish import notebooks, plotting
+from cislunar.publish.claims import AtMost, Claim, Within, printed_tolerance
 from cislunar.publish.report import ComparisonTable
 from cislunar.utils import paths
 
@@ -41,16 +42,15 @@ def test_save_figure_rejects_bad_names_and_formats(tmp_path):
     plt.close(fig)
 
 
-def test_comparison_table_rules():
+def test_comparison_table_rows_come_from_judged_claims():
     t = ComparisonTable("demo")
-    t.add_typed("period [d]", 6.5624, 6.56235, "reproduced")
-    with pytest.raises(ValueError, match="needs a note"):
-        t.add_typed("x", 1, 2, "differs")
-    with pytest.raises(ValueError, match="status"):
-        t.add_typed("x", 1, 2, "ok")
-    t.add_typed("y", 1, 2, "differs: printed value not periodic")
+    period = Claim("period [d]", 6.5624, Within(6.5624, printed_tolerance("6.5624")), source="Table 2")
+    t.add(period.judge(6.56235))
+    with pytest.raises(TypeError, match="verdict"):
+        t.add("x", 1, 2, "reproduced")  # a typed status word is not a row
+    t.add(Claim("y", 1.0, Within(1.0, 0.1), reason="printed value not periodic").judge(2.0))
     md = t.to_markdown()
-    assert md.count("\n|") == 4 and "6.5624" in md and "differs: printed" in md
+    assert md.count("\n|") == 4 and "6.5624" in md and "| differs |" in md and "printed value not periodic" in md
 
 
 def test_runner_names_the_failing_notebook_and_cell(tmp_path):
@@ -85,11 +85,11 @@ def test_status_words_follow_the_guide():
     from cislunar.publish.report import STATUSES, ComparisonTable
 
     assert STATUSES == ("reproduced", "consistent (tuned)", "differs", "derived", "not in paper", "beyond paper")
-    t = ComparisonTable("t").add_typed("z_lim", 0.1, 0.11, "consistent (tuned)", "window weight chosen to match")
-    assert "consistent (tuned)" in t.to_markdown()
-    for bad_status in ("agrees", "consistent"):
-        with pytest.raises(ValueError, match="status"):
-            ComparisonTable("t").add_typed("x", 1, 2, bad_status)
+    tuned = Claim("z_lim", 0.1, Within(0.1, 0.25, relative=True), tuned="window weight chosen to match")
+    t = ComparisonTable("t").add(tuned.judge(0.11))
+    assert "consistent (tuned)" in t.to_markdown() and "window weight chosen to match" in t.to_markdown()
+    with pytest.raises(ValueError, match="kind"):
+        Claim("x", 1.0, kind="agrees")
 
 
 def test_thousands_km_axes_labels_and_ticks():
@@ -265,8 +265,8 @@ def test_the_legend_defines_exactly_the_status_words_a_table_uses():
     from cislunar.publish.report import STATUS_MEANINGS, STATUSES
 
     assert set(STATUS_MEANINGS) == set(STATUSES)
-    t = ComparisonTable("t").add_typed("a", 1, 1.0, "reproduced", "within 1 %")
-    t.add_typed("b", 2, 3, "differs: too large", "why").add_typed("c", None, 4, "derived")
+    t = ComparisonTable("t").add(Claim("a", 1.0, Within(1.0, 0.01, relative=True)).judge(1.0))
+    t.add(Claim("b", 2.0, AtMost(2.5), reason="too large").judge(3.0)).add(Claim("c", kind="derived").judge(4.0))
     lines = t.legend().splitlines()
     assert [ln.split("**")[1] for ln in lines] == ["reproduced", "differs", "derived"]
     assert "fixed before comparing" in lines[0]
