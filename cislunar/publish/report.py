@@ -9,8 +9,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from cislunar.publish.claims import STATUS_MEANINGS, STATUSES, Verdict, fmt
 
 __all__ = ["ComparisonTable", "Row", "REPORT_METADATA_KEY", "STATUSES", "STATUS_MEANINGS", "fmt"]
