@@ -28,19 +28,42 @@
 # `cislunar.papers.greaves_scheeres_2021.tracking` / `cislunar.papers.greaves_scheeres_2021.detection` (notebook 10).
 
 # %% tags=["parameters"]
-QUICK = False
-SEED = 0
-OUTPUT_DIR = ""
+QUICK = False  # quick mode: smaller Monte Carlo samples (the sizes below left at None); every experiment still runs
+SEED = 0  # seed of the one random stream of the chapter (null runs, Figs. 6-9 runs, delay and reset-rule studies)
+OUTPUT_DIR = ""  # where figures are written ("" = the build's default)
+N_NULL = None  # no-maneuver runs for the metric's law, one period each (None: 4 quick, 16 full)
+MAGNITUDES_M_S = None  # burn sizes of the delay and reset-rule studies, m/s, increasing; the first is also swept
+#                        over the angle noise (None: 0.05, 0.3, 3 quick; 0.05, 0.1, 0.3, 1, 3 full)
+N_PER_MAGNITUDE = None  # single-trial adaptive runs per burn size, each filtered with both reset rules (None: 2 / 20)
+N_DELAY = None  # batched first-pass runs per burn size and per noise level, for the detection delays (None: 8 / 200)
+NOISE_SWEEP_URAD = None  # angle noise levels (1 sigma) of the smallest burn's delay sweep, micro-rad
+#                          (None: 5, 10, 30 quick; 5, 10, 15, 20, 30 full)
+Q_BASE_KM2_S3 = None  # the ballistic control weight of the adaptive filter, km^2/s^3 (None: 1e-18, notebook 10's
+#                       weight outside the apoapsis window)
+MAX_RESETS = None  # a run needing more resets than this counts as diverged (None: 5)
+WORKERS = None  # local processes for the delay and reset-rule studies, 1 = serial (None: 1)
+SCHEDULER = ""  # address of a Dask scheduler to run those studies on ("" = none; then WORKERS applies)
+
+# %% [markdown]
+# **Changing the chapter.** Every size and setting is a parameter of the cell above. A parameter left at `None` is
+# picked in the next cell from `QUICK` (quick mode shrinks the Monte Carlo samples, never skips an experiment); a
+# value you give, in Jupyter or with `-p NAME=VALUE` on the command line, is used as given in either mode. The
+# delay and reset-rule studies of Section 5 draw all their runs from the chapter's random stream first and then
+# filter them as independent tasks on the executor that `WORKERS` local processes or a Dask `SCHEDULER` provide,
+# so the numbers do not depend on where they run. The exercises at the end of the chapter start from here.
 
 # %%
-# Sizes derived from QUICK: quick mode shrinks the Monte Carlo samples, never skips an experiment.
-N_NULL = 4 if QUICK else 16  # no-maneuver runs for the metric's law (batched OCBE, one period each)
-MAGNITUDES_M_S = [0.05, 0.3, 3.0] if QUICK else [0.05, 0.1, 0.3, 1.0, 3.0]  # burn sizes of the delay study
-N_PER_MAGNITUDE = 2 if QUICK else 20  # single-trial adaptive runs per burn size and reset rule
-N_DELAY = 8 if QUICK else 200  # batched first-pass runs per burn size and per noise level (detection delays)
-NOISE_SWEEP_URAD = [5, 10, 30] if QUICK else [5, 10, 15, 20, 30]  # angle noise (1 sigma) of the 50 mm/s sweep
-Q_BASE_KM2_S3 = 1e-18  # the ballistic tuning (notebook 10's q outside the apoapsis window)
-MAX_RESETS = 5  # a run needing more resets than this is counted as diverged
+# Every parameter left at None is picked here from QUICK; a value the reader gave is used as given.
+n_null = N_NULL if N_NULL is not None else (4 if QUICK else 16)
+magnitudes_m_s = list(MAGNITUDES_M_S if MAGNITUDES_M_S is not None else
+                      ([0.05, 0.3, 3.0] if QUICK else [0.05, 0.1, 0.3, 1.0, 3.0]))
+n_per_magnitude = N_PER_MAGNITUDE if N_PER_MAGNITUDE is not None else (2 if QUICK else 20)
+n_delay = N_DELAY if N_DELAY is not None else (8 if QUICK else 200)
+noise_sweep_urad = list(NOISE_SWEEP_URAD if NOISE_SWEEP_URAD is not None else
+                        ([5, 10, 30] if QUICK else [5, 10, 15, 20, 30]))
+q_base_km2_s3 = Q_BASE_KM2_S3 if Q_BASE_KM2_S3 is not None else 1e-18
+max_resets = MAX_RESETS if MAX_RESETS is not None else 5
+workers = WORKERS if WORKERS is not None else 1
 
 import time
 
@@ -54,6 +77,7 @@ from cislunar.papers.greaves_scheeres_2021 import figures
 from cislunar.papers.greaves_scheeres_2021.claims.adaptive_ocbe import CLAIMS
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
+from cislunar.utils.executors import open_executor
 
 plotting.use_style()
 out = OUTPUT_DIR or None
@@ -62,7 +86,7 @@ table = ComparisonTable("09b Adaptive OCBE (Greaves & Scheeres 2021, Adaptive OC
 T_START = time.perf_counter()
 DAY = 86400.0 / em.time_unit_s
 nrho = orbits.nrho_9_2(em)
-setup = det.make_setup(em, nrho, Q_BASE_KM2_S3, Q_BASE_KM2_S3)  # constant ballistic tuning, start at periapsis
+setup = det.make_setup(em, nrho, q_base_km2_s3, q_base_km2_s3)  # constant ballistic tuning, start at periapsis
 sc, k_burn = setup.scenario, ads.first_seen_epoch(setup)
 print(f"9:2 NRHO, period {nrho.period_days:.3f} d; {sc.t.size} epochs every {sc.cadence_hours:.0f} h from periapsis; "
       f"burn at apoapsis t = {setup.t_maneuver / DAY:.3f} d, first seen at epoch {k_burn}")
@@ -98,7 +122,7 @@ print(f"9:2 NRHO, period {nrho.period_days:.3f} d; {sc.t.size} epochs every {sc.
 # without a maneuver (batched OCBE, ballistic tuning).
 
 # %%
-null = ads.null_metric_study(setup, N_NULL, rng)
+null = ads.null_metric_study(setup, n_null, rng)
 _ = plotting.save_figure(figures.metric_law(null), "09b_metric_law", output_dir=out)
 print(f"pooled metric: mean {null.metric.mean():.2f} (law 4, s.e. {null.standard_error:.2f}), exceeds the 99 % limit "
       f"at {100 * null.exceed_fraction:.1f} % of epochs, KS p = {null.ks_p:.2f}; resets: {null.n_resets}; "
@@ -145,7 +169,7 @@ print("rate noise / state-driven spread: az-rate 10^%.1f, el-rate 10^%.1f" % tup
 # period to shrink its uncertainty before the burn; the burn direction is drawn as in notebook 10 (Eqs. 3-4).
 
 # %%
-big = ads.adaptive_run(setup, det.draw_trial(rng, setup, magnitude_m_s=3.0), max_resets=MAX_RESETS)
+big = ads.adaptive_run(setup, det.draw_trial(rng, setup, magnitude_m_s=3.0), max_resets=max_resets)
 for d in big.detections:
     print(f"detected at epoch {d.epoch} ({(d.epoch - k_burn) * sc.cadence_hours:.0f} h after the first epoch that sees "
           f"the burn), declared at epoch {d.declared_epoch}; metric {d.metric_before:.1f} -> {d.metric_after:.2f}; "
@@ -168,7 +192,7 @@ _ = plotting.save_figure(figures.adaptive_control_metric(setup, big, "3 m/s"), "
 # ## 4 · A 50 mm/s burn (Figs. 8-9): late detection
 
 # %%
-small = ads.adaptive_run(setup, det.draw_trial(rng, setup, magnitude_m_s=0.05), max_resets=MAX_RESETS)
+small = ads.adaptive_run(setup, det.draw_trial(rng, setup, magnitude_m_s=0.05), max_resets=max_resets)
 if small.detections:
     d = small.detections[0]
     print(f"50 mm/s: detected at epoch {d.epoch}, {(d.epoch - k_burn) * sc.cadence_hours:.0f} h after the burn "
@@ -195,7 +219,7 @@ _ = plotting.save_figure(figures.adaptive_control_metric(setup, small, "50 mm/s"
 # difference; this run does not isolate it.
 
 # %%
-small_ml = ads.adaptive_run(setup, small.inputs, reset="likelihood", max_resets=MAX_RESETS)
+small_ml = ads.adaptive_run(setup, small.inputs, reset="likelihood", max_resets=max_resets)
 for rule, a_ in (("mean", small), ("likelihood", small_ml)):
     print(f"{rule:10s} rule: resets at epochs {[d.epoch for d in a_.detections]}, factors "
           f"{[f'{d.factor:.2g}' for d in a_.detections]}; final forward NEES {a_.final_nees:.1f} "
@@ -229,11 +253,12 @@ _ = plotting.save_figure(figures.adaptive_errors(setup, small_ml, "50 mm/s, like
 
 # %%
 t_delay = time.perf_counter()
-delays = ads.delay_study(setup, nrho, MAGNITUDES_M_S, NOISE_SWEEP_URAD, N_DELAY, rng)
+with open_executor(workers, SCHEDULER) as executor:
+    delays = ads.delay_study(setup, nrho, magnitudes_m_s, noise_sweep_urad, n_delay, rng, executor=executor)
 print(f"coast from the burn to periapsis {delays.coast_h:.1f} h; 'nearly periapsis' from {delays.late_from_h:.1f} h "
       f"after the burn")
-print(f"{N_DELAY} runs per burn size and noise level in {time.perf_counter() - t_delay:.0f} s; one run is "
-      f"{100 / N_DELAY:.1f} % of an outcome bar")
+print(f"{n_delay} runs per burn size and noise level in {time.perf_counter() - t_delay:.0f} s; one run is "
+      f"{100 / n_delay:.1f} % of an outcome bar")
 print(delays.report())
 
 # %%
@@ -264,7 +289,9 @@ _ = plotting.save_figure(figures.delays(delays), "09b_adaptive_delay_vs_burn", o
 
 # %%
 t_mc = time.perf_counter()
-rules = ads.reset_rule_study(setup, MAGNITUDES_M_S, N_PER_MAGNITUDE, rng, max_resets=MAX_RESETS)
+with open_executor(workers, SCHEDULER) as executor:
+    rules = ads.reset_rule_study(setup, magnitudes_m_s, n_per_magnitude, rng, max_resets=max_resets,
+                                 executor=executor)
 print(f"{len(rules.runs)} adaptive runs in {time.perf_counter() - t_mc:.0f} s")
 print(rules.report())
 _ = plotting.save_figure(figures.reset_rules(rules), "09b_adaptive_reset_rules", output_dir=out)
@@ -300,8 +327,25 @@ print(ads.reset_rule_reading(rules))
 # %%
 # Every row is a claim declared in cislunar.papers.greaves_scheeres_2021.claims.adaptive_ocbe with its criterion
 # (fixed before the comparison); closing_rows measures each one from the studies above.
-for key, row in ads.closing_rows(null, big, delays, rules, Q_BASE_KM2_S3).items():
+for key, row in ads.closing_rows(null, big, delays, rules, q_base_km2_s3).items():
     table.add(CLAIMS[key].judge(**row))
 print(ads.chain_report(rules))
 print(f"notebook wall time: {(time.perf_counter() - T_START) / 60:.1f} min")
 table.display()
+
+# %% [markdown]
+# ## Exercises
+#
+# Each exercise changes one parameter of the `parameters` cell at the top; rerun the chapter (in Jupyter, or with
+# `python -m cislunar.publish.notebooks --quick 09b -p NAME=VALUE`), write down your prediction first, then compare.
+# The worked solutions are functions of `cislunar.papers.greaves_scheeres_2021.exercises` that answer each question
+# at a small size in a few seconds and return the numbers with a one-paragraph answer.
+#
+# 1. **A burn between the sizes.** Set `MAGNITUDES_M_S = [0.05, 0.5, 3.0]`. Before running: where will the
+#    0.5 m/s burns fall among the four outcomes of Section 5, and how will their median delay compare with those
+#    of the 50 mm/s and 3 m/s burns? Think of what the metric is (the whitened innovation) and how a burn enters
+#    it. Check the delay table and the reset-rule table. Worked solution: `exercise_09b_burn_size`.
+# 2. **A filter that expects more.** Set `Q_BASE_KM2_S3 = 1e-12`, a control weight that admits a few cm/s of
+#    unmodelled velocity per 2-hour interval. Predict the mean of the metric without a maneuver (Section 1: is it
+#    still $\chi^2_4$ when $Q$ no longer matches the truth?), and whether the burns of Section 5 are still
+#    detected. Which closing-table rows would change status? Worked solution: `exercise_09b_base_weight`.

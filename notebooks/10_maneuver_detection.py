@@ -35,42 +35,76 @@
 # (a tuned reading). Both are carried through and the closing table says which rows rest on which.
 
 # %% tags=["parameters"]
-QUICK = False
-SEED = 0
-OUTPUT_DIR = ""
+QUICK = False  # quick mode: every Monte Carlo shrinks (the sizes below left at None); every step still runs
+SEED = 0  # root seed: each sub-study draws from its own child [SEED, k]; one study's sizes leave the others' draws
+OUTPUT_DIR = ""  # where figures are written ("" = the build's default)
+N_H0 = None  # non-maneuvering training runs per policy and orbit (None: 8 quick, 500 full; paper: 500)
+N_H1 = None  # maneuvering training runs per policy and orbit (None: 8 quick, 3000 full; paper: 3000)
+N_TEST = None  # test runs per hypothesis, policy and orbit (None: 4 quick, 100 full; paper: 100 + 100)
+OUTER_SIZE = None  # share of the training runs the outer-band stable NRHO runs; it gets half the tests (None: 0.2)
+N_MAP = None  # (H0, H1) runs per cell of the tuning map of Section 2 (None: (8, 8) quick, (150, 250) full)
+F_GRID = None  # window weight factors f of the map, units of the variance-matched weight, increasing
+#                (None: 0.03, 0.1, 0.2, 0.3, 0.5, 1.0)
+F_SIDE = None  # factors of the map's side axes (noise, window length, base weight), 9:2 NRHO (None: 0.1, 0.2, 0.3)
+Q_BASE = None  # control weight outside the apoapsis window, km^2/s^3 (None: 1e-18)
+WINDOW_HOURS = None  # length of the apoapsis window, hours (None: 8, the paper's)
+N_SPIKE = None  # runs per hypothesis of the Figs. 10-11 check (None: 8 quick, 200 full)
+N_POLICY_DRAWS = None  # draws that check the station-keeping distributions (None: 5000 quick, 200000 full)
+PM_J_SEEDS = None  # noise draws per direction in the +-j search of Section 4 (None: 1 quick, 3 full)
+PM_J_F = None  # window weight factors of the +-j search (None: 0.03, 0.1, 0.3, 1.0)
+PM_J_NOISE_URAD = None  # angle noise of the +-j search, micro-rad (None: 10, 100, 300, 1000)
+PM_J_OFFSET_H = None  # burn times after apoapsis in the +-j search, hours, inside the window (None: -3, 0, 3)
+N_PM_J_MC = None  # randomly pointed burns per policy where the +-j pattern appears (None: 8 quick, 600 full)
+N_Z05 = None  # 0.5 m/s burns per tuning factor for the health metric of Section 6 (None: 4 quick, 64 full)
+N_LEAD = None  # (no-burn runs for calibration and validation, runs per burn size) of the race of Section 6
+#                (None: (10, 2) quick, (200, 48) full)
+LEAD_MAGNITUDES = None  # burn sizes of the control-versus-residual race, m/s (None: 0.05, 0.1, 0.2, 0.5)
+N_BOOT = None  # bootstrap resamples for the standard errors of z_lim and of FP + MD (None: 4 quick, 40 full)
+BATCH = None  # trials the batched OCBE filters together, epoch by epoch (None: 8); results depend on it
+WORKERS = None  # local processes for the Monte Carlo, 1 = serial (None: 1 quick, 2 full)
+SCHEDULER = ""  # address of a Dask scheduler to run the Monte Carlo on ("" = none; then WORKERS applies)
+
+# %% [markdown]
+# **Changing the chapter.** Every size and setting is a parameter of the cell above. A parameter left at `None` is
+# picked in the next cell from `QUICK` (quick mode shrinks every Monte Carlo, never skips a step); a value you
+# give, in Jupyter or with `-p NAME=VALUE` on the command line, is used as given in either mode. Each sub-study
+# draws from its own child of `SEED`, and trial $i$ of a Monte Carlo always gets child $i$ of its sub-study's seed:
+# the numbers depend on the sizes and on `BATCH`, never on the executor that `WORKERS` local processes or a Dask
+# `SCHEDULER` provide. The exercises at the end of the chapter start from here.
 
 # %%
-# Sizes derived from QUICK: quick mode shrinks every Monte Carlo; every step still runs.
-N_H0 = 8 if QUICK else 500  # non-maneuvering training runs per policy and orbit (paper: 500)
-N_H1 = 8 if QUICK else 3000  # maneuvering training runs per policy and orbit (paper: 3000)
-N_TEST = 4 if QUICK else 100  # test runs per hypothesis, policy and orbit (paper: 100 + 100)
-N_MAP = (8, 8) if QUICK else (150, 250)  # H0, H1 runs per cell of the tuning map (Section 2)
-F_GRID = (0.03, 0.1, 0.2, 0.3, 0.5, 1.0)  # window weight factors f (units of the variance-matched weight)
-F_SIDE = (0.1, 0.2, 0.3)  # factors of the map's side axes (noise, window length, base weight), 9:2 NRHO
-N_SPIKE = 8 if QUICK else 200  # runs per hypothesis of the Figs. 10-11 check (constant tuning)
-N_POLICY_DRAWS = 5000 if QUICK else 200000  # draws to check the station-keeping distributions
-PM_J_SEEDS = 1 if QUICK else 3  # noise draws per direction in the +-j search (Section 4)
-PM_J_F = (0.03, 0.1, 0.3, 1.0)  # window weight factors of the +-j search
-PM_J_NOISE_URAD = (10.0, 100.0, 300.0, 1000.0)  # angle noise of the +-j search, micro-rad
-PM_J_OFFSET_H = (-3.0, 0.0, 3.0)  # burn time after apoapsis in the +-j search, hours (window: +-4 h)
-N_PM_J_MC = 8 if QUICK else 600  # randomly pointed burns per policy where the +-j pattern appears
-N_Z05 = 4 if QUICK else 64  # 0.5 m/s burns per tuning factor (health metric, Section 6)
-N_LEAD = (10, 2) if QUICK else (200, 48)  # no-burn runs (calibration, validation) and runs per burn size
-LEAD_MAGNITUDES = (0.05, 0.1, 0.2, 0.5)  # burn sizes of the control-versus-residual race, m/s
-N_BOOT = 4 if QUICK else 40  # bootstrap resamples for the standard errors of z_lim and of the expected error
-BATCH = 8  # trials that the batched OCBE filters together, epoch by epoch
-WORKERS = 1 if QUICK else 2  # processes for the Monte Carlo
+# Every parameter left at None is picked here from QUICK; a value the reader gave is used as given.
+N_H0 = N_H0 if N_H0 is not None else (8 if QUICK else 500)
+N_H1 = N_H1 if N_H1 is not None else (8 if QUICK else 3000)
+N_TEST = N_TEST if N_TEST is not None else (4 if QUICK else 100)
+OUTER_SIZE = OUTER_SIZE if OUTER_SIZE is not None else 0.2
+N_MAP = tuple(N_MAP if N_MAP is not None else ((8, 8) if QUICK else (150, 250)))
+F_GRID = tuple(F_GRID if F_GRID is not None else (0.03, 0.1, 0.2, 0.3, 0.5, 1.0))
+F_SIDE = tuple(F_SIDE if F_SIDE is not None else (0.1, 0.2, 0.3))
+Q_BASE = Q_BASE if Q_BASE is not None else 1e-18
+WINDOW_HOURS = WINDOW_HOURS if WINDOW_HOURS is not None else 8.0
+N_SPIKE = N_SPIKE if N_SPIKE is not None else (8 if QUICK else 200)
+N_POLICY_DRAWS = N_POLICY_DRAWS if N_POLICY_DRAWS is not None else (5000 if QUICK else 200000)
+PM_J_SEEDS = PM_J_SEEDS if PM_J_SEEDS is not None else (1 if QUICK else 3)
+PM_J_F = tuple(PM_J_F if PM_J_F is not None else (0.03, 0.1, 0.3, 1.0))
+PM_J_NOISE_URAD = tuple(PM_J_NOISE_URAD if PM_J_NOISE_URAD is not None else (10.0, 100.0, 300.0, 1000.0))
+PM_J_OFFSET_H = tuple(PM_J_OFFSET_H if PM_J_OFFSET_H is not None else (-3.0, 0.0, 3.0))
+N_PM_J_MC = N_PM_J_MC if N_PM_J_MC is not None else (8 if QUICK else 600)
+N_Z05 = N_Z05 if N_Z05 is not None else (4 if QUICK else 64)
+N_LEAD = tuple(N_LEAD if N_LEAD is not None else ((10, 2) if QUICK else (200, 48)))
+LEAD_MAGNITUDES = tuple(LEAD_MAGNITUDES if LEAD_MAGNITUDES is not None else (0.05, 0.1, 0.2, 0.5))
+N_BOOT = N_BOOT if N_BOOT is not None else (4 if QUICK else 40)
+BATCH = BATCH if BATCH is not None else 8
+workers = WORKERS if WORKERS is not None else (1 if QUICK else 2)
 
-import multiprocessing as mp
+import contextlib
 import time
-from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 from scipy import stats
 
 from cislunar.cr3bp import orbits
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
-from cislunar.estimation import adaptive_ocbe as ad
 from cislunar.estimation import consistency
 from cislunar.papers.greaves_scheeres_2021 import detection as det
 from cislunar.papers.greaves_scheeres_2021 import detection_studies as dstudies
@@ -82,18 +116,20 @@ from cislunar.papers.greaves_scheeres_2021.claims.maneuver_detection import (
 )
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
+from cislunar.utils.executors import open_executor
 
 plotting.use_style()
 out = OUTPUT_DIR or None
 rng = np.random.default_rng(SEED)
-executor = ProcessPoolExecutor(WORKERS, mp_context=mp.get_context("spawn")) if WORKERS > 1 else None
+# One executor for the whole chapter, opened here and closed in the last cell: its worker processes compile the
+# integrators once and keep them for every Monte Carlo below.
+executors = contextlib.ExitStack()
+executor = executors.enter_context(open_executor(workers, SCHEDULER))
 table = ComparisonTable("10 Maneuver detection (Greaves & Scheeres 2021, Eqs. 3-5, 33-35, Figs. 10-22, Tables 5-8)")
 OUTER = "stable NRHO (outer band)"
 ORBITS = {"9:2 NRHO": orbits.nrho_9_2(em), "stable NRHO": orbits.stable_nrho(em), OUTER: orbits.stable_nrho_outer(em)}
 STABLE = ("stable NRHO", OUTER)
-OUTER_SIZE = 0.2  # the outer-band candidate (notebook 09) runs a fifth of the training Monte Carlo, half the tests
 POLICIES = {"active": det.ACTIVE_POLICY, "quiet": det.QUIET_POLICY}
-V_MM = em.velocity_unit_km_s * 1e6  # LU/TU -> mm/s
 T_START = time.perf_counter()
 for name, o in ORBITS.items():
     print(f"{name}: period {o.period_days:.3f} d, perilune {o.perilune_radius_km:.0f} km, "
@@ -173,8 +209,6 @@ print(f"KS test of u_z against a uniform sphere: p {ks_txt}; against arcsine: "
 #   $f_c$ for the predictions.
 
 # %%
-Q_BASE = 1e-18  # km^2/s^3 outside the apoapsis window
-WINDOW_HOURS = 8.0
 SIGMA_ANGLE = tracking.DEFAULT_SIGMA_ANGLE_RAD
 VARIANTS = {"paper window, our noise": {}, "noise 2 urad": dict(sigma_angle_rad=2e-6),
             "noise 20 urad": dict(sigma_angle_rad=20e-6), "4-h window": dict(window_hours=4.0),
@@ -237,30 +271,9 @@ setups = {(o, p): det.make_setup(em, ORBITS[o], F_TUNE * det.window_control_weig
 setups_c = {(o, p): det.make_setup(em, ORBITS[o], F_C * det.window_control_weight(POLICIES[p], WINDOW_HOURS),
                                    Q_BASE, window_hours=WINDOW_HOURS) for o in ORBITS for p in POLICIES}
 s_q = setups["9:2 NRHO", "quiet"]
-sc_q = s_q.scenario
-demo = det.draw_trial(np.random.default_rng([SEED, 7]), s_q, magnitude_m_s=0.05, direction=(np.pi / 2, 0.0))
-q_tunings = {"constant": s_q.control_weight.max(), "apoapsis window": s_q.control_weight}
-runs = {name: det.run_trial_filter(s_q, demo, control_weight=q) for name, q in q_tunings.items()}
-panels = {name: ocbe_panels.panel_series(em, r, demo.truth, q_tunings[name], demo.y, s_q.observer_states, sc_q.model,
-                                sc_q.meas_cov) for name, r in runs.items()}
-burn_days = s_q.t_maneuver * em.time_unit_days
-nees_q = stats.chi2.ppf(consistency.NEES_PROBABILITY, 6)
-fig_summary = {}
-for name, r in runs.items():
-    pn = panels[name]
-    over = np.mean(pn.nees > nees_q, axis=1)  # fraction of epochs above the 99.9 % NEES quantile, fwd / smoothed
-    m_norm = pn.normalized_metric[0]
-    fig_summary[name] = dict(over=over, z_f=r.z_step * V_MM, z_s=r.z_smooth * V_MM,
-                             metric_over=int(np.sum(m_norm > 1)), trigger=ad.first_detection(pn.metric[0], pn.limit),
-                             sig_final=(pn.position_3sigma_km[0, -1], pn.velocity_3sigma_m_s[0, -1] * 1e3),
-                             contrast=pn.spike_contrast(burn_days))
-    print(f"{name:16s}: z forward {r.z_step * V_MM:6.2f} mm/s, smoothed {r.z_smooth * V_MM:6.2f} mm/s | epochs above "
-          f"NEES 99.9 %: forward {100 * over[0]:.0f} %, smoothed {100 * over[1]:.0f} % | forward metric above its "
-          f"limit at {fig_summary[name]['metric_over']} of {m_norm.size} epochs (adaptive rule "
-          f"{'would' if fig_summary[name]['trigger'] is not None else 'would not'} fire) | final forward 3-sigma "
-          f"{fig_summary[name]['sig_final'][0]:.2f} km, {fig_summary[name]['sig_final'][1]:.1f} mm/s | control spike "
-          f"contrast at the burn: forward {fig_summary[name]['contrast'][0]:.3g}, smoothed "
-          f"{fig_summary[name]['contrast'][1]:.3g}")
+demo = dstudies.run_tuning_demo(s_q, [SEED, 7], magnitude_m_s=0.05, direction=(np.pi / 2, 0.0))
+panels, burn_days = demo.panels, demo.burn_days
+print(demo.report())
 _ = plotting.save_figure(ocbe_panels.figure_errors(panels["constant"], "Fig. 10 analogue, constant q_w", burn_days=burn_days,
                                           velocity_unit="mm/s"), "10_fig10_constant_tuning_errors", output_dir=out)
 
@@ -278,33 +291,10 @@ _ = plotting.save_figure(ocbe_panels.figure_control_metric(panels["constant"], "
 # system"). Top: the forward (single-step, Eq. 32) and smoothed control norms; bottom: the normalised metrics.
 
 # %%
-_ = plotting.save_figure(ocbe_panels.figure_errors(panels["apoapsis window"], "Fig. 12 analogue, 8-h apoapsis window",
+_ = plotting.save_figure(ocbe_panels.figure_errors(panels["apoapsis window"], f"Fig. 12 analogue, {WINDOW_HOURS:g}-h apoapsis window",
                                           burn_days=burn_days, velocity_unit="mm/s"),
                          "10_fig12_window_tuning_errors", output_dir=out)
-pw = panels["apoapsis window"]
-k_b12 = int(np.searchsorted(pw.t_days, burn_days, side="right"))  # first epoch after the burn
-hours_after = (pw.t_days[k_b12:] - burn_days) * 24
-k_top12 = k_b12 + int(np.argmax(pw.position_3sigma_km[0, k_b12:]))
-v_ratio = pw.velocity_error_m_s[0, k_b12:] / pw.velocity_3sigma_m_s[0, k_b12:]
-p_ratio = pw.position_error_km[0, k_b12:] / pw.position_3sigma_km[0, k_b12:]
-near = v_ratio > 0.8  # velocity error within 20 % of its 3-sigma bound (or above it)
-k_end = int(np.argmin(near)) if not near.all() else near.size - 1  # end of the stretch right after the burn
-below_half = np.flatnonzero(v_ratio < 0.5)
-print(f"forward velocity error / its 3-sigma bound after the burn: {v_ratio[0]:.2f} at +{hours_after[0]:.0f} h, above "
-      f"0.8 at the first {k_end} epoch(s), below 0.5 from "
-      + (f"+{hours_after[below_half[0]]:.0f} h" if below_half.size else "never"))
-for what, r_ in (("velocity", v_ratio), ("position", p_ratio)):
-    later = np.flatnonzero(r_ > 0.8)
-    later = later[later >= k_end]
-    print(f"forward {what} error above 0.8 of its 3-sigma bound at {later.size} epochs from +{hours_after[k_end]:.0f} h"
-          + (f", between day {pw.t_days[k_b12 + later[0]]:.2f} and {pw.t_days[k_b12 + later[-1]]:.2f}; largest "
-             f"ratio {r_[later].max():.2f}" if later.size else ""))
-over12 = pw.nees[0, k_b12:] > nees_q
-print(f"forward NEES above its 99.9 % quantile at {int(over12.sum())} epochs after the burn, the first "
-      f"{int(np.argmin(over12)) if not over12.all() else over12.size} of them in a row")
-print(f"forward 3-sigma position: {pw.position_3sigma_km[0, k_b12]:.2f} km just after the burn, rising to "
-      f"{pw.position_3sigma_km[0, k_top12]:.2f} km at day {pw.t_days[k_top12]:.2f} (burn at day {burn_days:.2f}), "
-      f"{pw.position_3sigma_km[0, -1]:.2f} km at the end")
+print(demo.fig12_report())
 
 # %% [markdown]
 # **Fig. 12 analogue** (the paper: the window-tuned filter "still performs well"). Outside the window the
@@ -319,12 +309,10 @@ print(f"forward 3-sigma position: {pw.position_3sigma_km[0, k_b12]:.2f} km just 
 # 99.9 % quantile only at the first epochs after the burn (printed).
 
 # %%
-_ = plotting.save_figure(ocbe_panels.figure_control_metric(panels["apoapsis window"], "Fig. 13 analogue, 8-h apoapsis window",
+_ = plotting.save_figure(ocbe_panels.figure_control_metric(panels["apoapsis window"], f"Fig. 13 analogue, {WINDOW_HOURS:g}-h apoapsis window",
                                                   burn_days=burn_days),
                          "10_fig13_window_tuning_control_metric", output_dir=out)
-fs_c, fs_w = fig_summary["constant"], fig_summary["apoapsis window"]
-print(f"smoothed over forward z: constant {fs_c['z_s'] / fs_c['z_f']:.1f}, window {fs_w['z_s'] / fs_w['z_f']:.1f}; "
-      f"the window tuning's smoothed z is {fs_w['z_s'] / 50:.2f} of the 50 mm/s burn")
+print(demo.fig13_report())
 
 # %% [markdown]
 # **Fig. 13 analogue** (the paper: a consistent filter "with a smoothed control spike around apoapsis that is
@@ -643,7 +631,23 @@ J = dstudies.closing_rows(  # claim key -> the keyword arguments of Claim.judge 
 assert set(J) == set(CLAIMS), set(J) ^ set(CLAIMS)  # every declared claim is judged, none is typed
 for key, row in J.items():
     table.add(CLAIMS[key].judge(**row))
-if executor is not None:
-    executor.shutdown()
+executors.close()  # shuts the worker processes down
 print(f"notebook wall time: {(time.perf_counter() - T_START) / 60:.1f} min")
 table.display()
+
+# %% [markdown]
+# ## Exercises
+#
+# Each exercise changes one parameter of the `parameters` cell at the top; rerun the chapter (in Jupyter, or with
+# `python -m cislunar.publish.notebooks --quick 10 -p NAME=VALUE`), write down your prediction first, then compare.
+# The worked solutions are functions of `cislunar.papers.greaves_scheeres_2021.exercises` that answer each question
+# at a small size in a few seconds and return the numbers with a one-paragraph answer.
+#
+# 1. **The window weight.** Set `F_GRID = [0.03, 0.3, 1.0]`. Before running: how do the mean $z$ without a burn,
+#    the mean $z$ with one and the threshold $z_{lim}$ change as $f$ grows (what does the smoother fit as control
+#    when the window makes control cheap)? Does the test gain or lose power, and where does the tuning map put
+#    $f_c$? Check the map's table and figure in Section 2. Worked solution: `exercise_10_window_factor`.
+# 2. **Where the $\pm\hat\jmath$ pattern lives.** Set `PM_J_NOISE_URAD = [10, 3000]`. Predict the $\pm\hat\jmath$
+#    contrast at each noise level from the geometry printed in Section 4 (the line of sight from L2 to apoapsis),
+#    and what happens to $z$ of a 1 m/s burn when the angles barely see it. Worked solution:
+#    `exercise_10_pm_j_noise`.

@@ -2,7 +2,9 @@ r"""Studies of the adaptive OCBE on the paper's detection scenario (Greaves & Sc
 Figs. 6-9; notebook 09b).
 
 Each study draws its trials from a generator passed in (in a fixed order, so that a notebook calling them in
-sequence reproduces one random stream) and returns a frozen result:
+sequence reproduces one random stream) and returns a frozen result.  The studies with many runs draw every trial
+first and then filter them as independent tasks on an optional ``executor``
+(:func:`cislunar.utils.montecarlo.map_tasks`), so their results do not depend on where the filters run:
 
 * :func:`null_metric_study`: the OCBE metric of runs without a maneuver against its :math:`\chi^2_m` law;
 * :func:`adaptive_run`: one single-trial adaptive run with its panels (Figs. 6-9) and consistency numbers;
@@ -28,6 +30,7 @@ from cislunar.papers.greaves_scheeres_2021 import detection as det
 from cislunar.papers.greaves_scheeres_2021 import panels as ocbe_panels
 from cislunar.papers.greaves_scheeres_2021 import tracking
 from cislunar.utils import validation
+from cislunar.utils.montecarlo import map_tasks
 
 __all__ = ["OUTCOMES", "NullMetricStudy", "null_metric_study", "measurement_spread", "AdaptiveRun", "adaptive_run",
            "first_seen_epoch", "DelayOutcome", "delay_outcome", "first_detection_epochs", "DelayStudy",
@@ -271,16 +274,25 @@ def delay_outcome(setup: det.DetectionSetup, epochs, late_from: float) -> DelayO
                         int(np.sum(found & (ep < k_burn))), delays)
 
 
+def _draw_burns(setup, magnitude_m_s, n_runs, rng) -> list:
+    return [det.draw_trial(rng, setup, magnitude_m_s=magnitude_m_s) for _ in range(n_runs)]
+
+
+def _first_pass(task) -> np.ndarray:
+    """First detection epoch (-1: none) of one batch of drawn runs (a task of :func:`delay_study`)."""
+    setup, draws = task
+    sc = setup.scenario
+    return ad.first_pass_detections(setup.system, sc.t, np.array([d.y for d in draws]), setup.observer_states,
+                                    sc.model, sc.meas_cov, np.array([d.x0 for d in draws]), draws[0].P0,
+                                    setup.control_weight)
+
+
 def first_detection_epochs(setup: det.DetectionSetup, magnitude_m_s: float, n_runs: int,
                            rng: np.random.Generator) -> np.ndarray:
     """First detection epoch (-1: none) of ``n_runs`` runs with a randomly pointed burn, one batched pass."""
     _check_setup(setup)
     validation.rng(rng)
-    draws = [det.draw_trial(rng, setup, magnitude_m_s=magnitude_m_s) for _ in range(n_runs)]
-    sc = setup.scenario
-    return ad.first_pass_detections(setup.system, sc.t, np.array([d.y for d in draws]), setup.observer_states,
-                                    sc.model, sc.meas_cov, np.array([d.x0 for d in draws]), draws[0].P0,
-                                    setup.control_weight)
+    return _first_pass((setup, _draw_burns(setup, magnitude_m_s, n_runs, rng)))
 
 
 @dataclass(frozen=True)
@@ -331,7 +343,7 @@ class DelayStudy:
 
 
 def delay_study(setup: det.DetectionSetup, orbit, magnitudes_m_s, noise_urad, n_runs: int,
-                rng: np.random.Generator) -> DelayStudy:
+                rng: np.random.Generator, *, executor=None) -> DelayStudy:
     """Detection delays of the adaptive filter's first pass.
 
     Parameters
@@ -346,22 +358,33 @@ def delay_study(setup: det.DetectionSetup, orbit, magnitudes_m_s, noise_urad, n_
         Angle noise levels (1 sigma), micro-rad; the default level reuses the runs of the size sweep.
     n_runs : int
     rng : numpy.random.Generator
-        Consumed in the order: sizes, then noise levels.
+        Consumed in the order: sizes, then noise levels (all runs are drawn before any is filtered).
+    executor : concurrent.futures-style executor, optional
+        Runs the batched first passes, one task per burn size and noise level; serial when None.
     """
     _check_setup(setup)
     n_runs = validation.integer(n_runs, "n_runs", minimum=1)
+    validation.rng(rng)
     mags = [float(m) for m in magnitudes_m_s]
+    if not mags:
+        raise ValueError("magnitudes_m_s must hold at least one burn size")
     late_from = _late_from(setup, orbit.period)
-    by_size = {m: delay_outcome(setup, first_detection_epochs(setup, m, n_runs, rng), late_from) for m in mags}
     default_urad = tracking.DEFAULT_SIGMA_ANGLE_RAD * 1e6
-    by_noise = {}
+    keys, tasks = [], []
+    for m in mags:
+        keys.append(("size", m))
+        tasks.append((setup, _draw_burns(setup, m, n_runs, rng)))
     for s in noise_urad:
         if np.isclose(s, default_urad):
-            by_noise[s] = by_size[mags[0]]
-            continue
+            continue  # reuses the runs of the size sweep
         s_setup = det.make_setup(setup.system, orbit, setup.q_window_km2_s3, setup.q_base_km2_s3,
                                  sigma_angle_rad=s * 1e-6)
-        by_noise[s] = delay_outcome(s_setup, first_detection_epochs(s_setup, mags[0], n_runs, rng), late_from)
+        keys.append(("noise", s))
+        tasks.append((s_setup, _draw_burns(s_setup, mags[0], n_runs, rng)))
+    epochs = map_tasks(_first_pass, tasks, executor=executor, progress=False, desc="first passes")
+    outcome = {k: delay_outcome(t[0], ep, late_from) for k, t, ep in zip(keys, tasks, epochs)}
+    by_size = {m: outcome["size", m] for m in mags}
+    by_noise = {s: by_size[mags[0]] if np.isclose(s, default_urad) else outcome["noise", s] for s in noise_urad}
     hours = setup.system.time_unit_s / 3600.0
     return DelayStudy(by_size, by_noise, (orbit.period - setup.t_maneuver) * hours,
                       (late_from - setup.t_maneuver) * hours, n_runs)
@@ -432,27 +455,38 @@ class ResetRuleStudy:
                 sum(self.summary(m, rule)["n_detected"] for m in self.magnitudes_m_s))
 
 
-def reset_rule_study(setup: det.DetectionSetup, magnitudes_m_s, n_per_magnitude: int, rng: np.random.Generator, *,
-                     max_resets: int = 5) -> ResetRuleStudy:
-    """For each size, ``n_per_magnitude`` randomly pointed burns, each filtered (forward) with every rule of
-    :data:`cislunar.estimation.adaptive_ocbe.RESET_RULES`; inconsistency as in notebook 09 (more than
-    :data:`tracking.DIVERGED_FRACTION` of the epochs from the burn on above the 99.9 % NEES quantile)."""
-    _check_setup(setup)
-    n = validation.integer(n_per_magnitude, "n_per_magnitude", minimum=1)
-    mags = tuple(float(m) for m in magnitudes_m_s)
+def _reset_rule_runs(task) -> list:
+    """Both reset rules on one drawn run (a task of :func:`reset_rule_study`): one row per rule."""
+    setup, mag, inputs, max_resets = task
     lim = nees_limit()
     rows = []
-    for mag in mags:
-        for _ in range(n):
-            inputs = det.draw_trial(rng, setup, magnitude_m_s=mag)
-            for rule in ad.RESET_RULES:
-                try:
-                    a = adaptive_run(setup, inputs, reset=rule, smooth=False, max_resets=max_resets)
-                except (ad.ResetError, ocbe.FilterDivergenceError):
-                    rows.append((mag, rule, True, 1.0, True, max_resets + 1, False))
-                    continue
-                rows.append((mag, rule, bool(a.detections), a.nees_f_after,
-                             a.nees_f_after > tracking.DIVERGED_FRACTION, len(a.detections), bool(a.final_nees < lim)))
+    for rule in ad.RESET_RULES:
+        try:
+            a = adaptive_run(setup, inputs, reset=rule, smooth=False, max_resets=max_resets)
+        except (ad.ResetError, ocbe.FilterDivergenceError):
+            rows.append((mag, rule, True, 1.0, True, max_resets + 1, False))
+            continue
+        rows.append((mag, rule, bool(a.detections), a.nees_f_after,
+                     a.nees_f_after > tracking.DIVERGED_FRACTION, len(a.detections), bool(a.final_nees < lim)))
+    return rows
+
+
+def reset_rule_study(setup: det.DetectionSetup, magnitudes_m_s, n_per_magnitude: int, rng: np.random.Generator, *,
+                     max_resets: int = 5, executor=None) -> ResetRuleStudy:
+    """For each size, ``n_per_magnitude`` randomly pointed burns, each filtered (forward) with every rule of
+    :data:`cislunar.estimation.adaptive_ocbe.RESET_RULES`; inconsistency as in notebook 09 (more than
+    :data:`tracking.DIVERGED_FRACTION` of the epochs from the burn on above the 99.9 % NEES quantile).
+
+    All runs are drawn from ``rng`` first (sizes in order), then filtered one task per run on ``executor``
+    (serial when None); the rows come back in the order of the draws."""
+    _check_setup(setup)
+    n = validation.integer(n_per_magnitude, "n_per_magnitude", minimum=1)
+    validation.rng(rng)
+    max_resets = validation.integer(max_resets, "max_resets", minimum=1)
+    mags = tuple(float(m) for m in magnitudes_m_s)
+    tasks = [(setup, mag, det.draw_trial(rng, setup, magnitude_m_s=mag), max_resets) for mag in mags for _ in range(n)]
+    rows = [row for rows in map_tasks(_reset_rule_runs, tasks, executor=executor, progress=False,
+                                      desc="adaptive runs") for row in rows]
     return ResetRuleStudy(tuple(rows), mags, tuple(ad.RESET_RULES))
 
 

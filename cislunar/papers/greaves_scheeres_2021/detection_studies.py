@@ -1,6 +1,7 @@
 """Studies and aggregations of notebook 10 (Greaves & Scheeres 2021, "Maneuver Detection", Tables 5-8): the tuning
-map of the unstated window weight and its two readings (:func:`run_tuning_map`), and the standard errors behind the
-closing table's Monte Carlo tolerances.
+map of the unstated window weight and its two readings (:func:`run_tuning_map`), the single run of Figs. 10-13 under
+both tunings with its readout (:func:`run_tuning_demo`), the Monte Carlo studies of Sections 2-6, and the standard
+errors behind the closing table's Monte Carlo tolerances.
 
 The tolerances of the Monte Carlo comparisons are standard errors passed to
 :meth:`cislunar.publish.claims.Claim.judge` with the claims of
@@ -14,8 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from cislunar.estimation.consistency import nees, nees_limit
+from cislunar.estimation import adaptive_ocbe as ad
+from cislunar.estimation.consistency import NEES_PROBABILITY, nees, nees_limit
 from cislunar.papers.greaves_scheeres_2021 import detection as det
+from cislunar.papers.greaves_scheeres_2021 import panels as ocbe_panels
 from cislunar.papers.greaves_scheeres_2021 import tracking
 from cislunar.papers.greaves_scheeres_2021.claims.maneuver_detection import (
     PAPER_ACCURACY,
@@ -24,7 +27,7 @@ from cislunar.papers.greaves_scheeres_2021.claims.maneuver_detection import (
 from cislunar.utils import validation
 
 __all__ = ["accuracy_standard_error", "improvement_in_standard_errors", "finite_or", "CONSISTENT_FRACTION",
-           "TuningMap", "run_tuning_map", "SpikeStudy", "run_spike_study", "TAGS", "ratio_text",
+           "TuningMap", "run_tuning_map", "TuningDemo", "run_tuning_demo", "SpikeStudy", "run_spike_study", "TAGS", "ratio_text",
            "TrainingStudies", "run_training_studies", "DIRECTIONS", "PmJSearch", "run_pm_j_search", "BurnZStudy",
            "run_burn_z_study", "lead_report", "lead_reading", "closing_rows"]
 
@@ -209,6 +212,138 @@ def run_tuning_map(system, orbits: dict, policies: dict, variants: dict, f_grid,
                            "h0": st.h0.inconsistent_runs, "h1": st.h1.inconsistent_runs, "n": (len(st.h0), len(st.h1)),
                            "slope": np.polyfit(st.h1.magnitude, st.h1.z, 1)[0]}
     return TuningMap(out, tuple(orbits), tuple(policies), names, tuple(f_grid), tuple(f_side), dict(paper_zlim))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Figs. 10-13: one run under the two tunings
+# ---------------------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class TuningDemo:
+    """One quiet-policy run filtered twice: with the window weight held constant over the period (Figs. 10-11) and
+    with it only in the apoapsis window (Figs. 12-13).
+
+    Attributes
+    ----------
+    setup : detection.DetectionSetup
+        The window-tuned setup the run was drawn on.
+    inputs : detection.TrialInputs
+        The run (truth, measurements, hand-off).
+    control_weights : dict
+        Tuning (``"constant"``, ``"apoapsis window"``) -> control weight, a scalar or per interval (nondimensional).
+    runs : dict
+        Tuning -> the OCBE result (:func:`detection.run_trial_filter`).
+    panels : dict
+        Tuning -> :class:`panels.PanelSeries` (the series the figures draw).
+    burn_days : float
+        Burn epoch, days from the start of the track.
+    """
+
+    setup: det.DetectionSetup
+    inputs: det.TrialInputs
+    control_weights: dict
+    runs: dict
+    panels: dict
+    burn_days: float
+
+    @property
+    def nees_quantile(self) -> float:
+        """99.9 % quantile of the 6-dof chi-square law (an epoch above it is inconsistent)."""
+        return float(stats.chi2.ppf(NEES_PROBABILITY, 6))
+
+    def summary(self, tuning: str) -> dict:
+        """Per tuning: ``over`` (fraction of epochs above the NEES quantile, forward and smoothed), ``z_f`` and
+        ``z_s`` (forward and smoothed control integral, mm/s), ``metric_over`` (forward epochs with the normalised
+        metric above 1), ``trigger`` (first epoch of three consecutive exceedances, None if the adaptive rule would
+        not fire), ``sig_final`` (final forward 3-sigma position km and velocity mm/s) and ``contrast`` (control
+        spike contrast at the burn, forward and smoothed)."""
+        validation.choice(tuning, "tuning", tuple(self.runs))
+        r, pn = self.runs[tuning], self.panels[tuning]
+        v_mm = self.setup.system.velocity_unit_km_s * 1e6
+        return dict(over=np.mean(pn.nees > self.nees_quantile, axis=1), z_f=r.z_step * v_mm, z_s=r.z_smooth * v_mm,
+                    metric_over=int(np.sum(pn.normalized_metric[0] > 1)),
+                    trigger=ad.first_detection(pn.metric[0], pn.limit),
+                    sig_final=(pn.position_3sigma_km[0, -1], pn.velocity_3sigma_m_s[0, -1] * 1e3),
+                    contrast=pn.spike_contrast(self.burn_days))
+
+    def report(self) -> str:
+        """One line per tuning: z, NEES exceedances, the forward metric, the final bounds and the spike contrast."""
+        lines = []
+        for name in self.runs:
+            f = self.summary(name)
+            n_epochs = self.panels[name].normalized_metric[0].size
+            lines.append(
+                f"{name:16s}: z forward {f['z_f']:6.2f} mm/s, smoothed {f['z_s']:6.2f} mm/s | epochs above "
+                f"NEES 99.9 %: forward {100 * f['over'][0]:.0f} %, smoothed {100 * f['over'][1]:.0f} % | forward metric "
+                f"above its limit at {f['metric_over']} of {n_epochs} epochs (adaptive rule "
+                f"{'would' if f['trigger'] is not None else 'would not'} fire) | final forward 3-sigma "
+                f"{f['sig_final'][0]:.2f} km, {f['sig_final'][1]:.1f} mm/s | control spike contrast at the burn: "
+                f"forward {f['contrast'][0]:.3g}, smoothed {f['contrast'][1]:.3g}")
+        return "\n".join(lines)
+
+    def window_after_burn(self) -> dict:
+        """The window tuning's forward errors after the burn (Fig. 12): ``k_burn`` (first epoch after it),
+        ``hours_after``, ``velocity_ratio`` and ``position_ratio`` (error over its 3-sigma bound), ``k_end`` (end of
+        the stretch with the velocity ratio above 0.8 right after the burn) and ``nees_over`` (forward NEES above its
+        quantile, per epoch after the burn)."""
+        pw, b = self.panels["apoapsis window"], self.burn_days
+        k_b = int(np.searchsorted(pw.t_days, b, side="right"))
+        v_ratio = pw.velocity_error_m_s[0, k_b:] / pw.velocity_3sigma_m_s[0, k_b:]
+        near = v_ratio > 0.8  # velocity error within 20 % of its 3-sigma bound (or above it)
+        return dict(k_burn=k_b, hours_after=(pw.t_days[k_b:] - b) * 24, velocity_ratio=v_ratio,
+                    position_ratio=pw.position_error_km[0, k_b:] / pw.position_3sigma_km[0, k_b:],
+                    k_end=int(np.argmin(near)) if not near.all() else near.size - 1,
+                    nees_over=pw.nees[0, k_b:] > self.nees_quantile)
+
+    def fig12_report(self) -> str:
+        """The Fig. 12 readout: how long the forward errors stay near their bounds after the burn, the NEES
+        exceedances and the forward 3-sigma position bound after the window."""
+        pw, a = self.panels["apoapsis window"], self.window_after_burn()
+        k_b, h, v_ratio, k_end, over = a["k_burn"], a["hours_after"], a["velocity_ratio"], a["k_end"], a["nees_over"]
+        below_half = np.flatnonzero(v_ratio < 0.5)
+        lines = [f"forward velocity error / its 3-sigma bound after the burn: {v_ratio[0]:.2f} at +{h[0]:.0f} h, above "
+                 f"0.8 at the first {k_end} epoch(s), below 0.5 from "
+                 + (f"+{h[below_half[0]]:.0f} h" if below_half.size else "never")]
+        for what, r_ in (("velocity", v_ratio), ("position", a["position_ratio"])):
+            later = np.flatnonzero(r_ > 0.8)
+            later = later[later >= k_end]
+            lines.append(f"forward {what} error above 0.8 of its 3-sigma bound at {later.size} epochs from "
+                         f"+{h[k_end]:.0f} h"
+                         + (f", between day {pw.t_days[k_b + later[0]]:.2f} and {pw.t_days[k_b + later[-1]]:.2f}; "
+                            f"largest ratio {r_[later].max():.2f}" if later.size else ""))
+        lines.append(f"forward NEES above its 99.9 % quantile at {int(over.sum())} epochs after the burn, the first "
+                     f"{int(np.argmin(over)) if not over.all() else over.size} of them in a row")
+        k_top = k_b + int(np.argmax(pw.position_3sigma_km[0, k_b:]))
+        lines.append(f"forward 3-sigma position: {pw.position_3sigma_km[0, k_b]:.2f} km just after the burn, rising to "
+                     f"{pw.position_3sigma_km[0, k_top]:.2f} km at day {pw.t_days[k_top]:.2f} (burn at day "
+                     f"{self.burn_days:.2f}), {pw.position_3sigma_km[0, -1]:.2f} km at the end")
+        return "\n".join(lines)
+
+    def fig13_report(self) -> str:
+        """The Fig. 13 readout: smoothed over forward z for both tunings, and the window tuning's smoothed z over
+        the burn."""
+        fs_c, fs_w = self.summary("constant"), self.summary("apoapsis window")
+        burn_mm_s = self.inputs.magnitude_m_s * 1e3
+        return (f"smoothed over forward z: constant {fs_c['z_s'] / fs_c['z_f']:.1f}, window "
+                f"{fs_w['z_s'] / fs_w['z_f']:.1f}; the window tuning's smoothed z is {fs_w['z_s'] / burn_mm_s:.2f} of "
+                f"the {burn_mm_s:.0f} mm/s burn")
+
+
+def run_tuning_demo(setup: det.DetectionSetup, seed, *, magnitude_m_s: float = 0.05,
+                    direction=(np.pi / 2, 0.0)) -> TuningDemo:
+    r"""Draw one run with a burn of ``magnitude_m_s`` along ``direction`` (azimuth, elevation in rad; default
+    :math:`+\hat\jmath`) on the window-tuned ``setup`` (generator seeded with ``seed``) and filter it with the
+    window weight held constant over the period and with the setup's apoapsis window (Figs. 10-13)."""
+    validation.instance(setup, "setup", det.DetectionSetup, "a detection.DetectionSetup (detection.make_setup)")
+    validation.positive(magnitude_m_s, "magnitude_m_s")
+    inputs = det.draw_trial(np.random.default_rng(seed), setup, magnitude_m_s=magnitude_m_s, direction=direction)
+    weights = {"constant": setup.control_weight.max(), "apoapsis window": setup.control_weight}
+    runs = {name: det.run_trial_filter(setup, inputs, control_weight=q) for name, q in weights.items()}
+    sc = setup.scenario
+    panels = {name: ocbe_panels.panel_series(setup.system, r, inputs.truth, weights[name], inputs.y,
+                                             setup.observer_states, sc.model, sc.meas_cov) for name, r in runs.items()}
+    return TuningDemo(setup, inputs, weights, runs, panels, float(setup.t_maneuver * setup.system.time_unit_days))
 
 
 # ---------------------------------------------------------------------------------------------------------------

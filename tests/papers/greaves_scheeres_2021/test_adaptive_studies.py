@@ -98,3 +98,41 @@ def test_large_burn_run_and_closing_rows_are_judged_by_every_claim(setup, nrho):
     assert status["small late"] == "reproduced"  # no prompt run
     assert status["small re-converges"] == "differs"  # no detected run counts as 0
     assert status["base weight"] == "not in paper"
+
+
+def test_delay_study_draws_first_and_gives_the_same_outcomes_on_any_executor(setup, nrho):
+    from concurrent.futures import ThreadPoolExecutor  # noqa: PLC0415 - a thread pool is enough to check the order
+
+    mags, noise = (0.05, 3.0), (5.0, 10.0)
+    serial = ads.delay_study(setup, nrho, mags, noise, 3, np.random.default_rng(4))
+    with ThreadPoolExecutor(2) as pool:
+        pooled = ads.delay_study(setup, nrho, mags, noise, 3, np.random.default_rng(4), executor=pool)
+    # the draws are the sequential ones of the study before it had an executor: sizes first, then noise levels
+    rng = np.random.default_rng(4)
+    ep = [ads.first_detection_epochs(setup, m, 3, rng) for m in mags]
+    s5 = det.make_setup(em, nrho, 1e-18, 1e-18, sigma_angle_rad=5e-6)
+    ep5 = ads.first_detection_epochs(s5, 0.05, 3, rng)
+    late_from = setup.t_maneuver + 0.75 * (nrho.period - setup.t_maneuver)
+    for study in (serial, pooled):
+        for m, e in zip(mags, ep):
+            want = ads.delay_outcome(setup, e, late_from)
+            got = study.by_size[m]
+            assert (got.prompt, got.late, got.near, got.undetected) == (want.prompt, want.late, want.near,
+                                                                        want.undetected)
+            np.testing.assert_array_equal(got.delays_h, want.delays_h)
+        np.testing.assert_array_equal(study.by_noise[5.0].delays_h, ads.delay_outcome(s5, ep5, late_from).delays_h)
+        assert study.by_noise[10.0] is study.by_size[0.05]  # the default noise reuses the size sweep's runs
+        assert study.by_size[3.0].prompt == 1.0
+
+
+def test_reset_rule_study_is_the_same_on_any_executor(setup):
+    from concurrent.futures import ThreadPoolExecutor  # noqa: PLC0415
+
+    serial = ads.reset_rule_study(setup, (3.0,), 2, np.random.default_rng(5))
+    with ThreadPoolExecutor(2) as pool:
+        pooled = ads.reset_rule_study(setup, (3.0,), 2, np.random.default_rng(5), executor=pool)
+    assert serial.runs == pooled.runs and len(serial.runs) == 2 * len(ad.RESET_RULES)
+    # rows in the order of the draws, every rule on each drawn run
+    assert [r[1] for r in serial.runs] == list(ad.RESET_RULES) * 2
+    with pytest.raises(ValueError, match="max_resets"):
+        ads.reset_rule_study(setup, (3.0,), 1, np.random.default_rng(5), max_resets=0)

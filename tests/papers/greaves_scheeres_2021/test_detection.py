@@ -241,7 +241,6 @@ def test_lockstep_groups_equal_separate_batches_and_any_executor(short_setup):
 
 def test_trial_nees_equals_the_nees_of_the_filter_output(short_setup):
     """The NEES fields of a Monte Carlo trial are those of consistency.nees on the single-trial filter's estimates."""
-    from cislunar.papers.greaves_scheeres_2021 import tracking
     s = short_setup
     lim = stats.chi2.ppf(consistency.NEES_PROBABILITY, 6)
     batch = det.detection_trial_batch(np.random.default_rng(31), s, det.QUIET_POLICY, 2)

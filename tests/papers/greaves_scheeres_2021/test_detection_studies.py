@@ -8,6 +8,7 @@ import pytest
 
 from cislunar.cr3bp import orbits
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.estimation import consistency
 from cislunar.papers.greaves_scheeres_2021 import detection as det
 from cislunar.papers.greaves_scheeres_2021 import detection_studies as ds
 from cislunar.papers.greaves_scheeres_2021.claims.maneuver_detection import (
@@ -162,3 +163,136 @@ def test_a_small_spike_study_runs_and_is_bounded():
         assert all(0.0 <= x <= 1.0 for x in v["inc"]) and v["contrast"].shape == (2, 2) and v["sig_km"] > 0
     # the constant tuning admits more control everywhere: its forward bound is the larger one
     assert s.cells["constant", "H1"]["sig_km"] > s.cells["apoapsis window", "H1"]["sig_km"]
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Figs. 10-13: one run under the two tunings, and its readout
+# ---------------------------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def nrho_92():
+    return orbits.nrho_9_2(em)
+
+
+@pytest.fixture(scope="module")
+def quiet_window(nrho_92):
+    return det.make_setup(em, nrho_92, 0.1 * det.window_control_weight(det.QUIET_POLICY, 8.0), 1e-18)
+
+
+def test_tuning_demo_filters_one_run_twice_and_reads_it_out(quiet_window):
+    demo = ds.run_tuning_demo(quiet_window, [0, 7])
+    assert set(demo.runs) == set(demo.panels) == {"constant", "apoapsis window"}
+    # the constant tuning holds the window weight everywhere: never below the windowed weight
+    assert np.all(demo.control_weights["constant"] >= demo.control_weights["apoapsis window"])
+    assert demo.burn_days == pytest.approx(quiet_window.t_maneuver * em.time_unit_days)
+    assert demo.inputs.magnitude_m_s == 0.05 and demo.inputs.azimuth == pytest.approx(np.pi / 2)
+    v_mm = em.velocity_unit_km_s * 1e6
+    for name, r in demo.runs.items():
+        s = demo.summary(name)
+        assert s["z_s"] == pytest.approx(r.z_smooth * v_mm) and s["z_f"] == pytest.approx(r.z_step * v_mm)
+        assert np.all((0 <= s["over"]) & (s["over"] <= 1))
+        assert 0 <= s["metric_over"] <= demo.panels[name].metric.shape[1]
+    # the smoother sees the data after the burn: its z is larger than the forward one, and bounded by the burn
+    # plus what the window lets it fit of the noise
+    w = demo.summary("apoapsis window")
+    assert w["z_s"] > 2 * w["z_f"] and 0.3 * 50 < w["z_s"] < 2 * 50
+    # with the constant tuning the smoother also fits the noise all along the orbit: a larger z
+    assert demo.summary("constant")["z_s"] > w["z_s"]
+    a = demo.window_after_burn()
+    pw = demo.panels["apoapsis window"]
+    assert pw.t_days[a["k_burn"] - 1] <= demo.burn_days < pw.t_days[a["k_burn"]]
+    assert np.all(a["hours_after"] > 0) and a["velocity_ratio"].shape == a["nees_over"].shape
+    text = demo.report()
+    assert text.count("\n") == 1 and f"smoothed {w['z_s']:6.2f} mm/s" in text
+    assert "forward velocity error / its 3-sigma bound" in demo.fig12_report()
+    assert f"window {w['z_s'] / w['z_f']:.1f}" in demo.fig13_report() and "of the 50 mm/s burn" in demo.fig13_report()
+    with pytest.raises(ValueError, match="tuning"):
+        demo.summary("adaptive")
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# closing_rows end to end on small real studies: every declared claim measured once, none typed
+# ---------------------------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def small_studies():
+    """Every study of notebook 10 at the smallest sizes its functions accept (all three orbits: the claims name them)."""
+    outer = "stable NRHO (outer band)"
+    orbit_set = {"9:2 NRHO": orbits.nrho_9_2(em), "stable NRHO": orbits.stable_nrho(em),
+                 outer: orbits.stable_nrho_outer(em)}
+    policies = {"active": det.ACTIVE_POLICY, "quiet": det.QUIET_POLICY}
+    q_base, window = 1e-18, 8.0
+    tmap = ds.run_tuning_map(em, orbit_set, policies, {"paper window, our noise": {}, "4-h window":
+                                                       dict(window_hours=4.0)}, (0.1, 0.3), (0.3,), (4, 4), [0, 77],
+                             paper_zlim=PAPER_ZLIM, q_base_km2_s3=q_base, window_hours=window,
+                             sigma_angle_rad=10e-6, half_size_orbits=(outer,), batch_size=4)
+
+    def setups(f):
+        return {(o, p): det.make_setup(em, orbit_set[o], f * det.window_control_weight(policies[p], window), q_base)
+                for o in orbit_set for p in policies}
+
+    s_tune, s_c = setups(0.1), setups(tmap.f_c)
+    train = ds.run_training_studies(s_tune, s_c, policies, {o: (8, 8, 2) for o in orbit_set}, 0, 3, batch_size=4)
+    s_q = s_tune["9:2 NRHO", "quiet"]
+    spike = ds.run_spike_study(det.make_setup(em, orbit_set["9:2 NRHO"], s_q.q_window_km2_s3, s_q.q_window_km2_s3),
+                               s_q, 2, [0, 41])
+    pm_j = ds.run_pm_j_search(em, orbit_set["9:2 NRHO"], (0.1,), (10.0, 300.0), (0.0,), 1, [0, 31],
+                              q_base_km2_s3=q_base, window_hours=window)
+    pm_mc = {p: det.run_detection_monte_carlo(s_tune["9:2 NRHO", p], pol, 4, [0, 33, j], batch_size=4, progress=False)
+             for j, (p, pol) in enumerate(policies.items())}
+    burn_z = ds.run_burn_z_study(s_q, orbit_set["9:2 NRHO"], {0.1, tmap.f_c}, 0.5, 2, [0, 8], q_base_km2_s3=q_base,
+                                 window_hours=window)
+    lead = {}
+    for i, (tag, f_, sig) in enumerate((("f = 0.1, 10 urad", 0.1, 10.0), (f"f_c = {tmap.f_c:g}, 10 urad", tmap.f_c, 10.0),
+                                        ("f = 0.1, 100 urad", 0.1, 100.0))):
+        s_l = det.make_setup(em, orbit_set["9:2 NRHO"], f_ * det.window_control_weight(det.QUIET_POLICY, window),
+                             q_base, sigma_angle_rad=sig * 1e-6)
+        lead[tag] = det.health_lead_study(s_l, (0.5,), 10, 1, [0, 60, i], horizon_hours=6.0)
+    sig_level = {tag: burn_z.sigma_level(f_, g["9:2 NRHO", "quiet"].h1.z)
+                 for tag, f_, g in (("f = 0.1", 0.1, train.tuned), ("f_c", tmap.f_c, train.predicted))}
+    health = det.draw_trial(np.random.default_rng([0, 8]), s_q, magnitude_m_s=0.5)
+    rh = det.run_trial_filter(s_q, health)
+    rows = ds.closing_rows(
+        ks_text="< 1e-300", tmap=tmap, f_tune=0.1, counts=dict(n_h0=8, n_h1=8, n_test=2, outer_sizes=(8, 8, 2), n_spike=2,
+                                                            n_z05=2, n_lead=(10, 1), n_pm_j_mc=4, pm_j_seeds=1),
+        q_window_quiet=(s_q.q_window_km2_s3, s_c["9:2 NRHO", "quiet"].q_window_km2_s3), spike=spike, train=train,
+        pm_j=pm_j, pm_mc=pm_mc, burn_z=burn_z, sig_level=sig_level, lead=lead,
+        health_nees_mean=float(consistency.nees(rh.x_smooth, rh.P_smooth, health.truth).mean()),
+        health_residual_norms=rh.residual_norms, sigma_angle_rad=10e-6)
+    return dict(rows=rows, tmap=tmap, train=train, spike=spike, burn_z=burn_z, lead=lead, sig_level=sig_level)
+
+
+def test_closing_rows_measure_every_declared_claim_from_real_studies(small_studies):
+    rows = small_studies["rows"]
+    assert set(rows) == set(CLAIMS)  # every declared claim is measured, none is left to be typed
+    assert list(rows)[:3] == ["magnitude bounds", "pointing", "noise"]  # the table's order
+    statuses = {key: CLAIMS[key].judge(**row).status for key, row in rows.items()}
+    assert statuses["sizes"] == "differs"  # small sizes are not the paper's, and the row says so
+    for key in ("noise", "tuning", "FP/MD, 9:2 NRHO, quiet", "z_lim, stable NRHO (outer band), quiet"):
+        assert statuses[key] == "not in paper"
+
+
+def test_closing_rows_carry_the_studies_numbers(small_studies):
+    rows, train, tmap = small_studies["rows"], small_studies["train"], small_studies["tmap"]
+    for p in ("active", "quiet"):
+        assert rows[f"z_lim f=0.1, {p}"]["measured"] == train.tuned["9:2 NRHO", p].threshold.z_lim
+        row = rows[f"z_lim f_c, {p}"]
+        assert row["measured"] == train.predicted["9:2 NRHO", p].threshold.z_lim
+        assert row["standard_error"] == pytest.approx(train.se(("9:2 NRHO", p), "f_c", 0)) and row["standard_error"] > 0
+        acc = rows[f"accuracy f_c, {p}"]
+        assert acc["measured"] == train.accuracy(("9:2 NRHO", p), "f_c")
+        assert acc["standard_error"] == ds.accuracy_standard_error(PAPER_ACCURACY[p], train.tuned["9:2 NRHO", p].score.n)
+    assert f"f_c = {tmap.f_c:g}" in rows["tuning"]["measured"]
+    # the health rows: the mean of the 0.5 m/s burns and its single-run spread, at both tunings
+    z = small_studies["burn_z"].z
+    assert rows["health z, f = 0.1"]["measured"] == pytest.approx(z[0.1].mean())
+    assert rows["health z, f_c"]["standard_error"] == pytest.approx(z[tmap.f_c].std(ddof=1))
+    assert rows["health sigma, f_c"]["measured"] == small_studies["sig_level"]["f_c"]
+    # the Fig. 10 row is the spike study's verdict; fractions stay fractions
+    assert rows["fig10"]["measured"] == small_studies["spike"].fig10_ok
+    assert 0.0 <= rows["fig11"]["measured"] <= 1.0 and 0.0 <= rows["fig13"]["measured"] <= 1.0
+    for o in tmap.orbits:
+        assert 0.0 <= rows[f"window consistent f=0.1, {o}"]["measured"] <= 1.0
+    assert rows["window consistent"]["measured"] == train.worst_predicted
+    # the lead rows are keyed by the f_c label without its value, and hold a verdict per setting
+    assert {k for k in rows if k.startswith("control first")} == {
+        "control first, f = 0.1, 10 urad", "control first, f_c, 10 urad", "control first, f = 0.1, 100 urad"}
+    assert all(isinstance(rows[k]["measured"], bool) for k in rows if k.startswith("control first"))
