@@ -150,8 +150,10 @@ def _ocbe_batch(system, t, y, obs, model, R, x, P0, qs, n_sub, tol) -> BatchOCBE
     zero, eye = np.zeros(6), np.eye(6)
 
     def update(S, x_ref, k):  # Eqs. 24-28 about the reference x_ref (the deviation's prior mean is zero)
-        val, _, Ht = model.evaluate(obs[k], x_ref)
-        S_new, b, e = srif._measurement_update(S, zero, Ht, model.residual(y[:, k], val), R)
+        if not np.all(np.isfinite(x_ref)):  # a diverged estimate (was refused by model.evaluate's check)
+            raise ValueError("target contains NaN or infinite values")
+        val, _, Ht = model._evaluate(obs[k], x_ref)  # arrays checked above: the unchecked kernels
+        S_new, b, e = srif._measurement_update(S, zero, Ht, model._residual(y[:, k], val), R)
         return S_new, x_ref + srif._solve_upper(S_new, b), e
 
     x_pred = np.empty((B, N, 6))

@@ -555,8 +555,10 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
         vis = np.flatnonzero(avail[k])
         if vis.size == 0:
             return S, x_ref.copy(), 0.0
-        val, _, Ht = model.evaluate(obs[k, vis], x_ref)
-        dy = model.residual(y[k, vis], val).reshape(-1)
+        if not np.all(np.isfinite(x_ref)):  # a diverged estimate (was refused by model.evaluate's check)
+            raise ValueError("target contains NaN or infinite values")
+        val, _, Ht = model._evaluate(obs[k, vis], x_ref)  # arrays checked above: the unchecked kernels
+        dy = model._residual(y[k, vis], val).reshape(-1)
         Rk = np.kron(np.eye(vis.size), R[k])
         S_new, b, e = srif._measurement_update(S, np.zeros(6), Ht.reshape(-1, 6), dy, Rk)
         return S_new, x_ref + srif._cov_of_sri(S_new, b)[0], e
@@ -579,7 +581,7 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
             tr = _transition(system, x, grid, qs[n], tol)
             Phi = tr.phi[-1]
             Phi_xx, Phi_xp = Phi[:6, :6], Phi[:6, 6:]
-            Q = ocbe_process_noise(Phi)
+            Q = _process_noise(Phi_xx, Phi_xp)
             S_bar, _, term = srif._time_update(S, np.zeros(6), Phi_xx, eye6, Q)  # Eq. 23 (b_x,n|n = 0)
             x_prior = tr.x[-1]
             x_pred.append(x_prior.copy())

@@ -144,19 +144,37 @@ def cholesky_spd(P, name: str = "P", *, rtol: float = 1e-8) -> np.ndarray:
     Raises
     ------
     ValueError
-        Not square, NaN, asymmetric beyond ``rtol`` or not positive definite (names ``name``).
+        Not square, NaN, asymmetric beyond ``rtol``, not positive definite or numerically singular (correlation-matrix
+        eigenvalue ratio at most :data:`cislunar.utils.validation.SPD_RCOND`, see :func:`cislunar.utils.validation.spd`)
+        (names ``name``).
     """
+    return _cholesky(_spd(P, name, rtol))
+
+
+def _spd(P, name, rtol=1e-8):
+    """The checks of :func:`check_spd` (one pass of :func:`cislunar.utils.validation.spd`); returns the float array."""
     P = _square(P, name)
     rtol = _rtol(rtol)
-    scale = np.max(np.abs(P)) if P.size else 0.0
-    if scale == 0.0:
+    if not np.any(P):
         raise ValueError(f"{name} must be positive definite; got a zero matrix")
-    if np.max(np.abs(P - np.swapaxes(P, -1, -2))) > rtol * scale:
-        raise ValueError(f"{name} must be symmetric (max asymmetry {np.max(np.abs(P - np.swapaxes(P, -1, -2))):.3g})")
+    return validation.spd(P, name, batch=True, rtol=rtol)
+
+
+def _cholesky(P, name: str = "P"):
+    """Lower Cholesky factor of the symmetric part of checked (or computed) SPD matrices, no argument checks.
+
+    The inner kernel of :func:`cholesky_spd`; a failed factorisation (a computed matrix that lost definiteness)
+    still raises a ``ValueError`` naming ``name``.
+    """
     try:
-        return np.linalg.cholesky(symmetrize(P))
+        return np.linalg.cholesky(_sym(P))
     except np.linalg.LinAlgError as exc:
         raise ValueError(f"{name} must be positive definite (Cholesky factorisation failed)") from exc
+
+
+def _logdet(P, name: str = "P"):
+    """:func:`logdet_spd` of checked (or computed) SPD matrices, no argument checks."""
+    return 2.0 * np.sum(np.log(np.diagonal(_cholesky(P, name), axis1=-2, axis2=-1)), axis=-1)
 
 
 def check_spd(P, name: str = "P", *, rtol: float = 1e-8) -> np.ndarray:
@@ -166,9 +184,7 @@ def check_spd(P, name: str = "P", *, rtol: float = 1e-8) -> np.ndarray:
     matrix (correlation-matrix eigenvalue ratio at most :data:`cislunar.utils.validation.SPD_RCOND`, see
     :func:`cislunar.utils.validation.spd`).
     """
-    cholesky_spd(P, name, rtol=rtol)
-    validation.spd(P, name, batch=True, rtol=max(rtol, 1e-8))
-    return symmetrize(P)
+    return _sym(_spd(P, name, rtol))
 
 
 def check_psd(Q, name: str = "Q", *, rtol: float = 1e-8) -> np.ndarray:
@@ -199,8 +215,7 @@ def check_psd(Q, name: str = "Q", *, rtol: float = 1e-8) -> np.ndarray:
 
 def logdet_spd(P, name: str = "P") -> np.ndarray:
     """:math:`\\ln|P|` of SPD matrices ``(..., n, n)`` from the Cholesky factor, :math:`2\\sum_i \\ln L_{ii}`."""
-    L = cholesky_spd(P, name)
-    return 2.0 * np.sum(np.log(np.diagonal(L, axis1=-2, axis2=-1)), axis=-1)
+    return _logdet(_spd(P, name), name)
 
 
 def block_diag(blocks) -> np.ndarray:
@@ -209,16 +224,20 @@ def block_diag(blocks) -> np.ndarray:
     With an array input the leading axes are kept: ``(..., k, n, n) -> (..., k n, k n)``.
     """
     if isinstance(blocks, np.ndarray) and blocks.ndim >= 3:
-        blocks = validation.square(blocks, "blocks", batch=True)
-        k, n = blocks.shape[-3], blocks.shape[-1]
-        out = np.zeros(blocks.shape[:-3] + (k * n, k * n))
-        for i in range(k):
-            out[..., i * n:(i + 1) * n, i * n:(i + 1) * n] = blocks[..., i, :, :]
-        return out
+        return _block_diag(validation.square(blocks, "blocks", batch=True))
     items = validation.one_or_many(blocks, "blocks", np.ndarray, "square matrix")
     mats = [validation.square(np.atleast_2d(validation.as_array(b, f"blocks[{i}]")), f"blocks[{i}]")
             for i, b in enumerate(items)]
     return scipy.linalg.block_diag(*mats)
+
+
+def _block_diag(blocks: np.ndarray) -> np.ndarray:
+    """:func:`block_diag` of a checked float array ``(..., k, n, n)`` (no argument checks)."""
+    k, n = blocks.shape[-3], blocks.shape[-1]
+    out = np.zeros(blocks.shape[:-3] + (k * n, k * n))
+    for i in range(k):
+        out[..., i * n:(i + 1) * n, i * n:(i + 1) * n] = blocks[..., i, :, :]
+    return out
 
 
 # --------------------------------------------------------------------------------------------------------------
@@ -467,7 +486,7 @@ def ekf_update(P, H, R):
     m = H.shape[-2]
     if R.shape[-1] != m:
         raise ValueError(f"R must be ({m}, {m}) to match H; got {R.shape}")
-    cholesky_spd(R, "R")
+    _spd(R, "R")
     return _ekf_update(P, H, R)
 
 
@@ -476,7 +495,7 @@ def _ekf_update(P, H, R):
     n = P.shape[-1]
     HT = np.swapaxes(H, -1, -2)
     S = _sym(H @ P @ HT + R)
-    L = cholesky_spd(S, "S (innovation covariance)")
+    L = _cholesky(S, "S (innovation covariance)")
     # K^T = S^{-1} H P via two triangular solves
     HP = H @ P
     KT = np.linalg.solve(np.swapaxes(L, -1, -2), np.linalg.solve(L, HP))
@@ -549,13 +568,49 @@ def covariance_analysis(P0, F, Q, H, R) -> CovarianceHistory:
     return CovarianceHistory(prior, post, S)
 
 
+#: The last few checked ``(P0, Q, R)`` of :func:`_check_linear_system`: ``((N, M), inputs, outputs)``, most recent
+#: first.  Callers that evaluate many windows (the SCvx information models, their Hessians) hold them fixed and
+#: change only F and H, so the SPD / PSD checks and R's Cholesky factors run once per window.
+_CHECKED_NOISE: list = []
+_CHECKED_NOISE_SIZE = 4
+
+
+def _same_array(a, b) -> bool:
+    return type(a) is np.ndarray and a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a, b)
+
+
+def _checked_noise(P0, Q, R, H):
+    """Cached checked ``(P0, Q, R, LR)`` for inputs equal entry by entry to ones checked before (else None)."""
+    if type(H) is not np.ndarray or H.ndim != 3:
+        return None
+    key = H.shape[:2]
+    for k, raw, out in _CHECKED_NOISE:
+        if k == key and all(_same_array(a, b) for a, b in zip((P0, Q, R), raw)):
+            return out
+    return None
+
+
 def _check_linear_system(P0, F, Q, H, R, *, chol_R: bool = False):
     """Validate the matrices of a linear-Gaussian measurement sequence (shared with :mod:`cislunar.sensing.information`).
 
     Returns ``(P0, F, Q, H, R)`` as float arrays (Q, R broadcast to sequences), plus the Cholesky factors of R
-    when ``chol_R``.
+    when ``chol_R``.  ``P0``, ``Q`` and ``R`` equal (entry by entry) to ones checked in one of the last few calls
+    are not checked again: the same read-only arrays are returned, so values are bit-for-bit those of a full check.
     """
-    P0 = check_spd(_square(P0, "P0"), "P0")
+    hit = _checked_noise(P0, Q, R, H)
+    if hit is not None:
+        P0c, Qc, Rc, LRc = hit
+        H = validation.as_array(H, "H", ndim=(3,))
+        if H.shape[-1] != P0c.shape[0]:
+            raise ValueError(f"H must have shape (N, M, {P0c.shape[0]}) to match P0; got {H.shape}")
+        N, n = H.shape[0], P0c.shape[0]
+        F = validation.as_array(F, "F")
+        if N == 1 and F.size == 0:
+            F = np.zeros((0, n, n))
+        F = _as_sequence(F, "F", N - 1, (n, n), f" (N - 1 intervals from H {H.shape}, n from P0 {P0c.shape})")
+        return (P0c, F, Qc, H, Rc, LRc) if chol_R else (P0c, F, Qc, H, Rc)
+    raw = tuple(np.array(a, copy=True) if type(a) is np.ndarray else None for a in (P0, Q, R))
+    P0 = check_spd(P0, "P0")
     if P0.ndim != 2:
         raise ValueError(f"P0 must be a single (n, n) matrix; got {P0.shape}")
     n = P0.shape[0]
@@ -572,7 +627,7 @@ def _check_linear_system(P0, F, Q, H, R, *, chol_R: bool = False):
     F = _as_sequence(F, "F", N - 1, (n, n), ctx)
     Q = _as_sequence(Q, "Q", N - 1, (n, n), ctx) if np.size(Q) else np.zeros((0, n, n))
     if N > 1:
-        Qs = symmetrize(Q)
+        Qs = _sym(Q)
         if np.max(np.abs(Q - Qs)) > 1e-8 * max(np.max(np.abs(Q)), 1e-300):
             raise ValueError("Q must be symmetric")
         # PSD test: Q + jitter I must admit a Cholesky factor (jitter 1e-10 of the largest diagonal entry)
@@ -586,8 +641,16 @@ def _check_linear_system(P0, F, Q, H, R, *, chol_R: bool = False):
             raise ValueError("Q must be positive semi-definite") from exc
         Q = Qs
     R = _as_sequence(R, "R", N, (M, M), f" (N, M from H {H.shape})")
-    LR = cholesky_spd(R, "R")
-    R = symmetrize(R)
+    _spd(R[0] if R.strides[0] == 0 else R, "R")  # a broadcast (M, M) R is checked once
+    R = _sym(R)
+    LR = _cholesky(R, "R")
+    if all(a is not None for a in raw):
+        out = (P0, np.array(Q, copy=True), R, LR)
+        for a in out:
+            a.flags.writeable = False
+        _CHECKED_NOISE.insert(0, ((N, M), raw, out))
+        del _CHECKED_NOISE[_CHECKED_NOISE_SIZE:]
+        P0, Q, R, LR = out
     return (P0, F, Q, H, R, LR) if chol_R else (P0, F, Q, H, R)
 
 
@@ -731,6 +794,11 @@ def propagate_arcs(system: CR3BP, x0, t, *, q: float | None = None, order: int =
     order = validation.integer(order, "order", minimum=1, maximum=2)
     qq = None if q is None else validation.positive(q, "q", allow_zero=True)
     n_nodes = validation.integer(n_nodes, "n_nodes", minimum=2)
+    return _propagate_arcs(system, x0, t, qq, order, n_nodes)
+
+
+def _propagate_arcs(system, x0, t, qq, order, n_nodes) -> ObjectArcs:
+    """:func:`propagate_arcs` on checked arguments (``x0`` (K, 6), ``t`` increasing, ``qq`` float or None)."""
     K, N = x0.shape[0], t.size
     X = propagate(system, x0, t).x
     X = X if X.ndim == 3 else X[None]
@@ -776,37 +844,48 @@ def assemble_augmented(model: MeasurementModel, noise, P0, observer: ObjectArcs,
     if Q is not None:
         Q = _as_sequence(Q, "Q", N - 1, (n, n))
         check_psd(Q, "Q")
+    if not callable(noise):
+        noise = _spd(validation.as_array(noise, "noise", shape=(m, m)), "noise")
+    return _assemble(model, noise, P0, observer, targets, Q, i)
+
+
+def _assemble(model, noise, P0, observer, targets, Q, i) -> AugmentedLinearization:
+    """:func:`assemble_augmented` on checked arguments (``P0`` symmetrised, ``noise`` a checked (m, m) array or a
+    callable whose output is checked here, ``Q`` a checked sequence or None, ``i`` the observer index)."""
+    t = observer.t
+    NT, N, m = targets.x.shape[0], t.size, model.dim
+    n = 6 * (NT + 1)
     obs = observer.x[i]
     tgts = targets.x
     Fo = observer.F[i]
-    F = block_diag(np.moveaxis(np.concatenate([Fo[None], targets.F], axis=0), 0, 1))
+    F = _block_diag(np.moveaxis(np.concatenate([Fo[None], targets.F], axis=0), 0, 1))
     if Q is None:
         if observer.Q is None or targets.Q is None:
             raise ValueError("give Q, or arcs propagated with a process-noise PSD q")
-        Qa = block_diag(np.moveaxis(np.concatenate([observer.Q[i][None], targets.Q], axis=0), 0, 1))
+        Qa = _block_diag(np.moveaxis(np.concatenate([observer.Q[i][None], targets.Q], axis=0), 0, 1))
     else:
         Qa = Q
     stm = np.empty((N, 6, 6))
     stm[0] = np.eye(6)
     for k in range(1, N):
         stm[k] = Fo[k - 1] @ stm[k - 1]
-    _, Hs, Ht = model.evaluate(obs[None], tgts)  # (NT, N, m, 6)
+    _, Hs, Ht = model._evaluate(obs[None], tgts)  # (NT, N, m, 6)
     H = np.zeros((N, NT * m, n))
     for j in range(NT):
         H[:, j * m:(j + 1) * m, 0:6] = Hs[j]
         H[:, j * m:(j + 1) * m, 6 * (j + 1):6 * (j + 2)] = Ht[j]
-    if callable(noise):
+    if callable(noise):  # a user's function: its output is checked on every call
         Rt = validation.as_array(noise(obs[None], tgts), "noise(observer, target)", shape=(NT, N, m, m))
-    else:
-        Rt = np.broadcast_to(validation.as_array(noise, "noise", shape=(m, m)), (NT, N, m, m))
-    R = block_diag(np.moveaxis(Rt, 0, 1))
-    check_spd(R, "noise")
+        R = _block_diag(np.moveaxis(Rt, 0, 1))
+        check_spd(R, "noise")
+    else:  # checked by the caller (identical blocks: their block diagonal is SPD exactly when the block is)
+        R = _block_diag(np.moveaxis(np.broadcast_to(noise, (NT, N, m, m)), 0, 1))
     dF = dH = None
     if observer.stt is not None:
         Psi = observer.stt[i]
         dF = np.zeros((N - 1, n, n, 6))
         dF[:, 0:6, 0:6, :] = np.einsum("kabd,kdc->kabc", Psi, stm[:-1])
-        hess = model.hessian(obs[None], tgts)  # (NT, N, m, 6, 6): d2h/ddelta2
+        hess = model._hessian(obs[None], tgts)  # (NT, N, m, 6, 6): d2h/ddelta2
         # dH_obs/dx_S = +hess, dH_tgt/dx_S = -hess (delta = x_T - x_S); chain with Phi_S(t_k, t_0)
         dhx = np.einsum("ikabd,kdc->ikabc", hess, stm)
         dH = np.zeros((N, NT * m, n, 6))
@@ -882,7 +961,7 @@ def linearize_augmented(system: CR3BP, observer_x0, targets_x0, t, model: Measur
     derivatives = validation.boolean(derivatives, "derivatives")
     n_nodes = validation.integer(n_nodes, "n_nodes", minimum=2)
     if not callable(noise):
-        check_spd(validation.as_array(noise, "noise", shape=(model.dim, model.dim)), "noise")
-    obs = propagate_arcs(system, xs0, t, q=q, order=2 if derivatives else 1, n_nodes=n_nodes)
-    tgt = propagate_arcs(system, xt0, t, q=q, order=1, n_nodes=n_nodes)
-    return assemble_augmented(model, noise, P0, obs, tgt, Q=Q)
+        noise = _spd(validation.as_array(noise, "noise", shape=(model.dim, model.dim)), "noise")
+    obs = _propagate_arcs(system, xs0[None], t, q, 2 if derivatives else 1, n_nodes)
+    tgt = _propagate_arcs(system, xt0, t, q, 1, n_nodes)
+    return _assemble(model, noise, P0, obs, tgt, Q, 0)

@@ -63,9 +63,10 @@ from scipy.linalg import lapack as _lapack
 from cislunar.sensing.covariance import (
     AugmentedLinearization,
     _check_linear_system,
-    check_spd,
-    cholesky_spd,
-    logdet_spd,
+    _cholesky,
+    _logdet,
+    _spd,
+    _sym,
 )
 from cislunar.utils import validation
 
@@ -150,7 +151,12 @@ def stacked_derivative(F, H, dF, dH) -> np.ndarray:
     F = validation.as_array(F, "F", ndim=(3,))
     if F.shape != (N - 1, n, n):
         raise ValueError(f"F must have shape {(N - 1, n, n)} to match H {H.shape}; got {F.shape}")
-    dF, dH = _check_derivatives(F, H, dF, dH)
+    return _stacked_derivative(F, H, *_check_derivatives(F, H, dF, dH))
+
+
+def _stacked_derivative(F, H, dF, dH) -> np.ndarray:
+    """:func:`stacked_derivative` on checked arrays (no argument checks)."""
+    N, M, n = H.shape
     p = dH.shape[-1]
     dF_p = np.moveaxis(dF, -1, 1)  # (N-1, p, n, n)
     dH_p = np.moveaxis(dH, -1, 1)  # (N, p, M, n)
@@ -173,7 +179,7 @@ def mutual_information_dense(P0, F, Q, H, R) -> float:
     """
     Pt, Ht, Rt = stacked_matrices(P0, F, Q, H, R)
     S = Ht @ Pt @ Ht.T + Rt
-    return 0.5 * float(logdet_spd(0.5 * (S + S.T), "S_tilde") - logdet_spd(Rt, "R_tilde"))
+    return 0.5 * float(_logdet(0.5 * (S + S.T), "S_tilde") - _logdet(Rt, "R_tilde"))
 
 
 def mutual_information_gradient_dense(P0, F, Q, H, R, dF, dH):
@@ -199,11 +205,11 @@ def mutual_information_gradient_dense(P0, F, Q, H, R, dF, dH):
     P0, F, Q, H, R = _check_linear_system(P0, F, Q, H, R)
     dF, dH = _check_derivatives(F, H, dF, dH)
     Pt, Ht, Rt = _stacked(P0, F, Q, H, R)
-    dHt = stacked_derivative(F, H, dF, dH)
+    dHt = _stacked_derivative(F, H, dF, dH)
     S = Ht @ Pt @ Ht.T + Rt
     S = 0.5 * (S + S.T)
-    L = cholesky_spd(S, "S_tilde")
-    info = 0.5 * float(2.0 * np.sum(np.log(np.diag(L))) - logdet_spd(Rt, "R_tilde"))
+    L = _cholesky(S, "S_tilde")
+    info = 0.5 * float(2.0 * np.sum(np.log(np.diag(L))) - _logdet(Rt, "R_tilde"))
     # T_i = S^{-1}(dH_i P H^T + H P dH_i^T);  (1/2) tr T_i = tr(S^{-1} dH_i P H^T)
     PHt = Pt @ Ht.T  # (Nn, NM)
     Sinv = np.linalg.solve(L.T, np.linalg.solve(L, np.eye(S.shape[0])))
@@ -410,7 +416,7 @@ def mutual_information(P0, F, Q, H, R, *, return_terms: bool = False):
     return (total, terms) if return_terms else total
 
 
-def _gradient_adjoint(P0, F, Q, H, R, dF, dH):
+def _gradient_adjoint(P0, F, Q, H, LR, dF, dH):
     """Structured mutual information and gradient: adjoint (reverse-mode) derivative of the Kalman recursion, O(N).
 
     Forward pass: the square-root recursion of :func:`mutual_information` on whitened Jacobians
@@ -429,10 +435,9 @@ def _gradient_adjoint(P0, F, Q, H, R, dF, dH):
     precise than the prior.  Finally
     :math:`\\partial\\mathcal I/\\partial\\xi_i = \\sum_k\\langle L_{R_k}^{-T}\\bar{\\hat H}_k, \\partial_i H_k\\rangle
     + \\sum_k\\langle\\bar F_k, \\partial_i F_k\\rangle` -- two tensor contractions, so the cost does not grow with
-    the number of parameters.  Arguments and returns as in :func:`mutual_information_gradient_dense`.
+    the number of parameters.  Returns as in :func:`mutual_information_gradient_dense`; arguments checked by
+    :func:`mutual_information_gradient` (``LR``: Cholesky factors of R), no checks here.
     """
-    P0, F, Q, H, R, LR = _check_linear_system(P0, F, Q, H, R, chol_R=True)
-    dF, dH = _check_derivatives(F, H, dF, dH)
     LRinv = np.linalg.inv(LR)  # whitening: H_w = L_R^{-1} H; undone on the adjoint at the end
     Hw = LRinv @ H
     N, M, n = H.shape
@@ -478,7 +483,7 @@ def _tri_solve(L, B):
     return np.moveaxis(X.reshape(n, p, k), 1, 0)
 
 
-def _gradient_sqrt(P0, F, Q, H, R, dF, dH):
+def _gradient_sqrt(P0, F, Q, H, LR, dF, dH):
     """Forward-mode derivative of the square-root recursion of :func:`_sqrt_forward` (p tangent directions).
 
     ``method="sqrt-forward"``: the default before 2026-11-24, kept as the reference of the reverse mode
@@ -492,8 +497,6 @@ def _gradient_sqrt(P0, F, Q, H, R, dF, dH):
     :math:`d\\ln|S_k^{1/2}| = \\sum_{i<M}Y_{ii}`.  Every quantity is a factor or an orthogonal matrix, so the
     gradient keeps the accuracy of the value (the covariance-form adjoint loses ~5 digits on test case 2).
     """
-    P0, F, Q, H, R, LR = _check_linear_system(P0, F, Q, H, R, chol_R=True)
-    dF, dH = _check_derivatives(F, H, dF, dH)
     Hw = np.linalg.solve(LR, H)
     N, M, n = H.shape
     p = dH.shape[-1]
@@ -529,7 +532,7 @@ def _gradient_sqrt(P0, F, Q, H, R, dF, dH):
     return total, grad
 
 
-def _gradient_sqrt_reverse(P0, F, Q, H, R, dF, dH):
+def _gradient_sqrt_reverse(P0, F, Q, H, LR, dF, dH):
     """Reverse-mode (adjoint) derivative of the square-root recursion: value and gradient, cost independent of p.
 
     Notation (whitened :math:`\\hat H_k = L_{R_k}^{-1}H_k`): prior and posterior factors :math:`U_k, V_k`,
@@ -573,10 +576,9 @@ def _gradient_sqrt_reverse(P0, F, Q, H, R, dF, dH):
     evaluation on the test-case-2-sized benchmark window: 2.4e-8 relative (max abs), forward mode 1.8e-8; an
     eps-sized perturbation of the posterior factors alone moves the gradient by ~1e-7 there, so ~1e-8 is the
     double-precision floor of any square-root recursion and the two modes agree to ~4e-8 (1e-12 on
-    well-conditioned windows).  Arguments and returns as in :func:`mutual_information_gradient_dense`.
+    well-conditioned windows).  Returns as in :func:`mutual_information_gradient_dense`; arguments checked by
+    :func:`mutual_information_gradient` (``LR``: Cholesky factors of R), no checks here.
     """
-    P0, F, Q, H, R, LR = _check_linear_system(P0, F, Q, H, R, chol_R=True)
-    dF, dH = _check_derivatives(F, H, dF, dH)
     Hw = np.linalg.solve(LR, H)
     N, M, n = H.shape
     p = dH.shape[-1]
@@ -629,11 +631,10 @@ def mutual_information_gradient(P0, F, Q, H, R, dF, dH, *, method: str = "sqrt")
     grad : ndarray (p,)
     """
     validation.choice(method, "method", ("sqrt", "sqrt-forward", "adjoint"))
-    if method == "sqrt":
-        return _gradient_sqrt_reverse(P0, F, Q, H, R, dF, dH)
-    if method == "sqrt-forward":
-        return _gradient_sqrt(P0, F, Q, H, R, dF, dH)
-    return _gradient_adjoint(P0, F, Q, H, R, dF, dH)
+    P0, F, Q, H, R, LR = _check_linear_system(P0, F, Q, H, R, chol_R=True)  # checked once; the kernels do not
+    dF, dH = _check_derivatives(F, H, dF, dH)
+    kernel = {"sqrt": _gradient_sqrt_reverse, "sqrt-forward": _gradient_sqrt, "adjoint": _gradient_adjoint}[method]
+    return kernel(P0, F, Q, H, LR, dF, dH)
 
 
 def window_information(lin: AugmentedLinearization, *, method: str = "structured", gradient: bool = False):
@@ -670,8 +671,8 @@ def gaussian_kl(mean_p, cov_p, mean_q, cov_q) -> np.ndarray:
 
     Means broadcast over leading axes ``(..., d)``; covariances are single ``(d, d)`` SPD matrices.
     """
-    cp = check_spd(cov_p, "cov_p")
-    cq = check_spd(cov_q, "cov_q")
+    cp = _sym(_spd(cov_p, "cov_p"))
+    cq = _sym(_spd(cov_q, "cov_q"))
     if cp.ndim != 2 or cp.shape != cq.shape:
         raise ValueError(f"cov_p and cov_q must be (d, d) of the same shape; got {cp.shape} and {cq.shape}")
     d = cp.shape[0]
@@ -682,7 +683,7 @@ def gaussian_kl(mean_p, cov_p, mean_q, cov_q) -> np.ndarray:
     z = np.linalg.solve(Lq, diff)
     maha = np.sum(z**2, axis=0).reshape(np.broadcast_shapes(mp.shape, mq.shape)[:-1])
     tr = np.trace(np.linalg.solve(cq, cp))
-    return 0.5 * (tr + maha - d + logdet_spd(cq, "cov_q") - logdet_spd(cp, "cov_p"))
+    return 0.5 * (tr + maha - d + _logdet(cq, "cov_q") - _logdet(cp, "cov_p"))
 
 
 def monte_carlo_mutual_information(P0, F, Q, H, R, n_samples: int, rng: np.random.Generator):

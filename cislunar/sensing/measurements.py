@@ -333,13 +333,19 @@ def relative_state(observer, target) -> np.ndarray:
     ValueError
         Wrong last axis, NaN, or leading axes that do not broadcast.
     """
+    xs, xt = _checked_pair(observer, target)
+    return xt - xs
+
+
+def _checked_pair(observer, target):
+    """The checks of :func:`relative_state`: both states as float arrays ``(..., 6)`` with broadcasting leading axes."""
     xs = validation.as_array(observer, "observer", last=6)
     xt = validation.as_array(target, "target", last=6)
     try:
         np.broadcast_shapes(xs.shape, xt.shape)
     except ValueError as exc:
         raise ValueError(f"observer and target leading axes do not broadcast: {xs.shape} vs {xt.shape}") from exc
-    return xt - xs
+    return xs, xt
 
 
 @dataclass(frozen=True)
@@ -382,7 +388,12 @@ class MeasurementModel:
         H_target : ndarray, shape (..., dim, 6)
             :math:`\\partial h/\\partial \\mathbf x_{\\mathcal T} = \\partial h/\\partial\\boldsymbol\\delta`.
         """
-        val, jac = self._closed_form(relative_state(observer, target))
+        return self._evaluate(*_checked_pair(observer, target))
+
+    def _evaluate(self, observer, target):
+        """:meth:`evaluate` on checked float arrays (no argument checks: the inner loops of the filters and of the
+        linearisations, whose public entry points checked the states once)."""
+        val, jac = self._closed_form(target - observer)
         return val, -jac, jac
 
     def jacobians(self, observer, target):
@@ -397,7 +408,11 @@ class MeasurementModel:
         \\partial\\mathbf x_{\\mathcal T}` equal this tensor.  Exact (forward-mode second-order differentiation of
         the same formulas); degenerate geometry raises as in :meth:`evaluate`.
         """
-        rel = relative_state(observer, target)
+        return self._hessian(*_checked_pair(observer, target))
+
+    def _hessian(self, observer, target) -> np.ndarray:
+        """:meth:`hessian` on checked float arrays (no argument checks)."""
+        rel = target - observer
         self._closed_form(rel)  # geometry checks
         comps = self._generic(_Jet.variables(rel))
         out = np.zeros(rel.shape[:-1] + (self.dim, 6, 6))
@@ -408,9 +423,12 @@ class MeasurementModel:
 
     def residual(self, y, y_predicted) -> np.ndarray:
         """``y - y_predicted`` with angle components wrapped to :math:`[-\\pi, \\pi)`."""
-        y = validation.as_array(y, "y", last=self.dim)
-        yp = validation.as_array(y_predicted, "y_predicted", last=self.dim)
-        r = y - yp
+        return self._residual(validation.as_array(y, "y", last=self.dim),
+                              validation.as_array(y_predicted, "y_predicted", last=self.dim))
+
+    def _residual(self, y, y_predicted) -> np.ndarray:
+        """:meth:`residual` on checked float arrays (no argument checks)."""
+        r = y - y_predicted
         mask = np.asarray(self.angles, dtype=bool)
         r[..., mask] = wrap_angle(r[..., mask])
         return r

@@ -63,10 +63,7 @@ def test_estimated_control_and_bad_input(two_hours_near_perilune):
 from filterpy.kalman import KalmanFilter  # noqa: E402
 
 from cislunar.cr3bp.propagation import propagate  # noqa: E402
-from cislunar.sensing import (
-    measurements,
-    sites,  # noqa: E402
-)
+from cislunar.sensing import measurements, sites  # noqa: E402
 
 
 def _scenario(rng, dv_lu_tu=0.0, n_meas=13, q=Q_WEIGHT):
@@ -131,7 +128,6 @@ def test_costate_explains_the_update_through_the_dynamics(ocbe_run):
 
 def test_full_smoother_equals_rts_and_never_loses_information(ocbe_run):
     (t, *_rest), res = ocbe_run
-    q = _rest[-1]
     N = t.size
     assert np.allclose(res.x_smooth[-1], res.x_filt[-1]) and np.allclose(res.P_smooth[-1], res.P_filt[-1])
     xs, Ps = res.x_filt[-1].copy(), res.P_filt[-1].copy()

@@ -72,8 +72,6 @@ def test_text_inside_containers_is_refused_by_name(case, all_text, rnd):
     assert outcome == "named", f"{spec.label}({arg}={bad!r:.80}): {outcome}"
 
 
-@pytest.mark.xfail(strict=False, reason="open: sensing.information (stacked_matrices, mutual_information, ...) and "
-                   "other functions check SPD with their own Cholesky, not validation.spd (issue 20 item 2)")
 @settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.sampled_from(SPD_ARGS), st.integers(0, 2**32 - 1), st.integers(1, 3))
 def test_numerically_singular_covariances_are_refused_by_name(case, seed, rank_loss):
