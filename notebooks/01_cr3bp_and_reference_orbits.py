@@ -29,23 +29,38 @@
 #
 # All computation lives in the `cislunar` package; this notebook calls it and plots.
 
+# %% [markdown]
+# **How to use this chapter.** The next cell (tagged `parameters`) holds every size a reader might change: the
+# finite-difference steps of Section 2, the continuation step of the halo family, the sampling of the visibility
+# checks and of the all-pairs station sweep, the line-of-sight statistics and the trial values of $\mu$. Leave an
+# entry at `None` and the notebook picks it (the values in brackets in the comments: a coarser sampling when
+# `QUICK = True`, then the full run); give a value (edit the cell, or pass `-p NAME=VALUE` to the runner) and it is
+# used as given in both modes. Every orbit and every check is computed in both modes. Nothing here is random and
+# nothing runs in parallel (every computation takes seconds), so the chapter has no `WORKERS` parameter.
+
 # %% tags=["parameters"]
 QUICK = False
-SEED = 0
+SEED = 0  # no random draws in this chapter; kept for the common parameter interface
 OUTPUT_DIR = ""
+FD_STEPS = None  # finite-difference steps of the STM/STT study, 1e-9 to 10^-2.5 (None: 8 quick, 15 full)
+HALO_STEP = None  # pseudo-arclength step along the southern L2 halo family (None: 0.03 quick, 0.01 full)
+DRO_MEMBERS = None  # members of the DRO family drawn, 0.95 to 0.70 LU (None: 13 quick, 51 full)
+MU_STEP = 1e-9  # trial offsets +-MU_STEP of the mass ratio either side of the adopted mu (dimensionless)
+SAMPLES = None  # points per orbit, uniform in time, for the station coverage checks (None: 1500 quick, 8000 full)
+OUTAGE_SPAN_DAYS = 365.25  # span of the line-of-sight (occultation) statistics, days
+OUTAGE_STEP_S = None  # line-of-sight sampling step for those statistics, s (None: 300 quick, 60 full)
+SWEEP_GRID_DEG = None  # [lat, lon] spacing of the all-pairs site sweep, deg (None: [10, 20] quick, [5, 10] full)
+SWEEP_SAMPLES = None  # 9:2 NRHO samples, uniform in time, for that sweep (None: 3000 quick, 12000 full)
+PERILUNE_HALF_WIDTH_H = 6.0  # hours either side of the 9:2 NRHO's perilune in the station timeline, h
 
 # %%
-# Sizes derived from QUICK: quick mode samples more coarsely, but computes every orbit and every check.
-FD_STEPS = 8 if QUICK else 15  # finite-difference steps in the STM/STT error-versus-step study
-HALO_STEP = 0.03 if QUICK else 0.01  # pseudo-arclength step along the halo family
-DRO_MEMBERS = 13 if QUICK else 51  # members of the DRO family drawn
-SAMPLES = 1500 if QUICK else 8000  # points per orbit for visibility checks
-SWEEP_GRID_DEG = (10.0, 20.0) if QUICK else (5.0, 10.0)  # (latitude, longitude) spacing of the all-pairs site sweep
-SWEEP_SAMPLES = 3000 if QUICK else 12000  # 9:2 NRHO samples, uniform in time, for the sweep (197 s / 47 s apart)
-OUTAGE_SPAN_DAYS = 365.25  # occultation statistics over one year in both modes
-OUTAGE_STEP_S = 300.0 if QUICK else 60.0  # line-of-sight sampling step for those statistics, s
-
-import dataclasses
+fd_steps = FD_STEPS if FD_STEPS is not None else (8 if QUICK else 15)
+halo_step = HALO_STEP if HALO_STEP is not None else (0.03 if QUICK else 0.01)
+dro_members = DRO_MEMBERS if DRO_MEMBERS is not None else (13 if QUICK else 51)
+samples = SAMPLES if SAMPLES is not None else (1500 if QUICK else 8000)
+outage_step_s = OUTAGE_STEP_S if OUTAGE_STEP_S is not None else (300.0 if QUICK else 60.0)
+sweep_grid_deg = tuple(SWEEP_GRID_DEG) if SWEEP_GRID_DEG is not None else ((10.0, 20.0) if QUICK else (5.0, 10.0))
+sweep_samples = SWEEP_SAMPLES if SWEEP_SAMPLES is not None else (3000 if QUICK else 12000)
 
 import numpy as np
 
@@ -54,7 +69,7 @@ from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.cr3bp.dynamics import SYNODIC_MONTH_DAYS
 from cislunar.papers.greaves_scheeres_2021 import reference_orbits as ro
 from cislunar.papers.greaves_scheeres_2021.claims.reference_orbits import CLAIMS as GS
-from cislunar.papers.wolf_jones import reference
+from cislunar.papers.wolf_jones import reference_tables as wjt
 from cislunar.papers.wolf_jones.claims.reference_orbits import CLAIMS as WJ
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
@@ -108,7 +123,7 @@ for k, p in enumerate(L, 1):
 
 # %%
 nrho = orbits.nrho_9_2(em)
-fd = ro.variational_check(em, nrho, FD_STEPS)
+fd = ro.variational_check(em, nrho, fd_steps)
 _ = plotting.save_figure(ro.figure_variational_check(fd), "01_stm_stt_vs_finite_differences", output_dir=out)
 print(f"best agreement: STM {fd.best_stm:.1e}, STT {fd.best_stt:.1e}")
 
@@ -129,12 +144,8 @@ print(f"best agreement: STM {fd.best_stm:.1e}, STT {fd.best_stt:.1e}")
 # printed to nine digits should close to about $10^{-8}$.
 
 # %%
-checks = [reference.verify_table_row(em, row) for row in reference.load_wolf_jones_table()]
-print(f"{'table':>5} {'row':>12} {'printed vy0':>12} {'corrected vy0':>14} {'closure as printed':>19} "
-      f"{'period [d]':>10} {'Jacobi C':>12}")
-for c in checks:
-    print(f"{c.table:>5} {c.label:>12} {c.vy0:12.9f} {c.corrected.x0[4]:14.9f} {c.raw_closure:19.2e} "
-          f"{c.corrected.period_days:10.4f} {c.corrected.jacobi:12.9f}")
+tables = wjt.dro_table_study(em, dro_members)
+print(tables.rows_report())
 
 # %% [markdown]
 # Every row closes to the printed precision **except the observer's initial state** $x_S(t_0)$ (the same in both
@@ -147,43 +158,33 @@ for c in checks:
 # second and third significant digits ("0.529" for "0.556").
 
 # %%
-obs = next(c for c in checks if c.label == "observer_t0")
-others = [c for c in checks if c.label != "observer_t0"]
-targets = [c for c in checks if c.label.startswith("target")]
-print(f"printed observer state: C = {em.jacobi(np.array([obs.x0, 0, 0, 0, obs.vy0, 0])):.6f}; "
-      f"corrected: C = {obs.corrected.jacobi:.6f}; targets only: C in "
-      f"[{min(c.corrected.jacobi for c in targets):.6f}, {max(c.corrected.jacobi for c in targets):.6f}]; "
-      f"all other rows (corrected): C in "
-      f"[{min(c.corrected.jacobi for c in others):.6f}, {max(c.corrected.jacobi for c in others):.6f}]")
-MU_TRIALS = (em.mu, em.mu + 1e-9, em.mu - 1e-9, 0.0121505856, 0.01215058, 0.01215)
-mu_closure = {mu: max(reference.verify_table_row(dataclasses.replace(em, mu=mu), r).raw_closure
-                      for r in reference.load_wolf_jones_table() if r.label != "observer_t0") for mu in MU_TRIALS}
-print(f"largest closure of the printed periodic rows (criterion CLOSURE_TOL = {reference.CLOSURE_TOL:.0e}):")
-for mu, cl in mu_closure.items():
-    print(f"  mu = {mu:.15f} (d mu = {mu - em.mu:+.1e}): {cl:.1e}  "
-          f"{'closes' if cl < reference.CLOSURE_TOL else 'fails'}")
-dros = orbits.dro_family(em, np.linspace(0.95, 0.70, DRO_MEMBERS))
-wj_groups = {}  # Table 2 and Table 4 print the same observer_t0 row: one orbit, both labels
-for c in checks:
-    wj_groups.setdefault((c.x0, c.vy0), []).append(c)
-wj_groups = sorted(wj_groups.values(), key=lambda g: g[0].x0)  # left to right in the zoom panels
-x_moon = em.secondary_position[0]
-wj_cross = np.array([(g[0].x0 - x_moon) * em.length_unit_km for g in wj_groups])  # Moon-centred x0, km
-wj_period = np.array([g[0].corrected.period_days for g in wj_groups])
-print(f"W&J DROs: {len(wj_groups)} distinct orbits, x-axis crossings {wj_cross.min():.0f} to {wj_cross.max():.0f} km "
-      f"from the Moon (spread {np.ptp(wj_cross):.0f} km), periods {wj_period.min():.3f}-{wj_period.max():.3f} d; "
-      f"family drawn: periods {min(o.period_days for o in dros):.1f}-{max(o.period_days for o in dros):.1f} d")
-zoom_x0 = np.linspace(wj_cross.max() + 1500.0, wj_cross.min() - 1500.0, 12) / em.length_unit_km + x_moon
-dros_zoom = orbits.dro_family(em, zoom_x0, seed=wj_groups[-1][0].corrected.x0)
+obs = tables.observer
+print(tables.observer_report())
 
+# %% [markdown]
+# **How tightly do the printed rows pin $\mu$?** Neither paper prints the mass ratio. A row printed to nine digits
+# closes to about $10^{-8}$ only in a system whose $\mu$ is close to the one its authors used: change $\mu$ and the
+# periodic orbit through the printed $x_0$ needs a different $\dot y_0$, so the printed state stops closing. We
+# propagate the six rows that are periodic as printed (all but the observer's start) in systems that differ only in
+# $\mu$ (the adopted value, $\mu \pm$ `MU_STEP`, and three values found in the literature) and keep each trial's
+# largest closure $\max\|x(T) - x_0\|$ (`wjt.mu_closure_study`). Away from the adopted value the closure grows
+# linearly with $|\Delta\mu|$: $\partial x(T)/\partial\mu$ is of order 100 LU for these orbits, so $10^{-9}$ in
+# $\mu$ costs about $2.5\times10^{-7}$, more than the criterion `CLOSURE_TOL` = $10^{-7}$.
 
-def wj_label(c):
-    """Row label; Table 4's labels other than target3_t0 are lost in the paper's text (our inference)."""
-    return f"Table {c.table}: {c.label}" + (" (label inferred)" if c.table == 4 and c.label != "target3_t0" else "")
+# %%
+mu_study = wjt.mu_closure_study(em, wjt.mu_trials(em, MU_STEP))
+print(mu_study.report())
 
+# %% [markdown]
+# **The printed orbits on the family.** Table 2 and Table 4 print the same observer start, so the eight rows are
+# seven distinct orbits (`tables.groups`, each with every label that prints it, sorted by where it crosses the
+# $x$ axis). We continue the planar DRO family with $x_0$ held fixed (natural-parameter continuation) from 0.95 to
+# 0.70 LU, `DRO_MEMBERS` members, and, for the zoom, twelve members across the printed orbits' crossings.
 
-groups = [(g[0].corrected, " = ".join(wj_label(c) for c in g)) for g in wj_groups]
-fig = ro.figure_dro_family(em, dros, dros_zoom, groups, np.array([obs.x0, 0, 0, 0, obs.vy0, 0]))
+# %%
+print(tables.groups_report())
+fig = ro.figure_dro_family(em, tables.family, tables.zoom_family, tables.figure_groups,
+                           np.array([obs.x0, 0, 0, 0, obs.vy0, 0]))
 _ = plotting.save_figure(fig, "01_dro_family_wolf_jones", output_dir=out)
 
 # %% [markdown]
@@ -221,7 +222,7 @@ _ = plotting.save_figure(fig, "01_dro_family_wolf_jones", output_dir=out)
 # family members that fall in the band.
 
 # %%
-halo = ro.halo_family_study(em, HALO_STEP)
+halo = ro.halo_family_study(em, halo_step)
 stable, outer = halo.stable, halo.outer
 print(halo.report())
 _ = plotting.save_figure(ro.figure_halo_stability(em, halo), "01_halo_stability_vs_perilune", output_dir=out)
@@ -280,10 +281,10 @@ _ = plotting.save_figure(ro.figure_nrho_family(em, halo), "01_nrho_family_fig2",
 # default stations do.
 
 # %%
-visibility = ro.observer_visibility(em, {"9:2": nrho, "stable (inner)": stable, "stable (outer)": outer}, SAMPLES,
-                                    OUTAGE_SPAN_DAYS, OUTAGE_STEP_S)
-print(ro.visibility_report(visibility, OUTAGE_SPAN_DAYS, OUTAGE_STEP_S))
-sweep = ro.station_pair_sweep(em, nrho, SWEEP_GRID_DEG, SWEEP_SAMPLES)
+visibility = ro.observer_visibility(em, {"9:2": nrho, "stable (inner)": stable, "stable (outer)": outer}, samples,
+                                    OUTAGE_SPAN_DAYS, outage_step_s)
+print(ro.visibility_report(visibility, OUTAGE_SPAN_DAYS, outage_step_s))
+sweep = ro.station_pair_sweep(em, nrho, sweep_grid_deg, sweep_samples)
 print(sweep.report())
 
 # %% [markdown]
@@ -313,7 +314,8 @@ print(sweep.report())
 # stations leave a short gap (its "all three" value above is below 100%); the outer-band orbit is fully covered.
 
 # %%
-peri = ro.perilune_visibility(em, nrho, visibility["9:2"].best_pair_stations, half_width_h=6.0)
+peri = ro.perilune_visibility(em, nrho, visibility["9:2"].best_pair_stations,
+                             half_width_h=PERILUNE_HALF_WIDTH_H)
 print(peri.report())
 _ = plotting.save_figure(ro.figure_observer_sites(em, halo, peri), "01_observer_sites_fig3", output_dir=out)
 
@@ -351,8 +353,21 @@ _ = plotting.save_figure(ro.figure_observer_sites(em, halo, peri), "01_observer_
 # The STM and STT rows check the variational equations of section 2 and have nothing to compare with in the
 # papers; they are reported as "beyond paper".
 
+# %% [markdown]
+# **The window arithmetic.** Wolf & Jones give the windows as fractions of the observer's DRO period $P$:
+# $[3P/4, 3P/2]$ for test case 1 and $[P, 2P]$ for test case 2, and in days as "between 12 and 23" and "between
+# roughly 17 and 32". With $P$ = 3.725 TU (the corrected observer DRO) each reading of the time unit turns the
+# fractions into days (`wjt.window_study`), and we measure the largest distance of a window end from the text's
+# four day counts. Two facts follow without any unit: $[3P/4, 3P/2]$ has end ratio 2 for every $P$, while
+# $23/12 = 1.92$, so no period fits both ends exactly; and the ends meet 12 and 23 days within the 1-day tolerance
+# only for the range of $P$ printed in the window row's note.
+
 # %%
-TOL, T92 = reference.CLOSURE_TOL, 2 / 9 * SYNODIC_MONTH_DAYS
+windows = wjt.window_study(em, obs.corrected.period, tolerance_days=WJ["window_case1"].criterion.limit)
+print(windows.report())
+
+# %%
+T92 = 2 / 9 * SYNODIC_MONTH_DAYS
 table.add(GS["nrho_period"].judge(nrho.period_days, note="imposed: half period held at (2/9 synodic month)/2, 2/9 x "
                                   f"{SYNODIC_MONTH_DAYS} d = {T92:.6f} d (the resonance defines it)"))
 table.add(GS["nrho_perilune"].judge(nrho.perilune_radius_km, note="public 3200-3300 km (reference notes)"))
@@ -367,70 +382,79 @@ table.add(GS["stable_perilune_period"].judge(stable.perilune_radius_km,
                                              shown=f"{stable.perilune_radius_km:.1f} / {stable.period_days:.4f}"))
 (lo, hi), n_band = halo.band_perilune_km, len(halo.outer_band)
 table.add(GS["outer_band"].judge(lo, shown=f"{lo:.0f}-{hi:.0f} ({n_band} family members)", note="members with "
-                                 f"every Broucke index in [-1, 1]; family step {HALO_STEP} (band edges to that resolution)"))
+                                 f"every Broucke index in [-1, 1]; family step {halo_step} (band edges to that "
+                                 "resolution)"))
 table.add(GS["outer_member"].judge(outer.perilune_radius_km, shown=f"{outer.perilune_radius_km:.0f} / "
                                    f"{outer.period_days:.3f} / {outer.stability_index:.6f}"))
-mu_pinned = mu_closure[em.mu] < TOL and all(cl >= TOL for m, cl in mu_closure.items() if abs(m - em.mu) >= 0.9e-9)
-table.add(WJ["mu"].judge(mu_pinned, shown=f"{em.mu} (max closure {mu_closure[em.mu]:.1e})",
+table.add(WJ["mu"].judge(mu_study.pinned, shown=f"{em.mu} (max closure {mu_study.adopted_closure:.1e})",
           note="not in either paper; value of JPL's three-body database; largest closure per trial d mu: "
-          + ", ".join(f"{m - em.mu:+.1e} -> {mu_closure[m]:.1e}" for m in MU_TRIALS[1:]) + "; CLOSURE_TOL was "
-          "set to 1e-7 with these closures in view: at 1e-6 the rows would pin mu only to about 4e-9"))
+          f"{mu_study.trials_text()}; CLOSURE_TOL was set to 1e-7 with these closures in view: at 1e-6 the rows "
+          "would pin mu only to about 4e-9"))
 table.add(WJ["length_unit"].judge(em.length_unit_km))
 table.add(WJ["time_unit_s"].judge(em.time_unit_s, shown=f"{em.time_unit_s} ({em.time_unit_days:.4f} d)"))
-for c in checks:
+for c in tables.checks:
     table.add(WJ[f"closure_table{c.table}_{c.label}"].judge(
         c.raw_closure, shown=f"{c.raw_closure:.1e}", note=f"T = {c.corrected.period_days:.4f} d, C = "
         f"{c.corrected.jacobi:.8f}" + ("" if c.periodic_as_printed else
                                        f"; corrected vy0 = {c.corrected.x0[4]:.9f} used instead of {c.vy0}")))
-P_tu, TU_LITERAL_DAYS = obs.corrected.period, SYNODIC_MONTH_DAYS / (2 * np.pi)  # W&J's words read literally
-W1_PAPER, W2_PAPER = (12.0, 23.0), (17.0, 32.0)  # "between 12 and 23 days"; "between roughly 17 and 32 days"
-WIN_TOL_D = WJ["window_case1"].criterion.limit  # tolerance on each window end, days (as in notebook 05)
-win = {}
-for unit_name, tu_d in (("standard", em.time_unit_days), ("P_synodic/2pi", TU_LITERAL_DAYS)):
-    P = P_tu * tu_d
-    w1, w2 = (0.75 * P, 1.5 * P), (P, 2 * P)
-    win[unit_name] = (w1, w2, max(abs(a - b) for a, b in zip(w1 + w2, W1_PAPER + W2_PAPER)))
-    print(f"time unit {unit_name:14s} = {tu_d:.4f} d: P = {P:.2f} d; case 1 window {w1[0]:.1f}-{w1[1]:.1f} d, "
-          f"case 2 window {w2[0]:.1f}-{w2[1]:.1f} d; largest miss of the paper's 12, 23, 17, 32 d: "
-          f"{win[unit_name][2]:.1f} d")
-(w1, w2, _), (l1, l2, miss_lit) = win["standard"], win["P_synodic/2pi"]
-ratio_paper = W1_PAPER[1] / W1_PAPER[0]
-print(f"ratio of the window ends: paper 23/12 = {ratio_paper:.3f}; [3P/4, 3P/2] gives 2 for any P and time unit")
-miss_start, miss_end = abs(w1[0] - W1_PAPER[0]), abs(w1[1] - W1_PAPER[1])
-P_fit = (max((W1_PAPER[0] - WIN_TOL_D) * 4 / 3, (W1_PAPER[1] - WIN_TOL_D) * 2 / 3),  # periods for which [3P/4,
-         min((W1_PAPER[0] + WIN_TOL_D) * 4 / 3, (W1_PAPER[1] + WIN_TOL_D) * 2 / 3))  # 3P/2] meets both ends
+(w1, w2), (l1, l2) = windows.windows["standard"], windows.windows["P_synodic/2pi"]
+(miss_start, miss_end), (p_lo, p_hi), tol_d = windows.case1_misses, windows.fitting_periods, windows.tolerance_days
 table.add(WJ["window_case1"].judge(
     max(miss_start, miss_end), shown=f"{w1[0]:.1f} to {w1[1]:.1f}",
-    reason=f"the window end misses by {max(miss_start, miss_end):.1f} d (> {WIN_TOL_D:g} d)",
-    note=f"window [3P/4, 3P/2], P = {P_tu:.3f} TU = {P_tu * em.time_unit_days:.2f} d (corrected observer DRO); "
+    reason=f"the window end misses by {max(miss_start, miss_end):.1f} d (> {tol_d:g} d)",
+    note=f"window [3P/4, 3P/2], P = {windows.period_tu:.3f} TU = {windows.period_days:.2f} d (corrected observer DRO); "
     f"misses {miss_start:.1f} d (start) and {miss_end:.1f} d (end); [3P/4, 3P/2] fits 12 and 23 d within "
-    f"{WIN_TOL_D:g} d only for P between {P_fit[0]:.1f} and {P_fit[1]:.1f} d, shorter than this DRO's "
-    f"{P_tu * em.time_unit_days:.2f} d (23/12 = {ratio_paper:.2f} against 2: no P fits both exactly)"))
+    f"{tol_d:g} d only for P between {p_lo:.1f} and {p_hi:.1f} d, shorter than this DRO's "
+    f"{windows.period_days:.2f} d (23/12 = {23 / 12:.2f} against 2: no P fits both exactly)"))
 table.add(WJ["time_unit_reading"].judge(
-    bool(win["standard"][2] < miss_lit), shown=f"{em.time_unit_days:.4f} d (literal reading {TU_LITERAL_DAYS:.4f} d)",
-    note=f"largest miss of the windows' day counts: standard unit {win['standard'][2]:.1f} d (case 1 "
-    f"{w1[0]:.1f}-{w1[1]:.1f}, case 2 {w2[0]:.1f}-{w2[1]:.1f}), literal P_synodic/2pi {miss_lit:.1f} d (case 1 "
-    f"{l1[0]:.1f}-{l1[1]:.1f}, case 2 {l2[0]:.1f}-{l2[1]:.1f}); the standard unit is used"))
+    windows.standard_fits_better, shown=f"{em.time_unit_days:.4f} d (literal reading "
+    f"{windows.units_days['P_synodic/2pi']:.4f} d)",
+    note=f"largest miss of the windows' day counts: standard unit {windows.miss('standard'):.1f} d (case 1 "
+    f"{w1[0]:.1f}-{w1[1]:.1f}, case 2 {w2[0]:.1f}-{w2[1]:.1f}), literal P_synodic/2pi "
+    f"{windows.miss('P_synodic/2pi'):.1f} d (case 1 {l1[0]:.1f}-{l1[1]:.1f}, case 2 {l2[0]:.1f}-{l2[1]:.1f}); the "
+    "standard unit is used"))
 table.add(GS["stm"].judge(fd.best_stm, shown=f"{fd.best_stm:.1e}", note="relative, best step"),
           GS["stt"].judge(fd.best_stt, shown=f"{fd.best_stt:.1e}", note="relative, best step"))
 los = visibility["9:2"].l2
 table.add(GS["l2_line_of_sight"].judge(
     los.count, shown=f"{100 * los.clear_fraction:.2f}% clear, {los.count} outages", note=f"no occulted sample among "
-    f"{ro.line_of_sight_samples(OUTAGE_SPAN_DAYS, OUTAGE_STEP_S)} over {OUTAGE_SPAN_DAYS} d ({OUTAGE_STEP_S:g}-s "
+    f"{ro.line_of_sight_samples(OUTAGE_SPAN_DAYS, outage_step_s)} over {OUTAGE_SPAN_DAYS} d ({outage_step_s:g}-s "
     "steps); observer at rest at L2 (choice)"))
-for key, (name, v) in zip(("9_2", "inner", "outer"), visibility.items()):
+for key, v in zip(("9_2", "inner", "outer"), visibility.values()):
     st, crit = v.dro, v.dro_criteria
     table.add(GS[f"dro_outages_{key}"].judge(
         all(crit.values()), reason="not " + ", ".join(k for k, ok in crit.items() if not ok),
         shown=f"{st.count} outages in {OUTAGE_SPAN_DAYS} d, {100 * (1 - st.clear_fraction):.2f}% of time, longest "
         f"{st.longest_h:.2f} h, one per {st.mean_interval_days:.1f} d", note=f"target period {v.period_days:.2f} d; "
-        f"{OUTAGE_SPAN_DAYS} d at {OUTAGE_STEP_S:g}-s steps, DRO through x0 = 0.778 LU (choice)"))
+        f"{OUTAGE_SPAN_DAYS} d at {outage_step_s:g}-s steps, DRO through x0 = 0.778 LU (choice)"))
 v, fine = visibility["9:2"], sweep.fine
 table.add(GS["three_stations"].judge(
     bool(v.all3 == 1 and sweep.no_pair_suffices), shown=f"3: default three cover {100 * v.all3:.1f}%; best of "
     f"{sweep.n_pairs} grid pairs {100 * sweep.coarse.best_fraction:.2f}%", note=f"{sweep.coarse.n_samples} samples "
-    f"(uniform in time); {len(sweep.grid_sites)} sites on a {SWEEP_GRID_DEG[0]:g} deg x {SWEEP_GRID_DEG[1]:g} deg "
+    f"(uniform in time); {len(sweep.grid_sites)} sites on a {sweep_grid_deg[0]:g} deg x {sweep_grid_deg[1]:g} deg "
     f"grid, 0 deg mask; {sweep.coarse.n_full_pairs} full pairs; best pair {sweep.best_pair_names}; refined at 1 deg "
     f"around it: {fine.n_full_pairs} full pairs, best {100 * fine.best_fraction:.2f}%; default stations: south "
     "pole, 45N 90E, 45N 90W (choice)"))
 table.display()
+
+# %% [markdown]
+# ## Exercises
+#
+# Each exercise asks you to change one entry of the parameters cell, to predict what will happen before running,
+# and then to check. The worked solutions are functions of `cislunar.papers.greaves_scheeres_2021.exercises`, run
+# at small sizes (a few seconds each); each returns the numbers that answer the exercise and an `answer` paragraph.
+#
+# 1. **A finer walk along the halo family.** Halve `HALO_STEP` (0.03 in quick mode, so 0.015). Predict how many
+#    family members the continuation returns, how many fall in the outer stable band, how the band's printed edges
+#    move, and whether the stable NRHOs of Section 4 (and the closing-table rows about them) change. Worked
+#    solution: `exercises.exercise_01_halo_step`.
+# 2. **Could a finer site grid find a pair that suffices?** Set `SWEEP_GRID_DEG = [5, 10]` in quick mode (the full
+#    run's grid). The coarser grid's sites are all on the finer one: what does that guarantee about the best pair's
+#    coverage, and will the "surface stations needed" row change? Worked solution:
+#    `exercises.exercise_01_site_grid` (a 20° x 40° and a 10° x 20° grid).
+# 3. **How tightly do the tables pin $\mu$?** Set `MU_STEP = 1e-10`, then `MU_STEP = 1e-8`. Using the linear growth
+#    of the closure with $|\Delta\mu|$ (Section 3: about $2.5\times10^{-7}$ per $10^{-9}$ above the $10^{-8}$
+#    floor of nine printed digits), predict the closures printed for $\mu \pm$ `MU_STEP` and whether they pass
+#    `CLOSURE_TOL`; then check the printout of Section 3. (No separate worked solution: the notebook's own
+#    `wjt.mu_closure_study` is the check, and `tests/papers/wolf_jones/test_reference_tables.py` tests the linear
+#    growth.)

@@ -24,27 +24,51 @@
 # The paper's Table 3 (measurement noise) and Table 4 (final covariance levels) are missing from its text; what we
 # use instead is stated where it is used, and the closing table says where our results differ.
 
+# %% [markdown]
+# **How to use this chapter.** The next cell (tagged `parameters`) holds every setting a reader might change: the
+# cadences and Monte Carlo sizes, the angle noise and the OCBE control weight, the noise levels of Section 4 and the
+# grid of the regime map of Section 5b. Leave an entry at `None` and the notebook picks it (the values in brackets
+# in the comments: fewer cadences and runs when `QUICK = True`, then the full run); give a value (edit the cell, or
+# pass `-p NAME=VALUE` to the runner) and it is used as given in both modes. The Monte Carlo runs are spread over
+# `WORKERS` local processes or a Dask cluster (`SCHEDULER`); run $i$ of a set always draws from child $i$ of the
+# set's seed, so the numbers do not depend on where they run.
+
 # %% tags=["parameters"]
 QUICK = False
-SEED = 0
+SEED = 0  # root seed of every Monte Carlo set and of the typical run
 OUTPUT_DIR = ""
+CADENCES_H = None  # measurement cadences, hours (None: [2, 12] quick; [1/60, 10/60, 1, 2, 6, 12] full)
+N_RUNS = None  # Monte Carlo runs per (orbit, measurement type, cadence) (None: 2 quick, 20 full)
+N_RUNS_ONE_MINUTE = None  # runs at cadences under 0.1 h; 9450 updates per run at 1 min (None: 2 quick, 4 full)
+SIGMA_ANGLE_URAD = 10.0  # 1-sigma angle noise of Sections 2-5, micro-rad (rates: sqrt(2) x this per s, Eq. 13)
+CONTROL_WEIGHT_KM2_S3 = 1e-20  # OCBE control weight q per axis (acceleration power spectral density), km^2/s^3
+TYPICAL_CADENCE_H = 2.0  # cadence of the typical run of Section 2 (Fig. 5), hours
+NOISE_LEVELS_URAD = [100.0, 1000.0]  # larger angle noises tried on the 9:2 NRHO at 12 h (Section 4), micro-rad
+N_RUNS_FIVE = None  # runs of the five-observer, angles-only experiment (None: 2 quick, 20 full)
+HANDOFF_MAP = None  # regime map: hand-off 3-sigma scales (x 10 km, 10 cm/s) (None: [1, 300] quick; 0.1-1000 full)
+SIGMA_MAP = None  # regime map: angle noises, rad (None: [10e-6] quick; [1e-6, 10e-6, 100e-6] full)
+CADENCE_MAP = None  # regime map: cadences, hours (None: [12] quick; [2, 12] full)
+N_MAP = None  # runs per regime-map cell (None: 2 quick, 10 full)
+N_DRAWS_EXAMPLE = 10  # fresh draws per Fig. 4 analogue (the clearest divergence is shown)
+WORKERS = None  # local processes for the Monte Carlo, 1 = serial (None: 1 quick, 2 full)
+SCHEDULER = ""  # address of a Dask scheduler to run on, e.g. "tcp://10.0.0.5:8786" ("": none; WORKERS applies)
 
 # %%
-# Sizes derived from QUICK: fewer cadences and Monte Carlo runs in quick mode, the same experiments.
-CADENCES_H = [2.0, 12.0] if QUICK else [1 / 60, 10 / 60, 1.0, 2.0, 6.0, 12.0]
-N_RUNS = 2 if QUICK else 20  # Monte Carlo runs per (orbit, measurement type, cadence)
-N_RUNS_ONE_MINUTE = 2 if QUICK else 4  # the 1-minute cadence has 9450 updates per run
-N_RUNS_FIVE = 2 if QUICK else 20  # runs of the five-observer, angles-only experiment
-WORKERS = 1 if QUICK else 2  # processes for the Monte Carlo (a Dask client works the same way)
-# regime map (Section 5b), on all three orbits: hand-off 3-sigma scale (x 10 km, 10 cm/s), angle noise, cadence
-HANDOFF_MAP = [1.0, 300.0] if QUICK else [0.1, 1.0, 10.0, 100.0, 300.0, 1000.0]  # 1 km to 10,000 km (3 sigma)
-SIGMA_MAP = [10e-6] if QUICK else [1e-6, 10e-6, 100e-6]
-CADENCE_MAP = [12.0] if QUICK else [2.0, 12.0]
-N_MAP = 2 if QUICK else 10  # runs per regime-map cell
+cadences_full = [1 / 60, 10 / 60, 1.0, 2.0, 6.0, 12.0]  # 1 min, 10 min, 1 h, 2 h, 6 h, 12 h
+cadences_h = CADENCES_H if CADENCES_H is not None else ([2.0, 12.0] if QUICK else cadences_full)
+n_runs = N_RUNS if N_RUNS is not None else (2 if QUICK else 20)
+n_runs_one_minute = N_RUNS_ONE_MINUTE if N_RUNS_ONE_MINUTE is not None else (2 if QUICK else 4)
+n_runs_five = N_RUNS_FIVE if N_RUNS_FIVE is not None else (2 if QUICK else 20)
+handoff_full = [0.1, 1.0, 10.0, 100.0, 300.0, 1000.0]  # 1 km to 10,000 km (3 sigma)
+handoff_map = HANDOFF_MAP if HANDOFF_MAP is not None else ([1.0, 300.0] if QUICK else handoff_full)
+sigma_map = SIGMA_MAP if SIGMA_MAP is not None else ([10e-6] if QUICK else [1e-6, 10e-6, 100e-6])
+cadence_map = CADENCE_MAP if CADENCE_MAP is not None else ([12.0] if QUICK else [2.0, 12.0])
+n_runs_map = N_MAP if N_MAP is not None else (2 if QUICK else 10)
+workers = WORKERS if WORKERS is not None else (1 if QUICK else 2)
+sigma_angle = SIGMA_ANGLE_URAD / 1e6  # rad (division, so that 10.0 gives exactly 10e-6)
 
+import contextlib
 import time
-from concurrent.futures import ProcessPoolExecutor
-from dataclasses import replace
 
 import numpy as np
 
@@ -55,10 +79,14 @@ from cislunar.papers.greaves_scheeres_2021 import tracking
 from cislunar.papers.greaves_scheeres_2021.claims.observation_strategy import CLAIMS
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
+from cislunar.utils.executors import open_executor
 
 plotting.use_style()
 out = OUTPUT_DIR or None
-executor = ProcessPoolExecutor(WORKERS) if WORKERS > 1 else None
+# One executor for the whole chapter, opened here and closed before the closing table: its worker processes
+# compile the integrators once and keep them for every Monte Carlo set below.
+executors = contextlib.ExitStack()
+executor = executors.enter_context(open_executor(workers, SCHEDULER))
 table = ComparisonTable("09 OCBE observation strategy (Greaves & Scheeres 2021 §Measurements, §State Estimation, "
                         "§Observation Strategy)")
 nrho, stable, outer = orbits.nrho_9_2(em), orbits.stable_nrho(em), orbits.stable_nrho_outer(em)
@@ -96,7 +124,7 @@ for name, o in ORBITS.items():
 # The Jacobians are analytic (`cislunar.sensing.measurements`, tested against finite differences).
 
 # %%
-demo = obs.measurement_demo(em, nrho)
+demo = obs.measurement_demo(em, nrho, sigma_angle_rad=sigma_angle)
 print(demo.report())
 _ = plotting.save_figure(obs.figure_measurements(demo), "09_measurements_from_l2", output_dir=out)
 
@@ -133,9 +161,9 @@ _ = plotting.save_figure(obs.figure_measurements(demo), "09_measurements_from_l2
 # $\begin{bmatrix} S_q & 0 & 0\\ -S_x\Phi_{xx}^{-1} & S_x\Phi_{xx}^{-1} & 0\end{bmatrix}$, the measurement update
 # (Eqs. 24-28) triangularises $\begin{bmatrix}S_x & b_x\\ S_y^{-1}H & S_y^{-1}\delta y\end{bmatrix}$, and a
 # single-step smoother (Eqs. 29-30) gives the costate $\mathbf p_{n|n+1} = -P_{n|n}^{-1}(\mathbf x_{n|n+1}-
-# \mathbf x_{n|n})$ (Eq. 31) and the control estimate (Eq. 32). `cislunar.estimation.ocbe.ocbe_filter_smoother` implements
-# exactly this; its tests show that it equals a covariance-form EKF whose $Q$ is computed independently (Lyapunov
-# equation), that the full SRI smoother equals the Rauch-Tung-Striebel smoother, and that
+# \mathbf x_{n|n})$ (Eq. 31) and the control estimate (Eq. 32). `cislunar.estimation.ocbe.ocbe_filter_smoother`
+# implements exactly this; its tests show that it equals a covariance-form EKF whose $Q$ is computed independently
+# (Lyapunov equation), that the full SRI smoother equals the Rauch-Tung-Striebel smoother, and that
 # $Q = -\Phi_{xp}\Phi_{xx}^\top$ equals the exact discretisation of white-noise acceleration of density
 # $\tilde Q$.
 #
@@ -145,8 +173,9 @@ _ = plotting.save_figure(obs.figure_measurements(demo), "09_measurements_from_l2
 # tracks start at apoapsis, as in the paper's observation-strategy runs.
 
 # %%
-Q_QUIET = 1e-20 * em.time_unit_s**3 / em.length_unit_km**2  # km^2/s^3 -> LU^2/TU^3
-typical = obs.typical_run(em, nrho, 2.0, Q_QUIET, np.random.default_rng(SEED))
+Q_QUIET = CONTROL_WEIGHT_KM2_S3 * em.time_unit_s**3 / em.length_unit_km**2  # km^2/s^3 -> LU^2/TU^3
+typical = obs.typical_run(em, nrho, TYPICAL_CADENCE_H, Q_QUIET, np.random.default_rng(SEED),
+                          sigma_angle_rad=sigma_angle)
 _ = plotting.save_figure(obs.figure_typical_run(typical), "09_typical_run_fig5", output_dir=out)
 print(typical.report())
 
@@ -164,14 +193,17 @@ print(typical.report())
 # normalised estimation error squared, $\epsilon_n = \mathbf e_n^\top P_n^{-1}\mathbf e_n$, is $\chi^2_6$
 # distributed: mean 6, and above the 99.9% quantile (22.5) at 0.1% of epochs. We call a run **diverged** when more
 # than 5% of its epochs exceed that quantile, or when the filter fails numerically. Each Monte Carlo run draws its
-# own measurement noise and hand-off error (`tracking.filter_trial`); runs are spread over processes with a
-# `concurrent.futures` executor.
+# own measurement noise and hand-off error (`tracking.filter_trial`), from child $i$ of its set's seed, so a run's
+# result does not depend on where it runs; the runs go to the executor opened at the top (`WORKERS` processes, or
+# the Dask cluster at `SCHEDULER`). The helper below fixes what every set of this chapter shares (the system, the
+# control weight, the seed, the sizes and the executor) and leaves the measurement type, the noise, the cadences
+# and the orbits to each call.
 
 # %%
-def study(rates, sigma=tracking.DEFAULT_SIGMA_ANGLE_RAD, cadences=CADENCES_H, orbits_=ORBITS, **kw):
-    """The Monte Carlo of this chapter over cadences and orbits (fixed sizes, seed and executor)."""
+def study(rates, sigma=sigma_angle, cadences=cadences_h, orbits_=ORBITS, **kw):
+    """The Monte Carlo of this chapter over cadences and orbits (the sizes, seed and executor of the parameters)."""
     return obs.strategy_study(em, orbits_, cadences, Q_QUIET, rates=rates, sigma_angle_rad=sigma, seed=SEED,
-                              n_runs=kw.pop("n_runs", N_RUNS), n_runs_one_minute=N_RUNS_ONE_MINUTE,
+                              n_runs=kw.pop("n_runs", n_runs), n_runs_one_minute=n_runs_one_minute,
                               executor=executor, **kw)
 
 # %% [markdown]
@@ -179,7 +211,7 @@ def study(rates, sigma=tracking.DEFAULT_SIGMA_ANGLE_RAD, cadences=CADENCES_H, or
 
 # %%
 angles_only = study(rates=False)
-print(angles_only.report("angles only, L2 observer, 10 urad"))
+print(angles_only.report(f"angles only, L2 observer, {SIGMA_ANGLE_URAD:g} urad"))
 
 # %%
 cells = angles_only.diverged_cells()
@@ -195,13 +227,15 @@ print(f"angles only: most runs diverged in {len(cells)} of {len(angles_only.rows
 
 # %%
 noisier = {sig: study(rates=False, sigma=sig, cadences=[12.0], orbits_={"9:2 NRHO": nrho}).rows[0]
-           for sig in (100e-6, 1000e-6)}
+           for sig in (n / 1e6 for n in NOISE_LEVELS_URAD)}
 for sig, row in noisier.items():
     print(f"angles only, 12 h, sigma = {sig * 1e6:g} urad: diverged {100 * row[2]:.0f}%, median NEES {row[3]:.2f}, "
           f"final 3-sigma position {row[4]:.2f} km")
-row_five = study(rates=False, observers="all", sigma=1e-6, handoff_scale=0.1, cadences=[1.0],
-                 orbits_={"9:2 NRHO": nrho}, n_runs=N_RUNS_FIVE).rows[0]
-print(f"five observers, angles only, hourly, 1 urad, hand-off x0.1: diverged {100 * row_five[2]:.0f}%, "
+sigma_five = SIGMA_ANGLE_URAD / 10 / 1e6  # rad: a tenth of the angle noise above, as in Fig. 4
+row_five = study(rates=False, observers="all", sigma=sigma_five, handoff_scale=0.1, cadences=[1.0],
+                 orbits_={"9:2 NRHO": nrho}, n_runs=n_runs_five).rows[0]
+print(f"five observers, angles only, hourly, {sigma_five * 1e6:g} urad, hand-off x0.1: diverged "
+      f"{100 * row_five[2]:.0f}%, "
       f"median NEES {row_five[3]:.2f}, final 3-sigma position {row_five[4] * 1e3:.1f} m")
 
 # %% [markdown]
@@ -215,7 +249,8 @@ print(f"five observers, angles only, hourly, 1 urad, hand-off x0.1: diverged {10
 
 # %%
 with_rates = study(rates=True)
-print(with_rates.report("angles and rates, L2 observer, 10 urad and 14.1 urad/s"))
+print(with_rates.report(f"angles and rates, L2 observer, {SIGMA_ANGLE_URAD:g} urad and "
+                        f"{np.sqrt(2) * SIGMA_ANGLE_URAD:.1f} urad/s"))
 fig = obs.figure_final_uncertainty(with_rates, angles_only, ORBITS)
 _ = plotting.save_figure(fig, "09_final_uncertainty_vs_cadence_table4", output_dir=out)
 ratio = [ra[4] / an[4] for ra, an in zip(with_rates.rows, angles_only.rows)]
@@ -241,7 +276,7 @@ for label, cells_ in flagged.items():
           ", ".join(f"{n} {c:g} h ({100 * d:.0f}%)" for n, c, d in cells_) or "none")
 
 # %%
-long_gap = [c for c in CADENCES_H if c >= 6.0]
+long_gap = [c for c in cadences_h if c >= 6.0]
 print("orbits with a cell above 10 % inconsistent runs: "
       + "; ".join(f"{k}: {', '.join(sorted({n for n, _, _ in v})) or 'none'}" for k, v in flagged.items()))
 print(f"at the long cadences ({', '.join(f'{c:g} h' for c in long_gap)}), inconsistent runs (angles + rates) "
@@ -286,16 +321,16 @@ sc_map = tracking.make_scenario(em, nrho, 2.0, start="apoapsis", rates=True)
 _, P0_map = tracking.initial_estimate(em, sc_map.x_start, np.random.default_rng(0))
 _, _, H_map = sc_map.model.evaluate(sc_map.observers[0], sc_map.x_start)
 for mname, base in RATE_MODELS.items():
-    R_map = tracking.angles_rates_covariance(em, tracking.DEFAULT_SIGMA_ANGLE_RAD, base)
+    R_map = tracking.angles_rates_covariance(em, sigma_angle, base)
     spread = np.sqrt(np.diag(H_map[0] @ P0_map @ H_map[0].T) / np.diag(R_map))
     print(f"{mname:>28}: state-driven spread / noise of the rates {spread[2]:.2g}, {spread[3]:.2g} "
           f"(angles {spread[0]:.2g}, {spread[1]:.2g})")
 
 # %%
 t_map = time.perf_counter()
-regime = obs.regime_map(em, ORBITS, CADENCE_MAP, SIGMA_MAP, HANDOFF_MAP, RATE_MODELS, Q_QUIET, n_runs=N_MAP,
+regime = obs.regime_map(em, ORBITS, cadence_map, sigma_map, handoff_map, RATE_MODELS, Q_QUIET, n_runs=n_runs_map,
                         seed=SEED, executor=executor)
-print(f"regime map: {len(regime.cells) * N_MAP} runs in {time.perf_counter() - t_map:.0f} s")
+print(f"regime map: {len(regime.cells) * n_runs_map} runs in {time.perf_counter() - t_map:.0f} s")
 print(regime.table_report())
 
 # %%
@@ -317,7 +352,7 @@ print(regime.analysis_report())
 cell_92, cell_paper = regime.divergence_cells()
 for cell, name, what in ((cell_92, "09_fig4_typical_divergence", "9:2 NRHO divergence closest to the paper's set-up"),
                          (cell_paper, "09_fig4_divergence_at_papers_handoff", "Divergence at the paper's hand-off")):
-    example = obs.divergence_example(em, ORBITS[cell[0]], regime, cell, Q_QUIET, seed=SEED)
+    example = obs.divergence_example(em, ORBITS[cell[0]], regime, cell, Q_QUIET, seed=SEED, n_draws=N_DRAWS_EXAMPLE)
     if example.result is not None:
         _ = plotting.save_figure(obs.figure_divergence(example, what), name, output_dir=out)
     print(example.report(what))
@@ -374,7 +409,7 @@ for cell, name, what in ((cell_92, "09_fig4_typical_divergence", "9:2 NRHO diver
 
 # %%
 cand = obs.compare_stable_candidates(with_rates, "9:2 NRHO", ("stable NRHO (inner band)", "stable NRHO (outer band)"),
-                                     CADENCES_H)
+                                     cadences_h)
 print(cand.report())
 
 # %% [markdown]
@@ -407,27 +442,26 @@ print(cand.report())
 # The Table 4 rows have no paper value (the table is missing from the text) and only record our medians.
 
 # %%
-if executor is not None:
-    executor.shutdown()
-span = f"{obs.cadence_label(min(CADENCES_H))}-{obs.cadence_label(max(CADENCES_H))}"
+span = f"{obs.cadence_label(min(cadences_h))}-{obs.cadence_label(max(cadences_h))}"
 flag_a, flag_r = flagged["angles only"], flagged["angles + rates"]
 n_cells = len(angles_only.rows)
-table.add(replace(CLAIMS["angles_only_l2"], quantity=CLAIMS["angles_only_l2"].quantity.format(span=span)).judge(
+table.add(obs.filled(CLAIMS["angles_only_l2"], span=span).judge(
     len(cells) == n_cells, reason=("in no (orbit, cadence) cell did most angles-only runs diverge" if not cells else
                                    "most runs diverged only in some angles-only cells"),
     shown=f"most runs diverged in {len(cells)} of {n_cells} cells; cells above 10% inconsistent runs: "
     + ("; ".join(f"{n} {c:g} h: {100 * d:.0f}%" for n, c, d in flag_a) or "none"),
-    note="same 10% flag as the angles + rates row; 10 urad angles (Table 3 missing); other noise levels, cadences "
-    "and hand-offs in Section 4 and the regime map (Section 5b)"))
+    note=f"same 10% flag as the angles + rates row; {SIGMA_ANGLE_URAD:g} urad angles (Table 3 missing); other noise "
+    "levels, cadences and hand-offs in Section 4 and the regime map (Section 5b)"))
 for sig, row in noisier.items():
-    table.add(CLAIMS[f"angles_only_noise_{sig * 1e6:g}"].judge(bool(row[2] > 0.5), shown=f"{100 * row[2]:.0f}% diverged",
-                                                               note="noise level varied"))
+    table.add(obs.filled(CLAIMS["angles_only_noise"], noise=f"{sig * 1e6:g}").judge(
+        bool(row[2] > 0.5), shown=f"{100 * row[2]:.0f}% diverged", note="noise level varied"))
 table.add(CLAIMS["five_observers"].judge(bool(row_five[2] > 0.5), shown=f"{100 * row_five[2]:.0f}% diverged, NEES "
-                                         f"{row_five[3]:.1f}", note="1 urad, hand-off 3 sigma 1 km"))
+                                         f"{row_five[3]:.1f}", note=f"{sigma_five * 1e6:g} urad, hand-off 3 sigma "
+                                         "1 km"))
 flagged_orbits_rates = sorted({n for n, _, _ in flag_r})
 n_runs_rates = sum(len(v) for v in with_rates.runs.values())
 frac_rates = np.mean([r.diverged for v in with_rates.runs.values() for r in v])
-table.add(replace(CLAIMS["angles_rates_l2"], quantity=CLAIMS["angles_rates_l2"].quantity.format(span=span)).judge(
+table.add(obs.filled(CLAIMS["angles_rates_l2"], span=span).judge(
     not flag_r, shown=f"{100 * frac_rates:.1f}% of {n_runs_rates} runs inconsistent",
     reason=("many inconsistent runs only on the inner-band stable NRHO, the candidate judged unlike the paper's "
             "orbit ('Which stable NRHO, by evidence'); " + " and ".join(n for n in ORBITS if n not in
@@ -443,7 +477,7 @@ table.add(CLAIMS["typical_run"].judge(
     note="one run (Section 3)"))
 r92, rst, rso = (with_rates.by_cadence(n) for n in ORBITS)
 for cad in sorted(r92):
-    table.add(CLAIMS[f"table4_{obs.cadence_label(cad)}"].judge(
+    table.add(obs.filled(CLAIMS["table4"], cadence=obs.cadence_label(cad)).judge(
         r92[cad][4], shown=f"9:2 {r92[cad][4]:.3g} km / {r92[cad][5]:.3g} m/s; stable inner band {rst[cad][4]:.3g} "
         f"km / {rst[cad][5]:.3g} m/s; stable outer band {rso[cad][4]:.3g} km / {rso[cad][5]:.3g} m/s",
         note="median over runs; angles + rates from L2"))
@@ -456,19 +490,19 @@ table.add(CLAIMS["regime_contrast"].judge(
             + (" or with informative (dt = 1 TU) rates" if len(regime.model_names) > 2 else "")
             if sum(n_contrast.values()) == 0 else "no cell shows the contrast with the paper's 1-s rates"
             if n_contrast[regime.rates_paper] == 0 else "the contrast holds only in part of the map"),
-    note=f"map over hand-off {10 * min(HANDOFF_MAP):g}-{10 * max(HANDOFF_MAP):g} km, noise "
-    f"{'/'.join(f'{sg * 1e6:g}' for sg in SIGMA_MAP)} urad, cadence {'/'.join(f'{c:g}' for c in CADENCE_MAP)} h, "
-    f"all three orbits; {N_MAP} runs per cell; the dt = 1 TU rate reading is beyond the paper"))
+    note=f"map over hand-off {10 * min(handoff_map):g}-{10 * max(handoff_map):g} km, noise "
+    f"{'/'.join(f'{sg * 1e6:g}' for sg in sigma_map)} urad, cadence {'/'.join(f'{c:g}' for c in cadence_map)} h, "
+    f"all three orbits; {n_runs_map} runs per cell; the dt = 1 TU rate reading is beyond the paper"))
 for key, o in zip(("9_2", "inner", "outer"), ORBITS):
     at_paper, ons = regime.at_paper_handoff(o), regime.onset_km(o)
     table.add(CLAIMS[f"handoff_{key}"].judge(
         bool(min(at_paper) > 0.5), shown=(f"from {ons:g} km" if ons is not None else
-                                          f"none up to {10 * max(HANDOFF_MAP):g} km")
+                                          f"none up to {10 * max(handoff_map):g} km")
         + f"; at 10 km {obs.pct_span(at_paper)} of runs diverge",
         reason="consistent at the stated hand-off" if max(at_paper) <= 0.5 else
         "at 10 km most runs diverge only in some (noise, cadence) cells",
-        note=f"smallest hand-off over noise {'/'.join(f'{sg * 1e6:g}' for sg in SIGMA_MAP)} urad and cadence "
-        f"{'/'.join(f'{c:g}' for c in CADENCE_MAP)} h"))
+        note=f"smallest hand-off over noise {'/'.join(f'{sg * 1e6:g}' for sg in sigma_map)} urad and cadence "
+        f"{'/'.join(f'{c:g}' for c in cadence_map)} h"))
 b_in, b_out = cand.better["stable NRHO (inner band)"], cand.better["stable NRHO (outer band)"]
 ratio_outer = cand.ratio["stable NRHO (outer band)"]
 table.add(CLAIMS["outer_better"].judge(b_out, shown=f"smaller final sigma at {100 * b_out:.0f}% of cadences (ratio "
@@ -476,10 +510,30 @@ table.add(CLAIMS["outer_better"].judge(b_out, shown=f"smaller final sigma at {10
                                        f"{outer.perilune_radius_km:.0f} km)"))
 for key, name in (("inner", "stable NRHO (inner band)"), ("outer", "stable NRHO (outer band)")):
     claim = CLAIMS[f"{key}_consistent_long"]
-    table.add(replace(claim, quantity=claim.quantity.format(cadences="-".join(f"{c:g}" for c in long_gap))).judge(
+    table.add(obs.filled(claim, cadences="-".join(f"{c:g}" for c in long_gap)).judge(
         cand.inconsistent[name], shown=f"{100 * cand.inconsistent[name]:.0f} % of runs inconsistent (9:2 NRHO: "
         f"{100 * cand.inconsistent['9:2 NRHO']:.0f} %)", note="criterion fixed in advance (notebook 09's flag)"))
 table.add(CLAIMS["inner_better"].judge(b_in, shown=f"smaller final sigma at {100 * b_in:.0f}% of cadences",
                                        note="final epoch at apoapsis after one period; the paper's Table 4 values "
                                        "are not available to compare"))
+executors.close()  # shuts the worker processes down
 table.display()
+
+# %% [markdown]
+# ## Exercises
+#
+# Each exercise asks you to change one entry of the parameters cell, to predict what will happen before running,
+# and then to check. The worked solutions are functions of `cislunar.papers.greaves_scheeres_2021.exercises`, run
+# at small sizes (a few seconds each); each returns the numbers that answer the exercise and an `answer` paragraph.
+#
+# 1. **Noisier angles.** Set `SIGMA_ANGLE_URAD = 100` (ten times the default). Before running, use the information
+#    form of the measurement update (information adds as $H^\top R^{-1} H$, and $R \propto \sigma^2$) to predict
+#    the factor by which the Table 4 rows' final 3-sigma positions grow, and whether the angles-only runs of
+#    Section 4 start to diverge. Worked solution: `exercises.exercise_09_angle_noise`.
+# 2. **Denser tracking.** Add a 1-hour cadence to quick mode, `CADENCES_H = [1.0, 2.0, 12.0]`. If every measurement
+#    were independent information about a fixed state, the standard deviation would fall as the square root of
+#    their number: predict the 1-h row's final 3-sigma position from the 12-h one, then compare; is the gain more
+#    or less than the square root, and why? Worked solution: `exercises.exercise_09_cadence`.
+# 3. **A wider hand-off.** Set `HANDOFF_MAP = [1.0, 30.0, 300.0]` (10 km, 300 km and 3000 km, 3-sigma) and
+#    `N_MAP = 4`. Predict where most angles-only runs start to diverge, and whether the *filter's own* final
+#    3-sigma position (which the Table 4 rows report) shows it. Worked solution: `exercises.exercise_09_handoff`.

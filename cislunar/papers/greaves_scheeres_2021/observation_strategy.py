@@ -48,6 +48,7 @@ __all__ = [
     "figure_measurements",
     "figure_regime_map",
     "figure_typical_run",
+    "filled",
     "flagged_cells",
     "measurement_demo",
     "pct_span",
@@ -58,6 +59,11 @@ __all__ = [
 
 #: Where a diverged run's inconsistency starts.
 ONSETS = ("first update", "before perilune", "at or after perilune", "numerical failure")
+
+
+def filled(claim, **fields):
+    """``claim`` with the ``{name}`` fields of its quantity filled in (the cadences or noise a run used)."""
+    return dataclasses.replace(claim, quantity=claim.quantity.format(**fields))
 
 
 def cadence_label(cadence_h: float) -> str:
@@ -120,13 +126,16 @@ class MeasurementDemo:
                 f"1-sigma rate noise ({sig:.1f} urad/s); |azimuth rate| at apoapsis {rate[0, 0]:.1f} urad/s")
 
 
-def measurement_demo(system: CR3BP, orbit: PeriodicOrbit, cadence_hours: float = 2.0) -> MeasurementDemo:
-    """The L2 observer's noise-free angles and rates of ``orbit`` over one period from apoapsis."""
+def measurement_demo(system: CR3BP, orbit: PeriodicOrbit, cadence_hours: float = 2.0, *,
+                     sigma_angle_rad: float = tracking.DEFAULT_SIGMA_ANGLE_RAD) -> MeasurementDemo:
+    """The L2 observer's noise-free angles and rates of ``orbit`` over one period from apoapsis, with the 1-sigma
+    noise of angles ``sigma_angle_rad`` (rad) and of their rates (Eq. 13, 1-s baseline)."""
     check_system(system)
+    sigma_angle_rad = validation.positive(sigma_angle_rad, "sigma_angle_rad")
     sc = tracking.make_scenario(system, orbit, cadence_hours, start="apoapsis")
     y = sc.model(sc.observers[:, 0], tracking.simulate_truth(system, sc.x_start, sc.t))
-    return MeasurementDemo(system.tu_to_days(sc.t), y, np.sqrt(np.diag(tracking.angles_rates_covariance(system))),
-                           system.time_unit_s)
+    noise = np.sqrt(np.diag(tracking.angles_rates_covariance(system, sigma_angle_rad)))
+    return MeasurementDemo(system.tu_to_days(sc.t), y, noise, system.time_unit_s)
 
 
 def figure_measurements(demo: MeasurementDemo):
@@ -204,14 +213,16 @@ class TypicalRun:
 
 
 def typical_run(system: CR3BP, orbit: PeriodicOrbit, cadence_hours: float, control_weight: float,
-                rng: np.random.Generator) -> TypicalRun:
-    """Truth, measurements (L2, angles and rates, apoapsis start), hand-off draw and one OCBE filter/smoother run.
+                rng: np.random.Generator, *, sigma_angle_rad: float = tracking.DEFAULT_SIGMA_ANGLE_RAD) -> TypicalRun:
+    """Truth, measurements (L2, angles and rates, apoapsis start; angle noise ``sigma_angle_rad``, rad), hand-off
+    draw and one OCBE filter/smoother run.
 
     ``rng`` draws the measurement noise first, then the hand-off error."""
     check_system(system)
     validation.rng(rng)
     control_weight = validation.positive(control_weight, "control_weight")
-    sc = tracking.make_scenario(system, orbit, cadence_hours, start="apoapsis")
+    sigma_angle_rad = validation.positive(sigma_angle_rad, "sigma_angle_rad")
+    sc = tracking.make_scenario(system, orbit, cadence_hours, start="apoapsis", sigma_angle_rad=sigma_angle_rad)
     truth = tracking.simulate_truth(system, sc.x_start, sc.t)
     y = tracking.simulate_measurements(sc, truth, rng)
     x0, P0 = tracking.initial_estimate(system, sc.x_start, rng)

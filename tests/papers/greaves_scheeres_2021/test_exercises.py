@@ -65,3 +65,63 @@ def test_10_pm_j_pattern_needs_noisy_angles():
     assert np.all(np.abs(r.z_m_s[0] - 1.0) < 0.2)  # z recovers the 1 m/s burn at our noise ...
     assert r.z_m_s[1].max() < 0.7  # ... and falls short of it with noisy angles
     assert f"{r.contrast[1]:.2f}" in r.answer
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Notebooks 01 and 09 (section of the 01/09 helper)
+# ---------------------------------------------------------------------------------------------------------------
+def _frozen_with_answer_0109(result):
+    assert dataclasses.is_dataclass(result)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        result.answer = "changed"
+    assert isinstance(result.answer, str) and len(result.answer) > 200
+
+
+def test_01_halo_step_resolves_the_band_but_keeps_the_orbits():
+    r = ex.exercise_01_halo_step(steps=(0.03, 0.015))
+    _frozen_with_answer_0109(r)
+    # halving the step about doubles the members, in the family and in the outer band
+    assert 1.6 < r.n_members[1] / r.n_members[0] < 2.4 and r.n_band[1] > r.n_band[0] >= 1
+    assert np.all(r.band_km[:, 0] <= r.band_km[:, 1])
+    # the finer walk's band reaches at least as far: its listed span is not narrower (to 1 km)
+    assert r.band_km[1, 0] <= r.band_km[0, 0] + 1 and r.band_km[1, 1] >= r.band_km[0, 1] - 1
+    # the orbits used downstream are found by root finding: independent of the step, and inside the band
+    assert np.ptp(r.outer_perilune_km) < 1e-6 and np.ptp(r.stable_perilune_km) < 1e-6
+    assert r.band_km[1, 0] < r.outer_perilune_km[1] < r.band_km[1, 1]
+    with pytest.raises(ValueError, match="steps"):
+        ex.exercise_01_halo_step(steps=(0.03,))
+
+
+def test_01_site_grid_finer_grids_never_do_worse_and_never_suffice():
+    r = ex.exercise_01_site_grid(grids_deg=((20.0, 40.0), (10.0, 20.0)), samples=400)
+    _frozen_with_answer_0109(r)
+    assert r.n_sites[1] > r.n_sites[0]
+    # nested grids: the finer grid holds every coarse pair, so its best pair is at least as good
+    assert r.best_fraction[1] >= r.best_fraction[0] - 1e-12
+    assert np.all(r.best_fine_fraction >= r.best_fraction - 1e-12)  # the refinement contains the best pair too
+    assert np.all(r.n_full_pairs == 0) and np.all(r.best_fine_fraction < 1)
+    with pytest.raises(ValueError, match="grids_deg"):
+        ex.exercise_01_site_grid(grids_deg=((10.0, 20.0), (20.0, 40.0)))
+
+
+def test_09_angle_noise_scales_the_final_uncertainty():
+    r = ex.exercise_09_angle_noise(noise_urad=(10.0, 100.0), n_runs=3)
+    _frozen_with_answer_0109(r)
+    ratio = r.final_3sigma_km[1] / r.final_3sigma_km[0]
+    assert 0.6 * 10 < ratio <= 10 * 1.05  # nearly proportional to the noise, not more
+    assert np.all(r.diverged <= 0.5)  # noise alone does not make the filter diverge
+
+
+def test_09_cadence_denser_tracking_shrinks_the_uncertainty_with_diminishing_returns():
+    r = ex.exercise_09_cadence(cadences_h=(12.0, 2.0), n_runs=3)
+    _frozen_with_answer_0109(r)
+    assert r.n_measurements[1] > 5 * r.n_measurements[0] - 5
+    gain = r.final_3sigma_km[0] / r.final_3sigma_km[1]
+    assert 1.2 < gain <= np.sqrt(r.n_measurements[1] / r.n_measurements[0]) * 1.05
+
+
+def test_09_handoff_wide_priors_diverge_while_the_covariance_forgets_them():
+    r = ex.exercise_09_handoff(scales=(1.0, 300.0), n_runs=4)
+    _frozen_with_answer_0109(r)
+    assert r.diverged[0] <= 0.25 and r.diverged[1] >= 0.5
+    assert abs(r.final_3sigma_km[1] / r.final_3sigma_km[0] - 1) < 0.1

@@ -97,10 +97,30 @@ def test_measurement_demo_rate_noise_is_eq_13(nrho):
     demo = obs.measurement_demo(em, nrho, 12.0)
     assert demo.sigma_rate_urad_s == pytest.approx(np.sqrt(2) * 10.0)
     assert demo.y.shape == (demo.days.size, 4) and demo.days[0] == 0.0
+    # the noise follows the angle noise given (Eq. 13: the rate noise is sqrt(2) sigma over the 1-s baseline)
+    noisy = obs.measurement_demo(em, nrho, 12.0, sigma_angle_rad=30e-6)
+    assert noisy.sigma_rate_urad_s == pytest.approx(np.sqrt(2) * 30.0)
+    assert noisy.sigma[0] == pytest.approx(30e-6) and np.array_equal(noisy.y, demo.y)  # noise-free measurements
+    with pytest.raises(ValueError, match="sigma_angle_rad"):
+        obs.measurement_demo(em, nrho, 12.0, sigma_angle_rad=-1.0)
+
+
+def test_typical_run_uses_the_angle_noise_given(nrho):
+    quiet = obs.typical_run(em, nrho, 12.0, 1e-20 * em.time_unit_s**3 / em.length_unit_km**2,
+                            np.random.default_rng(0), sigma_angle_rad=10e-6)
+    noisy = obs.typical_run(em, nrho, 12.0, 1e-20 * em.time_unit_s**3 / em.length_unit_km**2,
+                            np.random.default_rng(0), sigma_angle_rad=100e-6)
+    assert np.sqrt(noisy.scenario.meas_cov[0, 0]) == pytest.approx(100e-6)
+    # ten times the noise: a final position uncertainty several times larger
+    final = [r.forward.final_sigma_pos_km for r in (quiet, noisy)]
+    assert 3 < final[1] / final[0] <= 10.5
 
 
 def test_claims_read_diverges_and_consistent_as_declared():
     assert CLAIMS["inner_consistent_long"].judge(0.10).status == "reproduced"
     assert CLAIMS["inner_consistent_long"].judge(0.15).status == "differs"
     assert CLAIMS["outer_better"].judge(1.0).status == "consistent (tuned)"
-    assert CLAIMS["table4_2 h"].judge(1.0, note="median").status == "not in paper"
+    assert obs.filled(CLAIMS["table4"], cadence="2 h").judge(1.0, note="median").status == "not in paper"
+    row = obs.filled(CLAIMS["angles_only_noise"], noise="100").judge(False, shown="0% diverged")
+    assert row.quantity == "angles only, 9:2 NRHO, 12 h, 100 urad" and row.status == "differs"
+    assert CLAIMS["angles_only_noise"].quantity.endswith("{noise} urad")  # the declaration itself is untouched

@@ -1,5 +1,6 @@
 """Claims of Wolf & Jones about their reference orbits (Tables 2 and 4, the units of their "Dynamics" section and
-the day counts of the test cases' windows), judged in notebook 01.
+the day counts of the test cases' windows), judged in notebook 01; measured by
+:mod:`cislunar.papers.wolf_jones.reference_tables`.
 
 Declarations only.  Every printed DRO state should close after one period within ``CLOSURE_TOL`` (1e-7 LU; rows
 printed to nine digits close to about 1e-8); the window ends of the text within 1 day.
@@ -8,16 +9,8 @@ printed to nine digits close to about 1e-8); the window ends of the text within 
 from __future__ import annotations
 
 from cislunar.papers.wolf_jones.reference import CLOSURE_TOL
+from cislunar.papers.wolf_jones.reference_tables import TABLE_ROWS, WINDOW_TOL_DAYS, row_label
 from cislunar.publish.claims import AtMost, Claim, Holds
-
-#: Rows of Tables 2 and 4 as the notebook labels them (Table 4's labels other than target3_t0 are inferred).
-TABLE_ROWS = ((2, "observer_t0"), (2, "observer_tf"), (2, "target1_t0"), (4, "observer_t0"), (4, "observer_tf"),
-              (4, "target1_t0"), (4, "target2_t0"), (4, "target3_t0"))
-
-
-def _row_label(table, label):
-    return f"Table {table}: {label}" + (" (label inferred)" if table == 4 and label != "target3_t0" else "")
-
 
 CLAIMS = {
     "mu": Claim(
@@ -29,11 +22,11 @@ CLAIMS = {
     "time_unit_s": Claim("time unit [s]", "not stated", kind="not in paper",
                          reason="our choice: sqrt(L^3 / G(M_E + M_M)); W&J define it only in words (row below)"),
     **{f"closure_table{t}_{label}": Claim(
-        f"W&J {_row_label(t, label)}: closure of printed state", "periodic DRO", AtMost(CLOSURE_TOL),
+        f"W&J {row_label(t, label)}: closure of printed state", "periodic DRO", AtMost(CLOSURE_TOL),
         source=f"Table {t}", reason="printed vy0 is not periodic")
        for t, label in TABLE_ROWS},
     "window_case1": Claim(
-        "W&J test case 1 observation window [d]", "12 to 23", AtMost(1.0), source="Test Case #1 text",
+        "W&J test case 1 observation window [d]", "12 to 23", AtMost(WINDOW_TOL_DAYS), source="Test Case #1 text",
         reason="the window end misses the text's day count by more than the 1-day tolerance (largest miss, days)"),
     "time_unit_reading": Claim(
         "W&J time unit", "P_synodic / 2 pi",
