@@ -326,8 +326,8 @@ _ = plotting.save_figure(ro.figure_observer_sites(em, halo, peri), "01_observer_
 # paper's text, and the text calls the orbit only "an approximate 9:2 resonance orbit": no 9:2 NRHO number is in
 # the paper. The period is imposed (the shooting constraint) and the stable NRHO is selected by its stability
 # index, so those rows are "derived"; the perilune and apolune radii are compared, in the note, with the public
-# values collected in `shared/reference-notes.md`, not with the paper. Every Wolf & Jones row is verified against
-# the closure criterion `cislunar.papers.wolf_jones.reference.CLOSURE_TOL`.
+# values stated with their sources on the book's Sources page (`book/sources.md`), not with the paper. Every
+# Wolf & Jones row is verified against the closure criterion `cislunar.papers.wolf_jones.reference.CLOSURE_TOL`.
 #
 # **How each row is judged.** Every row below is a claim declared, with its criterion, before anything is compared:
 # the Greaves & Scheeres rows in `cislunar.papers.greaves_scheeres_2021.claims.reference_orbits`, the Wolf & Jones
@@ -370,10 +370,10 @@ print(windows.report())
 T92 = 2 / 9 * SYNODIC_MONTH_DAYS
 table.add(GS["nrho_period"].judge(nrho.period_days, note="imposed: half period held at (2/9 synodic month)/2, 2/9 x "
                                   f"{SYNODIC_MONTH_DAYS} d = {T92:.6f} d (the resonance defines it)"))
-table.add(GS["nrho_perilune"].judge(nrho.perilune_radius_km, note="public 3200-3300 km (reference notes)"))
-table.add(GS["nrho_apolune"].judge(nrho.apolune_radius_km, note="public ~71000 km, +-1000 km (reference notes)"))
+table.add(GS["nrho_perilune"].judge(nrho.perilune_radius_km, note="public 3200-3300 km (book: Sources)"))
+table.add(GS["nrho_apolune"].judge(nrho.apolune_radius_km, note="public ~71000 km, +-1000 km (book: Sources)"))
 table.add(GS["nrho_state"].judge(nrho.x0[0], shown=f"[{nrho.x0[0]:.5f}, {nrho.x0[2]:.5f}, {nrho.x0[4]:.5f}]",
-          note="by shooting with the period imposed; the reference notes' [1.0219, -0.182, -0.1030] only seeds "
+          note="by shooting with the period imposed; the public [1.0219, -0.182, -0.1030] (book: Sources) only seeds "
           f"Newton (differs by {abs(nrho.x0[0] - 1.0219):.5f} in x0, {abs(nrho.x0[4] + 0.1030):.5f} in vy0)"))
 table.add(GS["nrho_stability"].judge(nrho.stability_index))
 table.add(GS["stable_stability"].judge(stable.stability_index, note="member at the period-doubling boundary nearest "

@@ -124,7 +124,7 @@ _ = table.add(*r.judged(CLAIMS))
 # angle at the spacecraft. Then $\sin\theta_1 = \rho_3 y$, $\cos\theta_1 = \rho_3 x + \mu\rho_3$,
 # $\sin\theta_2 = \rho_4 y$, $\cos\theta_2 = -\rho_4 x + (1-\mu)\rho_4$ with $\rho_3 = 1/r_{13}$,
 # $\rho_4 = 1/r_{23}$, and $r_{13}^2 = (x + 2\mu)x + y\,y + \mu^2$, $r_{23}^2 = (x+2\mu-2)x + y\,y + (1-\mu)^2$,
-# which is Eq. 22 with $\rho_5 = x$, $\rho_6 = y$ (the paper never defines $\rho_5,\rho_6$; reference notes).
+# which is Eq. 22 with $\rho_5 = x$, $\rho_6 = y$ (the paper never defines $\rho_5,\rho_6$; book: Sources).
 # **Eq. 23 prints a different $d(\rho) = [0,\rho_3,0,-\rho_4,\rho_5+2\pi_2,\rho_5+2\pi_2-2]$**, which repeats a
 # column of $C$ and drops the $\pi_2$ factors. Eq. 22's form is used; both are tested below.
 

@@ -26,7 +26,7 @@ Sources of the constants
   (``1.215058560962404e-2``).
 * Length unit 384400 km (mean Earth-Moon distance) and time unit
   :math:`\sqrt{L^3 / G(M_E+M_M)} = 375190.25852` s (about 4.3425 days), the "classical" units collected in
-  ``shared/reference-notes.md``.  JPL's database uses other units (389703.2648 km, 382981.2891 s); the two
+  ``book/sources.md``.  JPL's database uses other units (389703.2648 km, 382981.2891 s); the two
   conventions must not be mixed.
 * Lunar mean radius 1737.4 km, Earth mean radius 6371 km, synodic month 29.530589 days.
 """

@@ -560,7 +560,7 @@ def refine_on_family(system: CR3BP, a: PeriodicOrbit, b: PeriodicOrbit, func, *,
 # ----------------------------------------------------------------------------------------------------------
 # Named reference orbits
 # ----------------------------------------------------------------------------------------------------------
-#: Apolune guess of the southern 9:2 L2 NRHO (reference notes; corrected, never used as is).
+#: Apolune guess of the southern 9:2 L2 NRHO (public value, ``book/sources.md``; corrected, never used as is).
 NRHO_9_2_GUESS = np.array([1.0219, 0.0, -0.182, 0.0, -0.103, 0.0])
 
 
