@@ -78,7 +78,9 @@ def exercise_11_gamma(factor: float = 2.0, *, gamma: float = GAMMA, n_samples: i
     """Solve the theta1-only theorems at ``gamma`` and ``factor * gamma`` on the 2:1 orbit."""
     factor = validation.positive(factor, "factor")
     gamma = validation.positive(gamma, "gamma")
-    sc = paper_scenario(n_samples=validation.integer(n_samples, "n_samples", minimum=10))
+    n_samples = validation.integer(n_samples, "n_samples", minimum=10)
+    pole_radius = validation.positive(pole_radius, "pole_radius")
+    sc = paper_scenario(n_samples=n_samples)
     gs = (gamma, factor * gamma)
     kappa, noise = {}, {}
     for norm in ("h2", "hinf"):
@@ -123,12 +125,20 @@ class OrbitExercise:
 def exercise_11_orbit(orbit=(3, 1, 0.3), *, gamma: float = GAMMA, n_samples: int = 300,
                       pole_radius: float = POLE_RADIUS) -> OrbitExercise:
     """H-infinity allowance on the 2:1 orbit and on ``orbit`` (p, q, perigee radius in LU)."""
+    if isinstance(orbit, (str, bytes)):
+        raise validation.ArgumentTypeError(f"orbit must be a (p, q, perigee_radius) tuple; got {type(orbit).__name__}")
+    try:
+        orbit = tuple(orbit)
+    except TypeError:
+        raise validation.ArgumentTypeError(f"orbit must be a (p, q, perigee_radius) tuple; got "
+                                           f"{type(orbit).__name__}") from None
     if len(orbit) != 3:
         raise ValueError(f"orbit must be (p, q, perigee_radius); got {orbit!r}")
-    orbit = (validation.integer(orbit[0], "orbit p"), validation.integer(orbit[1], "orbit q"),
+    orbit = (validation.integer(orbit[0], "orbit p", minimum=1), validation.integer(orbit[1], "orbit q", minimum=1),
              validation.positive(orbit[2], "orbit perigee_radius"))
     gamma = validation.positive(gamma, "gamma")
     n_samples = validation.integer(n_samples, "n_samples", minimum=10)
+    pole_radius = validation.positive(pole_radius, "pole_radius")
     orbits = ((2, 1, 0.3), orbit)
     r13, allow, limit = [], [], []
     for p, q, rp in orbits:
@@ -231,6 +241,7 @@ def exercise_12_noise(factor: float = 2.0, *, sigma_deg: float = SIGMA_DEG, dt: 
     initial error (1 % of :data:`observer_simulation.INITIAL_ERROR`), the noise drawn from the same ``seed``."""
     factor = validation.positive(factor, "factor")
     sigma_deg = validation.positive(sigma_deg, "sigma_deg")
+    seed = validation.seed_entropy(seed, "seed")
     sc, design, t, truth = _h2_setup(validation.integer(n_samples, "n_samples", minimum=10),
                                      validation.positive(periods, "periods"), validation.positive(dt, "dt"))
     m, km = sc.model, sc.model.system.length_unit_km
@@ -332,7 +343,10 @@ def exercise_12_interval(factor: float = 0.5, *, dt: float = 0.004, n_samples: i
     """Allowances and the H2 guarantee of the notebook's designs at ``dt`` and ``factor * dt`` (no simulation)."""
     factor = validation.positive(factor, "factor")
     dt = validation.positive(dt, "dt")
-    sc = paper_scenario(n_samples=validation.integer(n_samples, "n_samples", minimum=10))
+    n_samples = validation.integer(n_samples, "n_samples", minimum=10)
+    n_verify = validation.integer(n_verify, "n_verify", minimum=1)
+    seed = validation.seed_entropy(seed, "seed")
+    sc = paper_scenario(n_samples=n_samples)
     od = obs.observer_designs(sc, n_verify, np.random.default_rng(seed))
     km = sc.model.system.length_unit_km
     dts = (dt, factor * dt)

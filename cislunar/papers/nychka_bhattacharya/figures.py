@@ -1,6 +1,9 @@
 """Figures of notebooks 11 and 12 (Nychka & Bhattacharya): each function draws one figure from a study result and
 returns it; the notebook saves it with :func:`cislunar.publish.plotting.save_figure`.
 
+Each function checks that its result arguments are the package's result objects and its numbers are valid before
+drawing anything.
+
 Axes: positions in LU (rotating frame), gamma in km where labelled, times in TU or minutes, angles in deg.
 """
 
@@ -12,14 +15,20 @@ import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from cislunar.cr3bp.dynamics import check_system
 from cislunar.estimation import lpv
+from cislunar.papers.nychka_bhattacharya import observer_simulation as obs
+from cislunar.papers.nychka_bhattacharya import sensing_precision as sp
+from cislunar.papers.nychka_bhattacharya.scenarios import Scenario
 from cislunar.publish import plotting
+from cislunar.utils import validation
 
 __all__ = ["resonant_orbit", "bandwidth", "precision_per_sensor", "trade_curve", "sensitivity", "fig3_observers"]
 
 
 def resonant_orbit(scenario):
-    """The orbit whose scheduling parameters bound the polytope, with the primaries."""
+    """The orbit whose scheduling parameters bound the polytope, with the primaries (a :class:`Scenario`)."""
+    scenario = validation.instance(scenario, "scenario", Scenario)
     lo, hi = scenario.r13_range
     fig, ax = plt.subplots(figsize=(5.5, 5))
     plotting.plot_rotating(ax, scenario.model.spatial(scenario.states), label="2:1 resonant orbit")
@@ -31,6 +40,7 @@ def resonant_orbit(scenario):
 
 def bandwidth(bw):
     """H-infinity precision and gain against the bandwidth bound R (a :class:`BandwidthStudy`)."""
+    bw = validation.instance(bw, "bw", sp.BandwidthStudy)
     fig, ax = plt.subplots(1, 2, figsize=(10, 3.6))
     ax[0].semilogx(bw.radii, bw.noise_deg, "o-", label="bandwidth-bounded optimum")
     ax[0].axhline(bw.limit_deg, color="k", ls="--", lw=0.8,
@@ -49,6 +59,7 @@ def bandwidth(bw):
 
 def precision_per_sensor(designs):
     """Fig. 2 analogue: the optimal precision of each of the six sensors (a :class:`Designs`)."""
+    designs = validation.instance(designs, "designs", sp.Designs)
     fig, ax = plt.subplots(figsize=(7.5, 3.8))
     w = 0.38
     xs = np.arange(6)
@@ -70,7 +81,11 @@ def precision_per_sensor(designs):
 
 
 def trade_curve(tc, gamma, length_unit_km):
-    """Required precision and Eq. 24 allowance against gamma (a :class:`TradeCurve`)."""
+    """Required precision and Eq. 24 allowance against gamma (a :class:`TradeCurve`); ``gamma`` (LU) is marked,
+    ``length_unit_km`` converts LU to km."""
+    tc = validation.instance(tc, "tc", sp.TradeCurve)
+    validation.positive(gamma, "gamma")
+    validation.positive(length_unit_km, "length_unit_km")
     fig, ax = plt.subplots(1, 2, figsize=(8.5, 3.8), layout="constrained")
     for norm, label in (("h2", "H2"), ("hinf", r"H$_\infty$")):
         ax[0].loglog(tc.gammas * length_unit_km, tc.kappa[norm], "o-", label=label)
@@ -89,7 +104,13 @@ def trade_curve(tc, gamma, length_unit_km):
 
 
 def sensitivity(study, reading, gamma, pole_radius):
-    """The sensitivity study in three rows sharing the orbit axis, sorted by max r13 (see notebook 11)."""
+    """The sensitivity study in three rows sharing the orbit axis, sorted by max r13 (see notebook 11): a
+    :class:`SensitivityStudy`, its :class:`SensitivityReading`, the bound ``gamma`` (LU) and the H-infinity
+    bandwidth bound ``pole_radius`` (1/TU) the study used."""
+    study = validation.instance(study, "study", sp.SensitivityStudy)
+    reading = validation.instance(reading, "reading", sp.SensitivityReading)
+    validation.positive(gamma, "gamma")
+    validation.positive(pole_radius, "pole_radius")
     TU_MIN = reading.minutes_per_tu
     hinf, h2i, j = study.hinf_deg, study.h2_intensity_deg, reading.level_index
     dt01, dteq = reading.dt_01, reading.dt_eq
@@ -160,7 +181,17 @@ def sensitivity(study, reading, gamma, pole_radius):
 
 def fig3_observers(sim, conv, crossings, system, gamma, sigma_deg):
     """Fig. 3 analogue: (a), (b) truth and estimate of each LPV observer with a magnified start; (c)-(e) position
-    error of H2, H-infinity and the EKF against the guarantees (see notebook 12)."""
+    error of H2, H-infinity and the EKF against the guarantees (see notebook 12).
+
+    ``sim``, ``conv`` and ``crossings`` are the :class:`Fig3Runs`, :class:`Convergence` and :class:`LineCrossings`
+    of one run; ``system`` converts LU to km; ``gamma`` (LU) and ``sigma_deg`` (deg) are labelled.
+    """
+    sim = validation.instance(sim, "sim", obs.Fig3Runs)
+    conv = validation.instance(conv, "conv", obs.Convergence)
+    crossings = validation.instance(crossings, "crossings", obs.LineCrossings)
+    system = check_system(system, "system")
+    validation.positive(gamma, "gamma")
+    validation.positive(sigma_deg, "sigma_deg", allow_zero=True)
     KM, t, truth, runs, span = system.length_unit_km, sim.t, sim.truth, sim.runs, sim.period
     fig = plt.figure(figsize=(8.5, 9.4), layout="constrained")
     top, bottom = fig.subfigures(2, 1, height_ratios=[1.62, 1.0])

@@ -54,6 +54,9 @@ def observer_designs(scenario: Scenario, n_verify: int, rng: np.random.Generator
     interior points (H2 first, drawing from ``rng``)."""
     scenario = validation.instance(scenario, "scenario", Scenario)
     n_verify = validation.integer(n_verify, "n_verify", minimum=1)
+    rng = validation.rng(rng, "rng")
+    gamma = validation.positive(gamma, "gamma")
+    pole_radius = validation.positive(pole_radius, "pole_radius")
     V = scenario.box.vertices()
     m = scenario.model
     des = {"h2": lpv.design_observer(m, V, gamma, "h2", sensors=THETA1_SENSORS),
@@ -125,6 +128,7 @@ class Fig3Runs:
 
     def median_settled(self, name: str) -> float:
         """Median position error of run ``name`` after 10 % of the run, LU."""
+        name = validation.choice(name, "name", tuple(self.runs))
         return float(np.median(self.runs[name].position_error[self.settled]))
 
 
@@ -138,6 +142,10 @@ def simulate_fig3(scenario: Scenario, designs: ObserverDesigns, dt: float, perio
     designs = validation.instance(designs, "designs", ObserverDesigns)
     dt = validation.positive(dt, "dt")
     periods = validation.positive(periods, "periods")
+    sigma_deg = validation.positive(sigma_deg, "sigma_deg", allow_zero=True)
+    rng = validation.rng(rng, "rng")
+    sigma_acc = validation.positive(sigma_acc, "sigma_acc", allow_zero=True)
+    p0_sigma = validation.positive(p0_sigma, "p0_sigma")
     initial_error = validation.as_array(initial_error, "initial_error", shape=(4,))
     m = scenario.model
     t = np.arange(0.0, periods * scenario.orbit.period, dt)
@@ -154,8 +162,10 @@ def simulate_fig3(scenario: Scenario, designs: ObserverDesigns, dt: float, perio
 def first_and_rms(t, position_error, bound: float, period: float) -> tuple:
     """First time (TU) the error falls below ``bound`` and the RMS error (LU) from 2 % of ``period`` after it
     (``(inf, inf)`` if never)."""
-    t = validation.as_array(t, "t", ndim=(1,))
+    t = validation.as_array(t, "t", ndim=(1,), min_size=1)
     e = validation.as_array(position_error, "position_error", shape=t.shape)
+    bound = validation.positive(bound, "bound", allow_zero=True)
+    period = validation.positive(period, "period")
     below = e < bound
     if not below.any():
         return np.inf, np.inf
@@ -199,14 +209,19 @@ class Convergence:
 
     def converges(self, name: str, period: float) -> bool:
         """First below the bound within 5 % of ``period``."""
+        name = validation.choice(name, "name", tuple(self.first))
+        period = validation.positive(period, "period")
         return bool(self.first[name] <= 0.05 * period)
 
     def stays(self, name: str) -> bool:
         """RMS after convergence below the bound."""
+        name = validation.choice(name, "name", tuple(self.rms))
         return bool(self.rms[name] <= self.bound[name])
 
     def e0_max_ok(self, initial_error: float, period: float) -> float:
         """Largest swept initial error (units of ``initial_error``) that still meets the 5 % criterion (NaN if none)."""
+        initial_error = validation.positive(initial_error, "initial_error", allow_zero=True)
+        period = validation.positive(period, "period")
         ok = [f * initial_error for f, tf in zip(self.e0_scales, self.first_sweep) if tf <= 0.05 * period]
         return max(ok) if ok else float("nan")
 
@@ -227,7 +242,9 @@ def convergence_study(scenario: Scenario, designs: ObserverDesigns, sim: Fig3Run
     scenario = validation.instance(scenario, "scenario", Scenario)
     designs = validation.instance(designs, "designs", ObserverDesigns)
     sim = validation.instance(sim, "sim", Fig3Runs)
+    sigma_deg = validation.positive(sigma_deg, "sigma_deg", allow_zero=True)
     scales = validation.as_array(e0_scales, "e0_scales", ndim=(1,), min_size=1)
+    seed = validation.seed_entropy(seed, "seed")
     m, des, t, P = scenario.model, designs.designs, sim.t, sim.period
     dth = np.degrees(np.angle(np.exp(1j * (np.stack([sim.meas.theta1, sim.meas.theta2])
                                            - np.stack(m.angles(sim.truth))))))
@@ -309,8 +326,11 @@ def window_rerun(scenario: Scenario, designs: ObserverDesigns, sim: Fig3Runs, dt
     designs = validation.instance(designs, "designs", ObserverDesigns)
     sim = validation.instance(sim, "sim", Fig3Runs)
     dt = validation.positive(dt, "dt")
+    periods = validation.positive(periods, "periods")
+    sigma_deg = validation.positive(sigma_deg, "sigma_deg", allow_zero=True)
+    rng = validation.rng(rng, "rng")
     m = scenario.model
-    t = np.arange(0.0, validation.positive(periods, "periods") * scenario.orbit.period, dt)
+    t = np.arange(0.0, periods * scenario.orbit.period, dt)
     truth = m.planar(propagate(m.system, scenario.orbit.x0, t).x)
     meas = make_measurements(m, t, truth, sigma_deg, rng)
     x0 = truth[0] + (sim.x_hat0 - sim.truth[0])

@@ -229,6 +229,7 @@ def allowances(al: sp.Allowances, D: sp.Designs, bw: sp.BandwidthStudy, orbit: s
     al = validation.instance(al, "al", sp.Allowances)
     D = validation.instance(D, "D", sp.Designs)
     bw = validation.instance(bw, "bw", sp.BandwidthStudy)
+    validation.instance(orbit, "orbit", str)
     tu_min, kp, kb = al.minutes_per_tu, al.kappa_paper, al.kappa_band_hinf
     text = "\n".join([
         f"H2: {al.h2_deg:.4f} deg (intensity reading);  Hinf: {al.hinf_deg:.4f} deg",
@@ -381,6 +382,7 @@ def measurements(sim: obs.Fig3Runs, sc: Scenario) -> Readout:
 def convergence(cv: obs.Convergence, sim: obs.Fig3Runs, system: CR3BP = EARTH_MOON) -> Readout:
     """Section 4: the guaranteed RMS of each design against the simulated runs."""
     cv = validation.instance(cv, "cv", obs.Convergence)
+    sim = validation.instance(sim, "sim", obs.Fig3Runs)
     km, span = _km(system), sim.period
     return Readout("\n".join(
         f"{n:4s}: guaranteed RMS {cv.bound[n] * km:7.1f} km; first below at {cv.first[n]:.3f} TU "
@@ -392,6 +394,7 @@ def convergence_time(cv: obs.Convergence, sim: obs.Fig3Runs, system: CR3BP = EAR
     """Section 4: the convergence time predicted by the slowest pole, the noise-free run and the initial-error
     sweep."""
     cv = validation.instance(cv, "cv", obs.Convergence)
+    sim = validation.instance(sim, "sim", obs.Fig3Runs)
     km, span, e0 = _km(system), sim.period, sim.initial_error
     lines = [f"{n:4s}: slowest closed-loop decay on the orbit {cv.decay[n]:.2f}/TU; predicted time from {e0 * km:.0f} "
              f"km to {cv.bound[n] * km:.0f} km: {cv.t_pred[n]:.2f} TU ({100 * cv.t_pred[n] / span:.1f} % of the period)"
@@ -406,6 +409,7 @@ def convergence_time(cv: obs.Convergence, sim: obs.Fig3Runs, system: CR3BP = EAR
 def line_crossings(lc: obs.LineCrossings, sim: obs.Fig3Runs, system: CR3BP = EARTH_MOON) -> Readout:
     """Section 5: the Earth-Moon line crossings and the running RMS near them and elsewhere."""
     lc = validation.instance(lc, "lc", obs.LineCrossings)
+    sim = validation.instance(sim, "sim", obs.Fig3Runs)
     km = _km(system)
     lines = ["Earth-Moon line crossed (rho from the estimate) from t = " + ", ".join(f"{t0:.2f}" for t0 in lc.starts)
              + " TU"]
@@ -420,6 +424,7 @@ def line_crossings(lc: obs.LineCrossings, sim: obs.Fig3Runs, system: CR3BP = EAR
 def converges(cv: obs.Convergence, sim: obs.Fig3Runs, system: CR3BP = EARTH_MOON) -> Readout:
     """Section 5: the two rows of Fig. 3's claim "converge rapidly and stay accurate"."""
     cv = validation.instance(cv, "cv", obs.Convergence)
+    sim = validation.instance(sim, "sim", obs.Fig3Runs)
     km, span, e0 = _km(system), sim.period, sim.initial_error
     rows = {}
     for n in ("h2", "hinf"):
@@ -445,6 +450,9 @@ def comparison(sim: obs.Fig3Runs, ww: obs.WindowRerun, od: obs.ObserverDesigns, 
     rows of the chapter."""
     sim = validation.instance(sim, "sim", obs.Fig3Runs)
     ww = validation.instance(ww, "ww", obs.WindowRerun)
+    od = validation.instance(od, "od", obs.ObserverDesigns)
+    al = validation.instance(al, "al", obs.AllowanceAtDt)
+    validation.positive(sigma_deg, "sigma_deg")
     km, tu_min, des = _km(system), _minutes(system), od.designs
     med, med_w, e0 = {n: sim.median_settled(n) for n in sim.runs}, ww.median, sim.initial_error
     h2_w = des["h2"].noise_per_sample_deg(ww.dt)[0]

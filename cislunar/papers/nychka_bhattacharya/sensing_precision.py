@@ -37,6 +37,7 @@ __all__ = [
     "H2_BAND_DEG",
     "HINF_BAND_DEG",
     "NORMS",
+    "OBJECTIVES",
     "Allowances",
     "BandwidthStudy",
     "Designs",
@@ -59,6 +60,8 @@ __all__ = [
 ]
 
 NORMS = ("h2", "hinf")
+#: The objectives of :func:`objective_norm_study`: :math:`\min\|\beta\|_p` for p = 1, 2, inf.
+OBJECTIVES = ("l1", "l2", "linf")
 #: The paper's "around 0.1 deg" (H2) and "0.08 deg" (H-infinity) as bands of their printed digits, deg.
 H2_BAND_DEG = (0.05, 0.15)
 HINF_BAND_DEG = (0.075, 0.085)
@@ -235,6 +238,8 @@ def verify_designs(scenario: Scenario, designs: Designs, n_samples: int, rng: np
     ``"hinf (6 sensors)"``."""
     scenario = validation.instance(scenario, "scenario", Scenario)
     designs = validation.instance(designs, "designs", Designs)
+    n_samples = validation.integer(n_samples, "n_samples", minimum=1)
+    rng = validation.rng(rng, "rng")
     out = {}
     for key, d in (("h2", designs.theta1["h2"]), ("hinf", designs.theta1["hinf"]),
                    ("h2 (6 sensors)", designs.all["h2"]), ("hinf (6 sensors)", designs.all["hinf"])):
@@ -263,6 +268,7 @@ class ObjectiveStudy:
 
     def same_theta1(self, objective: str) -> bool:
         r""":math:`|\kappa_{\sin}/\kappa_{\cos} - 1| <` ``same_tol`` for both norms under ``objective``."""
+        objective = validation.choice(objective, "objective", OBJECTIVES)
         return all(abs(self.designs[(objective, n)].kappa[0] / self.designs[(objective, n)].kappa[1] - 1)
                    < self.same_tol for n in NORMS)
 
@@ -274,6 +280,7 @@ class ObjectiveStudy:
 
     def all_used(self, objective: str) -> bool:
         """Both theorems use all six sensors under ``objective``."""
+        objective = validation.choice(objective, "objective", OBJECTIVES)
         return all(self.designs[(objective, n)].used.all() for n in NORMS)
 
     @property
@@ -349,6 +356,7 @@ class Allowances:
 def allowances(designs: Designs, system: CR3BP = EARTH_MOON) -> Allowances:
     """Eq. 24 read both ways for the theta1-only designs (solves Eq. 8b's literal reading once)."""
     designs = validation.instance(designs, "designs", Designs)
+    minutes = _minutes(check_system(system, "system"))
     d = designs.theta1
     noise = {n: float(np.min(d[n].noise_deg[:2])) for n in NORMS}
     k2 = float(np.min(d["h2"].kappa[:2]))
@@ -357,7 +365,6 @@ def allowances(designs: Designs, system: CR3BP = EARTH_MOON) -> Allowances:
     g = designs.gamma
     h2_lit = float(designs.lmi["h2"].solve(np.sqrt(g)).noise_deg[0])
     hinf_lit = float(np.degrees(np.arcsin(np.sqrt(g) / d["hinf"].kappa[0])))
-    minutes = _minutes(check_system(system, "system"))
     return Allowances(noise["h2"], noise["hinf"], k2, float(d["hinf"].kappa[0]), float(dt_01), float(dt_eq),
                       h2_lit, hinf_lit, minutes)
 
@@ -387,6 +394,8 @@ def trade_curve(designs: Designs, gammas) -> TradeCurve:
     """Sweep gamma on the built theta1-only problems (``gamma`` is a ``cp.Parameter``: no rebuild)."""
     designs = validation.instance(designs, "designs", Designs)
     g = validation.as_array(gammas, "gammas", ndim=(1,), min_size=2)
+    if np.any(g <= 0):
+        raise ValueError(f"gammas must be positive (LU); got {g}")
     kappa, noise = {}, {}
     for n in NORMS:
         sweep = lpv.gamma_sweep(designs.lmi[n], g)
