@@ -1,5 +1,8 @@
 """Figures of the AMOS 2023 chapters (notebooks 07 and 08): each function draws one figure from a study result and
-returns the matplotlib figure (saved by the notebook through :func:`cislunar.publish.plotting.save_figure`)."""
+returns the matplotlib figure (saved by the notebook through :func:`cislunar.publish.plotting.save_figure`).
+
+Every function checks that it was given the result object it draws (a wrong object is refused with an error naming
+the argument, before a figure is opened)."""
 
 from __future__ import annotations
 
@@ -9,12 +12,23 @@ from matplotlib.colors import LogNorm
 from matplotlib.patches import Rectangle
 from matplotlib.ticker import NullFormatter, ScalarFormatter
 
+from cislunar.cr3bp.dynamics import check_system
+from cislunar.cr3bp.orbits import PeriodicOrbit
 from cislunar.cr3bp.propagation import propagate
+from cislunar.cr3bp.torus import InvariantTorus
 from cislunar.guidance import ssat
+from cislunar.papers.greaves_scheeres_2023 import guidance_study as gs
+from cislunar.papers.greaves_scheeres_2023 import station_keeping as sk
+from cislunar.papers.greaves_scheeres_2023 import station_keeping_study as sks
+from cislunar.utils import validation
 
 __all__ = ["cost_over_directions", "grid_resolution", "informed_within_slices", "map_with_percentiles",
            "monte_carlo_range_errors", "policies_vs_coast", "range_and_fuel_maps", "ssat_scenario", "surfaces",
            "torus_and_nrho"]
+
+
+def _surface(value, name="S"):
+    return validation.instance(value, name, sk.StationKeepingSurface, "a StationKeepingSurface")
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -22,6 +36,8 @@ __all__ = ["cost_over_directions", "grid_resolution", "informed_within_slices", 
 # ---------------------------------------------------------------------------------------------------------------
 def ssat_scenario(system, pair):
     """Three panels: the pair about apolune (Moon-centred, 1000 km), range and Eq. 20 noise, and sqrt(J_rho)."""
+    check_system(system)
+    validation.instance(pair, "pair", gs.DemonstrationPair, "a DemonstrationPair")
     L = system.length_unit_km
     fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
     hours = pair.hours
@@ -58,6 +74,7 @@ def ssat_scenario(system, pair):
 
 def policies_vs_coast(study):
     """Every policy as the change of sqrt(J_rho(tau_f)) against no burn (percent), one panel per burn size."""
+    validation.instance(study, "study", gs.PolicyStudy, "a PolicyStudy")
     fig, axes = plt.subplots(1, len(study.results), figsize=(12, 4.8), sharey=False)
     for ax, (dv, r) in zip(np.atleast_1d(axes), study.results.items()):
         h = r.coast_hours
@@ -88,6 +105,7 @@ def _azel_deg(v):
 
 def cost_over_directions(dmap):
     """sqrt(J_rho) over the sphere of burn directions (azimuth/elevation), MMD axis, minimiser, line of sight."""
+    validation.instance(dmap, "dmap", gs.DirectionMap, "a DirectionMap")
     fig, ax = plt.subplots(figsize=(9, 4.5))
     az, el = _azel_deg(dmap.directions)
     sc = ax.scatter(az, el, c=dmap.range_sigma_km, s=8, cmap="viridis")
@@ -121,6 +139,9 @@ def cost_over_directions(dmap):
 def torus_and_nrho(system, orbit, torus):
     """Fig. 2: the torus surface about apoapsis (+-1.5 d, Moon-centred, 1000 km) with the NRHO arc, and the ring
     relative to the target at five times (km, equal axes)."""
+    check_system(system)
+    validation.instance(orbit, "orbit", PeriodicOrbit)
+    validation.instance(torus, "torus", InvariantTorus)
     L, HR = system.length_unit_km, 3600.0 / system.time_unit_s
     th_plot = np.linspace(0, 2 * np.pi, 49)
     fig = plt.figure(figsize=(13, 6))
@@ -188,6 +209,8 @@ def _surface_plot(ax, S, Z, title, zlabel, log=False, flip=False):
 def surfaces(S, which="burns"):
     """Fig. 3 (``which="burns"``: first and second burn) or Figs. 4-5 (``"range_fuel"``: log10 sqrt(J_rho) in m,
     the no-maneuver wall clipped to the largest maneuver value, and total fuel) as 3-D surfaces with u*."""
+    _surface(S)
+    validation.choice(which, "which", ("burns", "range_fuel"))
     fig = plt.figure(figsize=(13, 5.5))
     ax1 = fig.add_subplot(1, 2, 1, projection="3d")
     ax2 = fig.add_subplot(1, 2, 2, projection="3d")
@@ -239,6 +262,7 @@ def _range_map(ax, surf, fig):
 
 def range_and_fuel_maps(S):
     """Figs. 4 and 5 as maps (range uncertainty of the maneuvers, total fuel) with u* and the slice best."""
+    _surface(S)
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
     _range_map(axes[0], S, fig)
     axes[0].set_title("Fig. 4 as a map: range uncertainty (maneuvers only)")
@@ -291,6 +315,7 @@ def _percentile_panel(ax, surfaces_):
 
 def informed_within_slices(S):
     """sqrt(J_rho) over phase for three arrival slices, and the percentile of u* in every slice."""
+    _surface(S)
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.4))
     _slice_profiles(axes[0], S)
     axes[0].set_title("three arrival slices (maneuvers only)")
@@ -304,6 +329,22 @@ def informed_within_slices(S):
 
 def map_with_percentiles(S_map, map_title, panels, panel_title):
     """A range map of ``S_map`` next to the percentile of u* for each ``(label, surface, style)`` of ``panels``."""
+    _surface(S_map, "S_map")
+    validation.instance(map_title, "map_title", str, "a str")
+    validation.instance(panel_title, "panel_title", str, "a str")
+    if isinstance(panels, (str, bytes, dict)) or not hasattr(panels, "__iter__"):
+        raise validation.ArgumentTypeError(f"panels must be a sequence of (label, surface, style) tuples; got "
+                                           f"{type(panels).__name__}")
+    panels = list(panels)
+    if not panels:
+        raise ValueError("panels must hold at least one (label, surface, style) tuple")
+    for n, panel in enumerate(panels):
+        if not isinstance(panel, (tuple, list)) or len(panel) != 3:
+            raise validation.ArgumentTypeError(f"panels[{n}] must be a (label, surface, style) tuple; got "
+                                               f"{type(panel).__name__} {panel!r:.60}")
+        validation.instance(panel[0], f"panels[{n}] label", str, "a str")
+        _surface(panel[1], f"panels[{n}] surface")
+        validation.instance(panel[2], f"panels[{n}] style", str, "a str")
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
     _range_map(axes[0], S_map, fig)
     axes[0].set_title(map_title)
@@ -317,6 +358,8 @@ def map_with_percentiles(S_map, map_title, panels, panel_title):
 
 def grid_resolution(grid, no_maneuver_m):
     """Median percentile and sqrt(J_rho) of u* against the ring-angle count, both readings, both agent phases."""
+    validation.instance(grid, "grid", sks.GridStudy, "a GridStudy")
+    no_maneuver_m = validation.positive(no_maneuver_m, "no_maneuver_m")
     n_grid = grid.n_grid
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.4))
     for agent, col in ((0.0, "C0"), (0.75, "C1")):
@@ -346,6 +389,7 @@ def grid_resolution(grid, no_maneuver_m):
 
 def monte_carlo_range_errors(mcs):
     """RMS range error at t_f per policy and execution level, the filter's 1-sigma and the covariance analysis."""
+    validation.instance(mcs, "mcs", sks.MonteCarloStudy, "a MonteCarloStudy")
     summary = mcs.summary
     fig, ax = plt.subplots(figsize=(8.5, 4.6))
     labels = list(dict.fromkeys(p for p, _ in summary))

@@ -30,7 +30,9 @@ import numpy as np
 from scipy.optimize import brentq
 
 from cislunar.cr3bp.dynamics import CR3BP, check_system
+from cislunar.cr3bp.orbits import PeriodicOrbit
 from cislunar.cr3bp.propagation import propagate
+from cislunar.cr3bp.torus import InvariantTorus
 from cislunar.guidance import ssat
 from cislunar.sensing.measurements import AZIMUTH_ELEVATION
 from cislunar.utils import validation
@@ -63,6 +65,39 @@ def _hour(system):
     return 3600.0 / system.time_unit_s
 
 
+def _executor(value):
+    """``None`` (serial) or an executor with ``submit`` (checked before any work)."""
+    if value is not None and not callable(getattr(value, "submit", None)):
+        raise validation.ArgumentTypeError(f"executor must be None or have a submit(fn, *args) method (a "
+                                           f"concurrent.futures executor or a Dask Client); got {type(value).__name__}")
+    return value
+
+
+def _hours_on_grid(value, name, lo, hi=None):
+    """Whole hours (rounded to the nearest hour) in ``[lo, hi]`` (``hi=None``: no upper bound) from a non-empty 1-D
+    array, as a list of int."""
+    hours = [int(np.rint(h)) for h in validation.as_array(value, name, ndim=(1,), min_size=1)]
+    if min(hours) < lo or (hi is not None and max(hours) > hi):
+        raise ValueError(f"{name} must lie in [{lo}, {'inf' if hi is None else hi}] h; got {value!r:.80}")
+    return hours
+
+
+def _result_key(results, value, name, what):
+    """``value`` as a key of ``results`` (a study's dict), refused by name if it is not a number or was not run."""
+    key = validation.real(value, name)
+    if key not in results:
+        raise ValueError(f"{name} must be one of the {what} of the study {tuple(results)}; got {value!r}")
+    return key
+
+
+def _positive_values(value, name):
+    """A non-empty 1-D array of positive finite values."""
+    arr = validation.as_array(value, name, ndim=(1,), min_size=1)
+    if np.any(arr <= 0):
+        raise ValueError(f"{name} must be positive; got {value!r:.80}")
+    return arr
+
+
 def leading_hours(coast_hours, ok) -> float:
     """Longest coast (h) up to which ``ok`` holds for every shorter coast (0 if not even the first).
 
@@ -73,7 +108,12 @@ def leading_hours(coast_hours, ok) -> float:
     ok : array_like (m,) of bool
     """
     coast_hours = validation.as_array(coast_hours, "coast_hours", ndim=(1,), min_size=1)
-    ok = np.asarray(ok, dtype=bool)
+    try:
+        ok = np.asarray(ok)
+    except (TypeError, ValueError) as exc:  # ragged nested sequences
+        raise validation.ArgumentTypeError(f"ok must be an array of booleans; got {type(ok).__name__}") from exc
+    if ok.dtype.kind != "b":
+        raise validation.ArgumentTypeError(f"ok must be an array of booleans; got dtype {ok.dtype}")
     if ok.shape != coast_hours.shape:
         raise ValueError(f"ok must have the shape of coast_hours {coast_hours.shape}; got {ok.shape}")
     n = ok.size if ok.all() else int(np.argmin(ok))
@@ -179,6 +219,7 @@ def demonstration_pair(system: CR3BP, orbit, *, lead_days: float = 1.0, apolune_
     :func:`cislunar.guidance.ssat.initial_covariance`, no process noise.
     """
     check_system(system)
+    validation.instance(orbit, "orbit", PeriodicOrbit)
     lead_days = validation.positive(lead_days, "lead_days")
     apolune_range_km = validation.positive(apolune_range_km, "apolune_range_km")
     days = validation.integer(days, "days", minimum=1)
@@ -324,18 +365,20 @@ class PolicyStudy:
 
     def sign_percent(self, dv_m_s: float) -> np.ndarray:
         """How much worse the rejected sign of the MMD axis is, percent of :math:`\\sqrt{J_\\rho}`, per coast."""
-        r = self.results[dv_m_s]
+        r = self.results[_result_key(self.results, dv_m_s, "dv_m_s", "burn magnitudes")]
         return 100 * (r.mmd_other / r.mmd - 1)
 
     def optimum_at(self, dv_m_s: float, coast_hours: float) -> float:
         """:math:`\\sqrt{J_\\rho}` (km) of the true minimiser for one burn and coast; NaN if that coast was not run."""
-        r = self.results[dv_m_s]
+        r = self.results[_result_key(self.results, dv_m_s, "dv_m_s", "burn magnitudes")]
+        coast_hours = validation.real(coast_hours, "coast_hours")
         hit = np.flatnonzero(np.isclose(r.coast_hours, coast_hours, rtol=0.0, atol=1e-6))
         return float(r.optimum[hit[0]]) if hit.size else float("nan")
 
     def perpendicular_hours(self, dv_m_s: float, tol: float = 0.02) -> float:
         """Longest coast (h) up to which the best perpendicular direction is within ``tol`` of the optimum."""
-        r = self.results[dv_m_s]
+        r = self.results[_result_key(self.results, dv_m_s, "dv_m_s", "burn magnitudes")]
+        tol = validation.positive(tol, "tol", allow_zero=True)
         return leading_hours(r.coast_hours, r.perp_best <= (1 + tol) * r.optimum)
 
 
@@ -356,10 +399,11 @@ def policy_study(system: CR3BP, pair: DemonstrationPair, coast_hours, dv_m_s, *,
     burn magnitude on ``executor`` (``None``: serial)."""
     check_system(system)
     validation.instance(pair, "pair", DemonstrationPair)
-    coast_idx = tuple(int(np.rint(h)) for h in validation.as_array(coast_hours, "coast_hours", ndim=(1,), min_size=1))
-    if min(coast_idx) < 1 or max(coast_idx) > pair.t.size - 1:
-        raise ValueError(f"coast_hours must lie in [1, {pair.t.size - 1}] h (the pair's grid); got {coast_hours}")
-    dvs = [float(d) for d in validation.as_array(dv_m_s, "dv_m_s", ndim=(1,), min_size=1)]
+    coast_idx = tuple(_hours_on_grid(coast_hours, "coast_hours", 1, pair.t.size - 1))
+    dvs = [float(d) for d in _positive_values(dv_m_s, "dv_m_s")]
+    n_grid = validation.integer(n_grid, "n_grid", minimum=2)
+    n_perp = validation.integer(n_perp, "n_perp", minimum=1)
+    _executor(executor)
     V = system.velocity_unit_km_s
     kw = {"n_grid": n_grid, "n_perp": n_perp}
     tasks = [(system, pair.agent_x0, pair.target_x0, pair.t, list(coast_idx), dv * 1e-3 / V, pair.P0, kw)
@@ -412,7 +456,7 @@ def direction_map(system: CR3BP, pair: DemonstrationPair, study: PolicyStudy, co
     validation.instance(pair, "pair", DemonstrationPair)
     validation.instance(study, "study", PolicyStudy)
     k = validation.integer(coast_hours, "coast_hours", minimum=1, maximum=pair.t.size - 1)
-    dv = max(study.results) if dv_m_s is None else float(dv_m_s)
+    dv = max(study.results) if dv_m_s is None else _result_key(study.results, dv_m_s, "dv_m_s", "burn magnitudes")
     r = study.results[dv]
     i = int(np.argmin(np.abs(r.coast_hours - k)))
     D = ssat.fibonacci_sphere(validation.integer(n_grid, "n_grid", minimum=2))
@@ -476,6 +520,7 @@ def timing_study(system: CR3BP, pair: DemonstrationPair, surrogate: SurrogateChe
     validation.instance(pair, "pair", DemonstrationPair)
     validation.instance(surrogate, "surrogate", SurrogateCheck)
     dv = validation.positive(dv_m_s, "dv_m_s") * 1e-3 / system.velocity_unit_km_s
+    n_grid = validation.integer(n_grid, "n_grid", minimum=2)
     repeat_core = validation.integer(repeat_core, "repeat_core", minimum=1)
     repeat_optimum = validation.integer(repeat_optimum, "repeat_optimum", minimum=1)
     tk = pair.t[:int(surrogate.coast_hours) + 1]
@@ -507,12 +552,13 @@ class TrackingArcStudy:
 
     def within_hours(self, arc_hours) -> float:
         """Longest coast up to which MMD is within the tolerance for every coast, h."""
-        r = self.results[arc_hours]
+        r = self.results[_result_key(self.results, arc_hours, "arc_hours", "arc lengths")]
         return leading_hours(r.coast_hours, r.mmd_excess_percent <= self.tolerance_percent)
 
     def leading_run(self, arc_hours) -> int:
         """Number of leading coasts within the tolerance."""
-        ok = self.results[arc_hours].mmd_excess_percent <= self.tolerance_percent
+        ok = self.results[_result_key(self.results, arc_hours, "arc_hours", "arc lengths")].mmd_excess_percent \
+            <= self.tolerance_percent
         return ok.size if ok.all() else int(np.argmin(ok))
 
     @property
@@ -529,10 +575,13 @@ def tracking_arc_study(system: CR3BP, pair: DemonstrationPair, arc_hours, coast_
     ``executor`` (``None``: serial)."""
     check_system(system)
     validation.instance(pair, "pair", DemonstrationPair)
-    arcs = [int(np.rint(h)) for h in validation.as_array(arc_hours, "arc_hours", ndim=(1,), min_size=1)]
-    coast_idx = [int(np.rint(h)) for h in validation.as_array(coast_hours, "coast_hours", ndim=(1,), min_size=1)]
+    arcs = _hours_on_grid(arc_hours, "arc_hours", 0)
+    coast_idx = _hours_on_grid(coast_hours, "coast_hours", 1)
     dv = validation.positive(dv_m_s, "dv_m_s") * 1e-3 / system.velocity_unit_km_s
+    n_grid = validation.integer(n_grid, "n_grid", minimum=2)
+    n_perp = validation.integer(n_perp, "n_perp", minimum=1)
     tol = validation.positive(tolerance_percent, "tolerance_percent")
+    _executor(executor)
     HR = _hour(system)
     tasks = []
     for h in arcs:
@@ -600,12 +649,16 @@ def qpo_pair_study(system: CR3BP, torus, pair: DemonstrationPair, ring_angles_de
     in ``pair``; the comparison for each ring angle (deg, must include 0) and for 180 deg, one task per ring angle
     on ``executor`` (``None``: serial)."""
     check_system(system)
+    validation.instance(torus, "torus", InvariantTorus)
     validation.instance(pair, "pair", DemonstrationPair)
     angles = [float(a) for a in validation.as_array(ring_angles_deg, "ring_angles_deg", ndim=(1,), min_size=1)]
     if 0.0 not in angles:
         raise ValueError(f"ring_angles_deg must include 0 (the antipodal check); got {angles}")
-    coast_idx = [int(np.rint(h)) for h in validation.as_array(coast_hours, "coast_hours", ndim=(1,), min_size=1)]
+    coast_idx = _hours_on_grid(coast_hours, "coast_hours", 1, pair.t.size - 1)
     dv = validation.positive(dv_m_s, "dv_m_s") * 1e-3 / system.velocity_unit_km_s
+    n_grid = validation.integer(n_grid, "n_grid", minimum=2)
+    n_perp = validation.integer(n_perp, "n_perp", minimum=1)
+    _executor(executor)
     t_lead = -pair.lead_hours * _hour(system)
 
     kw = {"n_grid": n_grid, "n_perp": n_perp}

@@ -29,8 +29,9 @@ import numpy as np
 from scipy.stats import chi2, spearmanr
 
 from cislunar.cr3bp.dynamics import CR3BP, check_system
+from cislunar.cr3bp.orbits import PeriodicOrbit
 from cislunar.cr3bp.propagation import propagate
-from cislunar.cr3bp.torus import qpo_for_mean_range
+from cislunar.cr3bp.torus import InvariantTorus, qpo_for_mean_range
 from cislunar.guidance import ssat
 from cislunar.papers.greaves_scheeres_2023 import station_keeping as sk
 from cislunar.utils import validation
@@ -56,6 +57,36 @@ __all__ = [
 
 def _surface(value, name="surface"):
     return validation.instance(value, name, sk.StationKeepingSurface, "a StationKeepingSurface")
+
+
+def _torus(value):
+    return validation.instance(value, "torus", InvariantTorus, "an InvariantTorus")
+
+
+def _vector(value, name):
+    """A non-empty 1-D array of finite values (angles, times)."""
+    return validation.as_array(value, name, ndim=(1,), min_size=1)
+
+
+def _non_negative_vector(value, name):
+    arr = _vector(value, name)
+    if np.any(arr < 0):
+        raise ValueError(f"{name} must be non-negative; got {value!r:.80}")
+    return arr
+
+
+def _executor(value):
+    """``None`` (serial) or an executor with ``submit`` (checked before any work)."""
+    if value is not None and not callable(getattr(value, "submit", None)):
+        raise validation.ArgumentTypeError(f"executor must be None or have a submit(fn, *args) method (a "
+                                           f"concurrent.futures executor or a Dask Client); got {type(value).__name__}")
+    return value
+
+
+def _scenario_times(theta, t_arrival, t_burn, t_final):
+    """The ring angles (rad), arrival times, first-burn time and read-out time (TU) of a surface, checked."""
+    return (_vector(theta, "theta"), _vector(t_arrival, "t_arrival"), validation.real(t_burn, "t_burn"),
+            validation.real(t_final, "t_final"))
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -160,6 +191,12 @@ class GridStudy:
 
     def series(self, agent_phase: float, reading: str, key: str) -> np.ndarray:
         """One column (``key`` a :class:`GridRow` field) against ``n_grid`` for an agent phase and a reading."""
+        agent_phase = validation.real(agent_phase, "agent_phase")
+        validation.choice(reading, "reading", ("angle", "projection"))
+        validation.choice(key, "key", ("percentile", "sigma_m", "fuel_m_s", "more_fuel_percent", "best_m"))
+        phases = tuple(dict.fromkeys(g.agent_phase for g in self.rows))
+        if agent_phase not in phases:
+            raise ValueError(f"agent_phase must be one of the agent phases of the study {phases}; got {agent_phase!r}")
         return np.array([getattr(g, key) for g in self.rows if g.agent_phase == agent_phase and g.reading == reading])
 
 
@@ -185,7 +222,12 @@ def grid_resolution_study(system: CR3BP, torus, n_grid, t_arrival, t_burn: float
     each agent phase (fraction of a turn); arrival times ``t_arrival`` and burn/read-out times in TU; one task per
     surface on ``executor`` (``None``: serial)."""
     check_system(system)
-    ns = tuple(validation.integer(n, "n_grid entry", minimum=2) for n in n_grid)
+    _torus(torus)
+    ns = tuple(validation.integer(n, "n_grid entry", minimum=2) for n in _vector(n_grid, "n_grid"))
+    t_arrival = _vector(t_arrival, "t_arrival")
+    t_burn, t_final = validation.real(t_burn, "t_burn"), validation.real(t_final, "t_final")
+    agent_phases = _vector(agent_phases, "agent_phases")
+    _executor(executor)
     tasks = [(system, torus, n, float(phase), t_arrival, t_burn, t_final) for phase in agent_phases for n in ns]
     rows = map_tasks(_grid_task, tasks, executor=executor, progress=False, desc="ring-angle grids")
     return GridStudy(tuple(r for pair in rows for r in pair), ns)
@@ -235,6 +277,14 @@ def scenario_sweep(system: CR3BP, torus, theta, t_arrival, arrival_start_h: floa
     """One surface per (tracking arc before the first burn, burn lead before ``arrival_start_h``, agent ring angle);
     returns a tuple of :class:`SweepRow`; one task per setting on ``executor`` (``None``: serial)."""
     check_system(system)
+    _torus(torus)
+    theta, t_arrival = _vector(theta, "theta"), _vector(t_arrival, "t_arrival")
+    arrival_start_h = validation.real(arrival_start_h, "arrival_start_h")
+    t_final = validation.real(t_final, "t_final")
+    pre_arcs_h = _non_negative_vector(pre_arcs_h, "pre_arcs_h")
+    leads_h = _vector(leads_h, "leads_h")
+    agent_thetas = _vector(agent_thetas, "agent_thetas")
+    _executor(executor)
     HR = 3600.0 / system.time_unit_s
     tasks = []
     for pre_h in pre_arcs_h:
@@ -247,6 +297,7 @@ def scenario_sweep(system: CR3BP, torus, theta, t_arrival, arrival_start_h: floa
 
 def format_sweep(rows) -> str:
     """The rows of :func:`scenario_sweep` as a text table."""
+    rows = validation.sequence_of(rows, "rows", SweepRow, "SweepRow")
     lines = ["angle reading" + " " * 57 + "| projection reading",
              ("pre-arc h | lead h | agent phase | median pct (t_f) | best-quartile % (t_f) | median pct (arrival) | "
              "best-quartile % (arrival) | more-fuel % | median pct (t_f) | more-fuel %")]
@@ -266,8 +317,13 @@ def offset_study(system: CR3BP, torus, theta, t_arrival, t_burn: float, t_final:
     ...]}`` (percent); one task per surface on ``executor`` (``None``: serial).
     """
     check_system(system)
+    _torus(torus)
+    theta, t_arrival, t_burn, t_final = _scenario_times(theta, t_arrival, t_burn, t_final)
     validation.rng(rng)
+    distances_km = _non_negative_vector(distances_km, "distances_km")
     n_directions = validation.integer(n_directions, "n_directions", minimum=1)
+    agent_theta = validation.real(agent_theta, "agent_theta")
+    _executor(executor)
     L, V = system.length_unit_km, system.velocity_unit_km_s
     vel_per_km = torus.velocity_size_mps / torus.size_km  # m/s per km
     tasks = []  # offsets drawn in order first, surfaces computed after: same numbers on any executor
@@ -294,6 +350,13 @@ def member_study(system: CR3BP, orbit, theta, t_arrival, t_burn: float, t_final:
     mean range and ring size (km), and per reading of Eq. 25 the median percentile of :math:`\\mathbf u^*` and the
     percent of slices where it uses at most the median fuel.  Returns ``{statistic: dict}``."""
     check_system(system)
+    validation.instance(orbit, "orbit", PeriodicOrbit)
+    theta, t_arrival, t_burn, t_final = _scenario_times(theta, t_arrival, t_burn, t_final)
+    target_km = validation.positive(target_km, "target_km")
+    statistics = validation.one_or_many(statistics, "statistics", str, "str")
+    for stat in statistics:
+        validation.choice(stat, "statistics entry", ("mean_km", "ring_mean_km", "rms_km"))
+    agent_theta = validation.real(agent_theta, "agent_theta")
     out = {}
     for stat in statistics:
         tor, st = qpo_for_mean_range(orbit, target_km, statistic=stat)
@@ -317,6 +380,8 @@ POLICIES = ("informed u*\n(angle reading)", "informed u*\n(projection)", "uninfo
 
 def execution_levels(exec_abs_m_s: float, exec_rel: float) -> dict:
     """Execution-error levels: tag -> (1-sigma absolute m/s, relative fraction) per axis."""
+    exec_abs_m_s = validation.positive(exec_abs_m_s, "exec_abs_m_s", allow_zero=True)
+    exec_rel = validation.positive(exec_rel, "exec_rel", allow_zero=True)
     return {"perfect": (0.0, 0.0), "small": (exec_abs_m_s / 10, exec_rel / 10), "exec": (exec_abs_m_s, exec_rel)}
 
 
@@ -365,6 +430,10 @@ class MonteCarloStudy:
 
     def ratio(self, policy: str, level: str = "perfect") -> float:
         """RMS range error of ``policy`` over that of the uninformed choice."""
+        validation.choice(policy, "policy", POLICIES)
+        validation.choice(level, "level", tuple(self.levels))
+        if (policy, level) not in self.summary:
+            raise ValueError(f"level must be 'perfect' for {policy!r} (no burn to execute); got {level!r}")
         return self.summary[(policy, level)]["rms"] / self.summary[(POLICIES[2], level)]["rms"]
 
 
@@ -379,13 +448,15 @@ def filter_monte_carlo(system: CR3BP, surface, surface_projection, target_apolun
     """
     check_system(system)
     S, SP = _surface(surface), _surface(surface_projection, "surface_projection")
+    target_apolune_state = validation.as_state(target_apolune_state, "target_apolune_state", batch=False)
     n_trials = validation.integer(n_trials, "n_trials", minimum=1)
     seed = validation.integer(seed, "seed", minimum=0)
+    levels = execution_levels(exec_abs_m_s, exec_rel)
+    _executor(executor)
     inf, infp, uni, none = POLICIES
     j = int(np.argmin(np.abs(S.t_arrival_hours)))
     tgt_b = propagate(system, target_apolune_state, np.array([0.0, S.t[0]])).x[-1]  # target at start of tracking
     zero = int(np.argmin(S.fuel_m_s[j]))  # phase 0: no maneuver
-    levels = execution_levels(exec_abs_m_s, exec_rel)
     policies = {}
     for tag, (a, r) in levels.items():
         def mk(i, lab, a=a, r=r):

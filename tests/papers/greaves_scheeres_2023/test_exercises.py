@@ -106,3 +106,15 @@ def test_08_agent_phase_moves_the_projection_reading_out_of_the_valley():
     assert r.projection_percentile[0] < 25.0  # the valley (best quartile) for the baseline agent
     assert r.projection_percentile[1] >= 25.0  # out of it a quarter turn away
     assert np.all((0 <= r.angle_percentile) & (r.angle_percentile <= 100))
+
+
+def test_exercises_refuse_bad_parameters_before_any_work():
+    """Each parameter is checked up front (no torus or pair is built for a malformed request)."""
+    with pytest.raises(ValueError, match="scales"):
+        ex.exercise_08_execution_errors(scales=(0.0, 1.0))  # the answer compares the 2nd and 3rd scales
+    with pytest.raises(ValueError, match="coast_hours"):
+        ex.exercise_07_tracking_arc(coast_hours=(1, 100))  # beyond the pair's 72 h
+    with pytest.raises(TypeError, match="n_grid"):
+        ex.exercise_07_sphere_resolution(n_grid=None)
+    with pytest.raises(ValueError, match="arrival_hours"):
+        ex.exercise_08_ring_grid(arrival_hours=[np.nan])

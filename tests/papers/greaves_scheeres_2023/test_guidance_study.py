@@ -132,3 +132,22 @@ def test_sweeps_on_an_executor_match_the_serial_run(pair):
     # the burn sizes are not mixed up: a bigger burn moves the cost further from doing nothing
     r0, r1 = par.results[0.5], par.results[1.0]
     assert np.all(np.abs(r1.optimum - r1.none) > np.abs(r0.optimum - r0.none))
+
+
+def test_result_methods_and_sweeps_refuse_bad_arguments_by_name(pair, study):
+    with pytest.raises(ValueError, match="dv_m_s"):
+        study.sign_percent(2.0)  # a burn magnitude the study did not run
+    with pytest.raises(ValueError, match="dv_m_s"):
+        gs.direction_map(em, pair, study, coast_hours=3, dv_m_s=0.5, n_grid=20)
+    with pytest.raises(TypeError, match="ok"):
+        gs.leading_hours([1.0, 2.0], [1, 0])  # integers are not booleans
+    with pytest.raises(ValueError, match="dv_m_s"):
+        gs.policy_study(em, pair, [1], [-1.0], n_grid=20, n_perp=4)
+    with pytest.raises(TypeError, match="n_grid"):
+        gs.policy_study(em, pair, [1], [1.0], n_grid=2.5)
+    with pytest.raises(ValueError, match="arc_hours"):
+        gs.tracking_arc_study(em, pair, [-2], [1])
+    with pytest.raises(TypeError, match="torus"):
+        gs.qpo_pair_study(em, None, pair, [0.0], [1])
+    with pytest.raises(ValueError, match="coast_hours"):
+        gs.qpo_pair_study(em, torus_from_orbit(nrho_9_2(em), 5, 10.0), pair, [0.0], [30])  # beyond the 24-h grid

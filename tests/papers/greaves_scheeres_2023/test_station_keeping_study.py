@@ -118,3 +118,26 @@ def test_sweeps_on_an_executor_match_the_serial_run(torus, surface):
     assert list(par[2]) == [0.0, 5.0] and all(len(v) == 2 for v in par[2].values())
     # zero offset: both directions give the baseline surface
     assert par[2][0.0] == [pytest.approx(np.median(surface.informed_percentile))] * 2
+
+
+def test_studies_refuse_bad_arguments_by_name(torus, surface):
+    g = study.grid_resolution_study(em, torus, (4, 6), np.array([-6.0, 7.0]) * HR, -18 * HR, 12 * HR,
+                                    agent_phases=(0.0,))
+    with pytest.raises(ValueError, match="agent_phase"):
+        g.series(0.5, "angle", "sigma_m")  # a phase the study did not run
+    with pytest.raises(ValueError, match="key"):
+        g.series(0.0, "angle", "sigma")
+    with pytest.raises(TypeError, match="torus"):
+        study.scenario_sweep(em, "torus", surface.theta, surface.t_arrival, -6.0, 12 * HR)
+    with pytest.raises(ValueError, match="pre_arcs_h"):
+        study.scenario_sweep(em, torus, surface.theta, surface.t_arrival, -6.0, 12 * HR, pre_arcs_h=(-1.0,))
+    with pytest.raises(TypeError, match="executor"):
+        study.offset_study(em, torus, surface.theta, surface.t_arrival, -18 * HR, 12 * HR, np.random.default_rng(0),
+                           executor=object())
+    with pytest.raises(ValueError, match="statistics"):
+        study.member_study(em, nrho_9_2(em), surface.theta, surface.t_arrival, -18 * HR, 12 * HR,
+                           statistics=("median_km",))
+    with pytest.raises(ValueError, match="exec_rel"):
+        study.execution_levels(1e-3, -0.01)
+    with pytest.raises(TypeError, match="rows"):
+        study.format_sweep("rows")
