@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from cislunar.cr3bp.orbits import PeriodicOrbit
 from cislunar.estimation import adaptive_ocbe as ad
 from cislunar.estimation import consistency, ocbe
 from cislunar.papers.greaves_scheeres_2021 import detection as det
@@ -43,6 +44,22 @@ OUTCOMES = ("prompt", "late", "nearly periapsis", "not detected")
 
 def _check_setup(setup):
     validation.instance(setup, "setup", det.DetectionSetup, "a detection.DetectionSetup (detection.make_setup)")
+
+
+def _check_executor(executor):
+    """``None`` (serial) or an object with a ``submit`` method (a concurrent.futures executor, a Dask Client)."""
+    if executor is not None and not callable(getattr(executor, "submit", None)):
+        raise validation.ArgumentTypeError(f"executor must be None or have a submit(fn, *args) method (a "
+                                           f"concurrent.futures executor or a Dask Client); got "
+                                           f"{type(executor).__name__}")
+
+
+def _burn_sizes(value, name: str = "magnitudes_m_s") -> np.ndarray:
+    """A non-empty 1-D array of positive burn sizes, m/s."""
+    mags = validation.as_array(value, name, ndim=(1,), min_size=1)
+    if np.any(mags <= 0):
+        raise ValueError(f"{name} must be positive burn sizes (m/s); got {mags}")
+    return mags
 
 
 def first_seen_epoch(setup: det.DetectionSetup) -> int:
@@ -188,6 +205,9 @@ def adaptive_run(setup: det.DetectionSetup, inputs: det.TrialInputs, *, reset: s
     """
     _check_setup(setup)
     validation.instance(inputs, "inputs", det.TrialInputs)
+    validation.choice(reset, "reset", ad.RESET_RULES)
+    smooth = validation.boolean(smooth, "smooth")
+    max_resets = validation.integer(max_resets, "max_resets", minimum=0)
     em, sc = setup.system, setup.scenario
     a = ad.adaptive_ocbe(em, sc.t, inputs.y, setup.observer_states, sc.model, sc.meas_cov, inputs.x0, inputs.P0,
                          setup.control_weight, reset=reset, smooth=smooth, max_resets=max_resets)
@@ -262,7 +282,10 @@ def delay_outcome(setup: det.DetectionSetup, epochs, late_from: float) -> DelayO
     """
     _check_setup(setup)
     sc, k_burn = setup.scenario, first_seen_epoch(setup)
-    ep = validation.as_array(epochs, "epochs", ndim=(1,)).astype(int)
+    ep = validation.as_array(epochs, "epochs", ndim=(1,), min_size=1)
+    if np.any(ep != np.round(ep)) or np.any(ep < -1):
+        raise ValueError(f"epochs must be epoch indices (integers, -1 for no detection); got {ep}")
+    ep = ep.astype(int)
     late_from = validation.real(late_from, "late_from")
     found = ep >= k_burn - (ad.CONSECUTIVE_EPOCHS - 1)
     t_found = sc.t[np.where(found, ep, 0)]
@@ -291,6 +314,8 @@ def first_detection_epochs(setup: det.DetectionSetup, magnitude_m_s: float, n_ru
                            rng: np.random.Generator) -> np.ndarray:
     """First detection epoch (-1: none) of ``n_runs`` runs with a randomly pointed burn, one batched pass."""
     _check_setup(setup)
+    magnitude_m_s = validation.positive(magnitude_m_s, "magnitude_m_s", allow_zero=True)
+    n_runs = validation.integer(n_runs, "n_runs", minimum=1)
     validation.rng(rng)
     return _first_pass((setup, _draw_burns(setup, magnitude_m_s, n_runs, rng)))
 
@@ -363,11 +388,14 @@ def delay_study(setup: det.DetectionSetup, orbit, magnitudes_m_s, noise_urad, n_
         Runs the batched first passes, one task per burn size and noise level; serial when None.
     """
     _check_setup(setup)
+    validation.instance(orbit, "orbit", PeriodicOrbit, "a cislunar.cr3bp.orbits.PeriodicOrbit")
+    mags = [float(m) for m in _burn_sizes(magnitudes_m_s)]
+    noise = validation.as_array(noise_urad, "noise_urad", ndim=(1,), min_size=1)
+    if np.any(noise <= 0):
+        raise ValueError(f"noise_urad must be positive angle noise levels (micro-rad); got {noise}")
     n_runs = validation.integer(n_runs, "n_runs", minimum=1)
     validation.rng(rng)
-    mags = [float(m) for m in magnitudes_m_s]
-    if not mags:
-        raise ValueError("magnitudes_m_s must hold at least one burn size")
+    _check_executor(executor)
     late_from = _late_from(setup, orbit.period)
     default_urad = tracking.DEFAULT_SIGMA_ANGLE_RAD * 1e6
     keys, tasks = [], []
@@ -480,10 +508,11 @@ def reset_rule_study(setup: det.DetectionSetup, magnitudes_m_s, n_per_magnitude:
     All runs are drawn from ``rng`` first (sizes in order), then filtered one task per run on ``executor``
     (serial when None); the rows come back in the order of the draws."""
     _check_setup(setup)
+    mags = tuple(float(m) for m in _burn_sizes(magnitudes_m_s))
     n = validation.integer(n_per_magnitude, "n_per_magnitude", minimum=1)
     validation.rng(rng)
     max_resets = validation.integer(max_resets, "max_resets", minimum=1)
-    mags = tuple(float(m) for m in magnitudes_m_s)
+    _check_executor(executor)
     tasks = [(setup, mag, det.draw_trial(rng, setup, magnitude_m_s=mag), max_resets) for mag in mags for _ in range(n)]
     rows = [row for rows in map_tasks(_reset_rule_runs, tasks, executor=executor, progress=False,
                                       desc="adaptive runs") for row in rows]
@@ -536,6 +565,7 @@ def closing_rows(null: NullMetricStudy, big: AdaptiveRun, delays: DelayStudy, ru
     validation.instance(big, "big", AdaptiveRun)
     validation.instance(delays, "delays", DelayStudy)
     validation.instance(rules, "rules", ResetRuleStudy)
+    q_base_km2_s3 = validation.positive(q_base_km2_s3, "q_base_km2_s3")
     rows = {}
     m = null.metric
     rows["metric law"] = dict(measured=float(m.mean()), shown=f"chi2_4: mean {m.mean():.2f}, KS p = {null.ks_p:.2f}, "

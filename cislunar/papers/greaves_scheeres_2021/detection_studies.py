@@ -15,6 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from cislunar.cr3bp.dynamics import check_system
+from cislunar.cr3bp.orbits import PeriodicOrbit
 from cislunar.estimation import adaptive_ocbe as ad
 from cislunar.estimation.consistency import NEES_PROBABILITY, nees, nees_limit
 from cislunar.papers.greaves_scheeres_2021 import detection as det
@@ -30,6 +32,42 @@ __all__ = ["accuracy_standard_error", "improvement_in_standard_errors", "finite_
            "TuningMap", "run_tuning_map", "TuningDemo", "run_tuning_demo", "SpikeStudy", "run_spike_study", "TAGS", "ratio_text",
            "TrainingStudies", "run_training_studies", "DIRECTIONS", "PmJSearch", "run_pm_j_search", "BurnZStudy",
            "run_burn_z_study", "lead_report", "lead_reading", "closing_rows"]
+
+
+def _check_setup(setup, name: str = "setup") -> det.DetectionSetup:
+    return validation.instance(setup, name, det.DetectionSetup, "a detection.DetectionSetup (detection.make_setup)")
+
+
+def _check_orbit(orbit, name: str = "orbit") -> PeriodicOrbit:
+    return validation.instance(orbit, name, PeriodicOrbit, "a cislunar.cr3bp.orbits.PeriodicOrbit")
+
+
+def _check_executor(executor):
+    """``None`` (serial) or an object with a ``submit`` method (a concurrent.futures executor, a Dask Client)."""
+    if executor is not None and not callable(getattr(executor, "submit", None)):
+        raise validation.ArgumentTypeError(f"executor must be None or have a submit(fn, *args) method (a "
+                                           f"concurrent.futures executor or a Dask Client); got "
+                                           f"{type(executor).__name__}")
+
+
+def _positive_values(value, name: str) -> np.ndarray:
+    """A non-empty 1-D array of positive finite numbers (a set is taken in sorted order)."""
+    if isinstance(value, (set, frozenset)):
+        value = sorted(value)
+    v = validation.as_array(value, name, ndim=(1,), min_size=1)
+    if np.any(v <= 0):
+        raise ValueError(f"{name} must hold positive values; got {v}")
+    return v
+
+
+def _dict_of(value, name: str, cls, what: str) -> dict:
+    """A non-empty dict whose values are all ``cls`` instances (``what`` names the class)."""
+    validation.instance(value, name, dict, f"a dict of {what}")
+    if not value:
+        raise ValueError(f"{name} must hold at least one {what}")
+    for key, v in value.items():
+        validation.instance(v, f"{name}[{key!r}]", cls, f"a {what}")
+    return value
 
 
 def accuracy_standard_error(paper: float, n: int) -> float:
@@ -59,8 +97,9 @@ def improvement_in_standard_errors(error: float, reference: float, se_error: flo
 
 def finite_or(value: float, fallback: float) -> float:
     """``value`` if it is a finite number, else ``fallback`` (a ratio that could not be formed)."""
-    v = float(value)
-    return v if np.isfinite(v) else float(fallback)
+    v = validation.real(value, "value", finite=False)
+    fallback = validation.real(fallback, "fallback")
+    return v if np.isfinite(v) else fallback
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -193,9 +232,46 @@ def run_tuning_map(system, orbits: dict, policies: dict, variants: dict, f_grid,
     q_base_km2_s3, window_hours, sigma_angle_rad : float
         The base setting.
     """
+    check_system(system)
+    _dict_of(orbits, "orbits", PeriodicOrbit, "cislunar.cr3bp.orbits.PeriodicOrbit")
+    if "9:2 NRHO" not in orbits:
+        raise ValueError(f"orbits must contain the '9:2 NRHO' (the side axes run on it); got {list(orbits)}")
+    _dict_of(policies, "policies", det.StationKeepingPolicy, "detection.StationKeepingPolicy")
+    _dict_of(variants, "variants", dict, "dict of overrides")
+    for v, ov in variants.items():
+        unknown = set(ov) - {"sigma_angle_rad", "window_hours", "q_base"}
+        if unknown:
+            raise ValueError(f"variants[{v!r}] may override only sigma_angle_rad, window_hours and q_base; got "
+                             f"{sorted(unknown)}")
+    f_grid = tuple(float(f) for f in _positive_values(f_grid, "f_grid"))
+    f_side = tuple(float(f) for f in _positive_values(f_side, "f_side"))
+    validation.instance(n_map, "n_map", (tuple, list, np.ndarray), "a pair (H0 runs, H1 runs)")
+    if len(n_map) != 2:
+        raise ValueError(f"n_map must be a pair (H0 runs, H1 runs); got {n_map!r}")
+    n_map = tuple(validation.integer(n, "n_map", minimum=1) for n in n_map)
+    seed = validation.int_seed_list(seed, "seed", why="each cell appends its index")
+    validation.instance(paper_zlim, "paper_zlim", dict, "a dict policy -> threshold (m/s)")
+    for p in policies:
+        if p not in paper_zlim:
+            raise ValueError(f"paper_zlim must give a threshold for every policy; missing {p!r}")
+        validation.positive(paper_zlim[p], f"paper_zlim[{p!r}]")
+    q_base_km2_s3 = validation.positive(q_base_km2_s3, "q_base_km2_s3")
+    window_hours = validation.positive(window_hours, "window_hours")
+    sigma_angle_rad = validation.positive(sigma_angle_rad, "sigma_angle_rad")
+    if isinstance(half_size_orbits, (str, bytes)):
+        raise validation.ArgumentTypeError(f"half_size_orbits must be a sequence of orbit names; got a single "
+                                           f"{type(half_size_orbits).__name__} {half_size_orbits!r}")
+    try:
+        half = tuple(half_size_orbits)
+    except TypeError:
+        raise validation.ArgumentTypeError(f"half_size_orbits must be a sequence of orbit names; got "
+                                           f"{type(half_size_orbits).__name__}") from None
+    if any(o not in orbits for o in half):
+        raise ValueError(f"half_size_orbits must name orbits of orbits ({list(orbits)}); got {half!r}")
+    batch_size = validation.integer(batch_size, "batch_size", minimum=0)
+    _check_executor(executor)
     names = tuple(variants)
     base = names[0]
-    seed = [int(x) for x in np.atleast_1d(seed)]
     cells = [(o, p, f, base) for o in orbits for p in policies for f in f_grid]
     cells += [("9:2 NRHO", p, f, v) for v in names[1:] for p in policies for f in f_side]
     out = {}
@@ -335,7 +411,8 @@ def run_tuning_demo(setup: det.DetectionSetup, seed, *, magnitude_m_s: float = 0
     r"""Draw one run with a burn of ``magnitude_m_s`` along ``direction`` (azimuth, elevation in rad; default
     :math:`+\hat\jmath`) on the window-tuned ``setup`` (generator seeded with ``seed``) and filter it with the
     window weight held constant over the period and with the setup's apoapsis window (Figs. 10-13)."""
-    validation.instance(setup, "setup", det.DetectionSetup, "a detection.DetectionSetup (detection.make_setup)")
+    _check_setup(setup)
+    validation.seed_entropy(seed, "seed")
     validation.positive(magnitude_m_s, "magnitude_m_s")
     inputs = det.draw_trial(np.random.default_rng(seed), setup, magnitude_m_s=magnitude_m_s, direction=direction)
     weights = {"constant": setup.control_weight.max(), "apoapsis window": setup.control_weight}
@@ -404,8 +481,13 @@ class SpikeStudy:
 def run_spike_study(constant: det.DetectionSetup, window: det.DetectionSetup, n: int, seed) -> SpikeStudy:
     """Draw ``n`` runs without a burn and ``n`` with a quiet-policy burn (seeds ``[*seed, 0]`` and ``[*seed, 1]``,
     spawned per run) on the ``window`` setup, and filter both sets with both tunings (batched OCBE)."""
+    _check_setup(constant, "constant")
+    _check_setup(window, "window")
+    if constant.scenario.t.shape != window.scenario.t.shape or not np.allclose(constant.scenario.t,
+                                                                             window.scenario.t):
+        raise ValueError("constant and window must share the measurement epochs (the same runs are filtered on both)")
     n = validation.integer(n, "n", minimum=1)
-    seed = [int(x) for x in np.atleast_1d(seed)]
+    seed = validation.int_seed_list(seed, "seed", why="the two hypotheses append an index")
     sc = window.scenario
     inputs = {h: [det.draw_trial(r, window, pol) for r in np.random.default_rng([*seed, j]).spawn(n)]
               for j, (h, pol) in enumerate((("H0", None), ("H1", det.QUIET_POLICY)))}
@@ -438,6 +520,7 @@ TAGS = ("f = 0.1", "f_c")
 
 def ratio_text(v) -> str:
     """A Fig. 16 ratio as printed (NaN: no burn in a sector)."""
+    v = validation.real(v, "v", finite=False)
     return "no burn in a sector (small sample)" if np.isnan(v) else f"{v:.2f}"
 
 
@@ -565,8 +648,27 @@ def run_training_studies(setups: dict, setups_c: dict, policies: dict, sizes: di
     """The training and test Monte Carlo of every orbit and policy at f = 0.1 (``setups``, seeds ``[seed, i, j]``)
     and at f_c (``setups_c``, seeds ``[seed, 200 + i, j]``), then ``n_boot`` bootstrap resamples of each threshold
     (seeds ``[seed, 90, n, w]``).  ``sizes``: orbit -> (H0 train, H1 train, tests per hypothesis)."""
-    seed = validation.integer(seed, "seed", minimum=0)
+    _dict_of(setups, "setups", det.DetectionSetup, "detection.DetectionSetup")
+    _dict_of(setups_c, "setups_c", det.DetectionSetup, "detection.DetectionSetup")
+    _dict_of(policies, "policies", det.StationKeepingPolicy, "detection.StationKeepingPolicy")
+    validation.instance(sizes, "sizes", dict, "a dict orbit -> (H0 train, H1 train, tests per hypothesis)")
     orbit_names = list(dict.fromkeys(o for o, _ in setups))
+    for o in orbit_names:
+        for p in policies:
+            if (o, p) not in setups:
+                raise ValueError(f"setups must hold a setup per (orbit, policy); missing {(o, p)!r}")
+            if (o, p) not in setups_c:
+                raise ValueError(f"setups_c must hold a setup per (orbit, policy) of setups; missing {(o, p)!r}")
+        n3 = sizes.get(o)
+        if not isinstance(n3, (tuple, list)) or len(n3) != 3:
+            raise ValueError(f"sizes must give (H0 train, H1 train, tests per hypothesis) for {o!r}; got {n3!r}")
+        validation.integer(n3[0], f"sizes[{o!r}][0]", minimum=2)
+        validation.integer(n3[1], f"sizes[{o!r}][1]", minimum=2)
+        validation.integer(n3[2], f"sizes[{o!r}][2]", minimum=0)
+    seed = validation.integer(seed, "seed", minimum=0)
+    n_boot = validation.integer(n_boot, "n_boot", minimum=1)
+    batch_size = validation.integer(batch_size, "batch_size", minimum=0)
+    _check_executor(executor)
     studies, studies_c = {}, {}
     for i, o in enumerate(orbit_names):
         for j, p in enumerate(policies):
@@ -660,6 +762,15 @@ def run_pm_j_search(system, orbit, f_values, noise_urad, offsets_h, n_repeats: i
                     window_hours: float) -> PmJSearch:
     """1 m/s burns along the six axes (the same noise draws for every direction, seed ``seed``) for every window
     factor (active policy's variance-matched weight), angle noise and burn time (:func:`detection.direction_response`)."""
+    check_system(system)
+    _check_orbit(orbit)
+    f_values = tuple(float(f) for f in _positive_values(f_values, "f_values"))
+    noise_urad = tuple(float(s) for s in _positive_values(noise_urad, "noise_urad"))
+    offsets_h = tuple(float(o) for o in validation.as_array(offsets_h, "offsets_h", ndim=(1,), min_size=1))
+    n_repeats = validation.integer(n_repeats, "n_repeats", minimum=1)
+    validation.int_seed_list(seed, "seed", why="repeats append an index")
+    q_base_km2_s3 = validation.positive(q_base_km2_s3, "q_base_km2_s3")
+    window_hours = validation.positive(window_hours, "window_hours")
     dirs = np.radians(np.array(list(DIRECTIONS.values())))
     cells, setup = {}, None
     for f in f_values:
@@ -711,6 +822,14 @@ def run_burn_z_study(setup: det.DetectionSetup, orbit, factors, magnitude_m_s: f
                      q_base_km2_s3: float, window_hours: float) -> BurnZStudy:
     """Draw ``n`` burns of ``magnitude_m_s`` on ``setup`` (seed ``seed``, spawned per run) and filter them with the quiet
     window tuning at each factor of ``factors`` (sorted)."""
+    _check_setup(setup)
+    _check_orbit(orbit)
+    _positive_values(factors, "factors")
+    magnitude_m_s = validation.positive(magnitude_m_s, "magnitude_m_s")
+    n = validation.integer(n, "n", minimum=1)
+    validation.seed_entropy(seed, "seed")
+    q_base_km2_s3 = validation.positive(q_base_km2_s3, "q_base_km2_s3")
+    window_hours = validation.positive(window_hours, "window_hours")
     runs = [det.draw_trial(r, setup, magnitude_m_s=magnitude_m_s) for r in np.random.default_rng(seed).spawn(n)]
     z = {}
     for f in sorted(set(factors)):
@@ -722,6 +841,8 @@ def run_burn_z_study(setup: det.DetectionSetup, orbit, factors, magnitude_m_s: f
 
 def lead_report(lead: dict, n_h0: int) -> str:
     """The control-versus-residual race per setting (``lead``: label -> detection.HealthLeadStudy), as text."""
+    _dict_of(lead, "lead", det.HealthLeadStudy, "detection.HealthLeadStudy")
+    n_h0 = validation.integer(n_h0, "n_h0", minimum=1)
     lines = []
     for tag, h in lead.items():
         fr = h.outcome_fractions()
@@ -741,6 +862,7 @@ def lead_report(lead: dict, n_h0: int) -> str:
 
 def lead_reading(lead: dict) -> str:
     """Where the control test is first in most runs, and the 0.5 m/s race, per setting (text)."""
+    _dict_of(lead, "lead", det.HealthLeadStudy, "detection.HealthLeadStudy")
     lines = []
     for tag, h in lead.items():
         fr = h.outcome_fractions()
@@ -791,6 +913,33 @@ def closing_rows(*, ks_text: str, tmap: TuningMap, f_tune: float, q_window_quiet
     sigma_angle_rad : float
         Our angle noise.
     """
+    validation.instance(ks_text, "ks_text", str)
+    validation.instance(tmap, "tmap", TuningMap)
+    f_tune = validation.positive(f_tune, "f_tune")
+    q_window_quiet = validation.as_array(q_window_quiet, "q_window_quiet", shape=(2,))
+    if np.any(q_window_quiet <= 0):
+        raise ValueError(f"q_window_quiet must be two positive weights (km^2/s^3); got {q_window_quiet}")
+    validation.instance(counts, "counts", dict)
+    missing = {"n_h0", "n_h1", "n_test", "outer_sizes", "n_spike", "n_z05", "n_lead", "n_pm_j_mc",
+               "pm_j_seeds"} - set(counts)
+    if missing:
+        raise ValueError(f"counts must give every size; missing {sorted(missing)}")
+    validation.instance(spike, "spike", SpikeStudy)
+    validation.instance(train, "train", TrainingStudies)
+    validation.instance(pm_j, "pm_j", PmJSearch)
+    _dict_of(pm_mc, "pm_mc", det.MonteCarloSample, "detection.MonteCarloSample")
+    if not {"active", "quiet"} <= set(pm_mc):
+        raise ValueError(f"pm_mc must hold the 'active' and 'quiet' samples; got {list(pm_mc)}")
+    validation.instance(burn_z, "burn_z", BurnZStudy)
+    validation.instance(sig_level, "sig_level", dict)
+    if set(sig_level) != set(TAGS):
+        raise ValueError(f"sig_level must give a sigma level per tag {TAGS}; got {list(sig_level)}")
+    for tag in TAGS:
+        validation.real(sig_level[tag], f"sig_level[{tag!r}]")
+    _dict_of(lead, "lead", det.HealthLeadStudy, "detection.HealthLeadStudy")
+    health_nees_mean = validation.real(health_nees_mean, "health_nees_mean")
+    validation.as_array(health_residual_norms, "health_residual_norms", ndim=(1,), min_size=1)
+    sigma_angle_rad = validation.positive(sigma_angle_rad, "sigma_angle_rad")
     F_C, F_TUNE, F_GRID, F_SIDE = tmap.f_c, f_tune, tmap.f_grid, tmap.f_side
     VARIANTS, POLICIES, ORBITS, STABLE = tmap.variants, tmap.policies, tmap.orbits, tmap.orbits[1:]
     F_MATCH = {p: tmap.f_match(p) for p in POLICIES}

@@ -12,9 +12,11 @@ import numpy as np
 from scipy import stats
 
 from cislunar.estimation import adaptive_ocbe as ad
+from cislunar.estimation.ocbe import OCBEResult
 from cislunar.papers.greaves_scheeres_2021 import adaptive_studies as ads
 from cislunar.papers.greaves_scheeres_2021 import detection as det
 from cislunar.papers.greaves_scheeres_2021 import panels as ocbe_panels
+from cislunar.utils import validation
 
 __all__ = ["metric_law", "adaptive_errors", "adaptive_control_metric", "delays", "reset_rules", "station_keeping_policy",
            "control_integral_pdfs", "z_vs_maneuver", "pm_j_search", "health_lead", "health_metric", "tuning_map"]
@@ -22,8 +24,65 @@ __all__ = ["metric_law", "adaptive_errors", "adaptive_control_metric", "delays",
 _OUTCOME_COLORS = {"prompt": "C0", "late": "C3", "nearly periapsis": "C1", "not detected": "0.6"}
 
 
+def _check_setup(setup) -> det.DetectionSetup:
+    return validation.instance(setup, "setup", det.DetectionSetup, "a detection.DetectionSetup (detection.make_setup)")
+
+
+def _names(value, name: str, *, at_most: int | None = None) -> list:
+    """A non-empty sequence of str (orbit, policy or setting names; a single str is refused), as a list."""
+    if isinstance(value, (str, bytes)):
+        raise validation.ArgumentTypeError(f"{name} must be a sequence of names; got a single "
+                                           f"{type(value).__name__} {value!r:.60}")
+    try:
+        names = list(value)
+    except TypeError:
+        raise validation.ArgumentTypeError(f"{name} must be a sequence of names; got {type(value).__name__}") from None
+    if not names:
+        raise ValueError(f"{name} must hold at least one name")
+    for i, n in enumerate(names):
+        validation.instance(n, f"{name}[{i}]", str, "a str")
+    if at_most is not None and len(names) > at_most:
+        raise ValueError(f"{name} must hold at most {at_most} names (one per panel); got {len(names)}")
+    return names
+
+
+def _cells(value, name: str, keys, what: str) -> dict:
+    """A dict holding every key of ``keys`` (``what``: what its values are, for the message)."""
+    validation.instance(value, name, dict, f"a dict of {what}")
+    missing = [k for k in keys if k not in value]
+    if missing:
+        raise ValueError(f"{name} has no entry for {missing[0]!r} (of {len(missing)} missing)")
+    return value
+
+
+def _dict_of(value, name: str, cls, what: str) -> dict:
+    """A non-empty dict whose values are all ``cls`` instances (``what`` names the class)."""
+    validation.instance(value, name, dict, f"a dict of {what}")
+    if not value:
+        raise ValueError(f"{name} must hold at least one {what}")
+    for key, v in value.items():
+        validation.instance(v, f"{name}[{key!r}]", cls, f"a {what}")
+    return value
+
+
+def _values(value, name: str, *, positive: bool = False) -> np.ndarray:
+    """A non-empty 1-D finite array (positive if asked)."""
+    v = validation.as_array(value, name, ndim=(1,), min_size=1)
+    if positive and np.any(v <= 0):
+        raise ValueError(f"{name} must hold positive values; got {v}")
+    return v
+
+
+def _check_run(run) -> ads.AdaptiveRun:
+    validation.instance(run, "run", ads.AdaptiveRun, "an adaptive_studies.AdaptiveRun (adaptive_studies.adaptive_run)")
+    if run.panels is None:
+        raise ValueError("run must be a smoothed adaptive run (adaptive_run(..., smooth=True)): it has no panels")
+    return run
+
+
 def metric_law(null: ads.NullMetricStudy):
     """Histogram and Q-Q plot of the pooled no-maneuver metric against its chi-square law (notebook 09b, Sec. 1)."""
+    validation.instance(null, "null", ads.NullMetricStudy, "an adaptive_studies.NullMetricStudy")
     pooled, law, lim = null.metric, ad.metric_law(null.dof), ad.metric_limit(null.dof)
     fig, ax = plt.subplots(1, 2, figsize=(11, 3.8))
     xx = np.linspace(0, 20, 300)
@@ -48,6 +107,9 @@ def _days(setup: det.DetectionSetup, t) -> float:
 
 def adaptive_errors(setup: det.DetectionSetup, run: ads.AdaptiveRun, title: str):
     """Fig. 6/8 layout of an adaptive run: position and velocity error norms with 3-sigma, forward and smoothed."""
+    _check_setup(setup)
+    _check_run(run)
+    validation.instance(title, "title", str)
     return ocbe_panels.figure_errors(run.panels, title, burn_days=_days(setup, setup.t_maneuver),
                                      detection_days=[_days(setup, d.time) for d in run.detections])
 
@@ -55,6 +117,9 @@ def adaptive_errors(setup: det.DetectionSetup, run: ads.AdaptiveRun, title: str)
 def adaptive_control_metric(setup: det.DetectionSetup, run: ads.AdaptiveRun, title: str):
     """Fig. 7/9 layout of an adaptive run: control norm and normalised metric, forward and smoothed; crosses: what
     the online filter saw before the first reset (its three strikes)."""
+    _check_setup(setup)
+    _check_run(run)
+    validation.instance(title, "title", str)
     dets = run.detections
     return ocbe_panels.figure_control_metric(run.panels, title, burn_days=_days(setup, setup.t_maneuver),
                                              detection_days=[_days(setup, d.time) for d in dets],
@@ -64,6 +129,7 @@ def adaptive_control_metric(setup: det.DetectionSetup, run: ads.AdaptiveRun, tit
 
 def delays(study: ads.DelayStudy):
     """Delay after the burn per size, and stacked outcome bars per size and per angle noise (notebook 09b, Sec. 5)."""
+    validation.instance(study, "study", ads.DelayStudy, "an adaptive_studies.DelayStudy")
     mags = list(study.by_size)
     mm = np.array(mags) * 1e3
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
@@ -93,6 +159,7 @@ def delays(study: ads.DelayStudy):
 
 def reset_rules(study: ads.ResetRuleStudy):
     """Inconsistent-after-the-burn and re-converged fractions per burn size for each reset rule (notebook 09b)."""
+    validation.instance(study, "study", ads.ResetRuleStudy, "an adaptive_studies.ResetRuleStudy")
     mm = np.array(study.magnitudes_m_s) * 1e3
     fig, ax = plt.subplots(1, 2, figsize=(11, 4))
     for j, rule in enumerate(study.rules):
@@ -119,6 +186,15 @@ def reset_rules(study: ads.ResetRuleStudy):
 def station_keeping_policy(magnitudes: dict, policies: dict, uz):
     """Eq. 5 magnitude draws against the truncated-Gaussian PDF per policy, and the k component of Eqs. 3-4 pointing
     against the arcsine law and a uniform sphere.  ``magnitudes``: policy name -> draws [m/s]."""
+    _dict_of(policies, "policies", det.StationKeepingPolicy, "detection.StationKeepingPolicy")
+    if len(policies) > 2:
+        raise ValueError(f"policies must hold at most 2 policies (one panel each); got {len(policies)}")
+    _cells(magnitudes, "magnitudes", list(policies), "magnitude draws [m/s] per policy")
+    for name in policies:
+        _values(magnitudes[name], f"magnitudes[{name!r}]")
+    uz = _values(uz, "uz")
+    if np.any(np.abs(uz) > 1):
+        raise ValueError("uz must hold direction components in [-1, 1]")
     fig, ax = plt.subplots(1, 3, figsize=(14, 3.8))
     for name, pol in policies.items():
         m, d = magnitudes[name], pol.magnitude_distribution
@@ -143,7 +219,13 @@ def station_keeping_policy(magnitudes: dict, policies: dict, uz):
 def control_integral_pdfs(studies: dict, orbit_names, policy_names):
     """Figs. 14-15 and 18-19 analogues: histograms and KDEs of z under H0 and H1, with z_lim, per orbit (rows) and
     policy (column pairs; active in m/s, quiet in mm/s).  ``studies``: (orbit, policy) -> detection.PolicyStudy."""
-    fig, ax = plt.subplots(len(orbit_names), 4, figsize=(16, 3.3 * len(orbit_names)))
+    orbit_names = _names(orbit_names, "orbit_names")
+    policy_names = _names(policy_names, "policy_names", at_most=2)
+    _cells(studies, "studies", [(o, p) for o in orbit_names for p in policy_names], "detection.PolicyStudy")
+    for o in orbit_names:
+        for p in policy_names:
+            validation.instance(studies[o, p], f"studies[{(o, p)!r}]", det.PolicyStudy, "a detection.PolicyStudy")
+    fig, ax = plt.subplots(len(orbit_names), 4, figsize=(16, 3.3 * len(orbit_names)), squeeze=False)
     for row, o in enumerate(orbit_names):
         for k, p in enumerate(policy_names):
             st = studies[o, p]
@@ -173,6 +255,12 @@ def control_integral_pdfs(studies: dict, orbit_names, policy_names):
 def z_vs_maneuver(studies: dict, orbit_names, policy_names):
     """Figs. 16-17, 20-21 analogues on the 9:2 NRHO's training runs: z over the pointing, z/|dv| over the azimuth,
     z against the magnitude (the first two orbits of ``orbit_names`` overlaid)."""
+    orbit_names = _names(orbit_names, "orbit_names")
+    policy_names = _names(policy_names, "policy_names", at_most=2)
+    _cells(studies, "studies", [(o, p) for o in ["9:2 NRHO", *orbit_names[:2]] for p in policy_names],
+           "detection.PolicyStudy (the 9:2 NRHO's included)")
+    for key in {(o, p) for o in ["9:2 NRHO", *orbit_names[:2]] for p in policy_names}:
+        validation.instance(studies[key], f"studies[{key!r}]", det.PolicyStudy, "a detection.PolicyStudy")
     fig, ax = plt.subplots(2, 3, figsize=(15, 8))
     for row, p in enumerate(policy_names):
         h1 = studies["9:2 NRHO", p].h1
@@ -199,6 +287,18 @@ def pm_j_search(pmj: dict, f_values, noise_urad, offsets_h, f_pm: float, sig_pm:
     """The +-j search: paired contrast against the angle noise per window factor (burn at apoapsis), per burn time
     at ``f_pm``, and the random-burn runs of the regime ``(f_pm, sig_pm)`` coloured by z/|dv|.
     ``pmj``: (f, noise, offset) -> (z per direction, contrast)."""
+    f_values = _values(f_values, "f_values", positive=True)
+    noise_urad = _values(noise_urad, "noise_urad", positive=True)
+    offsets_h = _values(offsets_h, "offsets_h")
+    f_pm = validation.positive(f_pm, "f_pm")
+    sig_pm = validation.positive(sig_pm, "sig_pm")
+    validation.instance(pmj, "pmj", dict, "a dict (f, noise, offset) -> (z per direction, contrast)")
+    if any((f, s, 0.0) not in pmj for f in f_values for s in noise_urad):
+        raise ValueError("pmj must hold a cell (f, noise, 0.0) for every f of f_values and noise of noise_urad")
+    if any((f_pm, s, off) not in pmj for s in noise_urad for off in offsets_h):
+        raise ValueError("pmj must hold a cell (f_pm, noise, offset) for every noise of noise_urad and offset of "
+                         "offsets_h (f_pm must be a factor of the search)")
+    validation.instance(active_sample, "active_sample", det.MonteCarloSample, "a detection.MonteCarloSample")
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
     for f, mk in zip(f_values, "osD^"):
         ax[0].plot(noise_urad, [pmj[f, s, 0.0][1] for s in noise_urad], marker=mk, label=f"f = {f:g}")
@@ -224,7 +324,9 @@ def pm_j_search(pmj: dict, f_values, noise_urad, offsets_h, f_pm: float, sig_pm:
 def health_lead(lead: dict):
     """Fig. 22 race: per burn size, the share of runs where the control or the residual test fires first, both at
     the same epoch, or neither within 24 h.  ``lead``: label -> detection.HealthLeadStudy."""
-    fig, ax = plt.subplots(1, len(lead), figsize=(5 * len(lead), 3.8), sharey=True)
+    _dict_of(lead, "lead", det.HealthLeadStudy, "detection.HealthLeadStudy")
+    fig, ax = plt.subplots(1, len(lead), figsize=(5 * len(lead), 3.8), sharey=True, squeeze=False)
+    ax = ax[0]
     for a, (tag, h) in zip(ax, lead.items()):
         fr = h.outcome_fractions()
         x = np.arange(h.magnitudes_m_s.size)
@@ -243,6 +345,16 @@ def health_lead(lead: dict):
 def health_metric(setup: det.DetectionSetup, inputs: det.TrialInputs, result, reference, z_m_s: float):
     """Fig. 22 analogue of one run: smoothed position error and 3-sigma, whitened residual norms against the 99 %
     level of a 4-dof residual, and z against the quiet training runs (``reference``: a detection.PolicyStudy)."""
+    _check_setup(setup)
+    validation.instance(inputs, "inputs", det.TrialInputs, "a detection.TrialInputs (detection.draw_trial)")
+    validation.instance(result, "result", OCBEResult, "an ocbe.OCBEResult (detection.run_trial_filter)")
+    n = setup.scenario.t.size
+    if inputs.truth.shape[0] != n:
+        raise ValueError(f"inputs must be drawn on setup (truth of {inputs.truth.shape[0]} epochs, setup {n})")
+    if result.x_smooth is None or result.x_smooth.shape[0] != n:
+        raise ValueError(f"result must be a smoothed run on setup's {n} epochs")
+    validation.instance(reference, "reference", det.PolicyStudy, "a detection.PolicyStudy")
+    z_m_s = validation.positive(z_m_s, "z_m_s")
     em = setup.system
     fig, ax = plt.subplots(1, 3, figsize=(15, 3.8))
     hours = setup.scenario.t * em.time_unit_s / 3600
@@ -269,6 +381,21 @@ def tuning_map(tmap: dict, orbit_names, policy_names, variants, base_variant: st
     """The tuning map (notebook 10, Section 2): top row all orbits at the paper's window (H1 forward and smoothed
     inconsistent runs, FP + MD); bottom row the 9:2 NRHO per setting (worst cell, z_lim over the paper's, FP + MD).
     ``tmap``: (orbit, policy, f, variant) -> cell dict; ``worst(o, p, f, v)``: worst inconsistent fraction."""
+    orbit_names = _names(orbit_names, "orbit_names")
+    policy_names = _names(policy_names, "policy_names")
+    variants = _names(variants, "variants")
+    validation.choice(base_variant, "base_variant", variants)
+    f_grid = _values(f_grid, "f_grid", positive=True)
+    f_side = _values(f_side, "f_side", positive=True)
+    f_c = validation.positive(f_c, "f_c")
+    f_tune = validation.positive(f_tune, "f_tune")
+    _cells(paper_zlim, "paper_zlim", policy_names, "thresholds [m/s] per policy")
+    for p in policy_names:
+        validation.positive(paper_zlim[p], f"paper_zlim[{p!r}]")
+    validation.callable_(worst, "worst")
+    keys = [(o, p, f, base_variant) for o in orbit_names for p in policy_names for f in f_grid]
+    keys += [("9:2 NRHO", p, f, v) for v in variants if v != base_variant for p in policy_names for f in f_side]
+    _cells(tmap, "tmap", keys, "cells (orbit, policy, f, variant) -> dict")
     fig, ax = plt.subplots(2, 3, figsize=(15, 8.4))
     for o, col in zip(orbit_names, ("C0", "C1", "C2")):
         for p, ls in zip(policy_names, ("-", "--")):

@@ -65,6 +65,18 @@ def measurements(case: studies.Case2Sweep, row6: studies.PlanRow, *, n_nodes: in
         The plan solved at the baseline's impulse plus ``extra_mps`` (m/s, met within ``rtol``).
     """
     validation.instance(case, "case", studies.Case2Sweep)
+    validation.instance(row6, "row6", studies.PlanRow)
+    n_nodes = validation.integer(n_nodes, "n_nodes", minimum=4)
+    sigma = validation.real(sigma, "sigma")
+    for value, name, cls in ((gc, "gc", studies.GradientCheck), (ms, "ms", studies.MirrorStudy),
+                             (ko, "ko", studies.KeepOutStudy), (nr, "nr", studies.NoiseReadings),
+                             (fr, "fr", studies.Front), (departures, "departures", Departures),
+                             (obs_mean, "obs_mean", dict), (tgt_mean, "tgt_mean", dict), (common, "common", dict)):
+        validation.instance(value, name, cls)
+    if budget_row is not None:
+        validation.instance(budget_row, "budget_row", dict, "a dict (budget, alpha, dv, rms, interp) or None")
+    extra_mps = validation.real(extra_mps, "extra_mps")
+    rtol = validation.in_range(rtol, "rtol", 0.0, 1.0, closed=False)
     sc, ok, by_alpha = case.scenario, case.ok, case.by_alpha
     em, ALPHAS, N_NODES, SIGMA = sc.system, case.alphas, n_nodes, sigma
     BUDGET_EXTRA_MPS, BUDGET_RTOL = extra_mps, rtol

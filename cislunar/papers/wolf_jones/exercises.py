@@ -17,8 +17,8 @@ import numpy as np
 
 from cislunar.cr3bp.dynamics import EARTH_MOON
 from cislunar.guidance import scvx
+from cislunar.papers.wolf_jones import _checks, nodes_study, scenarios, scvx_study
 from cislunar.papers.wolf_jones import mutual_information_study as mi_study
-from cislunar.papers.wolf_jones import nodes_study, scenarios, scvx_study
 from cislunar.papers.wolf_jones import test_case_studies as tc_studies  # notebooks 05-06
 from cislunar.sensing import information as info
 from cislunar.sensing import measurements as meas
@@ -76,6 +76,7 @@ def exercise_02_monte_carlo_samples(n_samples: int = 4000, factor: int = 4, seed
     """
     n = validation.integer(n_samples, "n_samples", minimum=100)
     f = validation.integer(factor, "factor", minimum=2)
+    seed = validation.integer(seed, "seed", minimum=0)
     runs = [mi_study.scalar_worked_example(m, np.random.default_rng(seed)) for m in (n, f * n)]
     se = tuple(r.monte_carlo_se for r in runs)
     ratio = se[0] / se[1]
@@ -176,9 +177,10 @@ def exercise_03_node_count(n_nodes=(12, 24), sigma: float = 1.0) -> NodeCountAns
 
     Solves the transfer on each node count of ``n_nodes`` (ascending) from the ballistic guess.
     """
-    counts = tuple(sorted(validation.integer(n, "n_nodes", minimum=6) for n in n_nodes))
+    counts = tuple(sorted(_checks.integers(n_nodes, "n_nodes", minimum=6)))
     if len(counts) < 2:
         raise ValueError("n_nodes needs at least two node counts")
+    sigma = validation.positive(sigma, "sigma", allow_zero=True)
     runs = [scvx_study.solve(scvx_study.transfer_problem(n, sigma)) for n in counts]
     mps = EARTH_MOON.velocity_unit_km_s * 1e3
     imp = tuple(float(r.impulse * mps) for r in runs)
@@ -255,6 +257,9 @@ def exercise_04_control_size(factor: float = 2.0, n_nodes: int = 24, draws: int 
     f = validation.positive(factor, "factor")
     if f <= 1:
         raise ValueError(f"factor must be above 1; got {factor!r}")
+    n_nodes = validation.integer(n_nodes, "n_nodes", minimum=3)
+    draws = validation.integer(draws, "draws", minimum=1)
+    seed = validation.integer(seed, "seed", minimum=0)
     em = EARTH_MOON
     arcs = nodes_study.reference_arcs(em)
     dro = {nodes_study.DRO_ARC: arcs[nodes_study.DRO_ARC]}
@@ -294,6 +299,8 @@ def exercise_04_node_count(n_nodes: int = 24, draws: int = 4, seed: int = 0) -> 
     about ``2^6 = 64``.
     """
     n = validation.integer(n_nodes, "n_nodes", minimum=6)
+    draws = validation.integer(draws, "draws", minimum=1)
+    seed = validation.integer(seed, "seed", minimum=0)
     em = EARTH_MOON
     arcs = nodes_study.reference_arcs(em)
     dro = {nodes_study.DRO_ARC: arcs[nodes_study.DRO_ARC]}
@@ -362,9 +369,10 @@ def exercise_05_node_count(n_nodes=(10, 14, 18), sigma: float = 1.0) -> MinimumI
     Solves alpha_h = 0 with the chapter's modified SCvx from the ballistic DRO on each grid of ``n_nodes``
     (increasing) nodes.
     """
-    counts = tuple(validation.integer(n, "n_nodes", minimum=6) for n in n_nodes)
+    counts = _checks.integers(n_nodes, "n_nodes", minimum=6)
     if len(counts) < 2 or any(b <= a for a, b in zip(counts, counts[1:])):
         raise ValueError(f"n_nodes must hold at least two increasing node counts; got {n_nodes!r}")
+    sigma = validation.real(sigma, "sigma")
     sc = scenarios.test_case_1()
     mps = sc.system.velocity_unit_km_s * 1e3
     info_model = sc.information_model()
@@ -415,10 +423,12 @@ def exercise_05_penalty_iterations(max_iter=(10, 30), *, n_nodes: int = 10, alph
     Runs the printed method (``method="penalty"``, ``information_model="linear"``) from the ballistic DRO of test
     case 1 on ``n_nodes`` Sundman nodes at each iteration limit of ``max_iter`` (increasing).
     """
-    limits = tuple(validation.integer(m, "max_iter", minimum=1) for m in max_iter)
+    limits = _checks.integers(max_iter, "max_iter", minimum=1)
     if len(limits) != 2 or limits[1] <= limits[0]:
         raise ValueError(f"max_iter must be two increasing iteration limits; got {max_iter!r}")
     n = validation.integer(n_nodes, "n_nodes", minimum=6)
+    alpha = validation.in_range(alpha, "alpha", 0.0, 1.0)
+    gamma = validation.positive(gamma, "gamma")
     sc = scenarios.test_case_1()
     t, k_ws, _ = sc.node_times(n, 1.0)
     x_ball, u_ball = sc.ballistic_guess(t)
@@ -436,7 +446,8 @@ def exercise_05_penalty_iterations(max_iter=(10, 30), *, n_nodes: int = 10, alph
         conv.append(ok)
         defect.append(float(hist[-1]["max_defect"]))
         eta.append(float(hist[-1]["eta"]))
-        best.append(float(min(h["new_cost"] for h in hist if h["accepted"])))
+        accepted = [h["new_cost"] for h in hist if h["accepted"]]
+        best.append(float(min(accepted)) if accepted else float("nan"))  # NaN: no step accepted within the limit
     answer = (f"More iterations do not make the printed method converge: with {limits[0]} and {limits[1]} "
               f"iterations (gamma = {gamma:g}, alpha_h = {alpha:g}, {n} nodes) it converges "
               f"{'in neither run' if not any(conv) else 'in ' + str(sum(conv)) + ' run(s)'}. What the extra "
@@ -475,7 +486,7 @@ def exercise_06_close_pass_scan(d_range_km=(1e-6, 1e-2), n_points: int = 7) -> C
     2.30`` nats per decade, without bound.  Runs the chapter's scan (:func:`test_case_studies.keep_out_scan`) from
     the ballistic window-start state.
     """
-    lo, hi = (float(v) for v in d_range_km)
+    lo, hi = (float(v) for v in validation.as_array(d_range_km, "d_range_km", shape=(2,)))
     if not 0 < lo < hi:
         raise ValueError(f"d_range_km must be (closest, farthest) with 0 < closest < farthest; got {d_range_km!r}")
     n = validation.integer(n_points, "n_points", minimum=3)
@@ -515,10 +526,11 @@ def exercise_06_free_run_iterations(max_iter=(10, 30), *, n_nodes: int = 12,
 
     Runs :func:`test_case_studies.free_run` from the ballistic guess at each iteration limit of ``max_iter``.
     """
-    limits = tuple(validation.integer(m, "max_iter", minimum=1) for m in max_iter)
+    limits = _checks.integers(max_iter, "max_iter", minimum=1)
     if len(limits) != 2 or limits[1] <= limits[0]:
         raise ValueError(f"max_iter must be two increasing iteration limits; got {max_iter!r}")
     n = validation.integer(n_nodes, "n_nodes", minimum=6)
+    alpha = validation.in_range(alpha, "alpha", 0.0, 1.0)
     sc = scenarios.test_case_2()
     info_model = sc.information_model()
     t, k_ws, _ = sc.node_times(n, 1.0)

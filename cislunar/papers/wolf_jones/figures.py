@@ -12,10 +12,13 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.collections import LineCollection
 
+from cislunar.cr3bp.dynamics import check_system
 from cislunar.cr3bp.propagation import propagate
+from cislunar.papers.wolf_jones import _checks
 from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.papers.wolf_jones import test_case_studies as studies
 from cislunar.publish import plotting
+from cislunar.utils import validation
 
 __all__ = ["convergence", "trajectories", "relative_motion", "thrust", "crlb_axes", "pareto", "equal_impulse",
            "keep_out_motivation", "absolute_trajectory", "relative_three_planes", "z_mirror", "thrust_profiles",
@@ -26,8 +29,33 @@ def _floor(v):
     return max(abs(v), 1e-16)
 
 
+def _show(show, n: int) -> list:
+    """Indices of the weights to draw: a non-empty sequence of integers in [0, n)."""
+    idx = list(_checks.integers(show, "show", minimum=0))
+    if max(idx) >= n:
+        raise ValueError(f"show must hold indices below {n} (the number of weights); got {idx}")
+    return idx
+
+
+def _same_length(n: int, **vectors) -> dict:
+    """Finite 1-D vectors, each of ``n`` entries (``n`` None: the length of the first)."""
+    out = {}
+    for name, value in vectors.items():
+        out[name] = _checks.vector(value, name, n=n)
+        n = out[name].size if n is None else n
+    return out
+
+
+def _window_days(value) -> np.ndarray:
+    w = validation.as_array(value, "window_days", shape=(2,))
+    if not w[0] < w[1]:
+        raise ValueError(f"window_days must be (start, end) with start < end; got {w}")
+    return w
+
+
 def convergence(penalty: studies.PenaltyStudy):
     """Predicted decrease, trust radius and largest defect per iteration: our solver against the printed one."""
+    validation.instance(penalty, "penalty", studies.PenaltyStudy)
     ha, hp = penalty.cold.history, penalty.printed["history"]
     its, itp = [h["iteration"] for h in ha], [h["iteration"] for h in hp]
     fig, axes = plt.subplots(1, 3, figsize=(14, 3.8))
@@ -49,6 +77,8 @@ def convergence(penalty: studies.PenaltyStudy):
 
 def trajectories(case: studies.Case1Sweep, show):
     """Fig. 1 analogue: the plans of the alpha_h indices ``show``, Moon-centred, thrust arcs red, coasts blue."""
+    validation.instance(case, "case", studies.Case1Sweep)
+    show = _show(show, len(case.alphas))
     sc, em, mps = case.scenario, case.scenario.system, case.scenario.system.velocity_unit_km_s * 1e3
     ref_dro = propagate(em, sc.observer_x0, np.linspace(0.0, sc.duration, 600)).x
     fig, axes = plt.subplots(1, 2, figsize=(10, 5.6))
@@ -76,6 +106,11 @@ def trajectories(case: studies.Case1Sweep, show):
 
 def relative_motion(alphas, rel_km):
     """Fig. 2 analogue: position relative to the reference DRO (``rel_km`` per alpha_h, km), x-y plane."""
+    alphas = _checks.vector(alphas, "alphas")
+    rel_km = _checks.sequence(rel_km, "rel_km")
+    if len(rel_km) != alphas.size:
+        raise ValueError(f"rel_km must hold one array per weight ({alphas.size}); got {len(rel_km)}")
+    rel_km = [validation.as_array(r, f"rel_km[{i}]", ndim=(2,), last=3) for i, r in enumerate(rel_km)]
     fig, ax = plt.subplots(figsize=(6.5, 5.5))
     cmap = plt.get_cmap("viridis")
     for j, (a, rel) in enumerate(zip(alphas, rel_km)):
@@ -90,6 +125,8 @@ def relative_motion(alphas, rel_km):
 
 def thrust(case: studies.Case1Sweep, show):
     """Fig. 3 analogue: |a| and its components over time for the alpha_h indices ``show`` (window shaded)."""
+    validation.instance(case, "case", studies.Case1Sweep)
+    show = _show(show, len(case.alphas))
     sc, em = case.scenario, case.scenario.system
     fig, axes = plt.subplots(1, 2, figsize=(13, 4.3), sharey=True, layout="constrained")
     scale = em.acceleration_unit_km_s2 * 1e6  # mm/s^2
@@ -113,6 +150,11 @@ def thrust(case: studies.Case1Sweep, show):
 
 def crlb_axes(system, alphas, crlb):
     """Fig. 4 analogue: CRLB position 1-sigma per axis (km) of observer and target over the window."""
+    check_system(system)
+    alphas = _checks.vector(alphas, "alphas")
+    crlb = validation.sequence_of(crlb, "crlb", wj.CRLBResult, "CRLBResult")
+    if len(crlb) != alphas.size:
+        raise ValueError(f"crlb must hold one CRLBResult per weight ({alphas.size}); got {len(crlb)}")
     cmap = plt.get_cmap("viridis")
     days_w = system.tu_to_days(crlb[0].t)
     fig, axes = plt.subplots(3, 2, figsize=(12, 8), sharex=True)
@@ -134,6 +176,8 @@ def crlb_axes(system, alphas, crlb):
 
 def pareto(alphas, impulse_mps, term_obs, term_tgt):
     """Fig. 5 analogue: total impulse against terminal position RMS, observer and target, labelled by alpha_h."""
+    v = _same_length(None, alphas=alphas, impulse_mps=impulse_mps, term_obs=term_obs, term_tgt=term_tgt)
+    alphas, impulse_mps, term_obs, term_tgt = v["alphas"], v["impulse_mps"], v["term_obs"], v["term_tgt"]
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
     for ax, term, name in zip(axes, (term_obs, term_tgt), ("observer", "target")):
         ax.plot(impulse_mps, term, "o-")
@@ -146,6 +190,13 @@ def pareto(alphas, impulse_mps, term_obs, term_tgt):
 
 def equal_impulse(impulse_mps, term_obs, budget_rows):
     """Solved equal-impulse plans against the sweep grid and its log-linear interpolation (zoom on the baseline)."""
+    impulse_mps = _checks.vector(impulse_mps, "impulse_mps", min_size=2)
+    term_obs = _checks.vector(term_obs, "term_obs", n=impulse_mps.size)
+    if np.any(term_obs <= 0):
+        raise ValueError("term_obs must be positive terminal RMS values (km)")
+    budget_rows = _checks.sequence(budget_rows, "budget_rows", allow_empty=True)
+    for i, r in enumerate(budget_rows):
+        validation.instance(r, f"budget_rows[{i}]", studies.BudgetRow, "a BudgetRow")
     fig, ax = plt.subplots(figsize=(7, 4.6), layout="constrained")
     x_hi = max([r.budget for r in budget_rows] + [impulse_mps[1]]) * 1.6  # zoom: the budgets and the next grid point
     zoom = impulse_mps <= x_hi
@@ -180,6 +231,8 @@ _PLANES = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
 
 def keep_out_motivation(scan: studies.KeepOutScan, keep_out_km: float):
     """MI gain against the closest approach to target 1, with the adopted keep-out."""
+    validation.instance(scan, "scan", studies.KeepOutScan)
+    keep_out_km = validation.positive(keep_out_km, "keep_out_km")
     fig, ax = plt.subplots(figsize=(6, 3.8))
     ax.semilogx(scan.d_km, scan.gain, "o-")
     ax.axvline(keep_out_km, color="C3", ls="--")
@@ -192,6 +245,10 @@ def keep_out_motivation(scan: studies.KeepOutScan, keep_out_km: float):
 
 def absolute_trajectory(sc, t, res, alpha):
     """Fig. 6 analogue: single-shooting flight of a plan in three planes (thrust red, coast blue), 10^3 km."""
+    validation.instance(sc, "sc", wj.Scenario)
+    t = validation.time_grid(t, "t", increasing=True)
+    _checks.plan(res, "res", n=t.size)
+    alpha = validation.real(alpha, "alpha")
     em = sc.system
     fig, axd = plotting.three_plane_axes(figsize=(15, 4.6))
     tf, xf = wj.fly(sc, t, res.u)
@@ -225,6 +282,9 @@ def absolute_trajectory(sc, t, res, alpha):
 def relative_three_planes(case: studies.Case2Sweep, departure_km, show):
     """Fig. 7 analogue: plans of the weights ``show`` relative to the reference DRO in three planes, and the
     largest departure (``departure_km`` per converged weight) against alpha_h."""
+    validation.instance(case, "case", studies.Case2Sweep)
+    departure_km = _checks.vector(departure_km, "departure_km", n=len(case.ok))
+    show = [validation.real(a, f"show[{i}]") for i, a in enumerate(_checks.sequence(show, "show"))]
     sc, t, ok = case.scenario, case.t, case.ok
     em = sc.system
     fig, axs = plt.subplots(1, 4, figsize=(17, 4.6), gridspec_kw={"width_ratios": [1, 1, 1, 0.8]})
@@ -263,6 +323,13 @@ def relative_three_planes(case: studies.Case2Sweep, departure_km, show):
 
 def z_mirror(sc, t, curves, window_days):
     """z over time of plans ``curves`` (``{(alpha, label): result or exception}``), window shaded."""
+    validation.instance(sc, "sc", wj.Scenario)
+    t = validation.time_grid(t, "t", increasing=True)
+    validation.instance(curves, "curves", dict, "a dict {(alpha, label): result or exception}")
+    for key, res in curves.items():
+        if not isinstance(res, Exception):
+            _checks.plan(res, f"curves[{key!r}]", n=t.size)
+    window_days = _window_days(window_days)
     em = sc.system
     fig, ax = plt.subplots(figsize=(11, 4.4))
     for n_, ((a, what), res) in enumerate(curves.items()):
@@ -281,6 +348,15 @@ def z_mirror(sc, t, curves, window_days):
 
 def thrust_profiles(sc, t, plans, window_days):
     """Fig. 8 analogue: node accelerations of ``plans`` (``[(alpha, result)]``) in mm/s^2, window shaded."""
+    validation.instance(sc, "sc", wj.Scenario)
+    t = validation.time_grid(t, "t", increasing=True)
+    plans = _checks.sequence(plans, "plans")
+    for i, pair in enumerate(plans):
+        if not isinstance(pair, (tuple, list)) or len(pair) != 2:
+            raise validation.ArgumentTypeError(f"plans[{i}] must be a pair (alpha, result); got {type(pair).__name__}")
+        validation.real(pair[0], f"plans[{i}] alpha")
+        _checks.plan(pair[1], f"plans[{i}] result", n=t.size)
+    window_days = _window_days(window_days)
     em = sc.system
     fig, axes = plt.subplots(1, 2, figsize=(13, 4), sharey=True)
     days = em.tu_to_days(t)
@@ -302,6 +378,12 @@ def thrust_profiles(sc, t, plans, window_days):
 def crlb_objects(system, crlbs):
     """Fig. 9 analogue: position RMS (km) of the observer and each target over the window, ``crlbs`` a dict
     ``alpha -> CRLBResult`` (grey, blue, red in order)."""
+    check_system(system)
+    validation.instance(crlbs, "crlbs", dict, "a dict {alpha: CRLBResult}")
+    if not crlbs:
+        raise ValueError("crlbs must hold at least one CRLBResult")
+    for a, c in crlbs.items():
+        validation.instance(c, f"crlbs[{a!r}]", wj.CRLBResult, "a CRLBResult")
     names = ["observer", "target 1", "target 2", "target 3"]
     fig, axes = plt.subplots(1, 4, figsize=(15, 3.8), sharey=True)
     for i, ax in enumerate(axes):
@@ -317,6 +399,8 @@ def crlb_objects(system, crlbs):
 
 def noise_readings(system, readings: studies.NoiseReadings):
     """Test case 1's ballistic observer RMS under each reading of the process noise."""
+    check_system(system)
+    validation.instance(readings, "readings", studies.NoiseReadings)
     fig, ax = plt.subplots(figsize=(7, 4))
     for (t, rms), row in zip(readings.curves, readings.rows):
         ax.semilogy(system.tu_to_days(t), rms, "o-", ms=3, label=row[0])
@@ -329,6 +413,7 @@ def noise_readings(system, readings: studies.NoiseReadings):
 
 def pareto_fronts(fr: studies.Front):
     """Fig. 10 analogue: impulse against terminal RMS (observer, targets), and MI against RMS."""
+    validation.instance(fr, "fr", studies.Front)
     dvs, rms_obs, rms_tgt, mis = fr.dv, fr.rms_obs, fr.rms_tgt, fr.mi
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
     axes[0].loglog(np.maximum(dvs, 1e-3), rms_obs, "o-")
@@ -363,6 +448,12 @@ def pareto_fronts(fr: studies.Front):
 def keep_out_sweep(radius_rows, neighbours, keep_out_km, alpha):
     """MI and terminal RMS against the keep-out radius at one weight; dashed: the neighbouring weights' optima
     (``neighbours``: PlanRows)."""
+    radius_rows = validation.sequence_of(radius_rows, "radius_rows", studies.RadiusRow, "RadiusRow")
+    neighbours = _checks.sequence(neighbours, "neighbours", allow_empty=True)
+    for i, nb in enumerate(neighbours):
+        validation.instance(nb, f"neighbours[{i}]", studies.PlanRow, "a PlanRow")
+    keep_out_km = validation.positive(keep_out_km, "keep_out_km")
+    alpha = validation.real(alpha, "alpha")
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
     dd = np.array([r.d for r in radius_rows])
     bind = np.array([r.binds for r in radius_rows])

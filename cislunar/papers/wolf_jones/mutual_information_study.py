@@ -29,6 +29,7 @@ import numpy as np
 
 from cislunar.cr3bp.dynamics import CR3BP, EARTH_MOON, check_system
 from cislunar.cr3bp.propagation import find_events, propagate
+from cislunar.papers.wolf_jones import _checks
 from cislunar.sensing import covariance as cov
 from cislunar.sensing import information as info
 from cislunar.sensing import measurements as meas
@@ -138,6 +139,8 @@ def constant_velocity_toy(dt: float = 1.0, n_times: int = 3, *, psd: float = 0.0
     variance ``r``; process noise of PSD ``psd`` discretised exactly (Van Loan); prior ``diag(1, 0.5)``."""
     dt = validation.positive(dt, "dt")
     n = validation.integer(n_times, "n_times", minimum=2)
+    psd = validation.positive(psd, "psd", allow_zero=True)
+    r = validation.positive(r, "r")
     F = np.tile([[1.0, dt], [0.0, 1.0]], (n - 1, 1, 1))
     Q = np.tile(psd * np.array([[dt**3 / 3, dt**2 / 2], [dt**2 / 2, dt]]), (n - 1, 1, 1))
     H = np.tile([[[1.0, 0.0]]], (n, 1, 1))
@@ -273,6 +276,8 @@ def window_crlb(window: Case2Window) -> WindowCRLB:
 def observer_information(window: Case2Window, x) -> float:
     """Eq. 18 (chain rule) of the window re-propagated from observer window-start state ``x`` (LU, LU/TU), with the
     process noise held at the reference's (as the paper's gradient assumes)."""
+    validation.instance(window, "window", Case2Window)
+    x = validation.as_state(x, "x", batch=False)
     lin = window.lin
     return info.window_information(cov.linearize_augmented(window.system, x, window.start[1:], window.t,
                                                            meas.RANGE_RANGE_RATE, window.R, lin.P0, Q=lin.Q))
@@ -334,8 +339,9 @@ def linearisation_check(window: Case2Window, gradient: GradientCheck,
                         steps_km=(1.0, 10.0, 100.0, 1000.0)) -> LinearisationCheck:
     """Step the observer along the unit structured gradient by each of ``steps_km`` (km converted to LU) and compare
     the re-propagated MI with ``I + grad . dx`` (Eq. 44)."""
+    validation.instance(window, "window", Case2Window)
     validation.instance(gradient, "gradient", GradientCheck)
-    steps = np.asarray(steps_km, dtype=float)
+    steps = _checks.vector(steps_km, "steps_km")
     direction = gradient.structured / np.linalg.norm(gradient.structured)
     dx = np.array([direction * window.system.km_to_lu(s) for s in steps])
     true = np.array([observer_information(window, window.start[0] + d) for d in dx])
@@ -471,9 +477,12 @@ def baseline_study(window: Case2Window, n_baselines: int, *, min_phase: float = 
 
 def crossover(sizes, ratios) -> str:
     """Window size at which the dense/structured time ratio first reaches 1 (log-log interpolation), as text."""
-    sizes, ratios = list(sizes), np.asarray(ratios, dtype=float)
-    if len(sizes) != ratios.size or not sizes:
-        raise ValueError("sizes and ratios must be non-empty and of equal length")
+    _checks.vector(sizes, "sizes")
+    sizes, ratios = list(sizes), _checks.vector(ratios, "ratios")
+    if len(sizes) != ratios.size:
+        raise ValueError(f"sizes and ratios must be of equal length; got {len(sizes)} and {ratios.size}")
+    if np.any(ratios <= 0):
+        raise ValueError("ratios must be positive (time ratios)")
     if ratios[0] >= 1.0:
         return f"at or below N = {sizes[0]}"
     j = int(np.argmax(ratios >= 1.0))
@@ -506,7 +515,9 @@ def timing_study(window: Case2Window, sizes, *, min_time: float = 0.1, repeat: i
     """Time dense Eq. 18 and the chain rule (value, value + gradient) on one DRO period of the window's geometry
     with ``N`` equally spaced measurement times for each ``N`` in ``sizes``."""
     validation.instance(window, "window", Case2Window)
-    sizes = tuple(validation.integer(n, "size", minimum=2) for n in sizes)
+    sizes = _checks.integers(sizes, "sizes", minimum=2)
+    min_time = validation.positive(min_time, "min_time")
+    repeat = validation.integer(repeat, "repeat", minimum=1)
     results = []
     for n in sizes:
         t_n = np.linspace(window.P_ref, 2 * window.P_ref, n)
@@ -523,6 +534,7 @@ def timing_study(window: Case2Window, sizes, *, min_time: float = 0.1, repeat: i
 
 def figure_angular_noise(mean_range_km: float = 215.0):
     """AMOS Eq. 20 angular noise against range, with the resolution/pointing crossover and the AMOS mean range."""
+    mean_range_km = validation.positive(mean_range_km, "mean_range_km")
     rho_km = np.logspace(0, 5, 200)  # 1 km up: below it the noise exceeds 4 mrad, of no use for tracking
     sig = meas.angular_sigma(rho_km, meas.AMOS_SIGMA_MIN_RAD, meas.AMOS_RESOLUTION_KM)
     fig, ax = plt.subplots(figsize=(5.5, 3.5))
@@ -537,6 +549,7 @@ def figure_angular_noise(mean_range_km: float = 215.0):
 
 def figure_crlb(crlb: WindowCRLB):
     """Total / in-plane / out-of-plane RMS along the window, target over observer in-plane RMS, and the gains."""
+    validation.instance(crlb, "crlb", WindowCRLB)
     days = crlb.days
     fig, (ax1, ax2, ax3) = plt.subplots(1, 3, figsize=(14, 4.0), layout="constrained")
     for i in range(4):
@@ -561,6 +574,7 @@ def figure_crlb(crlb: WindowCRLB):
 
 def figure_baseline(curves):
     """MI gain and terminal CRLB (in-plane and total) against the mean baseline, one colour per measurement type."""
+    curves = validation.sequence_of(curves, "curves", BaselineCurve, "BaselineCurve")
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.6))
     for k, c in enumerate(curves):
         b_km = c.baseline_km
@@ -583,6 +597,7 @@ def figure_baseline(curves):
 
 def figure_timing(timing: TimingStudy):
     """Time per evaluation against the number of measurement times, log-log."""
+    validation.instance(timing, "timing", TimingStudy)
     sizes, res = list(timing.sizes), timing.results
     fig, ax = plt.subplots(figsize=(5.5, 3.8))
     ax.loglog(sizes, [1e3 * r.dense_value for r in res], "o-", label="dense Eq. 18")

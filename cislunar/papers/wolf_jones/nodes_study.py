@@ -25,7 +25,7 @@ import numpy as np
 from cislunar.cr3bp import orbits, propagation
 from cislunar.cr3bp.dynamics import CR3BP, check_system
 from cislunar.guidance import discretization as D
-from cislunar.papers.wolf_jones import reference
+from cislunar.papers.wolf_jones import _checks, reference
 from cislunar.publish import plotting
 from cislunar.utils import validation
 from cislunar.utils.montecarlo import map_tasks
@@ -79,10 +79,26 @@ class NodeSweep:
 def node_sweep(system: CR3BP, arcs: dict, sigmas, n_nodes: int) -> NodeSweep:
     """Sundman nodes (Eqs. 37-39) for every arc of ``arcs`` and every exponent of ``sigmas``."""
     check_system(system)
+    arcs = _arcs(arcs)
     n = validation.integer(n_nodes, "n_nodes", minimum=3)
-    sigmas = tuple(validation.positive(s, "sigma", allow_zero=True) for s in sigmas)
+    sigmas = tuple(validation.positive(s, f"sigmas[{i}]", allow_zero=True)
+                   for i, s in enumerate(_checks.sequence(sigmas, "sigmas")))
     nodes = {(name, s): D.sundman_nodes(system, x0, tf, n, s)[0] for name, (x0, tf) in arcs.items() for s in sigmas}
     return NodeSweep(dict(arcs), sigmas, n, nodes)
+
+
+def _arcs(arcs) -> dict:
+    """Check ``{name: (x0 (6,), tf > 0)}`` and return it as a dict of ``(ndarray, float)``."""
+    validation.instance(arcs, "arcs", dict, "a dict {name: (x0, tf)}")
+    if not arcs:
+        raise ValueError("arcs must hold at least one arc")
+    out = {}
+    for name, arc in arcs.items():
+        if not isinstance(arc, (tuple, list)) or len(arc) != 2:
+            raise validation.ArgumentTypeError(f"arcs[{name!r}] must be a pair (x0, tf); got {type(arc).__name__}")
+        out[name] = (validation.as_state(arc[0], f"arcs[{name!r}] x0", batch=False),
+                     validation.positive(arc[1], f"arcs[{name!r}] tf"))
+    return out
 
 
 def _draw_profiles(rng: np.random.Generator, draws: int) -> list:
@@ -116,9 +132,13 @@ def linearisation_error(system: CR3BP, x0, t_nodes, draws: int, rng: np.random.G
     arc.  Each interval starts from its reference node (multiple shooting, as SCvx linearises); the nonlinear flow
     with the perturbed controls is compared with the affine prediction of Eq. 28 about the ballistic reference.
     """
+    check_system(system)
+    x0 = validation.as_state(x0, "x0", batch=False)
+    t_nodes = validation.time_grid(t_nodes, "t_nodes", increasing=True)
     n = validation.integer(draws, "draws", minimum=1)
     validation.instance(rng, "rng", np.random.Generator)
-    return _error_of_profiles(system, x0, t_nodes, _draw_profiles(rng, n), float(a_max))
+    a_max = validation.positive(a_max, "a_max", allow_zero=True)
+    return _error_of_profiles(system, x0, t_nodes, _draw_profiles(rng, n), a_max)
 
 
 @dataclass(frozen=True)
@@ -153,13 +173,16 @@ def linearisation_sweep(system: CR3BP, sweep: NodeSweep, draws: int, rng: np.ran
     through ``executor`` (:func:`cislunar.utils.montecarlo.map_tasks`; ``None``: serially), so the result does not
     depend on the executor.
     """
+    check_system(system)
     validation.instance(sweep, "sweep", NodeSweep)
     if 0.0 not in sweep.sigmas:
         raise ValueError("the sweep must contain sigma = 0 (uniform nodes), the reference of every gain")
     n = validation.integer(draws, "draws", minimum=1)
     validation.instance(rng, "rng", np.random.Generator)
     a_max = float(validation.positive(a_max, "a_max", allow_zero=True))
-    extra_seeds = [validation.integer(seed, "extra seed", minimum=0) for seed in extra_seeds]
+    extra_seeds = [validation.integer(seed, f"extra_seeds[{i}]", minimum=0)
+                   for i, seed in enumerate(_checks.sequence(extra_seeds, "extra_seeds", allow_empty=True))]
+    _checks.executor(executor)
     keys = list(sweep.nodes)
     tasks = [(system, sweep.arcs[name][0], sweep.nodes[name, s], _draw_profiles(rng, n), a_max) for name, s in keys]
     x0 = sweep.arcs[DRO_ARC][0]
@@ -177,13 +200,18 @@ def linearisation_sweep(system: CR3BP, sweep: NodeSweep, draws: int, rng: np.ran
 def eq40_residual(t_nodes, a_max: float) -> float:
     """Largest relative residual of Eq. 40, ``(u_k + u_{k+1}) / (2 dt_k) = a_max``, for the minimum-norm bounds of
     Eq. 41 on ``t_nodes``."""
-    t = np.asarray(t_nodes, dtype=float)
+    t = validation.time_grid(t_nodes, "t_nodes", increasing=True)
+    a_max = validation.positive(a_max, "a_max")
     u = D.max_control_per_node(t, a_max)
     return float(np.max(np.abs((u[:-1] + u[1:]) / (2 * np.diff(t)) - a_max)) / a_max)
 
 
 def moon_distance_km(system: CR3BP, x0, tf: float, n: int = 1500) -> np.ndarray:
     """Distance to the Moon along the arc from ``x0`` over ``[0, tf]`` at ``n`` equally spaced times, km."""
+    check_system(system)
+    x0 = validation.as_state(x0, "x0", batch=False)
+    tf = validation.positive(tf, "tf")
+    n = validation.integer(n, "n", minimum=2)
     dense = propagation.propagate(system, x0, np.linspace(0, tf, n)).x
     return np.linalg.norm(dense[:, :3] - system.secondary_position, axis=1) * system.length_unit_km
 
@@ -195,6 +223,8 @@ def moon_distance_km(system: CR3BP, x0, tf: float, n: int = 1500) -> np.ndarray:
 
 def figure_node_spacing(system: CR3BP, sweep: NodeSweep):
     """Node spacing (hours) against time, one panel per arc, one curve per sigma."""
+    check_system(system)
+    validation.instance(sweep, "sweep", NodeSweep)
     em = system
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.6), layout="constrained")
     for ax, name in zip(axes, sweep.arcs):
@@ -218,6 +248,10 @@ def figure_node_spacing(system: CR3BP, sweep: NodeSweep):
 
 def figure_nodes_on_orbits(system: CR3BP, sweep: NodeSweep):
     """Each arc (Moon-centred, DRO in x-y, NRHO in y-z) with its nodes for sigma = 0 and the largest sigma."""
+    check_system(system)
+    validation.instance(sweep, "sweep", NodeSweep)
+    if 0.0 not in sweep.sigmas:
+        raise ValueError("sweep must contain sigma = 0 (uniform nodes, drawn against the largest sigma)")
     em = system
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.4), layout="constrained")
     for ax, name, plane in zip(axes, sweep.arcs, ("xy", "yz")):
@@ -238,6 +272,8 @@ def figure_nodes_on_orbits(system: CR3BP, sweep: NodeSweep):
 
 def figure_linearisation_error(sweep: NodeSweep, lin: LinearisationSweep):
     """Linearisation error against sigma, one curve per arc."""
+    validation.instance(sweep, "sweep", NodeSweep)
+    validation.instance(lin, "lin", LinearisationSweep)
     fig, ax = plt.subplots()
     for name in sweep.arcs:
         ax.semilogy(sweep.sigmas, [lin.errors[name, s] for s in sweep.sigmas], "o-", label=name)
@@ -250,6 +286,10 @@ def figure_linearisation_error(sweep: NodeSweep, lin: LinearisationSweep):
 
 def figure_node_bounds(system: CR3BP, sweep: NodeSweep, arc: str, a_max: float):
     """Eq. 41 minimum-norm node bounds as printed (impulse units, m/s) on ``arc`` for every sigma."""
+    check_system(system)
+    validation.instance(sweep, "sweep", NodeSweep)
+    validation.choice(arc, "arc", tuple(sweep.arcs))
+    a_max = validation.positive(a_max, "a_max")
     em = system
     fig, ax = plt.subplots()
     for s in sweep.sigmas:

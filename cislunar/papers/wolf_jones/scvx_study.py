@@ -27,7 +27,7 @@ import numpy as np
 from cislunar.cr3bp.propagation import propagate
 from cislunar.guidance import discretization as D
 from cislunar.guidance import scvx
-from cislunar.papers.wolf_jones import scenarios
+from cislunar.papers.wolf_jones import _checks, scenarios
 from cislunar.publish import plotting
 from cislunar.utils import validation
 from cislunar.utils.montecarlo import map_tasks
@@ -95,6 +95,8 @@ def transfer_problem(n_nodes: int, sigma: float = 1.0, *, a_max_km_s2: float | N
     the thrust-acceleration bound ``a_max_km_s2`` (km/s^2; ``None``: Table 3's value)."""
     n = validation.integer(n_nodes, "n_nodes", minimum=4)
     sigma = validation.positive(sigma, "sigma", allow_zero=True)
+    if a_max_km_s2 is not None:
+        a_max_km_s2 = validation.positive(a_max_km_s2, "a_max_km_s2")
     sc = scenarios.test_case_1() if a_max_km_s2 is None else scenarios.test_case_1(a_max_km_s2=a_max_km_s2)
     dro = sc.row_checks["observer_t0"].corrected
     t, k_ws, k_we = sc.node_times(n, sigma)
@@ -107,10 +109,20 @@ def solve(problem: TransferProblem, settings: scvx.SCvxSettings | None = None, *
           u_guess=None) -> scvx.SCvxResult:
     """One SCvx run of ``problem`` (default: ballistic state guess, zero controls, default settings)."""
     validation.instance(problem, "problem", TransferProblem)
+    if settings is not None:
+        validation.instance(settings, "settings", scvx.SCvxSettings)
     x = problem.x_guess if x_guess is None else x_guess
     u = np.zeros((problem.t.size, 3)) if u_guess is None else u_guess
     return scvx.solve_scvx(problem.system, problem.t, x, u, problem.u_max, x_final=problem.x_final,
                            settings=scvx.SCvxSettings() if settings is None else settings)
+
+
+def _run(result, name: str = "result"):
+    """An SCvx run with an iteration history (an SCvxResult, an SCvxError or any object with a ``history`` list)."""
+    if not isinstance(getattr(result, "history", None), list):
+        raise validation.ArgumentTypeError(f"{name} must be an SCvx run with a history list (an SCvxResult or "
+                                           f"SCvxError); got {type(result).__name__}")
+    return result
 
 
 @dataclass(frozen=True)
@@ -138,6 +150,8 @@ class IterationSummary:
 
 def iteration_summary(result, settings: scvx.SCvxSettings) -> IterationSummary:
     """Summarise ``result.history`` under the noise rule of ``settings``."""
+    _run(result)
+    validation.instance(settings, "settings", scvx.SCvxSettings)
     hist = result.history
     if not hist:
         raise ValueError("the result has no iteration history")
@@ -164,6 +178,8 @@ class ShootingCheck:
 
 def single_shooting(problem: TransferProblem, u) -> ShootingCheck:
     """Fly the first-order-hold control ``u`` (LU/TU^2 at the nodes) through the nonlinear dynamics from ``x0``."""
+    validation.instance(problem, "problem", TransferProblem)
+    u = validation.as_array(u, "u", shape=(problem.t.size, 3))
     em = problem.system
     x = D.propagate_foh(em, problem.x0, problem.t, u)
     return ShootingCheck(x, float(np.linalg.norm(x[-1, :3] - problem.x_final[:3]) * em.length_unit_km),
@@ -204,11 +220,13 @@ def guess_study(problem: TransferProblem, n_guesses: int, rng: np.random.Generat
     The random controls are drawn from ``rng`` here, guess after guess; the runs then go through ``executor``
     (:func:`cislunar.utils.montecarlo.map_tasks`; ``None``: serially), so the result does not depend on it.
     """
+    validation.instance(problem, "problem", TransferProblem)
     n = validation.integer(n_guesses, "n_guesses", minimum=1)
     validation.instance(rng, "rng", np.random.Generator)
     ref = validation.positive(reference_impulse, "reference_impulse")
     scale = validation.positive(control_scale, "control_scale", allow_zero=True)
     max_iter = validation.integer(max_iter, "max_iter", minimum=1)
+    _checks.executor(executor)
     t = problem.t
     guess = blended_guess(problem)
     tasks = [(problem, guess,
@@ -226,6 +244,9 @@ def guess_study(problem: TransferProblem, n_guesses: int, rng: np.random.Generat
 
 def figure_iterations(result, settings: scvx.SCvxSettings, velocity_unit_km_s: float):
     """Cost per step (with the multiplier-update jumps), impulse after each step and largest defect after each step."""
+    _run(result)
+    validation.instance(settings, "settings", scvx.SCvxSettings)
+    velocity_unit_km_s = validation.positive(velocity_unit_km_s, "velocity_unit_km_s")
     hist = result.history
     updates = [h["iteration"] for h in hist if h["multiplier_update"]]
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.4), layout="constrained")
@@ -263,6 +284,9 @@ def figure_iterations(result, settings: scvx.SCvxSettings, velocity_unit_km_s: f
 
 def figure_converged_control(problem: TransferProblem, u, shooting: ShootingCheck):
     """Thrust-acceleration norm at the nodes (window shaded) and the flown trajectory minus the initial DRO."""
+    validation.instance(problem, "problem", TransferProblem)
+    u = validation.as_array(u, "u", shape=(problem.t.size, 3))
+    validation.instance(shooting, "shooting", ShootingCheck)
     em, t = problem.system, problem.t
     k_ws, k_we = problem.k_window
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.6), layout="constrained")

@@ -21,9 +21,11 @@ import numpy as np
 from scipy.stats import spearmanr
 
 from cislunar.cr3bp import orbits
+from cislunar.cr3bp.dynamics import check_system
 from cislunar.cr3bp.propagation import ImpactError, propagate, propagate_stm
 from cislunar.guidance import discretization as D
 from cislunar.guidance import scvx
+from cislunar.papers.wolf_jones import _checks
 from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.sensing import covariance as cov
 from cislunar.utils import montecarlo, validation
@@ -36,7 +38,7 @@ __all__ = ["case1_scenario_summary", "SlipStudy", "table2_slip", "Case1Sweep", "
            "noise_readings", "Front", "front", "RecordingInformation", "FreeRun", "free_run", "RadiusRow", "radius_row",
            "alt_grid_sweep", "MirrorStudy", "mirror_study", "case2_budget", "radius_summary", "dominated_note",
            "KeepOutStudy", "keep_out_study", "Case2Runs", "case2_runs", "KeepOutJobs",
-           "queue_keep_out_runs"]
+           "queue_keep_out_runs", "dense_flight"]
 
 
 def _mps(system) -> float:
@@ -46,6 +48,29 @@ def _mps(system) -> float:
 def _dv(res, system) -> float:
     """Total impulse of an SCvx result in m/s."""
     return res.impulse * system.velocity_unit_km_s * 1e3
+
+
+def _alphas(value, name: str = "alphas") -> np.ndarray:
+    """Homotopy weights: a non-empty, strictly increasing vector inside [0, 1]."""
+    a = _checks.vector(value, name)
+    if np.any(a < 0) or np.any(a > 1) or np.any(np.diff(a) <= 0):
+        raise ValueError(f"{name} must be strictly increasing within [0, 1]; got {a}")
+    return a
+
+
+def _node(value, name: str, n: int) -> int:
+    """A node index on a grid of ``n`` nodes."""
+    return validation.integer(value, name, minimum=0, maximum=n - 1)
+
+
+def _rows(value, name: str, width: int, *, allow_empty: bool = True) -> list:
+    """A sequence of tuples of ``width`` entries."""
+    rows = _checks.sequence(value, name, allow_empty=allow_empty)
+    for i, r in enumerate(rows):
+        if not isinstance(r, tuple) or len(r) != width:
+            raise validation.ArgumentTypeError(f"{name}[{i}] must be a tuple of {width} entries; got "
+                                               f"{type(r).__name__} {r!r:.60}")
+    return rows
 
 
 # --------------------------------------------------------------------------------------------------------------
@@ -115,6 +140,7 @@ class SlipStudy:
 def case1_scenario_summary(sc: wj.Scenario) -> str:
     """The test case 1 scenario in words: period, window, measurements, thrust bound, process noise, and the
     printed observer state against its periodic correction."""
+    validation.instance(sc, "sc", wj.Scenario)
     em, tm, chk = sc.system, sc.measurement_times, sc.row_checks["observer_t0"]
     return "\n".join([
         f"P_ref = {em.tu_to_days(sc.period):.3f} d; scenario {em.tu_to_days(sc.duration):.2f} d; window "
@@ -138,9 +164,10 @@ def table2_slip(sc: wj.Scenario, sc2: wj.Scenario, n_nodes: int, sigma: float = 
     sigma : float
         Sundman exponent.
     """
-    for s in (sc, sc2):
-        validation.instance(s, "scenario", wj.Scenario)
+    validation.instance(sc, "sc", wj.Scenario)
+    validation.instance(sc2, "sc2", wj.Scenario)
     n_nodes = validation.integer(n_nodes, "n_nodes", minimum=4)
+    sigma = validation.real(sigma, "sigma")
     em = sc.system
     try:
         propagate(em, sc.observer_x0_printed, [0.0, sc.duration])
@@ -282,7 +309,10 @@ def sweep_test_case_1(sc: wj.Scenario, n_nodes: int, alphas, *, sigma: float = 1
     """
     validation.instance(sc, "sc", wj.Scenario)
     n_nodes = validation.integer(n_nodes, "n_nodes", minimum=4)
-    alphas = tuple(float(a) for a in alphas)
+    alphas = tuple(float(a) for a in _alphas(alphas))
+    sigma = validation.real(sigma, "sigma")
+    forward_hessian = validation.boolean(forward_hessian, "forward_hessian")
+    validation.boolean(progress, "progress")
     t, k_ws, k_we = sc.node_times(n_nodes, sigma)
     x_ball, u_ball = sc.ballistic_guess(t)
     info = sc.information_model()
@@ -392,6 +422,11 @@ def penalty_study(case: Case1Sweep, gammas, n_iter: int, n_iter_long: int, *, al
     validation.instance(case, "case", Case1Sweep)
     n_iter = validation.integer(n_iter, "n_iter", minimum=1)
     n_iter_long = validation.integer(n_iter_long, "n_iter_long", minimum=1)
+    gammas = _checks.vector(gammas, "gammas")
+    if np.any(gammas <= 0):
+        raise ValueError(f"gammas must be positive penalty weights; got {gammas}")
+    alpha = validation.in_range(alpha, "alpha", 0.0, 1.0)
+    _checks.executor(executor)
     tasks = [(float(g), n_iter, "linear") for g in gammas] + [(1e3, n_iter_long, "linear"), (1e3, n_iter, "quadratic")]
     run = functools.partial(_penalty_task, _penalty_problem(case, alpha))
     if executor is None:
@@ -476,9 +511,13 @@ def mesh_check(case: Case1Sweep, n_alt: int, alpha: float, *, sigma: float = 1.0
     """Solve ``alpha`` again on an ``n_alt``-node Sundman grid, warm-started from the sweep's solution
     interpolated onto it, and compare."""
     validation.instance(case, "case", Case1Sweep)
+    n_alt = validation.integer(n_alt, "n_alt", minimum=4)
+    if validation.real(alpha, "alpha") not in case.alphas:
+        raise ValueError(f"alpha must be one of the sweep's weights {case.alphas}; got {alpha!r}")
+    sigma = validation.real(sigma, "sigma")
     sc, i = case.scenario, case.index(alpha)
     b = case.best[i]
-    t_alt, k_alt, _ = sc.node_times(validation.integer(n_alt, "n_alt", minimum=4), sigma)
+    t_alt, k_alt, _ = sc.node_times(n_alt, sigma)
     x_alt = np.stack([np.interp(t_alt, case.t, b.x[:, j]) for j in range(6)], axis=1)
     u_alt = np.stack([np.interp(t_alt, case.t, b.u[:, j]) for j in range(3)], axis=1)
     solver = wj.ScenarioSolver(sc, t_alt, k_alt, information=case.info, settings=case.solver.settings)
@@ -491,6 +530,9 @@ def mesh_check(case: Case1Sweep, n_alt: int, alpha: float, *, sigma: float = 1.0
 
 def dense_flight(case: Case1Sweep, res, n: int = 600):
     """Dense re-flight of a plan (FOH control, linear between nodes): ``(t, x, u)`` on ``n`` points plus nodes."""
+    validation.instance(case, "case", Case1Sweep)
+    _checks.plan(res, "res", n=case.t.size)
+    n = validation.integer(n, "n", minimum=2)
     sc = case.scenario
     td = np.union1d(case.t, np.linspace(0.0, case.t[-1], n))
     ud = np.stack([np.interp(td, case.t, res.u[:, i]) for i in range(3)], axis=1)
@@ -499,6 +541,8 @@ def dense_flight(case: Case1Sweep, res, n: int = 600):
 
 def departures_km(case: Case1Sweep, n: int = 400) -> tuple:
     """Per alpha_h: ``(t, relative position to the reference DRO (k, 3) in km)``, and the largest distance (km)."""
+    validation.instance(case, "case", Case1Sweep)
+    n = validation.integer(n, "n", minimum=2)
     sc = case.scenario
     rel, dep = [], []
     for r in case.best:
@@ -586,8 +630,13 @@ def budget_study(case: Case1Sweep, term_obs, extras_mps, *, rtol: float = 0.02) 
     Returns ``(rows, messages)``: a :class:`BudgetRow` per budget reached, and one line per budget (reached or
     not)."""
     validation.instance(case, "case", Case1Sweep)
+    term_obs = _checks.vector(term_obs, "term_obs", n=len(case.alphas))
+    if np.any(term_obs <= 0):
+        raise ValueError("term_obs must be positive terminal RMS values (km)")
+    extras_mps = _checks.vector(extras_mps, "extras_mps")
+    rtol = validation.in_range(rtol, "rtol", 0.0, 1.0, closed=False)
     sc, mps = case.scenario, _mps(case.scenario.system)
-    imp, term_obs = case.impulse_mps, np.asarray(term_obs, dtype=float)
+    imp = case.impulse_mps
     rows, msgs = [], []
     for extra in extras_mps:
         b = imp[0] + extra
@@ -647,7 +696,10 @@ class GradientCheck:
 def gradient_check(info, x, system, *, h: float = 2e-7) -> GradientCheck:
     """Check ``info``'s gradient at ``x`` by fourth-order central differences (step ``h``) and probe the MI's
     z-curvature (1 m/s in vz either way)."""
+    validation.callable_(info, "info")
     x = validation.as_array(x, "x", shape=(6,))
+    check_system(system)
+    h = validation.positive(h, "h")
     i0 = info(x)
     i1, g = info(x, 1)
     g_fd = np.array([(8 * (info(x + h * e) - info(x - h * e)) - (info(x + 2 * h * e) - info(x - 2 * h * e)))
@@ -690,7 +742,12 @@ def _observer_passing_at(system, t2, r_tgt, d_km, x0, iterations=6):
 def keep_out_scan(sc: wj.Scenario, info, x_ws, n_points: int, *, d_range_km=(1e-6, 3000.0)) -> KeepOutScan:
     """Scan the closest approach to target 1 at the middle measurement over ``n_points`` log-spaced distances."""
     validation.instance(sc, "sc", wj.Scenario)
+    validation.callable_(info, "info")
+    x_ws = validation.as_state(x_ws, "x_ws", batch=False)
     n_points = validation.integer(n_points, "n_points", minimum=2)
+    d_range_km = validation.as_array(d_range_km, "d_range_km", shape=(2,))
+    if not 0 < d_range_km[0] < d_range_km[1]:
+        raise ValueError(f"d_range_km must be (closest, farthest) with 0 < closest < farthest; got {d_range_km}")
     em, tm = sc.system, sc.measurement_times
     t2 = tm[[0, tm.size // 2]]
     r_tgt = propagate(em, info.targets_x0[0], t2).x[-1, :3]
@@ -723,6 +780,12 @@ class PlanRow:
 
 def plan_row(sc: wj.Scenario, solver, k_ws: int, k_we: int, alpha: float, res, source: str = "") -> PlanRow:
     """Figures of merit of one converged plan on ``solver``'s grid."""
+    validation.instance(sc, "sc", wj.Scenario)
+    validation.instance(solver, "solver", wj.ScenarioSolver)
+    k_ws, k_we = _node(k_ws, "k_ws", solver.t.size), _node(k_we, "k_we", solver.t.size)
+    alpha = validation.real(alpha, "alpha")
+    _checks.plan(res, "res", n=solver.t.size)
+    validation.instance(source, "source", str)
     em = sc.system
     ko = sc.keep_out(k_ws)
     u_norm = np.linalg.norm(res.u, axis=1)
@@ -806,6 +869,11 @@ class Case2Sweep:
 
 def case2_rows(sc: wj.Scenario, solver, k_ws: int, k_we: int, sweep, seconds: float = float("nan")) -> Case2Sweep:
     """Evaluate every best plan of a test-case-2 sweep (:func:`plan_row`)."""
+    validation.instance(sc, "sc", wj.Scenario)
+    validation.instance(solver, "solver", wj.ScenarioSolver)
+    k_ws, k_we = _node(k_ws, "k_ws", solver.t.size), _node(k_we, "k_we", solver.t.size)
+    validation.instance(sweep, "sweep", scvx.SweepResult)
+    seconds = validation.real(seconds, "seconds", finite=False)
     rows = [None if res is None else plan_row(sc, solver, k_ws, k_we, a, res, src)
             for a, res, src in zip(sweep.alphas, sweep.best, sweep.source)]
     return Case2Sweep(sc, tuple(float(a) for a in sweep.alphas), solver.t, k_ws, k_we, solver, sweep, rows, seconds)
@@ -813,6 +881,9 @@ def case2_rows(sc: wj.Scenario, solver, k_ws: int, k_we: int, sweep, seconds: fl
 
 def departure_km(sc: wj.Scenario, t, res) -> float:
     """Largest distance (km) of a plan's re-flight from the reference DRO over the scenario."""
+    validation.instance(sc, "sc", wj.Scenario)
+    t = validation.time_grid(t, "t", increasing=True)
+    _checks.plan(res, "res", n=t.size)
     tf, xf = wj.fly(sc, t, res.u, refine=4)
     rel = (xf - propagate(sc.system, sc.observer_x0, tf).x)[:, :3] * sc.system.length_unit_km
     return float(np.max(np.linalg.norm(rel, axis=1)))
@@ -832,6 +903,11 @@ class GridDepartures:
 
 def grid_departures(sc: wj.Scenario, t, k_ws: int, sweep, weight: float) -> GridDepartures:
     """Departures on one node grid from a sweep's best plans; ``weight``: the alpha_h of the mesh check."""
+    validation.instance(sc, "sc", wj.Scenario)
+    t = validation.time_grid(t, "t", increasing=True)
+    k_ws = _node(k_ws, "k_ws", t.size)
+    validation.instance(sweep, "sweep", scvx.SweepResult)
+    weight = validation.real(weight, "weight")
     al, dep, at = [], [], None
     for a, res in zip(sweep.alphas, sweep.best):
         if res is None:
@@ -860,6 +936,10 @@ class MirrorPair:
 
 def mirror_pair(a, b, k_we: int, system) -> MirrorPair:
     """Compare plan ``a`` with plan ``b`` and with ``b``'s mirror image across z = 0."""
+    _checks.plan(a, "a", controls=False)
+    _checks.plan(b, "b", controls=False, n=np.shape(a.x)[0])
+    k_we = _node(k_we, "k_we", np.shape(a.x)[0])
+    check_system(system)
     L = system.length_unit_km
     return MirrorPair(tuple(float(x_[k_we, 2] * L) for x_ in (a.x, b.x)),
                       float(np.max(np.linalg.norm((a.x - b.x @ _MIRROR)[:, :3], axis=1)) * L),
@@ -868,12 +948,15 @@ def mirror_pair(a, b, k_we: int, system) -> MirrorPair:
 
 def mirrored(res) -> tuple:
     """``(x, u)`` of a plan mirrored across z = 0 (z, vz, a_z -> -z, -vz, -a_z)."""
+    _checks.plan(res, "res")
     return res.x @ _MIRROR, res.u @ _MIRROR_U
 
 
 def relative_rms_km(sc: wj.Scenario, x_window_start) -> tuple:
     """Terminal position RMS (km) of each object, of each target relative to the observer, and of the mean
     position of all four (the common part), from the CRLB recursion of Fig. 9."""
+    validation.instance(sc, "sc", wj.Scenario)
+    x_window_start = validation.as_state(x_window_start, "x_window_start", batch=False)
     em, tm = sc.system, sc.measurement_times
     lin = cov.linearize_augmented(em, x_window_start, sc.targets_at([tm[0]])[:, 0], tm, sc.model, sc.noise,
                                   sc.prior_covariance, q=sc.q)
@@ -906,6 +989,10 @@ class NoiseReadings:
 
 def noise_readings(sc2: wj.Scenario, x2_ball_ws, x2_plan_ws, sc1: wj.Scenario) -> NoiseReadings:
     """CRLB of test case 1's ballistic observer and of two test-case-2 window starts under every reading."""
+    validation.instance(sc2, "sc2", wj.Scenario)
+    x2_ball_ws = validation.as_state(x2_ball_ws, "x2_ball_ws", batch=False)
+    x2_plan_ws = validation.as_state(x2_plan_ws, "x2_plan_ws", batch=False)
+    validation.instance(sc1, "sc1", wj.Scenario)
     em = sc1.system
     x1_ws = propagate(em, sc1.observer_x0, [0.0, sc1.window[0]]).x[-1]
     rows, curves = [], []
@@ -938,6 +1025,7 @@ class Front:
 
 def front(ok) -> Front:
     """Aggregate converged plans (:class:`PlanRow`, increasing alpha_h) into the front of Fig. 10."""
+    ok = validation.sequence_of(ok, "ok", PlanRow, "PlanRow")
     dvs = np.array([r.dv for r in ok])
     rms_obs = np.array([r.crlb.terminal_rms_km[0] for r in ok])
     rms_tgt = np.array([r.crlb.terminal_rms_km[1:] for r in ok])
@@ -991,9 +1079,17 @@ class FreeRun:
 
 def free_run(sc: wj.Scenario, t, k_ws: int, info, alpha: float, x_guess, u_guess, max_iter: int) -> FreeRun:
     """Solve ``alpha`` without any keep-out, recording the closest approach of every reference."""
+    validation.instance(sc, "sc", wj.Scenario)
+    t = validation.time_grid(t, "t", increasing=True)
+    k_ws = validation.integer(k_ws, "k_ws", minimum=1, maximum=t.size - 2)
+    validation.callable_(info, "info")
+    alpha = validation.in_range(alpha, "alpha", 0.0, 1.0)
+    x_guess = validation.as_array(x_guess, "x_guess", shape=(t.size, 6))
+    u_guess = validation.as_array(u_guess, "u_guess", shape=(t.size, 3))
+    max_iter = validation.integer(max_iter, "max_iter", minimum=1)
     rec = RecordingInformation(info)
     solver = wj.ScenarioSolver(sc, t, k_ws, information=rec, keep_out=False,
-                               settings=scvx.SCvxSettings(max_iter=validation.integer(max_iter, "max_iter", minimum=1)))
+                               settings=scvx.SCvxSettings(max_iter=max_iter))
     try:
         out = solver(alpha, x_guess, u_guess)
     except scvx.SCvxError as exc:
@@ -1025,6 +1121,12 @@ class RadiusRow:
 
 def radius_row(sc: wj.Scenario, k_ws: int, d: float, src: str, res, reference_x) -> RadiusRow:
     """Figures of merit of the plan solved with keep-out radius ``d`` km."""
+    validation.instance(sc, "sc", wj.Scenario)
+    _checks.plan(res, "res")
+    k_ws = _node(k_ws, "k_ws", np.shape(res.x)[0])
+    d = validation.positive(d, "d")
+    validation.instance(src, "src", str)
+    reference_x = validation.as_array(reference_x, "reference_x", shape=np.shape(res.x))
     em = sc.system
     closest = float(sc.keep_out(k_ws).ranges(res.x[k_ws]).min() * em.length_unit_km)
     return RadiusRow(d, src, _dv(res, em), res.information, wj.evaluate_crlb(sc, res.x[k_ws]).terminal_rms_km[0],
@@ -1036,7 +1138,14 @@ def radius_row(sc: wj.Scenario, k_ws: int, d: float, src: str, res, reference_x)
 def alt_grid_sweep(sc: wj.Scenario, info, n_nodes: int, alphas, settings, *, sigma: float = 1.0, executor=None):
     """The two-way sweep of test case 2 (424 km keep-out) on another Sundman grid: ``(t, k_ws, SweepResult)``;
     with an executor its two chains run side by side."""
-    t, k, _ = sc.node_times(validation.integer(n_nodes, "n_nodes", minimum=4), sigma)
+    validation.instance(sc, "sc", wj.Scenario)
+    validation.callable_(info, "info")
+    n_nodes = validation.integer(n_nodes, "n_nodes", minimum=4)
+    alphas = _alphas(alphas)
+    validation.instance(settings, "settings", scvx.SCvxSettings)
+    sigma = validation.real(sigma, "sigma")
+    _checks.executor(executor)
+    t, k, _ = sc.node_times(n_nodes, sigma)
     solver = wj.ScenarioSolver(sc, t, k, information=info, keep_out=True, settings=settings)
     return t, k, wj.sweep_both_ways(solver, alphas, *sc.ballistic_guess(t), executor=executor)
 
@@ -1099,9 +1208,16 @@ def case2_runs(sc: wj.Scenario, solver, alphas, x_guess, u_guess, *, seed_alphas
     Every run is deterministic, so the results do not depend on the executor.
     """
     validation.instance(sc, "sc", wj.Scenario)
-    validation.callable_(solver, "solver")
-    seed_alphas = tuple(float(a) for a in seed_alphas)
-    alt_nodes = tuple(validation.integer(n, "alt_nodes", minimum=4) for n in alt_nodes)
+    validation.instance(solver, "solver", wj.ScenarioSolver)
+    alphas = _alphas(alphas)
+    x_guess = validation.as_array(x_guess, "x_guess", shape=(solver.t.size, 6))
+    u_guess = validation.as_array(u_guess, "u_guess", shape=(solver.t.size, 3))
+    seed_alphas = tuple(validation.in_range(a, f"seed_alphas[{i}]", 0.0, 1.0)
+                        for i, a in enumerate(_checks.sequence(seed_alphas, "seed_alphas", allow_empty=True)))
+    alt_nodes = tuple(validation.integer(n, f"alt_nodes[{i}]", minimum=4)
+                      for i, n in enumerate(_checks.sequence(alt_nodes, "alt_nodes", allow_empty=True)))
+    sigma = validation.real(sigma, "sigma")
+    _checks.executor(executor)
     seed_jobs = {(a, z): _submit(executor, solver, a, *sc.seeded_guess(solver.t, z))
                  for a in seed_alphas for z in (+1, -1)}
     t0 = time.perf_counter()
@@ -1149,7 +1265,16 @@ def queue_keep_out_runs(case: Case2Sweep, row6, d_min_km, *, warm: bool, x_guess
     :meth:`KeepOutJobs.collect` is called.
     """
     validation.instance(case, "case", Case2Sweep)
+    validation.instance(row6, "row6", PlanRow)
+    d_min_km = _checks.vector(d_min_km, "d_min_km")
+    if np.any(d_min_km <= 0):
+        raise ValueError(f"d_min_km must be positive keep-out radii (km); got {d_min_km}")
     validation.boolean(warm, "warm")
+    if x_guess is not None:
+        x_guess = validation.as_array(x_guess, "x_guess", shape=(case.t.size, 6))
+    if u_guess is not None:
+        u_guess = validation.as_array(u_guess, "u_guess", shape=(case.t.size, 3))
+    _checks.executor(executor)
     sc, t, k_ws, info, settings, a6 = (case.scenario, case.t, case.k_ws, case.solver.information,
                                        case.solver.settings, row6.alpha)
     guess = (row6.res.x, row6.res.u) if warm else (x_guess, u_guess)
@@ -1238,6 +1363,11 @@ def mirror_study(case: Case2Sweep, pair_rows, mirror_row, seeded: dict) -> Mirro
     """Compare the sweep's optima at the paper's pair of weights, re-solve the mirror of ``mirror_row``'s optimum
     and compare the +z/-z seeded solutions ``seeded`` (``(alpha, sign) -> result or SCvxError``)."""
     validation.instance(case, "case", Case2Sweep)
+    pair_rows = validation.sequence_of(pair_rows, "pair_rows", PlanRow, "PlanRow")
+    if len(pair_rows) != 2:
+        raise ValueError(f"pair_rows must hold two PlanRows; got {len(pair_rows)}")
+    validation.instance(mirror_row, "mirror_row", PlanRow)
+    validation.instance(seeded, "seeded", dict, "a dict {(alpha, sign): result or SCvxError}")
     em, k_we = case.scenario.system, case.k_we
     a, b = pair_rows
     pair = mirror_pair(a.res, b.res, k_we, em) if a.alpha != b.alpha else None
@@ -1261,6 +1391,8 @@ def case2_budget(case: Case2Sweep, extra_mps: float, *, rtol: float = 0.02) -> t
     """The most informative plan at the baseline's impulse plus ``extra_mps`` (m/s): ``(row or None, message)``;
     the row holds ``budget, alpha, dv, rms`` and the log-interpolated RMS of the sweep at the spent impulse."""
     validation.instance(case, "case", Case2Sweep)
+    extra_mps = validation.real(extra_mps, "extra_mps")
+    rtol = validation.in_range(rtol, "rtol", 0.0, 1.0, closed=False)
     ok, base, sc = case.ok, case.by_alpha.get(0.0), case.scenario
     if base is None:
         return None, "no converged baseline"
@@ -1285,6 +1417,12 @@ def case2_budget(case: Case2Sweep, extra_mps: float, *, rtol: float = 0.02) -> t
 
 def radius_summary(radius_rows, row6, d_min_km, keep_out_km: float, alpha: float, same_plan_km: float) -> str:
     """The keep-out radius table at the Fig. 6 weight, and what each radius below the adopted one found."""
+    radius_rows = validation.sequence_of(radius_rows, "radius_rows", RadiusRow, "RadiusRow")
+    validation.instance(row6, "row6", PlanRow)
+    d_min_km = _checks.vector(d_min_km, "d_min_km")
+    keep_out_km = validation.positive(keep_out_km, "keep_out_km")
+    alpha = validation.real(alpha, "alpha")
+    same_plan_km = validation.positive(same_plan_km, "same_plan_km")
     lines = [f"alpha_h = {alpha:g}: {'keep-out [km]':>13} {'start':>6} {'dV [m/s]':>9} {'MI [nats]':>10} "
              f"{'RMS obs [km]':>13} {'closest [km]':>13} {'binds':>6} {'max|z| [km]':>11}"]
     lines += [f"{'':>14}{r.d:>13.0f} {r.src:>6} {r.dv:>9.2f} {r.mi:>10.2f} {r.rms:>13.1f} {r.closest:>13.1f} "
@@ -1307,6 +1445,11 @@ def radius_summary(radius_rows, row6, d_min_km, keep_out_km: float, alpha: float
 def dominated_note(case: Case2Sweep, dominated, row6, radius_rows, amax_rows) -> str:
     """Why plans of the front are dominated: their closest approach, and re-solves at the Fig. 6 weight (other
     keep-out radii, other a_max readings) that reach a lower RMS than the sweep's plan there."""
+    validation.instance(case, "case", Case2Sweep)
+    dominated = _rows(dominated, "dominated", 4)
+    validation.instance(row6, "row6", PlanRow)
+    radius_rows = validation.sequence_of(radius_rows, "radius_rows", RadiusRow, "RadiusRow")
+    amax_rows = _rows(amax_rows, "amax_rows", 4)
     if not dominated:
         return "no dominated plan"
     ko = case.scenario.keep_out_km
@@ -1397,6 +1540,11 @@ def keep_out_study(case: Case2Sweep, row6, free: FreeRun, radius_results: dict, 
     """Collect the keep-out radius solves (``radius km -> result or SCvxError``, all at ``row6``'s weight) and the
     a_max readings (``label -> (solver, result or SCvxError)``) against the sweep's plan ``row6``."""
     validation.instance(case, "case", Case2Sweep)
+    validation.instance(row6, "row6", PlanRow)
+    validation.instance(free, "free", FreeRun)
+    validation.instance(radius_results, "radius_results", dict, "a dict {radius km: result or SCvxError}")
+    validation.instance(amax_results, "amax_results", dict, "a dict {label: (solver, result or SCvxError)}")
+    validation.choice(radius_start, "radius_start", ("cold", "warm"))
     sc, k_ws = case.scenario, case.k_ws
     nk = free.outcome
     free_range = np.nan if free.failed else float(sc.keep_out(k_ws).ranges(nk.x[k_ws]).min() * sc.system.length_unit_km)

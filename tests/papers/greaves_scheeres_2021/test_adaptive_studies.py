@@ -136,3 +136,34 @@ def test_reset_rule_study_is_the_same_on_any_executor(setup):
     assert [r[1] for r in serial.runs] == list(ad.RESET_RULES) * 2
     with pytest.raises(ValueError, match="max_resets"):
         ads.reset_rule_study(setup, (3.0,), 1, np.random.default_rng(5), max_resets=0)
+
+
+def test_study_arguments_are_refused_by_name_before_any_run(setup, nrho):
+    rng = np.random.default_rng(0)
+    k = ads.first_seen_epoch(setup)
+    with pytest.raises(ValueError, match="epochs"):
+        ads.delay_outcome(setup, [k + 0.5], 0.0)  # an epoch index is an integer
+    with pytest.raises(ValueError, match="epochs"):
+        ads.delay_outcome(setup, [], 0.0)  # no run: the fractions would be NaN
+    with pytest.raises(ValueError, match="epochs"):
+        ads.delay_outcome(setup, [-2], 0.0)  # -1 is the only "none"
+    inputs = det.draw_trial(np.random.default_rng(1), setup, magnitude_m_s=3.0)
+    for kw, name in ((dict(reset="median"), "reset"), (dict(smooth="yes"), "smooth"), (dict(max_resets=-1),
+                                                                                         "max_resets")):
+        with pytest.raises(ValueError, match=name):
+            ads.adaptive_run(setup, inputs, **kw)
+    for args, name in (((nrho, [0.05, -1.0], (10.0,)), "magnitudes_m_s"), ((nrho, [], (10.0,)), "magnitudes_m_s"),
+                       ((nrho, [0.05], ()), "noise_urad"), ((nrho, [0.05], (0.0,)), "noise_urad"),
+                       (("nrho", [0.05], (10.0,)), "orbit")):
+        with pytest.raises(ValueError, match=name):
+            ads.delay_study(setup, *args, 1, rng)
+    with pytest.raises(TypeError, match="executor"):
+        ads.delay_study(setup, nrho, [0.05], (10.0,), 1, rng, executor=object())
+    with pytest.raises(TypeError, match="executor"):
+        ads.reset_rule_study(setup, (3.0,), 1, rng, executor="pool")
+    with pytest.raises(ValueError, match="n_runs"):
+        ads.first_detection_epochs(setup, 0.05, 0, rng)
+    with pytest.raises(ValueError, match="magnitude_m_s"):
+        ads.first_detection_epochs(setup, -0.05, 1, rng)
+    # none of these drew from the generator: the checks come before the draws
+    assert rng.bit_generator.state == np.random.default_rng(0).bit_generator.state

@@ -296,3 +296,73 @@ def test_closing_rows_carry_the_studies_numbers(small_studies):
     assert {k for k in rows if k.startswith("control first")} == {
         "control first, f = 0.1, 10 urad", "control first, f_c, 10 urad", "control first, f = 0.1, 100 urad"}
     assert all(isinstance(rows[k]["measured"], bool) for k in rows if k.startswith("control first"))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# argument checks at the public boundary, and the figures on a single orbit or setting
+# ---------------------------------------------------------------------------------------------------------------
+def test_study_arguments_are_refused_by_name(quiet_window, nrho_92):
+    policies = {"quiet": det.QUIET_POLICY}
+    base = dict(paper_zlim={"quiet": 0.02}, q_base_km2_s3=1e-18, window_hours=8.0, sigma_angle_rad=1e-5)
+    for args, kw, name in (
+            (({"stable": nrho_92}, policies, {"b": {}}), {}, "9:2 NRHO"),
+            (({"9:2 NRHO": nrho_92}, policies, {"b": {"sigma": 1e-6}}), {}, "variants"),
+            (({"9:2 NRHO": nrho_92}, policies, {"b": {}}), dict(half_size_orbits="9:2 NRHO"), "half_size_orbits"),
+            (({"9:2 NRHO": nrho_92}, policies, {"b": {}}), dict(paper_zlim={"active": 0.2}), "paper_zlim"),
+            (({"9:2 NRHO": nrho_92}, policies, {"b": {}}), dict(executor=3), "executor")):
+        with pytest.raises(ValueError, match=name):
+            ds.run_tuning_map(em, *args, (0.1,), (0.1,), (4, 4), [0, 1], **{**base, **kw})
+    key = ("9:2 NRHO", "quiet")
+    with pytest.raises(ValueError, match="setups_c"):
+        ds.run_training_studies({key: quiet_window}, {}, policies, {"9:2 NRHO": (4, 4, 0)}, 0, 2)
+    with pytest.raises(ValueError, match="sizes"):
+        ds.run_training_studies({key: quiet_window}, {key: quiet_window}, policies, {"9:2 NRHO": (4, 4)}, 0, 2)
+    with pytest.raises(ValueError, match="constant"):
+        ds.run_spike_study(det.make_setup(em, nrho_92, 1e-12, 1e-12, cadence_hours=4.0), quiet_window, 1, [0])
+    with pytest.raises(TypeError, match="seed"):
+        ds.run_tuning_demo(quiet_window, None)  # would draw fresh OS entropy
+    with pytest.raises(ValueError, match="factors"):
+        ds.run_burn_z_study(quiet_window, nrho_92, set(), 0.5, 1, [0], q_base_km2_s3=1e-18, window_hours=8.0)
+    with pytest.raises(ValueError, match="offsets_h"):
+        ds.run_pm_j_search(em, nrho_92, (0.1,), (10.0,), (np.nan,), 1, [0], q_base_km2_s3=1e-18, window_hours=8.0)
+    with pytest.raises(TypeError, match="value"):
+        ds.finite_or("nan", 1.0)
+    assert ds.ratio_text(np.float64("nan")).startswith("no burn") and ds.ratio_text(1.234) == "1.23"
+
+
+def _policy_study(shift):
+    z0 = np.array([1.0, 1.2, 0.9, 1.1, 1.3, 1.05]) * 1e-4
+    z1 = z0 * 10 + shift
+    n = z0.size
+    sample = lambda z: det.MonteCarloSample(z, z, np.full(n, 1e-3), np.zeros(n), np.zeros(n),  # noqa: E731
+                                            *(np.zeros(n),) * 4)
+    return det.PolicyStudy(sample(z0), sample(z1), None, None, det.ml_threshold(z0, z1), None)
+
+
+def test_figures_draw_a_single_orbit_or_setting_and_refuse_missing_cells():
+    import matplotlib.pyplot as plt
+
+    from cislunar.papers.greaves_scheeres_2021 import figures
+
+    st = {("9:2 NRHO", "quiet"): _policy_study(0.0)}
+    fig = figures.control_integral_pdfs(st, ["9:2 NRHO"], ["quiet"])  # one row of panels
+    assert len(fig.axes) == 4 and fig.axes[0].get_title().startswith("9:2 NRHO, quiet: 6 H0 + 6 H1 runs")
+    plt.close(fig)
+    with pytest.raises(ValueError, match="studies"):
+        figures.control_integral_pdfs(st, ["9:2 NRHO", "stable NRHO"], ["quiet"])
+    with pytest.raises(TypeError, match="orbit_names"):
+        figures.control_integral_pdfs(st, "9:2 NRHO", ["quiet"])  # a single name, not a list of them
+    h = det.HealthLeadStudy(np.array([0.2, 0.5]), np.array([2.0, 4.0]), np.array([[0, -1], [0, 1]]),
+                            np.array([[1, -1], [0, -1]]), 0.0, 0.1, np.ones((2, 2)), np.ones(3), 0.00135)
+    fig = figures.health_lead({"one setting": h})
+    bars = fig.axes[0].patches
+    assert len(bars) == 4 * 2  # four outcomes stacked per burn size
+    tops = [sum(b.get_height() for b in bars[i::2]) for i in range(2)]
+    assert tops == pytest.approx([100.0, 100.0])  # the outcomes partition the runs
+    plt.close(fig)
+    pmj = {(0.1, 10.0, 0.0): (np.ones(6), 1.0)}
+    with pytest.raises(ValueError, match="f_pm"):
+        figures.pm_j_search(pmj, (0.1,), (10.0,), (0.0,), 0.3, 10.0, st["9:2 NRHO", "quiet"].h1)
+    with pytest.raises(ValueError, match="tmap"):
+        figures.tuning_map({}, ["9:2 NRHO"], ["quiet"], ["base"], "base", (0.1,), (0.1,), 0.1, 0.1, {"quiet": 0.02},
+                           lambda *a: 0.0)
