@@ -23,6 +23,8 @@ import importlib
 import inspect
 import pickle
 import pkgutil
+import signal
+import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 
@@ -1069,20 +1071,28 @@ def _fails_first_then_slow(rng):
     return 1.0
 
 
-def test_keyboard_interrupt_stops_a_threaded_run_promptly():
-    import _thread
-    import threading
+_MAIN_THREAD = threading.main_thread().ident
 
+
+def _interrupting_trial(rng):
+    """Sends SIGINT to the main thread when the 12th trial starts: the interrupt comes at a fixed point of the run,
+    not after a wall-clock delay (which made the test flaky under load)."""
+    _CALLS["slow"] += 1
+    if _CALLS["slow"] == 12:
+        signal.pthread_kill(_MAIN_THREAD, signal.SIGINT)
+    time.sleep(0.05)
+    return float(rng.random())
+
+
+def test_keyboard_interrupt_stops_a_threaded_run_promptly():
     _CALLS.clear()
-    timer = threading.Timer(0.3, _thread.interrupt_main)
     with ThreadPoolExecutor(2) as pool:
-        timer.start()
         with pytest.raises(KeyboardInterrupt):
-            montecarlo.run_monte_carlo(_slow_trial, 400, 0, executor=pool, chunk_size=20, progress=False)
+            montecarlo.run_monte_carlo(_interrupting_trial, 400, 0, executor=pool, chunk_size=20, progress=False)
         started_at_raise = _CALLS["slow"]
-    # counted, not timed: two workers at 50 ms a trial start about 12 trials in 0.3 s; the chunks in flight stop at
-    # their next trial, so far fewer than the 400 queued ever start (all of them would without cancellation)
-    assert started_at_raise <= 60 and _CALLS["slow"] <= started_at_raise + 2, _CALLS
+    # counted, not timed: the interrupt arrives when trial 12 starts; the chunks in flight stop at their next trial,
+    # so far fewer than the 400 queued ever start (all of them would without cancellation)
+    assert 12 <= started_at_raise <= 60 and _CALLS["slow"] <= started_at_raise + 2, _CALLS
 
 
 def test_seeding_is_todays_whatever_the_chunking():

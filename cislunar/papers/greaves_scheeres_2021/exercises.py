@@ -28,6 +28,7 @@ from cislunar.cr3bp.dynamics import EARTH_MOON
 from cislunar.papers.greaves_scheeres_2021 import adaptive_studies as ads
 from cislunar.papers.greaves_scheeres_2021 import detection as det
 from cislunar.papers.greaves_scheeres_2021 import detection_studies as ds
+from cislunar.papers.greaves_scheeres_2021 import tracking
 from cislunar.utils import validation
 
 __all__ = [
@@ -85,9 +86,12 @@ def exercise_09b_burn_size(magnitudes_m_s=(0.05, 0.3, 3.0), n_runs: int = 8, see
     if mags.size < 2 or np.any(mags <= 0) or np.any(np.diff(mags) <= 0):
         raise ValueError(f"magnitudes_m_s must hold at least two positive increasing sizes; got {magnitudes_m_s!r}")
     n_runs = validation.integer(n_runs, "n_runs", minimum=2)
+    seed = validation.integer(seed, "seed", minimum=0)
     nrho = orbits.nrho_9_2(EARTH_MOON)
     setup = det.make_setup(EARTH_MOON, nrho, 1e-18, 1e-18)
-    d = ads.delay_study(setup, nrho, mags, [], n_runs, np.random.default_rng(seed))
+    # no noise sweep: the default noise level reuses the runs of the size sweep (no extra draw, no extra filtering)
+    d = ads.delay_study(setup, nrho, mags, [tracking.DEFAULT_SIGMA_ANGLE_RAD * 1e6], n_runs,
+                        np.random.default_rng(seed))
     outcomes = [d.by_size[m] for m in mags]
     mean_delay = np.array([(o.delays_h.sum() + o.undetected * o.n * d.coast_h) / o.n for o in outcomes])
     prompt = np.array([o.prompt for o in outcomes])
@@ -146,6 +150,7 @@ def exercise_09b_base_weight(q_km2_s3=(1e-18, 1e-12), magnitude_m_s: float = 0.3
     magnitude_m_s = validation.positive(magnitude_m_s, "magnitude_m_s")
     n_null = validation.integer(n_null, "n_null", minimum=1)
     n_runs = validation.integer(n_runs, "n_runs", minimum=1)
+    seed = validation.integer(seed, "seed", minimum=0)
     nrho = orbits.nrho_9_2(EARTH_MOON)
     means, ses, found = [], [], []
     for qi in q:
@@ -205,6 +210,7 @@ def exercise_10_window_factor(f=(0.03, 0.3, 1.0), n_runs: int = 8, seed: int = 0
     if f.size < 2 or np.any(f <= 0) or np.any(np.diff(f) <= 0):
         raise ValueError(f"f must hold at least two positive increasing factors; got {f!r}")
     n_runs = validation.integer(n_runs, "n_runs", minimum=4)
+    seed = validation.integer(seed, "seed", minimum=0)
     nrho = orbits.nrho_9_2(EARTH_MOON)
     q_star = det.window_control_weight(det.QUIET_POLICY, 8.0)
     rows = []
@@ -258,6 +264,7 @@ def exercise_10_pm_j_noise(noise_urad=(10.0, 1000.0), f: float = 0.03, n_repeats
         raise ValueError(f"noise_urad must hold at least two positive increasing levels; got {noise_urad!r}")
     f = validation.positive(f, "f")
     n_repeats = validation.integer(n_repeats, "n_repeats", minimum=1)
+    seed = validation.integer(seed, "seed", minimum=0)
     nrho = orbits.nrho_9_2(EARTH_MOON)
     dirs = np.radians(np.array(list(ds.DIRECTIONS.values())))
     zs = []
@@ -294,7 +301,6 @@ def exercise_10_pm_j_noise(noise_urad=(10.0, 1000.0), f: float = 0.03, n_repeats
 # ===============================================================================================================
 from cislunar.papers.greaves_scheeres_2021 import observation_strategy as _obs_01_09  # noqa: E402
 from cislunar.papers.greaves_scheeres_2021 import reference_orbits as _ro_01_09  # noqa: E402
-from cislunar.papers.greaves_scheeres_2021 import tracking as _tracking_01_09  # noqa: E402
 
 __all__ += [
     "AngleNoiseAnswer09",
@@ -313,10 +319,13 @@ __all__ += [
 _Q_QUIET_09 = 1e-20 * EARTH_MOON.time_unit_s**3 / EARTH_MOON.length_unit_km**2
 
 
-def _increasing_01_09(values, name):
+def _increasing_01_09(values, name, *, decreasing=False):
+    """At least two positive values, strictly increasing (or strictly decreasing when asked), as a float array."""
     arr = validation.as_array(values, name, ndim=(1,)).astype(float)
-    if arr.size < 2 or np.any(arr <= 0) or np.any(np.diff(arr) <= 0):
-        raise ValueError(f"{name} must hold at least two positive increasing values; got {values!r}")
+    order = arr[::-1] if decreasing else arr
+    if arr.size < 2 or np.any(arr <= 0) or np.any(np.diff(order) <= 0):
+        raise ValueError(f"{name} must hold at least two positive {'de' if decreasing else 'in'}creasing values; "
+                         f"got {values!r}")
     return arr
 
 
@@ -350,7 +359,7 @@ class HaloStepAnswer01:
 def exercise_01_halo_step(steps=(0.03, 0.015)) -> HaloStepAnswer01:
     """Exercise 01.1 (parameter ``HALO_STEP``): continue the southern L2 halo family at each step (coarse first)
     and list its outer stable band (:func:`reference_orbits.halo_family_study`)."""
-    steps = _increasing_01_09(steps[::-1], "steps")[::-1]
+    steps = _increasing_01_09(steps, "steps", decreasing=True)
     studies = [_ro_01_09.halo_family_study(EARTH_MOON, float(s)) for s in steps]
     n_members = np.array([len(st.family) for st in studies])
     n_band = np.array([len(st.outer_band) for st in studies])
@@ -400,9 +409,15 @@ class SiteGridAnswer01:
 def exercise_01_site_grid(grids_deg=((20.0, 40.0), (10.0, 20.0)), samples: int = 600) -> SiteGridAnswer01:
     """Exercise 01.2 (parameter ``SWEEP_GRID_DEG``): the all-pairs sweep of :func:`reference_orbits.station_pair_sweep`
     on grids from coarse to fine, against ``samples`` points of the 9:2 NRHO uniform in time."""
-    grids = tuple((float(a), float(b)) for a, b in grids_deg)
+    arr = validation.as_array(grids_deg, "grids_deg", shape=(None, 2))
+    grids = tuple((float(a), float(b)) for a, b in arr)
     if len(grids) < 2 or any(f[0] >= c[0] or f[1] >= c[1] for c, f in zip(grids, grids[1:])):
         raise ValueError(f"grids_deg must go from coarse to strictly finer spacings; got {grids_deg!r}")
+    for lat, lon in grids:
+        if not (lat > 0 and lon > 0) or abs(180.0 / lat - round(180.0 / lat)) > 1e-9 \
+                or abs(360.0 / lon - round(360.0 / lon)) > 1e-9:
+            raise ValueError(f"grids_deg spacings must divide 180 deg (latitude) and 360 deg (longitude) exactly; "
+                             f"got {(lat, lon)}")
     samples = validation.integer(samples, "samples", minimum=10)
     nrho = orbits.nrho_9_2(EARTH_MOON)
     sweeps = [_ro_01_09.station_pair_sweep(EARTH_MOON, nrho, g, samples) for g in grids]
@@ -453,6 +468,7 @@ def exercise_09_angle_noise(noise_urad=(10.0, 100.0), cadence_h: float = 12.0, n
     noise = _increasing_01_09(noise_urad, "noise_urad")
     cadence_h = validation.positive(cadence_h, "cadence_h")
     n_runs = validation.integer(n_runs, "n_runs", minimum=1)
+    seed = validation.integer(seed, "seed", minimum=0)
     nrho = orbits.nrho_9_2(EARTH_MOON)
     rows = [_obs_01_09.strategy_study(EARTH_MOON, {"9:2 NRHO": nrho}, [cadence_h], _Q_QUIET_09, rates=False,
                                       n_runs=n_runs, seed=seed, sigma_angle_rad=float(n) / 1e6).rows[0]
@@ -495,13 +511,14 @@ class CadenceAnswer09:
 
 def exercise_09_cadence(cadences_h=(12.0, 2.0), n_runs: int = 3, seed: int = 0) -> CadenceAnswer09:
     """Exercise 09.2 (parameter ``CADENCES_H``): angles-only Monte Carlo at each cadence (sparse first)."""
-    cads = _increasing_01_09(cadences_h[::-1], "cadences_h")[::-1]
+    cads = _increasing_01_09(cadences_h, "cadences_h", decreasing=True)
     n_runs = validation.integer(n_runs, "n_runs", minimum=1)
+    seed = validation.integer(seed, "seed", minimum=0)
     nrho = orbits.nrho_9_2(EARTH_MOON)
     study = _obs_01_09.strategy_study(EARTH_MOON, {"9:2 NRHO": nrho}, [float(c) for c in cads], _Q_QUIET_09,
                                       rates=False, n_runs=n_runs, seed=seed)
     final = np.array([row[4] for row in study.rows])
-    n_meas = np.array([len(_tracking_01_09.make_scenario(EARTH_MOON, nrho, float(c), start="apoapsis").t)
+    n_meas = np.array([len(tracking.make_scenario(EARTH_MOON, nrho, float(c), start="apoapsis").t)
                        for c in cads])
     gain, root = final[0] / final[-1], np.sqrt(n_meas[-1] / n_meas[0])
     answer = (
@@ -542,6 +559,7 @@ def exercise_09_handoff(scales=(1.0, 300.0), n_runs: int = 4, seed: int = 0) -> 
     hand-off scale (same seeds: the same noise, a larger initial error)."""
     sc = _increasing_01_09(scales, "scales")
     n_runs = validation.integer(n_runs, "n_runs", minimum=1)
+    seed = validation.integer(seed, "seed", minimum=0)
     nrho = orbits.nrho_9_2(EARTH_MOON)
     rows = [_obs_01_09.strategy_study(EARTH_MOON, {"9:2 NRHO": nrho}, [12.0], _Q_QUIET_09, rates=False,
                                       n_runs=n_runs, seed=seed, handoff_scale=float(h)).rows[0] for h in sc]

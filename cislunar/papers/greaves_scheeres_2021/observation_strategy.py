@@ -29,6 +29,7 @@ from cislunar.cr3bp.dynamics import CR3BP, check_system
 from cislunar.cr3bp.orbits import PeriodicOrbit
 from cislunar.estimation import consistency, ocbe
 from cislunar.papers.greaves_scheeres_2021 import tracking
+from cislunar.publish.claims import Claim
 from cislunar.utils import validation
 from cislunar.utils.montecarlo import run_monte_carlo
 
@@ -63,19 +64,46 @@ ONSETS = ("first update", "before perilune", "at or after perilune", "numerical 
 
 def filled(claim, **fields):
     """``claim`` with the ``{name}`` fields of its quantity filled in (the cadences or noise a run used)."""
-    return dataclasses.replace(claim, quantity=claim.quantity.format(**fields))
+    validation.instance(claim, "claim", Claim, "a cislunar.publish.claims.Claim")
+    try:
+        quantity = claim.quantity.format(**fields)
+    except (KeyError, IndexError) as exc:
+        raise ValueError(f"fields must fill every {{name}} of the claim's quantity {claim.quantity!r}; missing "
+                         f"{exc}") from None
+    return dataclasses.replace(claim, quantity=quantity)
 
 
 def cadence_label(cadence_h: float) -> str:
     """'10 min' or '2 h'."""
+    cadence_h = validation.positive(cadence_h, "cadence_h")
     return f"{cadence_h * 60:g} min" if cadence_h < 1 else f"{cadence_h:g} h"
 
 
 def _check_orbits(orbits_):
-    validation.instance(orbits_, "orbits", dict, "a dict of name -> cislunar.cr3bp.orbits.PeriodicOrbit")
+    what = "a dict of name -> cislunar.cr3bp.orbits.PeriodicOrbit"
+    validation.instance(orbits_, "orbits_", dict, what)
+    if not orbits_:
+        raise ValueError("orbits_ must hold at least one orbit")
     for o in orbits_.values():
-        validation.instance(o, "orbits", PeriodicOrbit, "a dict of name -> cislunar.cr3bp.orbits.PeriodicOrbit")
+        validation.instance(o, "orbits_", PeriodicOrbit, what)
     return orbits_
+
+
+def _positive_values(values, name: str) -> tuple:
+    """A non-empty 1-D sequence of positive finite numbers, as a tuple of float."""
+    arr = validation.as_array(values, name, ndim=(1,), min_size=1)
+    if np.any(arr <= 0):
+        raise ValueError(f"{name} must be positive; got {arr}")
+    return tuple(float(v) for v in arr)
+
+
+def _check_executor(executor):
+    """``None`` (serial) or an object with a ``submit`` method (a concurrent.futures executor, a Dask Client)."""
+    if executor is not None and not callable(getattr(executor, "submit", None)):
+        raise validation.ArgumentTypeError(f"executor must be None or have a submit(fn, *args) method (a "
+                                           f"concurrent.futures executor or a Dask Client); got "
+                                           f"{type(executor).__name__}")
+    return executor
 
 
 def _bounds_3sigma(system, P):
@@ -140,6 +168,7 @@ def measurement_demo(system: CR3BP, orbit: PeriodicOrbit, cadence_hours: float =
 
 def figure_measurements(demo: MeasurementDemo):
     """Angles (left) and signed rates on a symmetric-log axis with the 1-sigma rate noise (right)."""
+    validation.instance(demo, "demo", MeasurementDemo, "a MeasurementDemo (measurement_demo)")
     days, y, T = demo.days, demo.y, demo.time_unit_s
     fig, axes = plt.subplots(1, 2, figsize=(12, 3.8))
     axes[0].plot(days, np.degrees(y[:, 0]), label="azimuth")
@@ -249,6 +278,7 @@ def _error_panels(system, ax_pos, ax_vel, t, x, P, truth, title):
 
 def figure_typical_run(run: TypicalRun):
     """Forward filter (left) and smoother (right): error norms and 3-sigma bounds."""
+    validation.instance(run, "run", TypicalRun, "a TypicalRun (typical_run)")
     system, sc, res = run.scenario.system, run.scenario, run.result
     fig, axes = plt.subplots(2, 2, figsize=(12, 6), sharex=True)
     _error_panels(system, axes[0, 0], axes[1, 0], sc.t, res.x_filt, res.P_filt, run.truth, "forward filter")
@@ -305,7 +335,19 @@ class StrategyStudy:
 
 
 def flagged_cells(rows, limit: float = 0.10) -> list:
-    """(orbit, cadence, fraction) of rows where more than ``limit`` of the runs were inconsistent."""
+    """(orbit, cadence, fraction) of rows where more than ``limit`` of the runs were inconsistent.
+
+    ``rows`` are :attr:`StrategyStudy.rows`: tuples ``(orbit, cadence h, diverged fraction, ...)``.
+    """
+    if isinstance(rows, (str, bytes, dict)) or not hasattr(rows, "__iter__"):
+        raise validation.ArgumentTypeError(f"rows must be a sequence of StrategyStudy rows; got {type(rows).__name__}")
+    rows = list(rows)
+    for i, row in enumerate(rows):
+        if not isinstance(row, (tuple, list)) or len(row) < 3:
+            raise validation.ArgumentTypeError(f"rows[{i}] must be a StrategyStudy row (orbit, cadence, diverged "
+                                               f"fraction, ...); got {row!r:.60}")
+        validation.in_range(row[2], f"rows[{i}] diverged fraction", 0.0, 1.0)
+    limit = validation.in_range(limit, "limit", 0.0, 1.0)
     return [(name, cad, div) for name, cad, div, *_ in rows if div > limit]
 
 
@@ -320,11 +362,17 @@ def strategy_study(system: CR3BP, orbits_: dict, cadences, control_weight: float
     """
     check_system(system)
     _check_orbits(orbits_)
+    cadences = _positive_values(cadences, "cadences")
+    control_weight = validation.positive(control_weight, "control_weight")
     rates = validation.boolean(rates, "rates")
     n_runs = validation.integer(n_runs, "n_runs", minimum=1)
     n_one = n_runs if n_runs_one_minute is None else validation.integer(n_runs_one_minute, "n_runs_one_minute",
                                                                         minimum=1)
     seed = validation.integer(seed, "seed", minimum=0)
+    validation.choice(observers, "observers", ("L2", "all"))
+    sigma_angle_rad = validation.positive(sigma_angle_rad, "sigma_angle_rad")
+    handoff_scale = validation.positive(handoff_scale, "handoff_scale")
+    _check_executor(executor)
     results = {}
     for k, (name, orb) in enumerate(orbits_.items()):
         for j, cad in enumerate(cadences):
@@ -337,8 +385,24 @@ def strategy_study(system: CR3BP, orbits_: dict, cadences, control_weight: float
     return StrategyStudy(results, rates)
 
 
+def _names(value, name: str) -> tuple:
+    """A non-empty sequence of str, or a dict keyed by them (a single str is refused: it would be read letter by
+    letter)."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+        raise validation.ArgumentTypeError(f"{name} must be a sequence of names (str); got {type(value).__name__}")
+    out = tuple(value)
+    if not out:
+        raise ValueError(f"{name} must hold at least one name")
+    for i, v in enumerate(out):
+        validation.instance(v, f"{name}[{i}]", str)
+    return out
+
+
 def figure_final_uncertainty(rates: StrategyStudy, angles: StrategyStudy, orbit_names):
     """Final 3-sigma position and velocity against cadence (medians over runs; the paper's Table 4 analogue)."""
+    validation.instance(rates, "rates", StrategyStudy, "a StrategyStudy (strategy_study)")
+    validation.instance(angles, "angles", StrategyStudy, "a StrategyStudy (strategy_study)")
+    orbit_names = _names(orbit_names, "orbit_names")
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.2))
     for io, (name, marker) in enumerate(zip(orbit_names, "os^")):
         for rows, ls, lab, ms in ((rates.rows, "-", "angles + rates", 9), (angles.rows, ":", "angles only", 4)):
@@ -367,6 +431,7 @@ def _onset_class(run, t, t_perilune):
 
 def pct_span(values) -> str:
     """'a-b %' of fractions (or 'a %' when both round alike)."""
+    values = validation.as_array(values, "values", ndim=(1,), min_size=1)
     lo, hi = 100 * min(values), 100 * max(values)
     return f"{lo:.0f} %" if round(lo) == round(hi) else f"{lo:.0f}-{hi:.0f} %"
 
@@ -551,8 +616,17 @@ def regime_map(system: CR3BP, orbits_: dict, cadences, sigmas, handoffs, rate_mo
     """
     check_system(system)
     _check_orbits(orbits_)
+    cadences = _positive_values(cadences, "cadences")
+    sigmas = _positive_values(sigmas, "sigmas")
+    handoffs = _positive_values(handoffs, "handoffs")
+    validation.instance(rate_models, "rate_models", dict, "a dict of name -> differencing baseline (s)")
+    for m, b in rate_models.items():
+        validation.instance(m, "rate_models", str, "a dict of name (str) -> differencing baseline (s)")
+        validation.positive(b, "rate_models")
+    control_weight = validation.positive(control_weight, "control_weight")
     n_runs = validation.integer(n_runs, "n_runs", minimum=1)
     seed = validation.integer(seed, "seed", minimum=0)
+    _check_executor(executor)
     cells, onsets = {}, {}
     models = [("angles", False, 1.0)] + [(m, True, b) for m, b in rate_models.items()]
     for io, (oname, orb) in enumerate(orbits_.items()):
@@ -576,6 +650,7 @@ def regime_map(system: CR3BP, orbits_: dict, cadences, sigmas, handoffs, rate_mo
 
 def figure_regime_map(rmap: RegimeMap):
     """One panel per orbit, cadence and noise: diverged runs against hand-off, one curve per model."""
+    validation.instance(rmap, "rmap", RegimeMap, "a RegimeMap (regime_map)")
     n_cols = len(rmap.cadences) * len(rmap.sigmas)
     n_orb = len(rmap.orbit_names)
     handoff_km = [10.0 * h for h in rmap.handoffs]
@@ -652,6 +727,12 @@ def divergence_example(system: CR3BP, orbit: PeriodicOrbit, rmap: RegimeMap, cel
     """Rerun ``n_draws`` fresh draws (seeds ``[seed, 404, k]``) of an angles-only map ``cell`` and keep the diverged
     one with the largest mean NEES."""
     check_system(system)
+    validation.instance(orbit, "orbit", PeriodicOrbit, "a cislunar.cr3bp.orbits.PeriodicOrbit")
+    validation.instance(rmap, "rmap", RegimeMap, "a RegimeMap (regime_map)")
+    if not isinstance(cell, tuple) or len(cell) != 5 or cell not in rmap.cells:
+        raise ValueError(f"cell must be a key (orbit, cadence, sigma, model, handoff) of rmap.cells; got {cell!r:.80}")
+    control_weight = validation.positive(control_weight, "control_weight")
+    seed = validation.integer(seed, "seed", minimum=0)
     n_draws = validation.integer(n_draws, "n_draws", minimum=1)
     _, cad, sig, _, h = cell
     scn = tracking.make_scenario(system, orbit, cad, start="apoapsis", rates=False, sigma_angle_rad=sig)
@@ -675,6 +756,10 @@ def divergence_example(system: CR3BP, orbit: PeriodicOrbit, rmap: RegimeMap, cel
 
 def figure_divergence(example: DivergenceExample, what: str):
     """Error norms, 3-sigma bounds and the NEES against its 99.9 % quantile; perilune dotted."""
+    validation.instance(example, "example", DivergenceExample, "a DivergenceExample (divergence_example)")
+    if example.result is None:
+        raise ValueError("example holds no completed diverged run (result is None): nothing to draw")
+    validation.instance(what, "what", str)
     orbit_name, cad, sig, _, h = example.cell
     sc, run, system = example.scenario, example.result, example.scenario.system
     fig, axes = plt.subplots(3, 1, figsize=(8, 7.5), sharex=True)
@@ -738,6 +823,19 @@ class StableCandidates:
 def compare_stable_candidates(rates: StrategyStudy, reference: str, candidates, cadences) -> StableCandidates:
     """Compare ``candidates`` (orbit names) with the ``reference`` orbit on the median final 3-sigma position and
     the diverged runs at cadences of 6 h or more."""
+    validation.instance(rates, "rates", StrategyStudy, "a StrategyStudy (strategy_study)")
+    names = {name for name, _ in rates.runs}
+    validation.instance(reference, "reference", str)
+    if reference not in names:
+        raise ValueError(f"reference must be an orbit of the study {sorted(names)}; got {reference!r}")
+    candidates = _names(candidates, "candidates")
+    for c in candidates:
+        if c not in names:
+            raise ValueError(f"candidates must be orbits of the study {sorted(names)}; got {c!r}")
+    study_cadences = {cad for _, cad in rates.runs}
+    cadences = tuple(float(c) for c in validation.as_array(cadences, "cadences", ndim=(1,), min_size=1))
+    if any(c not in study_cadences for c in cadences):
+        raise ValueError(f"cadences must be cadences of the study {sorted(study_cadences)}; got {cadences}")
     r92 = rates.by_cadence(reference)
     rows = {name: rates.by_cadence(name) for name in candidates}
     long_gap = tuple(c for c in cadences if c >= 6.0)

@@ -89,7 +89,7 @@ def variational_check(system: CR3BP, orbit: PeriodicOrbit, n_steps: int, *, log1
     check_system(system)
     validation.instance(orbit, "orbit", PeriodicOrbit, "a cislunar.cr3bp.orbits.PeriodicOrbit")
     n_steps = validation.integer(n_steps, "n_steps", minimum=2)
-    lo, hi = (validation.real(v, "log10_range") for v in log10_range)
+    lo, hi = (float(v) for v in validation.as_array(log10_range, "log10_range", shape=(2,)))
     exact = propagation.propagate_stt(system, orbit.x0, orbit.period)
     steps = np.logspace(lo, hi, n_steps)
     stm_err, stt_err = [], []
@@ -103,6 +103,7 @@ def variational_check(system: CR3BP, orbit: PeriodicOrbit, n_steps: int, *, log1
 
 def figure_variational_check(check: VariationalCheck):
     """Error against step for the STM and STT, with the :math:`h^2` and :math:`1/h` guides."""
+    validation.instance(check, "check", VariationalCheck, "a VariationalCheck (variational_check)")
     steps, stm_err, stt_err = check.steps, check.stm_error, check.stt_error
     fig, ax = plt.subplots()
     ax.loglog(steps, stm_err, "o-", label="STM  (central differences of the state)")
@@ -120,6 +121,27 @@ def figure_variational_check(check: VariationalCheck):
 # ---------------------------------------------------------------------------------------------------------------
 # DRO figure (Wolf & Jones orbits passed in as plain orbits and labels)
 # ---------------------------------------------------------------------------------------------------------------
+def _check_groups(groups) -> list:
+    """A non-empty sequence of (PeriodicOrbit, str) pairs, one of whose labels mentions ``observer_t0``."""
+    what = "a sequence of (PeriodicOrbit, label) pairs"
+    if isinstance(groups, (str, bytes, dict)) or not hasattr(groups, "__iter__"):
+        raise validation.ArgumentTypeError(f"groups must be {what}; got {type(groups).__name__}")
+    out = []
+    for i, item in enumerate(groups):
+        if not isinstance(item, (tuple, list)) or len(item) != 2:
+            raise validation.ArgumentTypeError(f"groups[{i}] must be a (PeriodicOrbit, label) pair; got "
+                                               f"{type(item).__name__}")
+        validation.instance(item[0], f"groups[{i}] orbit", PeriodicOrbit, "a cislunar.cr3bp.orbits.PeriodicOrbit")
+        validation.instance(item[1], f"groups[{i}] label", str)
+        out.append((item[0], item[1]))
+    if not out:
+        raise ValueError(f"groups must be {what}; got an empty sequence")
+    if not any("observer_t0" in label for _, label in out):
+        raise ValueError("groups must hold an orbit whose label mentions 'observer_t0' (its period sets the span "
+                         "of the printed state)")
+    return out
+
+
 def figure_dro_family(system: CR3BP, family, zoom_family, groups, printed_state):
     """The DRO family, a zoom on the -x crossing of the given DROs and their periods against that crossing.
 
@@ -132,6 +154,11 @@ def figure_dro_family(system: CR3BP, family, zoom_family, groups, printed_state)
     printed_state : array, shape (6,)
         A non-periodic state propagated for one period of the first orbit whose label mentions it (dashed).
     """
+    check_system(system)
+    family = validation.sequence_of(family, "family", PeriodicOrbit, "PeriodicOrbit")
+    zoom_family = validation.sequence_of(zoom_family, "zoom_family", PeriodicOrbit, "PeriodicOrbit")
+    groups = _check_groups(groups)
+    printed_state = validation.as_state(printed_state, "printed_state", batch=False)
     em = system
     colours = [plt.cm.tab10(i) for i in (0, 1, 2, 4, 5, 6, 8, 9)[:len(groups)]]  # no red (printed observer)
     x_moon = em.secondary_position[0]
@@ -271,12 +298,18 @@ def halo_family_study(system: CR3BP, step: float) -> HaloFamilyStudy:
                            tuple(family), step)
 
 
+def _check_study(study, name: str = "study") -> HaloFamilyStudy:
+    return validation.instance(study, name, HaloFamilyStudy, "a HaloFamilyStudy (halo_family_study)")
+
+
 _ORBIT_STYLES = (("nrho", "C0", "9:2 NRHO"), ("stable", "C1", "stable NRHO (inner band)"),
                  ("outer", "C2", "stable NRHO (outer band)"))
 
 
 def figure_halo_stability(system: CR3BP, study: HaloFamilyStudy):
     """Stability index against perilune radius along the family, with the three orbits and the outer band."""
+    check_system(system)
+    _check_study(study)
     nrho, stable, outer = study.nrho, study.stable, study.outer
     fig, ax = plt.subplots(figsize=(9.5, 4.6))
     ax.semilogy(study.perilune_km, study.stability_index, "-", color="0.3", label="southern L2 halo family")
@@ -302,6 +335,8 @@ def figure_halo_stability(system: CR3BP, study: HaloFamilyStudy):
 
 def figure_nrho_family(system: CR3BP, study: HaloFamilyStudy):
     """Analogue of the paper's Fig. 2: NRHO members (perilune < 20,000 km) with the three orbits highlighted."""
+    check_system(system)
+    _check_study(study)
     fig, axes = plotting.three_plane_axes(figsize=(13, 4.5))
     nrho_like = [o for o in study.family if o.perilune_radius_km < 20000]
     for o in nrho_like[:: max(1, len(nrho_like) // 10)]:
@@ -374,6 +409,9 @@ def observer_visibility(system: CR3BP, targets: dict, samples: int, span_days: f
     dict of str -> OrbitVisibility
     """
     check_system(system)
+    validation.instance(targets, "targets", dict, "a dict of name -> cislunar.cr3bp.orbits.PeriodicOrbit")
+    for o in targets.values():
+        validation.instance(o, "targets", PeriodicOrbit, "a dict of name -> cislunar.cr3bp.orbits.PeriodicOrbit")
     samples = validation.integer(samples, "samples", minimum=2)
     span_days = validation.positive(span_days, "span_days")
     step_s = validation.positive(step_s, "step_s")
@@ -381,7 +419,6 @@ def observer_visibility(system: CR3BP, targets: dict, samples: int, span_days: f
         sites.DEFAULT_STATIONS
     out = {}
     for name, o in targets.items():
-        validation.instance(o, "targets", PeriodicOrbit, "a dict of cislunar.cr3bp.orbits.PeriodicOrbit")
         cov = sites.surface_coverage(system, o.sample(samples)[1], stations)
         pairs = {(i, j): cov[[i, j]].any(axis=0).mean() for i in range(3) for j in range(i + 1, 3)}
         best = max(pairs, key=pairs.get)
@@ -395,11 +432,19 @@ def observer_visibility(system: CR3BP, targets: dict, samples: int, span_days: f
 
 def line_of_sight_samples(span_days: float, step_s: float) -> int:
     """Number of line-of-sight samples of :func:`cislunar.sensing.sites.occultation_outages` over the span."""
+    span_days = validation.positive(span_days, "span_days")
+    step_s = validation.positive(step_s, "step_s")
     return np.arange(0.0, span_days * 86400 + 0.5 * step_s, step_s).size
 
 
 def visibility_report(visibility: dict, span_days: float, step_s: float) -> str:
-    """The printed station-coverage and occultation tables."""
+    """The printed station-coverage and occultation tables (``visibility`` from :func:`observer_visibility`)."""
+    what = "a dict of name -> OrbitVisibility (observer_visibility)"
+    validation.instance(visibility, "visibility", dict, what)
+    for v in visibility.values():
+        validation.instance(v, "visibility", OrbitVisibility, what)
+    span_days = validation.positive(span_days, "span_days")
+    step_s = validation.positive(step_s, "step_s")
     stations = sites.DEFAULT_STATIONS
     lines = []
     for name, v in visibility.items():
@@ -475,10 +520,13 @@ def station_pair_sweep(system: CR3BP, orbit: PeriodicOrbit, grid_deg, samples: i
     the best pair's two sites (cross pairs included)."""
     check_system(system)
     validation.instance(orbit, "orbit", PeriodicOrbit, "a cislunar.cr3bp.orbits.PeriodicOrbit")
-    lat, lon = (validation.positive(g, "grid_deg") for g in grid_deg)
+    lat, lon = (validation.positive(g, "grid_deg") for g in validation.as_array(grid_deg, "grid_deg", shape=(2,)))
+    try:
+        grid_sites = tuple(sites.site_grid(lat, lon))
+    except ValueError as exc:
+        raise ValueError(f"grid_deg = ({lat:g}, {lon:g}) is not a valid site grid: {exc}") from None
     samples = validation.integer(samples, "samples", minimum=2)
     xs = orbit.sample(samples)[1]
-    grid_sites = tuple(sites.site_grid(lat, lon))
     coarse = sites.pair_coverage(system, xs, grid_sites, min_elevation_deg=0.0)
     bi, bj = coarse.best_pair
     near = tuple(sites.SurfaceStation(f"{la:+g},{lo:+g}", la, lo) for s in (grid_sites[bi], grid_sites[bj])
@@ -516,13 +564,24 @@ class PeriluneVisibility:
         return "\n".join(lines)
 
 
+def _station_indices(best_pair, n: int) -> tuple:
+    """Two distinct indices into the default stations."""
+    if isinstance(best_pair, (str, bytes, dict)) or not hasattr(best_pair, "__iter__"):
+        raise validation.ArgumentTypeError(f"best_pair must be two station indices; got {type(best_pair).__name__}")
+    pair = tuple(validation.integer(k, "best_pair", minimum=0, maximum=n - 1) for k in best_pair)
+    if len(pair) != 2 or pair[0] == pair[1]:
+        raise ValueError(f"best_pair must be two distinct station indices in 0..{n - 1}; got {pair}")
+    return pair
+
+
 def perilune_visibility(system: CR3BP, orbit: PeriodicOrbit, best_pair, *, half_width_h: float = 6.0
                         ) -> PeriluneVisibility:
     """Visibility of ``orbit`` from each default station within +-``half_width_h`` of perilune (30-s grid)."""
     check_system(system)
     validation.instance(orbit, "orbit", PeriodicOrbit, "a cislunar.cr3bp.orbits.PeriodicOrbit")
-    hw = validation.positive(half_width_h, "half_width_h")
     stations = sites.DEFAULT_STATIONS
+    best_pair = _station_indices(best_pair, len(stations))
+    hw = validation.positive(half_width_h, "half_width_h")
     hours = np.linspace(-hw, hw, round(2 * hw * 120) + 1)
     # the grid starts at apolune (t = 0, where orbit.x0 holds) and the first point is dropped
     x = propagation.propagate(system, orbit.x0, np.r_[0.0, orbit.period / 2 + hours * 3600.0 / system.time_unit_s]).x[1:]
@@ -536,6 +595,9 @@ def perilune_visibility(system: CR3BP, orbit: PeriodicOrbit, best_pair, *, half_
 def figure_observer_sites(system: CR3BP, study: HaloFamilyStudy, perilune: PeriluneVisibility):
     """The observers and the three orbits in three planes, a zoom on the Moon with the stations' horizons and the
     timeline of station visibility around the 9:2 NRHO's perilune (the paper's Fig. 3 analogue)."""
+    check_system(system)
+    _check_study(study)
+    validation.instance(perilune, "perilune", PeriluneVisibility, "a PeriluneVisibility (perilune_visibility)")
     em = system
     stations = sites.DEFAULT_STATIONS
     l2_state, dro_obs = sites.l2_observer_state(em), sites.dro_observer_orbit(em)

@@ -125,3 +125,21 @@ def test_09_handoff_wide_priors_diverge_while_the_covariance_forgets_them():
     _frozen_with_answer_0109(r)
     assert r.diverged[0] <= 0.25 and r.diverged[1] >= 0.5
     assert abs(r.final_3sigma_km[1] / r.final_3sigma_km[0] - 1) < 0.1
+
+
+def test_exercise_parameters_are_refused_by_name():
+    """Every exercise checks its parameters before any run."""
+    for fn, kwargs, name in ((ex.exercise_09b_burn_size, dict(seed=-1), "seed"),
+                             (ex.exercise_09b_base_weight, dict(seed="a"), "seed"),
+                             (ex.exercise_10_window_factor, dict(seed=1.5), "seed"),
+                             (ex.exercise_10_pm_j_noise, dict(seed=None), "seed"),
+                             (ex.exercise_09_angle_noise, dict(seed=True), "seed"),
+                             (ex.exercise_09_cadence, dict(cadences_h=None), "cadences_h"),
+                             (ex.exercise_09_cadence, dict(cadences_h=(2.0, 12.0)), "cadences_h"),  # sparse first
+                             (ex.exercise_09_handoff, dict(scales=(300.0, 1.0)), "scales"),
+                             (ex.exercise_01_halo_step, dict(steps=None), "steps"),
+                             (ex.exercise_01_halo_step, dict(steps=(0.015, 0.03)), "steps"),  # coarse first
+                             (ex.exercise_01_site_grid, dict(grids_deg=((40.0, 80.0), (30.0, 60.0))), "grids_deg"),
+                             (ex.exercise_01_site_grid, dict(grids_deg=(20.0, 40.0)), "grids_deg")):
+        with pytest.raises((ValueError, TypeError), match=name):
+            fn(**kwargs)

@@ -124,3 +124,35 @@ def test_claims_read_diverges_and_consistent_as_declared():
     row = obs.filled(CLAIMS["angles_only_noise"], noise="100").judge(False, shown="0% diverged")
     assert row.quantity == "angles only, 9:2 NRHO, 12 h, 100 urad" and row.status == "differs"
     assert CLAIMS["angles_only_noise"].quantity.endswith("{noise} urad")  # the declaration itself is untouched
+
+
+def test_public_boundary_names_the_bad_argument(nrho):
+    """Configuration errors are refused by name before any Monte Carlo run (not as a failed trial)."""
+    orbits_ = {"9:2 NRHO": nrho}
+    for kwargs, name in ((dict(control_weight=-1.0), "control_weight"), (dict(cadences=[]), "cadences"),
+                         (dict(cadences=[2.0, -1.0]), "cadences"), (dict(handoff_scale=0.0), "handoff_scale"),
+                         (dict(executor="pool"), "executor"), (dict(observers="moon"), "observers")):
+        args = dict(cadences=[12.0], control_weight=Q) | kwargs
+        with pytest.raises((ValueError, TypeError), match=name):
+            obs.strategy_study(em, orbits_, args["cadences"], args["control_weight"], rates=False, n_runs=1,
+                               seed=0, **{k: v for k, v in kwargs.items() if k not in ("cadences", "control_weight")})
+    with pytest.raises(TypeError, match="orbits_"):
+        obs.strategy_study(em, [nrho], [12.0], Q, rates=False, n_runs=1, seed=0)
+    with pytest.raises(TypeError, match="rate_models"):
+        obs.regime_map(em, orbits_, [12.0], [1e-5], [1.0], {"rates": "1 s"}, Q, n_runs=1, seed=0)
+    runs = {(name, cad): (_summary(False),) for name in ("ref", "a") for cad in (2.0, 12.0)}
+    study = obs.StrategyStudy(runs, True)
+    with pytest.raises(ValueError, match="reference"):
+        obs.compare_stable_candidates(study, "9:2", ("a",), (2.0, 12.0))
+    with pytest.raises(TypeError, match="candidates"):
+        obs.compare_stable_candidates(study, "ref", "a", (2.0, 12.0))  # one name, not its letters
+    with pytest.raises(ValueError, match="cadences"):
+        obs.compare_stable_candidates(study, "ref", ("a",), (6.0,))  # not a cadence of the study
+    with pytest.raises(TypeError, match="rows"):
+        obs.flagged_cells("abc")
+    with pytest.raises(ValueError, match="fields"):
+        obs.filled(CLAIMS["table4"])  # its quantity has a {cadence} field to fill
+    with pytest.raises(ValueError, match="values"):
+        obs.pct_span([])
+    with pytest.raises(ValueError, match="cadence_h"):
+        obs.cadence_label(0.0)

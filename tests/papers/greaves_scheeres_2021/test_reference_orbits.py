@@ -90,3 +90,32 @@ def test_claims_judge_the_measured_rows():
     assert CLAIMS["dro_outages_9_2"].judge(True).status == "consistent (tuned)"
     assert CLAIMS["l2_line_of_sight"].judge(0).status == "reproduced"
     assert CLAIMS["l2_line_of_sight"].judge(2).status == "differs"
+
+
+def test_public_boundary_names_the_bad_argument(nrho):
+    """Malformed inputs are refused by name before any propagation (the reliability sweep covers every kind)."""
+    with pytest.raises(ValueError, match="grid_deg.*divide 180"):
+        ro.station_pair_sweep(em, nrho, (40.0, 80.0), 20)  # 40 deg does not divide 180 deg
+    with pytest.raises(ValueError, match="grid_deg"):
+        ro.station_pair_sweep(em, nrho, (30.0,), 20)
+    with pytest.raises(ValueError, match="best_pair"):
+        ro.perilune_visibility(em, nrho, (1, 1))  # the same station twice is not a pair
+    with pytest.raises(ValueError, match="best_pair"):
+        ro.perilune_visibility(em, nrho, (0, 3))  # three default stations: indices 0..2
+    with pytest.raises(TypeError, match="best_pair"):
+        ro.perilune_visibility(em, nrho, "01")
+    with pytest.raises(ValueError, match="log10_range"):
+        ro.variational_check(em, nrho, 2, log10_range=(-6.0,))
+    with pytest.raises(TypeError, match="targets"):
+        ro.observer_visibility(em, [nrho], 20, 1.0, 600.0)
+    with pytest.raises(TypeError, match="visibility"):
+        ro.visibility_report({"9:2": nrho}, 1.0, 600.0)
+    with pytest.raises(ValueError, match="step_s"):
+        ro.line_of_sight_samples(1.0, 0.0)
+    dro = orbits.dro_family(em, np.array([0.8]))[0]
+    with pytest.raises(ValueError, match="observer_t0"):  # the printed state's span is the observer's period
+        ro.figure_dro_family(em, [dro], [dro], [(dro, "target 1")], dro.x0)
+    with pytest.raises(TypeError, match=r"groups\[0\]"):
+        ro.figure_dro_family(em, [dro], [dro], [dro], dro.x0)
+    with pytest.raises(TypeError, match="study"):
+        ro.figure_halo_stability(em, nrho)
