@@ -14,12 +14,14 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export PYTHONHASHSEED := 0
 export JUPYTER_PREFER_ENV_PATH := 1
+# hypothesis keeps its example database and caches in the venv, not in the repository
+export HYPOTHESIS_STORAGE_DIRECTORY ?= $(CURDIR)/.venv/hypothesis
 
 .PHONY: all test unit lint notebooks-quick reproduce notebooks notebook book check-book bench clean distclean venv lock
 # pytest's cache (the quick notebooks' last run times) lives in the venv, the one scratch folder of `make test`
 PYTEST := $(PY) -m pytest -o cache_dir=$(VENV)/pytest-cache
 # What `make test` may leave behind: nothing but .venv/ (compared before and after)
-REPO_STATE = git status --porcelain --ignored 2>/dev/null | grep -v '^!! \.venv/$$' || true
+REPO_STATE = { git status --porcelain --ignored 2>/dev/null | grep -v '^!! \.venv/$$' || true; }
 
 all: test
 
