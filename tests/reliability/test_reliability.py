@@ -1086,10 +1086,15 @@ def _interrupting_trial(rng):
 
 def test_keyboard_interrupt_stops_a_threaded_run_promptly():
     _CALLS.clear()
-    with ThreadPoolExecutor(2) as pool:
-        with pytest.raises(KeyboardInterrupt):
-            montecarlo.run_monte_carlo(_interrupting_trial, 400, 0, executor=pool, chunk_size=20, progress=False)
-        started_at_raise = _CALLS["slow"]
+    # Python's own SIGINT handler, whatever an earlier test in this worker (a kernel, a pool, a cluster) installed
+    saved = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with ThreadPoolExecutor(2) as pool:
+            with pytest.raises(KeyboardInterrupt):
+                montecarlo.run_monte_carlo(_interrupting_trial, 400, 0, executor=pool, chunk_size=20, progress=False)
+            started_at_raise = _CALLS["slow"]
+    finally:
+        signal.signal(signal.SIGINT, saved)
     # counted, not timed: the interrupt arrives when trial 12 starts; the chunks in flight stop at their next trial,
     # so far fewer than the 400 queued ever start (all of them would without cancellation)
     assert 12 <= started_at_raise <= 60 and _CALLS["slow"] <= started_at_raise + 2, _CALLS
