@@ -40,7 +40,7 @@ N_BASELINES = None  # observer phase offsets in the baseline study of section 6 
 BASELINE_MAX_PHASE = None  # longest observer lead in section 6, fraction of the DRO period [-] (None: 0.5)
 TIMING_SIZES = None  # measurement times per window in section 7 [-] (None: [5, 9, 17] quick, up to 65 full)
 TIMING_MIN_TIME = None  # seconds per timing run in section 7 [s] (None: 0.02 quick, 0.1 full)
-WORKERS = None  # processes for the baseline study [-] (None: 1, serial); the timing study always runs serially
+WORKERS = 1  # processes for the baseline study [-] (1: serial); the timing study always runs serially
 SCHEDULER = ""  # address of a Dask scheduler for the baseline study, e.g. "tcp://10.0.0.5:8786" ("": none)
 
 # %%

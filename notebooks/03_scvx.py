@@ -37,7 +37,7 @@ A_MAX_KM_S2 = None  # thrust-acceleration bound outside the window [km/s^2] (Non
 N_GUESSES = None  # random initial guesses in section 4 [-] (None: 2 quick, 6 full)
 GUESS_CONTROL_SCALE = None  # size of the guesses' random controls, fraction of a_max [-] (None: 0.05)
 GUESS_MAX_ITER = None  # SCvx iteration limit of each run from a random guess [-] (None: 200)
-WORKERS = None  # processes for the runs of section 4 [-] (None: 1, serial)
+WORKERS = 1  # processes for the runs of section 4 [-] (1: serial)
 SCHEDULER = ""  # address of a Dask scheduler for section 4, e.g. "tcp://10.0.0.5:8786" ("": none)
 
 # %%

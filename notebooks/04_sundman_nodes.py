@@ -35,7 +35,7 @@ N_NODES = None  # nodes over each reference arc [-] (None: 24 quick, 48 full)
 N_DRAWS = None  # random control profiles per (arc, sigma) [-] (None: 2 quick, 8 full)
 N_EXTRA_SEEDS = None  # further draw seeds for the DRO robustness check [-] (None: 1 quick, 3 full)
 CONTROL_SIZE_KM_S2 = None  # amplitude of the random control profiles [km/s^2] (None: Table 3's a_max, 1e-6)
-WORKERS = None  # processes for the linearisation sweep [-] (None: 1, serial)
+WORKERS = 1  # processes for the linearisation sweep [-] (1: serial)
 SCHEDULER = ""  # address of a Dask scheduler for the sweep, e.g. "tcp://10.0.0.5:8786" ("": none)
 
 # %%

@@ -39,7 +39,7 @@ PRE_ARC_H = None  # tracking arc before the burn in section 4, whole hours (None
 PRE_ARC_SWEEP_H = None  # tracking arcs swept, whole hours (None: 6, 12, 24, 48; PRE_ARC_H is added if missing)
 RING_ANGLES_DEG = None  # initial ring angles of the agent on the QPO, deg, must include 0 (None: 0, 45, 90, 135)
 TIMING_REPEAT = None  # runs of the true minimiser timed, best kept (None: 2 quick, 1 full)
-WORKERS = None  # local processes for the sweeps, 1 = serial (None: 1)
+WORKERS = 1  # local processes for the sweeps (1: serial)
 SCHEDULER = ""  # address of a Dask scheduler to run the sweeps on ("" = none; then WORKERS applies)
 
 # %% [markdown]

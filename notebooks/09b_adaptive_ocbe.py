@@ -41,7 +41,7 @@ NOISE_SWEEP_URAD = None  # angle noise levels (1 sigma) of the smallest burn's d
 Q_BASE_KM2_S3 = None  # the ballistic control weight of the adaptive filter, km^2/s^3 (None: 1e-18, notebook 10's
 #                       weight outside the apoapsis window)
 MAX_RESETS = None  # a run needing more resets than this counts as diverged (None: 5)
-WORKERS = None  # local processes for the delay and reset-rule studies, 1 = serial (None: 1)
+WORKERS = 1  # local processes for the delay and reset-rule studies (1: serial)
 SCHEDULER = ""  # address of a Dask scheduler to run those studies on ("" = none; then WORKERS applies)
 
 # %% [markdown]

@@ -51,7 +51,7 @@ GAMMA_RANGE = None  # (smallest, largest) gamma of the trade curve, LU (None: (3
 N_STUDY = None  # samples per orbit period in the sensitivity study (None: 400 quick, 1000 full)
 STUDY_ORBITS = None  # (p, q, perigee) of the study's orbits (None: 3 orbits quick, all eight RESONANT_CANDIDATES full)
 STUDY_LEVELS = None  # disturbance levels of the study, LU/TU^2 (None: [0, 1e-3] quick, [0, 1e-4, 1e-3, 1e-2] full)
-WORKERS = None  # local processes for the sensitivity study (None: 1, serial)
+WORKERS = 1  # local processes for the sensitivity study (1: serial)
 SCHEDULER = ""  # address of a Dask scheduler to run the study on, e.g. "tcp://10.0.0.5:8786" ("": none)
 
 # %%

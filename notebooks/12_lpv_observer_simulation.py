@@ -46,7 +46,7 @@ NOISE_DEG = None  # standard deviation of the angle noise on theta1 and theta2, 
 E0_SCALE = None  # multiplier of the initial estimate error (None: 1, i.e. about 10,900 km and 14 m/s)
 N_ORBIT = None  # samples along one period of the orbit that bound rho (None: 600 quick, 4000 full)
 N_VERIFY = None  # random interior points of the polytope per gain in the verification (None: 30 quick, 500 full)
-WORKERS = None  # local processes for the initial-error sweep of Section 4 (None: 1, serial)
+WORKERS = 1  # local processes for the initial-error sweep of Section 4 (1: serial)
 SCHEDULER = ""  # address of a Dask scheduler to run that sweep on, e.g. "tcp://10.0.0.5:8786" ("": none)
 
 # %%
