@@ -281,8 +281,15 @@ def foh_discretize(system: CR3BP, t_nodes, x_nodes, u_nodes, *, tol: float = DEF
     n = t.size
     x = validation.as_array(x_nodes, "x_nodes", shape=(n, 6))
     u = validation.as_array(u_nodes, "u_nodes", shape=(n, 3))
-    _check_outside(system, x, "x_nodes")
     tol = _check_tol(tol)
+    return _foh_discretize(system, t, x, u, tol)
+
+
+def _foh_discretize(system: CR3BP, t, x, u, tol: float) -> FOHModel:
+    """Unchecked kernel of :func:`foh_discretize` (arrays already validated by the caller); the geometric guard
+    against reference nodes inside a primary stays, since the nodes of an SCvx iteration are computed."""
+    n = t.size
+    _check_outside(system, x, "x_nodes")
     A = np.empty((n - 1, 6, 6))
     Bm = np.empty((n - 1, 6, 3))
     Bp = np.empty((n - 1, 6, 3))

@@ -65,7 +65,8 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from cislunar.cr3bp.dynamics import CR3BP, check_system
-from cislunar.guidance.discretization import _check_outside, foh_discretize
+from cislunar.cr3bp.propagation import DEFAULT_TOL
+from cislunar.guidance.discretization import _check_outside, _foh_discretize
 from cislunar.utils import validation
 from cislunar.utils.progress import progress as _progress
 
@@ -296,6 +297,11 @@ def concave_part(H, floor: float = 0.0) -> np.ndarray:
     if H.size == 0:
         raise ValueError("H must be a non-empty square matrix; got shape (0, 0)")
     floor = validation.positive(floor, "floor", allow_zero=True)
+    return _concave_part(H, floor)
+
+
+def _concave_part(H, floor: float) -> np.ndarray:
+    """Unchecked kernel of :func:`concave_part` (``H`` a finite square array, ``floor`` >= 0)."""
     lam, V = np.linalg.eigh(0.5 * (H + H.T))
     lo = floor * float(np.max(np.abs(lam))) if lam.size else 0.0
     return V * np.sqrt(np.maximum(-lam, lo))[None, :]
@@ -516,7 +522,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
     def evaluate(x, u, order):
         """Nonlinear pieces at (x, u): FOH model, information value (and gradient), constraint values."""
         t0 = time.perf_counter()
-        model = foh_discretize(system, t, x, u)
+        model = _foh_discretize(system, t, x, u, DEFAULT_TOL)
         t1 = time.perf_counter()
         ival, grad = 0.0, np.zeros(6)
         if info is not None:
@@ -549,7 +555,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
             H = validation.as_array(info.hessian(x), "info.hessian(x)", shape=(6, 6))
         else:  # forward differences of the gradient from the one just computed
             H = finite_difference_hessian(lambda z: info(z, 1)[1], x, st.hessian_step, g0=g0)
-        return concave_part(H, st.curvature_floor), time.perf_counter() - t0
+        return _concave_part(H, st.curvature_floor), time.perf_counter() - t0
 
     ev = evaluate(x_ref, u_ref, 1)
     J_ref, obj_ref = cost_of(x_ref, u_ref, ev)

@@ -58,7 +58,7 @@ import numpy as np
 
 from cislunar.cr3bp.dynamics import CR3BP, check_system
 from cislunar.cr3bp.propagation import propagate_stm
-from cislunar.sensing.covariance import check_spd, covariance_analysis, state_covariance
+from cislunar.sensing.covariance import covariance_analysis, state_covariance
 from cislunar.sensing.measurements import (
     AMOS_RESOLUTION_KM,
     AMOS_SIGMA_MIN_RAD,
@@ -142,7 +142,8 @@ def _noise(sigma_min_rad, resolution_km):
 
 def _initial_cov(P0, name: str = "P0") -> np.ndarray:
     """A 12x12 SPD covariance of the inertial SSAT state (its symmetric part, as the filters use it)."""
-    return check_spd(validation.spd(P0, name, n=12), name)
+    P = validation.spd(P0, name, n=12)  # one check (it also refuses numerical singularity)
+    return 0.5 * (P + P.T)
 
 
 def _trajectory(value, name: str) -> "ImpulsiveTrajectory":
