@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import os
 from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +19,7 @@ import numpy as np
 from cislunar.cr3bp.dynamics import CR3BP, check_system
 from cislunar.cr3bp.orbits import PeriodicOrbit, correct_symmetric, half_period_guess
 from cislunar.cr3bp.propagation import propagate
-from cislunar.utils import paths, validation
+from cislunar.utils import validation
 
 __all__ = ["CLOSURE_TOL", "TableRow", "RowCheck", "load_wolf_jones_table", "verify_table_row"]
 
@@ -79,12 +80,15 @@ class RowCheck:
 
 
 def load_wolf_jones_table(path: str | Path | None = None) -> list[TableRow]:
-    """Read ``data/wolf_jones_dros.csv`` (comment lines start with ``#``)."""
+    """Read the transcribed DRO table (comment lines start with ``#``): ``path``, or by default the copy shipped
+    with the package (``cislunar.data``, read with :mod:`importlib.resources`, so an installed wheel works outside a
+    checkout)."""
     if path is not None:
         validation.instance(path, "path", (str, os.PathLike), "a str or os.PathLike (a file path)")
-    path = Path(path) if path is not None else paths.repo_root() / "data" / "wolf_jones_dros.csv"
-    with open(path, newline="") as fh:
-        lines = [ln for ln in fh if not ln.startswith("#")]
+        text = Path(path).read_text()
+    else:
+        text = resources.files("cislunar.data").joinpath("wolf_jones_dros.csv").read_text()
+    lines = [ln for ln in text.splitlines(keepends=True) if not ln.startswith("#")]
     return [TableRow(int(r["table"]), r["label"], float(r["x0"]), float(r["vy0"])) for r in csv.DictReader(lines)]
 
 
