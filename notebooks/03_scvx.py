@@ -30,7 +30,7 @@
 # %% tags=["parameters"]
 QUICK = False  # quick mode: every None below picks its smaller quick-mode value; the same experiments run
 SEED = 0  # seed of the notebook's random generator (the random initial guesses of section 4)
-OUTPUT_DIR = ""  # folder for the figures ("": the build's default)
+OUTPUT_DIR = ""  # folder for the figures (empty: build-scratch/ by hand, the build under the runner)
 N_NODES = None  # time nodes of the transfer [-] (None: 24 quick, 60 full)
 SIGMA = None  # Sundman exponent of the nodes, notebook 04 [-] (None: 1.0; the DRO is benign, it matters little)
 A_MAX_KM_S2 = None  # thrust-acceleration bound outside the window [km/s^2] (None: Table 3's 1e-6)

@@ -29,7 +29,7 @@
 # %% tags=["parameters"]
 QUICK = False  # quick mode: every None below picks its smaller quick-mode value; the same experiments run
 SEED = 0  # seed of the random control draws (further draw seeds are SEED + 1, SEED + 2, ...)
-OUTPUT_DIR = ""  # folder for the figures ("": the build's default)
+OUTPUT_DIR = ""  # folder for the figures (empty: build-scratch/ by hand, the build under the runner)
 SIGMAS = None  # Sundman exponents swept [-], must hold 0 and 1 (None: [0, 1, 2] quick, [0, 0.5, ..., 2] full)
 N_NODES = None  # nodes over each reference arc [-] (None: 24 quick, 48 full)
 N_DRAWS = None  # random control profiles per (arc, sigma) [-] (None: 2 quick, 8 full)

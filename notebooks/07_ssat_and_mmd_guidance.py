@@ -27,7 +27,7 @@
 # %% tags=["parameters"]
 QUICK = False  # quick mode: coarser sphere of burn directions and fewer coast times (the default sizes below)
 SEED = 0  # seed of the random states of the coordinate checks (section 1)
-OUTPUT_DIR = ""  # where figures are written ("" = the build's default)
+OUTPUT_DIR = ""  # folder for the figures (empty: build-scratch/ by hand, the build under the runner)
 N_GRID = None  # burn directions on the Fibonacci sphere (None: 600 quick, 3000 full)
 N_PERP = None  # burn directions on the circle perpendicular to the line of sight (None: 36 quick, 120 full)
 COAST_HOURS = None  # coast times tau_f - tau_0 swept, whole hours in 1-72 (None: 1, 4, 12, 24, 48 quick; 9 in full)

@@ -29,7 +29,7 @@
 # %% tags=["parameters"]
 QUICK = False  # quick mode: coarser surface, fewer sweep points, fewer Monte Carlo trials (the default sizes below)
 SEED = 0  # root seed of the Monte Carlo (streams [SEED, k]) and of the offset directions (stream [SEED, 8])
-OUTPUT_DIR = ""  # where figures are written ("" = the build's default)
+OUTPUT_DIR = ""  # folder for the figures (empty: build-scratch/ by hand, the build under the runner)
 N_SURF = None  # ring angles = arrival times of the station-keeping surface (None: 14 quick, 40 full; paper: not given)
 N_SWEEP = None  # arrival times in the sweep over the unstated scenario inputs (None: 10 quick, 16 full)
 N_GRID = None  # ring-angle counts of the resolution study of section 5b (None: 10, 20, 40 quick; 16 ... 640 full)

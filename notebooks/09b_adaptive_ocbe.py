@@ -30,7 +30,7 @@
 # %% tags=["parameters"]
 QUICK = False  # quick mode: smaller Monte Carlo samples (the sizes below left at None); every experiment still runs
 SEED = 0  # seed of the one random stream of the chapter (null runs, Figs. 6-9 runs, delay and reset-rule studies)
-OUTPUT_DIR = ""  # where figures are written ("" = the build's default)
+OUTPUT_DIR = ""  # folder for the figures (empty: build-scratch/ by hand, the build under the runner)
 N_NULL = None  # no-maneuver runs for the metric's law, one period each (None: 4 quick, 16 full)
 MAGNITUDES_M_S = None  # burn sizes of the delay and reset-rule studies, m/s, increasing; the first is also swept
 #                        over the angle noise (None: 0.05, 0.3, 3 quick; 0.05, 0.1, 0.3, 1, 3 full)

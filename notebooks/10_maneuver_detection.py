@@ -37,7 +37,7 @@
 # %% tags=["parameters"]
 QUICK = False  # quick mode: every Monte Carlo shrinks (the sizes below left at None); every step still runs
 SEED = 0  # root seed: each sub-study draws from its own child [SEED, k]; one study's sizes leave the others' draws
-OUTPUT_DIR = ""  # where figures are written ("" = the build's default)
+OUTPUT_DIR = ""  # folder for the figures (empty: build-scratch/ by hand, the build under the runner)
 N_H0 = None  # non-maneuvering training runs per policy and orbit (None: 8 quick, 500 full; paper: 500)
 N_H1 = None  # maneuvering training runs per policy and orbit (None: 8 quick, 3000 full; paper: 3000)
 N_TEST = None  # test runs per hypothesis, policy and orbit (None: 4 quick, 100 full; paper: 100 + 100)
