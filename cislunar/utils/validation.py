@@ -19,7 +19,7 @@ import numbers
 
 import numpy as np
 
-__all__ = ["ArgumentTypeError", "as_array", "as_state", "positive", "in_range", "time_grid", "real", "integer",
+__all__ = ["ArgumentTypeError", "dict_of", "as_array", "as_state", "positive", "in_range", "time_grid", "real", "integer",
            "boolean", "choice", "callable_", "rng", "spd", "psd", "upper_triangular", "square",
            "instance", "seed_entropy", "work_size"]
 
@@ -384,3 +384,13 @@ def time_grid(value, name: str = "t", *, increasing: bool = False) -> np.ndarray
     if not (np.all(d > 0) or np.all(d < 0)):
         raise ValueError(f"{name} must be strictly increasing or strictly decreasing")
     return t
+
+
+def dict_of(value, name: str, cls, what: str) -> dict:
+    """A non-empty dict whose values are all ``cls`` instances (``what`` names the class in messages)."""
+    instance(value, name, dict, f"a dict of {what}")
+    if not value:
+        raise ValueError(f"{name} must hold at least one {what}")
+    for key, v in value.items():
+        instance(v, f"{name}[{key!r}]", cls, f"a {what}")
+    return value

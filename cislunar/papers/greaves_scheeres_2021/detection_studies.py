@@ -60,16 +60,6 @@ def _positive_values(value, name: str) -> np.ndarray:
     return v
 
 
-def _dict_of(value, name: str, cls, what: str) -> dict:
-    """A non-empty dict whose values are all ``cls`` instances (``what`` names the class)."""
-    validation.instance(value, name, dict, f"a dict of {what}")
-    if not value:
-        raise ValueError(f"{name} must hold at least one {what}")
-    for key, v in value.items():
-        validation.instance(v, f"{name}[{key!r}]", cls, f"a {what}")
-    return value
-
-
 def accuracy_standard_error(paper: float, n: int) -> float:
     """Standard error of a detection accuracy over ``n`` test runs at the paper's rate ``paper``: the binomial
     standard error with a continuity correction of a quarter run, at least one percentage point.
@@ -233,11 +223,11 @@ def run_tuning_map(system, orbits: dict, policies: dict, variants: dict, f_grid,
         The base setting.
     """
     check_system(system)
-    _dict_of(orbits, "orbits", PeriodicOrbit, "cislunar.cr3bp.orbits.PeriodicOrbit")
+    validation.dict_of(orbits, "orbits", PeriodicOrbit, "cislunar.cr3bp.orbits.PeriodicOrbit")
     if "9:2 NRHO" not in orbits:
         raise ValueError(f"orbits must contain the '9:2 NRHO' (the side axes run on it); got {list(orbits)}")
-    _dict_of(policies, "policies", det.StationKeepingPolicy, "detection.StationKeepingPolicy")
-    _dict_of(variants, "variants", dict, "dict of overrides")
+    validation.dict_of(policies, "policies", det.StationKeepingPolicy, "detection.StationKeepingPolicy")
+    validation.dict_of(variants, "variants", dict, "dict of overrides")
     for v, ov in variants.items():
         unknown = set(ov) - {"sigma_angle_rad", "window_hours", "q_base"}
         if unknown:
@@ -648,9 +638,9 @@ def run_training_studies(setups: dict, setups_c: dict, policies: dict, sizes: di
     """The training and test Monte Carlo of every orbit and policy at f = 0.1 (``setups``, seeds ``[seed, i, j]``)
     and at f_c (``setups_c``, seeds ``[seed, 200 + i, j]``), then ``n_boot`` bootstrap resamples of each threshold
     (seeds ``[seed, 90, n, w]``).  ``sizes``: orbit -> (H0 train, H1 train, tests per hypothesis)."""
-    _dict_of(setups, "setups", det.DetectionSetup, "detection.DetectionSetup")
-    _dict_of(setups_c, "setups_c", det.DetectionSetup, "detection.DetectionSetup")
-    _dict_of(policies, "policies", det.StationKeepingPolicy, "detection.StationKeepingPolicy")
+    validation.dict_of(setups, "setups", det.DetectionSetup, "detection.DetectionSetup")
+    validation.dict_of(setups_c, "setups_c", det.DetectionSetup, "detection.DetectionSetup")
+    validation.dict_of(policies, "policies", det.StationKeepingPolicy, "detection.StationKeepingPolicy")
     validation.instance(sizes, "sizes", dict, "a dict orbit -> (H0 train, H1 train, tests per hypothesis)")
     orbit_names = list(dict.fromkeys(o for o, _ in setups))
     for o in orbit_names:
@@ -841,7 +831,7 @@ def run_burn_z_study(setup: det.DetectionSetup, orbit, factors, magnitude_m_s: f
 
 def lead_report(lead: dict, n_h0: int) -> str:
     """The control-versus-residual race per setting (``lead``: label -> detection.HealthLeadStudy), as text."""
-    _dict_of(lead, "lead", det.HealthLeadStudy, "detection.HealthLeadStudy")
+    validation.dict_of(lead, "lead", det.HealthLeadStudy, "detection.HealthLeadStudy")
     n_h0 = validation.integer(n_h0, "n_h0", minimum=1)
     lines = []
     for tag, h in lead.items():
@@ -862,7 +852,7 @@ def lead_report(lead: dict, n_h0: int) -> str:
 
 def lead_reading(lead: dict) -> str:
     """Where the control test is first in most runs, and the 0.5 m/s race, per setting (text)."""
-    _dict_of(lead, "lead", det.HealthLeadStudy, "detection.HealthLeadStudy")
+    validation.dict_of(lead, "lead", det.HealthLeadStudy, "detection.HealthLeadStudy")
     lines = []
     for tag, h in lead.items():
         fr = h.outcome_fractions()
@@ -927,7 +917,7 @@ def closing_rows(*, ks_text: str, tmap: TuningMap, f_tune: float, q_window_quiet
     validation.instance(spike, "spike", SpikeStudy)
     validation.instance(train, "train", TrainingStudies)
     validation.instance(pm_j, "pm_j", PmJSearch)
-    _dict_of(pm_mc, "pm_mc", det.MonteCarloSample, "detection.MonteCarloSample")
+    validation.dict_of(pm_mc, "pm_mc", det.MonteCarloSample, "detection.MonteCarloSample")
     if not {"active", "quiet"} <= set(pm_mc):
         raise ValueError(f"pm_mc must hold the 'active' and 'quiet' samples; got {list(pm_mc)}")
     validation.instance(burn_z, "burn_z", BurnZStudy)
@@ -936,7 +926,7 @@ def closing_rows(*, ks_text: str, tmap: TuningMap, f_tune: float, q_window_quiet
         raise ValueError(f"sig_level must give a sigma level per tag {TAGS}; got {list(sig_level)}")
     for tag in TAGS:
         validation.real(sig_level[tag], f"sig_level[{tag!r}]")
-    _dict_of(lead, "lead", det.HealthLeadStudy, "detection.HealthLeadStudy")
+    validation.dict_of(lead, "lead", det.HealthLeadStudy, "detection.HealthLeadStudy")
     health_nees_mean = validation.real(health_nees_mean, "health_nees_mean")
     validation.as_array(health_residual_norms, "health_residual_norms", ndim=(1,), min_size=1)
     sigma_angle_rad = validation.positive(sigma_angle_rad, "sigma_angle_rad")

@@ -55,16 +55,6 @@ def _cells(value, name: str, keys, what: str) -> dict:
     return value
 
 
-def _dict_of(value, name: str, cls, what: str) -> dict:
-    """A non-empty dict whose values are all ``cls`` instances (``what`` names the class)."""
-    validation.instance(value, name, dict, f"a dict of {what}")
-    if not value:
-        raise ValueError(f"{name} must hold at least one {what}")
-    for key, v in value.items():
-        validation.instance(v, f"{name}[{key!r}]", cls, f"a {what}")
-    return value
-
-
 def _values(value, name: str, *, positive: bool = False) -> np.ndarray:
     """A non-empty 1-D finite array (positive if asked)."""
     v = validation.as_array(value, name, ndim=(1,), min_size=1)
@@ -186,7 +176,7 @@ def reset_rules(study: ads.ResetRuleStudy):
 def station_keeping_policy(magnitudes: dict, policies: dict, uz):
     """Eq. 5 magnitude draws against the truncated-Gaussian PDF per policy, and the k component of Eqs. 3-4 pointing
     against the arcsine law and a uniform sphere.  ``magnitudes``: policy name -> draws [m/s]."""
-    _dict_of(policies, "policies", det.StationKeepingPolicy, "detection.StationKeepingPolicy")
+    validation.dict_of(policies, "policies", det.StationKeepingPolicy, "detection.StationKeepingPolicy")
     if len(policies) > 2:
         raise ValueError(f"policies must hold at most 2 policies (one panel each); got {len(policies)}")
     _cells(magnitudes, "magnitudes", list(policies), "magnitude draws [m/s] per policy")
@@ -324,7 +314,7 @@ def pm_j_search(pmj: dict, f_values, noise_urad, offsets_h, f_pm: float, sig_pm:
 def health_lead(lead: dict):
     """Fig. 22 race: per burn size, the share of runs where the control or the residual test fires first, both at
     the same epoch, or neither within 24 h.  ``lead``: label -> detection.HealthLeadStudy."""
-    _dict_of(lead, "lead", det.HealthLeadStudy, "detection.HealthLeadStudy")
+    validation.dict_of(lead, "lead", det.HealthLeadStudy, "detection.HealthLeadStudy")
     fig, ax = plt.subplots(1, len(lead), figsize=(5 * len(lead), 3.8), sharey=True, squeeze=False)
     ax = ax[0]
     for a, (tag, h) in zip(ax, lead.items()):
