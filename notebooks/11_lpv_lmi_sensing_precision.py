@@ -61,7 +61,13 @@ from cislunar.estimation import lpv
 from cislunar.papers.nychka_bhattacharya import figures, readout
 from cislunar.papers.nychka_bhattacharya import sensing_precision as sp
 from cislunar.papers.nychka_bhattacharya.claims.sensing_precision import CLAIMS
-from cislunar.papers.nychka_bhattacharya.scenarios import GAMMA, POLE_RADIUS, RESONANT_CANDIDATES, paper_scenario
+from cislunar.papers.nychka_bhattacharya.scenarios import (
+    GAMMA,
+    POLE_RADIUS,
+    RESONANT_CANDIDATES,
+    fig1_scene,
+    paper_scenario,
+)
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
 from cislunar.utils.executors import open_executor
@@ -151,6 +157,17 @@ r = readout.scenario(sc)
 print(r)
 _ = plotting.save_figure(figures.resonant_orbit(sc), "11_resonant_orbit", output_dir=out)
 _ = table.add(*r.judged(CLAIMS))
+
+# %% [markdown]
+# **Fig. 1 analogue: the surveillance concept.** The paper's Fig. 1 shows platforms (black dots) spread along a
+# planar resonant orbit, tracking a resident space object (magenta), without giving the orbits. Below: six
+# platforms equally spaced in time on the 2:1 orbit above, an RSO on a 3:1 resonant orbit (our choice, for
+# illustration), the lines of sight from every platform to the RSO, and, for one platform, the two navigation
+# lines whose angles it measures: $\theta_1$ at the Earth and $\theta_2$ at the Moon, the only measurements of the
+# observers in notebook 12.
+
+# %%
+_ = plotting.save_figure(figures.fig1_analogue(fig1_scene(sc), model.system), "11_fig1_analogue", output_dir=out)
 
 # %% [markdown]
 # ## 4 · Theorems 1 and 2 as derived (and where the printed text disagrees)

@@ -46,6 +46,8 @@ NOISE_DEG = None  # standard deviation of the angle noise on theta1 and theta2, 
 E0_SCALE = None  # multiplier of the initial estimate error (None: 1, i.e. about 10,900 km and 14 m/s)
 N_ORBIT = None  # samples along one period of the orbit that bound rho (None: 600 quick, 4000 full)
 N_VERIFY = None  # random interior points of the polytope per gain in the verification (None: 30 quick, 500 full)
+N_DRAWS = None  # angle-noise draws per orbit sample measuring the scheduling error of Section 6 (None: 5 quick, 50 full)
+N_BISECT = None  # bisection steps for the robust designs' least bound (None: 5 quick, 10 full)
 WORKERS = 1  # local processes for the initial-error sweep of Section 4 (1: serial)
 SCHEDULER = ""  # address of a Dask scheduler to run that sweep on, e.g. "tcp://10.0.0.5:8786" ("": none)
 
@@ -54,6 +56,7 @@ import numpy as np
 
 from cislunar.papers.nychka_bhattacharya import figures, readout
 from cislunar.papers.nychka_bhattacharya import observer_simulation as obs
+from cislunar.papers.nychka_bhattacharya import robust as rb
 from cislunar.papers.nychka_bhattacharya.claims.observer_simulation import CLAIMS
 from cislunar.papers.nychka_bhattacharya.scenarios import GAMMA, SIGMA_DEG, paper_scenario
 from cislunar.publish import plotting
@@ -66,6 +69,8 @@ sigma = NOISE_DEG if NOISE_DEG is not None else SIGMA_DEG
 e0_scale = E0_SCALE if E0_SCALE is not None else 1.0
 n_orbit = N_ORBIT if N_ORBIT is not None else (600 if QUICK else 4000)
 n_verify = N_VERIFY if N_VERIFY is not None else (30 if QUICK else 500)
+n_draws = N_DRAWS if N_DRAWS is not None else (5 if QUICK else 50)
+n_bisect = N_BISECT if N_BISECT is not None else (5 if QUICK else 10)
 workers = WORKERS if WORKERS is not None else 1
 
 plotting.use_style()
@@ -195,18 +200,71 @@ print(readout.line_crossings(lc, sim))
 _ = table.add(*readout.converges(cv, sim).judged(CLAIMS))
 
 # %% [markdown]
-# ## 6 · The same comparison at a sampling interval where the paper's numbers hold
+# ## 6 · Fig. 3 where the paper's H2 number holds, with every guarantee drawn
 #
-# At this notebook's `DT` the H2 design allows far more than 0.1 deg per sample (Section 2). Notebook 11's window where both of the
-# paper's numbers and its ordering hold on this orbit is roughly 100-400 min at the default disturbance level; at
-# $\Delta t_{0.1} =
-# 1/(\kappa_{H2}\sin 0.1°)^2$ (inside it) H2 allows exactly 0.1 deg per sample. Both observers are re-run there with
-# the same 0.1 deg noise, initial error and criterion for "Hinf error larger than H2" (median position error after
-# 10 % of the run, fixed before).
+# Section 5 judged the observers at this notebook's `DT`. Notebook 11 found the one sampling interval at which the
+# H2 design allows exactly the paper's 0.1 deg per sample, $\Delta t_{0.1} = 1/(\kappa_{H2}\sin 0.1°)^2$ (233 min on
+# this orbit): there the H2 guarantee is $\gamma$ itself, 500 km. This section re-flies Fig. 3 there and asks what
+# went wrong in Section 5: the LMIs certify the error for the *true* $\rho$, but the observer is scheduled on
+# $\hat\rho$ triangulated from noisy angles. Subtracting the observer from the truth gives, exactly,
+# $$\dot e = \bigl(A(\hat\rho)+LC(\hat\rho)\bigr)e + \delta_f + L(\delta_y + n),\quad
+#   \delta_f = (A(\rho)-A(\hat\rho))x + b(\rho)-b(\hat\rho),\quad \delta_y = (C(\rho)-C(\hat\rho))x + d(\rho)-d(\hat\rho),$$
+# so the guarantee needs $\hat\rho$ inside the polytope and no $\delta_f, \delta_y$. Here $\delta_f$ is the error
+# of the gravitational acceleration (an unmodelled acceleration) and $\delta_y$ on the $\theta_1$ channels is a
+# relative range error times $[\sin\theta_1, \cos\theta_1]$ (an extra sensor noise). First, how large are they?
+# A Monte Carlo over the angle noise along the orbit (`rb.scheduling_error`) measures them where the observer
+# triangulates, and the box that holds 99.9 % of the triangulated parameters.
 
 # %%
-ww = obs.window_rerun(sc, od, sim, al.dt_01, periods, sigma, np.random.default_rng(SEED + 1))
-r = readout.comparison(sim, ww, od, al, sigma)
+se = rb.scheduling_error(sc, sigma, n_draws, rng)
+print(readout.scheduling_error(se, sc.model.system))
+
+# %% [markdown]
+# **The robust design (beyond the paper).** The gravity error alone is hundreds of times the disturbance the
+# nominal design assumes. `rb.robust_designs` re-solves both theorems on the widened box with $\delta_f$ (on the
+# velocity rows, RMS size $s_f$) and $\delta_y$ (on the $\theta_1$ channels, size $s_y$) as two more exogenous inputs;
+# for H2 their sizes are intensities ($s\sqrt{\Delta t}$), for H-infinity RMS values. Instead of asking for the
+# least precision at the paper's $\gamma$ (the sensor is given: 0.1 deg per sample), it finds by bisection the least
+# bound $\gamma^*$ at which the sensor is precise enough. Each of the three inputs (noise, $\delta_f$, $\delta_y$)
+# then has unit normalised size, so the guaranteed RMS position error is $\sqrt3\,\gamma^*$. The guarantee is
+# probabilistic in one respect: the box holds 99.9 % of the triangulated parameters per component, not all of them
+# (a randomised LPV design, as in the paper's refs. [9], [10]); the simulation reports how often $\hat\rho$ left it.
+# Each robust gain is verified like the nominal ones, on the widened box.
+
+# %%
+rd = rb.robust_designs(sc, se, al.dt_01, n_verify, rng, iters=n_bisect)
+print(readout.robust_designs(rd, sc.model.system))
+
+# %% [markdown]
+# **Fig. 3 at 233 min.** The same truth and noisy angles feed three observers of each kind: the nominal design on
+# the triangulated $\hat\rho$ (the paper's set-up), the nominal design on the true $\rho$ (what its LMI certifies)
+# and the robust design on $\hat\rho$; each from the large initial error of Section 3 and from one a hundred times
+# smaller (about 109 km), so that the steady error and the transient can be told apart. The criteria were fixed
+# before the runs (`claims.observer_simulation`): the RMS error after the first 10 % of the run against each
+# design's guarantee.
+
+# %%
+ws = rb.simulate_window(sc, od, rd, periods, np.random.default_rng(SEED + 1))
+r = readout.window(ws, rd, cv, od, sc.model.system)
+print(r)
+_ = plotting.save_figure(figures.fig3_window(ws, sc.model.system), "12_fig3_233min", output_dir=out)
+_ = table.add(*r.judged(CLAIMS))
+
+# %% [markdown]
+# **Reading the result.** With the true $\rho$ the nominal observers stay inside their guarantees: the LMIs are
+# right about what they certify. With the triangulated $\hat\rho$ the same gains exceed them from either start, so
+# the shortfall is the scheduling error, not the transient. The robust designs hold their guarantee, but it is
+# about ten times the paper's 500 km: with $\theta_1$ and $\theta_2$ at 0.1 deg every 233 min, accounting for the
+# error of the scheduling parameters, the LMIs certify several thousand kilometres, and the simulated error lies
+# well inside that (the bound is loose: one quadratic Lyapunov function over the widened box, and an RMS gravity
+# error dominated by the few samples near perigee). Whether "the observers function without range sensors" is
+# judged below by each observer's own guarantee; falling well below the initial error (the earlier criterion) is
+# not the accuracy the LMIs promise.
+#
+# The error comparison of Fig. 3c at both intervals, with the nominal runs above:
+
+# %%
+r = readout.comparison(sim, ws.as_rerun(), od, al, sigma)
 print(r)
 _ = table.add(*r.judged(CLAIMS))
 

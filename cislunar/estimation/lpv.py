@@ -1121,7 +1121,6 @@ def _hinf_norm(A, B, C, rtol: float = 1e-9, max_iter: int = 50) -> float:
     lb = max(_sigma_max(A, B, C, w) for w in freqs)
     if lb == 0:
         return 0.0
-    A.shape[0]
     BB, CC = B @ B.T, C.T @ C
     for _ in range(max_iter):
         g = lb * (1.0 + 2.0 * rtol)

@@ -14,7 +14,10 @@ with :math:`y = [\sin\tilde\theta_1, \cos\tilde\theta_1, \sin\tilde\theta_2, \co
 are zero in the sparse designs) and :math:`\rho` obtained by triangulating the noisy angles
 (:meth:`CR3BPLPV.rho_from_angles`), except where :math:`|\sin\theta_3| < 0.04` (spacecraft near the Earth-Moon
 line), where :math:`\rho(\hat x)` from the current estimate is used, as in the paper.  Integrated with fixed-step
-RK4 (``substeps`` per measurement interval).
+RK4 (``substeps`` per measurement interval): wherever the three stages of a step are scheduled on measured (not
+estimated) :math:`\rho` the observer is linear in :math:`\hat x`, so those steps are precomputed, all at once, as
+the affine maps :math:`\hat x \mapsto \Phi\hat x + g` of the RK4 step (the same arithmetic, to rounding), and only the
+steps near the Earth-Moon line are integrated one by one.
 
 EKF (beyond the paper)
 ----------------------
@@ -171,79 +174,106 @@ def simulate_lpv_observer(model: CR3BPLPV, L, meas: Measurements, x_hat0, truth,
         rate = np.linalg.norm(L, 2) * c_max + 10.0
         dt_max = float(np.max(np.diff(meas.t))) if meas.t.size > 1 else 0.0
         substeps = max(4, int(np.ceil(dt_max * rate)))
+    stage_y, stage_rho, stage_sing = _stages(model, meas, truth, substeps, hold, exact_rho, thr, y_all, rho_all,
+                                             y_singular, singular)
+    m = meas.t.size
+    out = np.empty((m, 4))
+    out[0] = xh
+    h = np.repeat(np.diff(meas.t) / substeps, substeps)  # (n_steps,)
+    Phi = _linear_rk4_maps(model, L, h, stage_y, stage_rho)  # (n_steps, 5, 5); rows of singular steps unused
+    step_sing = np.any(stage_sing, axis=1)
     coef = model.affine_coefficients()
     A0, Ai, b0, bi = coef["A"][0], coef["A"][1:], coef["b"][0], coef["b"][1:]
     C0, Ci, d0, di = coef["C"][0], coef["C"][1:], coef["d"][0], coef["d"][1:]
     mu = model.mu
 
-    def rho_of(s):
-        r13 = np.hypot(s[0] + mu, s[1])
-        r23 = np.hypot(s[0] - 1.0 + mu, s[1])
-        return np.array([r13**-3, r23**-3, 1.0 / r13, 1.0 / r23, s[0], s[1]])
-
     def rhs(s, y, rho):
-        if rho is None:
-            rho = rho_of(s)
+        """Observer vector field; ``rho`` NaN: scheduled on the estimate (near the Earth-Moon line)."""
+        if np.isnan(rho[0]):
+            r13 = np.hypot(s[0] + mu, s[1])
+            r23 = np.hypot(s[0] - 1.0 + mu, s[1])
+            rho = np.array([r13**-3, r23**-3, 1.0 / r13, 1.0 / r23, s[0], s[1]])
         A = A0 + np.tensordot(rho, Ai, axes=1)
         C = C0 + np.tensordot(rho, Ci, axes=1)
         return (A + L @ C) @ s - L @ y + b0 + rho @ bi + L @ (d0 + rho @ di)
 
-    m = meas.t.size
-    out = np.empty((m, 4))
-    out[0] = xh
-    if hold == "noise":
-        t1_true, t2_true = model._angles(truth)
-        n1 = np.angle(np.exp(1j * (meas.theta1 - t1_true)))
-        n2 = np.angle(np.exp(1j * (meas.theta2 - t2_true)))
-
-        def sensed(k, tau):
-            """Continuous sensor: angles of the (Hermite-interpolated) truth at tau plus the noise held over k."""
-            hk = meas.t[k + 1] - meas.t[k]
-            u = (tau - meas.t[k]) / hk
-            h00, h10, h01, h11 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u, -2 * u**3 + 3 * u**2, u**3 - u**2
-            pos = (h00 * truth[k, :2] + h10 * hk * truth[k, 2:] + h01 * truth[k + 1, :2]
-                   + h11 * hk * truth[k + 1, 2:])
-            a1, a2 = model._angles(pos)
-            th1, th2 = a1 + n1[k], a2 + n2[k]
-            sing = abs(np.sin(th1 + th2)) < max(thr, 1e-9)
-            if exact_rho:
-                rho = rho_of(pos)
-            elif sing:
-                rho = None
-            else:
-                rho = model._rho_from_angles(th1, th2)
-            yv = np.zeros(6)
-            yv[:4] = np.sin(th1), np.cos(th1), np.sin(th2), np.cos(th2)
-            if rho is not None and not exact_rho:
-                yv[4:] = 1.0 / rho[2] ** 2, 1.0 / rho[3] ** 2
-            return yv, rho
+    i = 0
     for k in range(m - 1):
-        h = (meas.t[k + 1] - meas.t[k]) / substeps
-        if hold == "measurement":
-            rho = None if singular[k] else rho_all[k]
-            y = y_all[k] if not y_singular[k] else np.nan_to_num(y_all[k])  # ranges undefined there (zero gain)
-            for _ in range(substeps):
-                k1 = rhs(xh, y, rho)
-                k2 = rhs(xh + 0.5 * h * k1, y, rho)
-                k3 = rhs(xh + 0.5 * h * k2, y, rho)
-                k4 = rhs(xh + h * k3, y, rho)
-                xh = xh + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-        else:
-            for j in range(substeps):
-                t0 = meas.t[k] + j * h
-                ya, ra = sensed(k, t0)
-                yb, rb = sensed(k, t0 + 0.5 * h)
-                yc, rc = sensed(k, t0 + h)
+        for _ in range(substeps):
+            if step_sing[i]:  # a stage scheduled on the estimate: the step is nonlinear in it
+                hi, (ya, yb, yc), (ra, rb, rc) = h[i], stage_y[i], stage_rho[i]
                 k1 = rhs(xh, ya, ra)
-                k2 = rhs(xh + 0.5 * h * k1, yb, rb)
-                k3 = rhs(xh + 0.5 * h * k2, yb, rb)
-                k4 = rhs(xh + h * k3, yc, rc)
-                xh = xh + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+                k2 = rhs(xh + 0.5 * hi * k1, yb, rb)
+                k3 = rhs(xh + 0.5 * hi * k2, yb, rb)
+                k4 = rhs(xh + hi * k3, yc, rc)
+                xh = xh + hi / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+            else:
+                xh = Phi[i, :4, :4] @ xh + Phi[i, :4, 4]
+            i += 1
         if not np.all(np.isfinite(xh)):
             raise RuntimeError(f"LPV observer diverged at t = {meas.t[k + 1]:.4f} TU (step {k + 1})")
         out[k + 1] = xh
     err = truth - out
     return ObserverRun(meas.t, out, err, np.hypot(err[:, 0], err[:, 1]), singular)
+
+
+def _stages(model, meas, truth, substeps, hold, exact_rho, thr, y_all, rho_all, y_singular, singular):
+    """Measurement vector, scheduling parameters and singular flag at the three RK4 stage times of every step.
+
+    Returns ``y (n_steps, 3, 6)``, ``rho (n_steps, 3, 6)`` (NaN where the estimate schedules) and ``sing
+    (n_steps, 3)``; stages are the start, the midpoint (used by k2 and k3) and the end of each step.
+    """
+    m = meas.t.size
+    n_steps = (m - 1) * substeps
+    k = np.repeat(np.arange(m - 1), substeps)
+    if hold == "measurement":
+        y = np.repeat(np.where(y_singular[:-1, None], np.nan_to_num(y_all[:-1]), y_all[:-1]), substeps, axis=0)
+        rho = np.repeat(np.where(singular[:-1, None], np.nan, rho_all[:-1]), substeps, axis=0)
+        y, rho = (np.repeat(a[:, None, :], 3, axis=1) for a in (y, rho))
+        return y, rho, np.isnan(rho[..., 0])
+    t1_true, t2_true = model._angles(truth)
+    n1 = np.angle(np.exp(1j * (meas.theta1 - t1_true)))
+    n2 = np.angle(np.exp(1j * (meas.theta2 - t2_true)))
+    j = np.tile(np.arange(substeps), m - 1)
+    hk = (meas.t[1:] - meas.t[:-1])[k]
+    u = (j[:, None] + np.array([0.0, 0.5, 1.0])[None, :]) / substeps  # (n_steps, 3) fraction of the interval
+    h00, h10, h01, h11 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u, -2 * u**3 + 3 * u**2, u**3 - u**2
+    pos = (h00[..., None] * truth[k, None, :2] + (h10 * hk[:, None])[..., None] * truth[k, None, 2:]
+           + h01[..., None] * truth[k + 1, None, :2] + (h11 * hk[:, None])[..., None] * truth[k + 1, None, 2:])
+    a1, a2 = model._angles(pos)
+    th1, th2 = a1 + n1[k, None], a2 + n2[k, None]
+    y = np.zeros((n_steps, 3, 6))
+    y[..., 0], y[..., 1], y[..., 2], y[..., 3] = np.sin(th1), np.cos(th1), np.sin(th2), np.cos(th2)
+    if exact_rho:
+        return y, model._rho(pos), np.zeros((n_steps, 3), dtype=bool)
+    sing = np.abs(np.sin(th1 + th2)) < max(thr, 1e-9)
+    rho = np.full((n_steps, 3, 6), np.nan)
+    rho[~sing] = model._rho_from_angles(th1[~sing], th2[~sing])
+    y[~sing, 4] = 1.0 / rho[~sing, 2] ** 2
+    y[~sing, 5] = 1.0 / rho[~sing, 3] ** 2
+    return y, rho, sing
+
+
+def _linear_rk4_maps(model, L, h, y, rho):
+    r"""One classical RK4 step of the observer as an affine map, for every step at once.
+
+    With :math:`\rho` and :math:`y` given at the stages the observer is linear, :math:`\dot{\hat x} = M\hat x + c`
+    with :math:`M = A(\rho) + LC(\rho)`, :math:`c = b(\rho) + Ld(\rho) - Ly`; the RK4 step is then exactly
+    :math:`\hat x \mapsto \Phi\hat x + g`, returned as the augmented ``(n_steps, 5, 5)`` matrices
+    ``[[Phi, g], [0, 1]]`` (NaN rows for steps with a stage scheduled on the estimate).
+    """
+    r = np.nan_to_num(rho)
+    M = model._affine_kernel("A", r) + np.einsum("ij,...jk->...ik", L, model._affine_kernel("C", r))
+    c = model._affine_kernel("b", r) + np.einsum("ij,...j->...i", L, model._affine_kernel("d", r) - y)
+    K = np.zeros(M.shape[:-2] + (5, 5))
+    K[..., :4, :4], K[..., :4, 4] = M, c
+    eye = np.eye(5)
+    hh = h[:, None, None]
+    k1 = K[:, 0]
+    k2 = K[:, 1] @ (eye + 0.5 * hh * k1)
+    k3 = K[:, 1] @ (eye + 0.5 * hh * k2)
+    k4 = K[:, 2] @ (eye + hh * k3)
+    return eye + hh / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
 def simulate_ekf(model: CR3BPLPV, meas: Measurements, x_hat0, P0, truth, *, sigma_acc: float = 1e-3,
@@ -272,19 +302,27 @@ def simulate_ekf(model: CR3BPLPV, meas: Measurements, x_hat0, P0, truth, *, sigm
     truth = validation.as_array(truth, "truth", shape=(meas.t.size, 4))
     q = validation.positive(sigma_acc, "sigma_acc", allow_zero=True)
     substeps = validation.integer(substeps, "substeps", minimum=1)
-    sys = model.system
-    idx = [0, 1, 3, 4]
     R = np.eye(2) * meas.sigma**2
     Qc = np.zeros((4, 4))
     Qc[2, 2] = Qc[3, 3] = q**2
     mu = model.mu
+    F = np.zeros((4, 4))
+    F[0, 2] = F[1, 3] = 1.0
+    F[2, 3], F[3, 2] = 2.0, -2.0
 
     def deriv(s, P_):
-        s6 = np.zeros(6)
-        s6[idx] = s
-        f = sys.eom(s6)[idx]
-        F = sys.jacobian(s6)[np.ix_(idx, idx)]
-        return f, F @ P_ + P_ @ F.T + Qc
+        """Planar CR3BP field and the covariance rate (the planar rows of :meth:`CR3BP.eom`, :meth:`CR3BP.jacobian`)."""
+        x, y, vx, vy = s
+        dx1, dx2 = x + mu, x - 1.0 + mu
+        r1s, r2s = dx1 * dx1 + y * y, dx2 * dx2 + y * y
+        c1, c2 = (1.0 - mu) / r1s**1.5, mu / r2s**1.5
+        f = np.array([vx, vy, 2.0 * vy + x - c1 * dx1 - c2 * dx2, -2.0 * vx + y - (c1 + c2) * y])
+        e1, e2 = 3.0 * c1 / r1s, 3.0 * c2 / r2s
+        F[2, 0] = 1.0 - c1 - c2 + e1 * dx1 * dx1 + e2 * dx2 * dx2
+        F[3, 1] = 1.0 - c1 - c2 + (e1 + e2) * y * y
+        F[2, 1] = F[3, 0] = (e1 * dx1 + e2 * dx2) * y
+        FP = F @ P_
+        return f, FP + FP.T + Qc
 
     m = meas.t.size
     out = np.empty((m, 4))

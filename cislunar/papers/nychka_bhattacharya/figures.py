@@ -18,12 +18,13 @@ from matplotlib.patches import Patch
 from cislunar.cr3bp.dynamics import check_system
 from cislunar.estimation import lpv
 from cislunar.papers.nychka_bhattacharya import observer_simulation as obs
+from cislunar.papers.nychka_bhattacharya import robust as rb
 from cislunar.papers.nychka_bhattacharya import sensing_precision as sp
-from cislunar.papers.nychka_bhattacharya.scenarios import Scenario
+from cislunar.papers.nychka_bhattacharya.scenarios import Fig1Scene, Scenario
 from cislunar.publish import plotting
 from cislunar.utils import validation
 
-__all__ = ["resonant_orbit", "bandwidth", "precision_per_sensor", "trade_curve", "sensitivity", "fig3_observers"]
+__all__ = ["fig1_analogue", "fig3_window", "resonant_orbit", "bandwidth", "precision_per_sensor", "trade_curve", "sensitivity", "fig3_observers"]
 
 
 def resonant_orbit(scenario):
@@ -254,4 +255,73 @@ def fig3_observers(sim, conv, crossings, system, gamma, sigma_deg):
            Patch(color="0.85", label="first 5 % of the period")]
     bottom.legend(handles=key, loc="outside lower center", ncol=3, fontsize=8)
     bottom.suptitle("Position error (colour: observer)", fontsize=11)
+    return fig
+
+
+def fig1_analogue(scene, system):
+    """Fig. 1 analogue (a :class:`Fig1Scene`): platform orbit and platforms (black), the RSO and its orbit (magenta),
+    the lines of sight to the RSO, and one platform's celestial-navigation angles theta1 (at the Earth) and theta2
+    (at the Moon); axes in km, legend beside the plot."""
+    scene = validation.instance(scene, "scene", Fig1Scene)
+    system = check_system(system, "system")
+    KM, mu = system.length_unit_km, system.mu
+    earth, moon = np.array([-mu, 0.0]) * KM, np.array([1.0 - mu, 0.0]) * KM
+    fig, ax = plt.subplots(figsize=(8.5, 5.6), layout="constrained")
+    ax.plot(*(scene.orbit[:, :2] * KM).T, color="0.25", lw=1.0, label=scene.labels[0])
+    ax.plot(*(scene.rso_orbit[:, :2] * KM).T, color="m", lw=1.0, ls="--", label=scene.labels[1])
+    P, R = scene.platforms[:, :2] * KM, scene.rso[:2] * KM
+    for i, p in enumerate(P):
+        ax.plot([p[0], R[0]], [p[1], R[1]], color="m", lw=0.6, alpha=0.6, label="line of sight to the RSO" if i == 0
+                else None, zorder=2)
+    ax.plot(*P.T, "o", color="k", ms=6, label=f"{len(P)} platforms", zorder=4)
+    ax.plot(*R, "o", color="m", ms=8, label="RSO", zorder=5)
+    p0 = P[1 % len(P)]
+    for c, name in ((earth, "Earth"), (moon, "Moon")):
+        ax.plot([c[0], p0[0]], [c[1], p0[1]], color="C0", lw=0.9, ls=":", zorder=1,
+                label=r"navigation lines (angles $\theta_1$ at the Earth, $\theta_2$ at the Moon)" if name == "Earth"
+                else None)
+    ax.plot([earth[0], moon[0]], [0, 0], color="C0", lw=0.9, ls=":", zorder=1)
+    for c, lab, off in ((earth, r"$\theta_1$", (0.06, 0.03)), (moon, r"$\theta_2$", (-0.12, 0.03))):
+        ax.annotate(lab, c + np.array(off) * KM, color="C0", fontsize=10)
+    ax.plot(*earth, "o", color="C0", ms=9, label="Earth")
+    ax.plot(*moon, "o", color="0.55", ms=5, label="Moon")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x, rotating frame [km]")
+    ax.set_ylabel("y, rotating frame [km]")
+    ax.xaxis.set_major_formatter(mticker.FuncFormatter(lambda v, _: f"{v / 1e3:.0f}k" if v else "0"))
+    ax.yaxis.set_major_formatter(mticker.FuncFormatter(lambda v, _: f"{v / 1e3:.0f}k" if v else "0"))
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8)
+    ax.set_title("Fig. 1 analogue: resonant-orbit platforms tracking an RSO", fontsize=11)
+    return fig
+
+
+def fig3_window(ws, system):
+    """Fig. 3 at the sampling interval of a :class:`WindowStudy`: position error of the nominal observers
+    (triangulated and exact rho) and of the robust ones, with the nominal and robust guarantees drawn; rows: the
+    large and the small initial error; columns: H2, H-infinity."""
+    ws = validation.instance(ws, "ws", rb.WindowStudy)
+    KM = check_system(system, "system").length_unit_km
+    fig, ax = plt.subplots(2, 2, figsize=(9.0, 6.6), sharex=True, sharey=True, layout="constrained")
+    style = {"nominal": ("C0", "-", r"nominal LMI, triangulated $\rho$"),
+             "nominal, exact rho": ("0.55", "-", r"nominal LMI, true $\rho$"),
+             "robust": ("C3", "-", r"robust LMI, triangulated $\rho$")}
+    for i, start in enumerate(("large", "small")):
+        for j, (n, title) in enumerate((("h2", "H2"), ("hinf", r"H$_\infty$"))):
+            a = ax[i, j]
+            for design, (c, ls, _) in style.items():
+                a.semilogy(ws.t, ws.errors[(design, n, start)] * KM, color=c, ls=ls, lw=1.0, marker=".", ms=2.5)
+            a.axhline(ws.guarantee[("nominal", n)] * KM, color="C0", ls="--", lw=1.1)
+            a.axhline(ws.guarantee[("robust", n)] * KM, color="C3", ls="--", lw=1.1)
+            a.set_title(f"{title}, initial error {ws.e0[start] * KM:,.0f} km", fontsize=10)
+            a.axvspan(ws.t[0], 0.1 * (ws.t[-1] - ws.t[0]), color="0.9", lw=0, zorder=0)
+        ax[i, 0].set_ylabel("position error [km]")
+    for a in ax[1]:
+        a.set_xlabel("t [TU]")
+    key = [Line2D([], [], color=c, ls=ls, marker=".", label=lab) for c, ls, lab in style.values()]
+    key += [Line2D([], [], color="C0", ls="--", label=r"nominal guarantee (assumes true $\rho$)"),
+            Line2D([], [], color="C3", ls="--", label=r"robust guarantee $\sqrt{3}\,\gamma^*$"),
+            Patch(color="0.9", label="first 10 % (not in the RMS)")]
+    fig.legend(handles=key, loc="outside lower center", ncol=3, fontsize=8)
+    fig.suptitle(f"Fig. 3 at a {ws.dt * check_system(system, 'system').time_unit_s / 60:.0f}-min sampling interval "
+                 "(H2 allows 0.1 deg per sample), 0.1 deg angle noise", fontsize=11)
     return fig

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cislunar.cr3bp.dynamics import CR3BP, EARTH_MOON, check_system
+from cislunar.cr3bp.propagation import propagate
 from cislunar.estimation.lpv import (
     CR3BPLPV,
     ParameterBox,
@@ -31,7 +32,9 @@ __all__ = [
     "SIGMA_DEG",
     "SIN3_THRESHOLD",
     "THETA1_SENSORS",
+    "Fig1Scene",
     "Scenario",
+    "fig1_scene",
     "paper_scenario",
 ]
 
@@ -102,3 +105,48 @@ def paper_scenario(system: CR3BP = EARTH_MOON, *, p: int = 2, q: int = 1, perige
                                     source=f"planar {p}:{q} resonant orbit, x0 = {orbit.x0[0]:.6f} LU, "
                                            f"vy0 = {orbit.x0[4]:.6f} LU/TU, T = {orbit.period:.6f} TU")
     return Scenario(model, orbit, t, s, rho, box)
+
+
+@dataclass(frozen=True)
+class Fig1Scene:
+    """The paper's Fig. 1 set-up: surveillance platforms spread along a planar resonant orbit tracking an RSO.
+
+    Attributes
+    ----------
+    orbit : ndarray (n, 4)
+        The platforms' orbit over one period (LU, LU/TU).
+    platforms : ndarray (k, 4)
+        Platform states at the epoch, equally spaced in time along the orbit.
+    rso_orbit : ndarray (n, 4)
+        The RSO's orbit over one of its periods.
+    rso : ndarray (4,)
+        The RSO's state at the epoch.
+    labels : tuple of str
+        ``(platform orbit, RSO orbit)`` labels.
+    """
+
+    orbit: np.ndarray
+    platforms: np.ndarray
+    rso_orbit: np.ndarray
+    rso: np.ndarray
+    labels: tuple
+
+
+def fig1_scene(scenario: Scenario, n_platforms: int = 6, *, rso: tuple = (3, 1, 0.3), rso_phase: float = 0.3,
+               n_samples: int = 400) -> Fig1Scene:
+    """``n_platforms`` platforms equally spaced in time on ``scenario``'s orbit, and an RSO on the ``rso`` = (p, q,
+    perigee guess) resonant orbit at ``rso_phase`` (fraction of its period) of its own orbit; both drawn over one
+    period with ``n_samples`` points (the paper's Fig. 1 states no orbit: an illustration of the concept)."""
+    scenario = validation.instance(scenario, "scenario", Scenario)
+    k = validation.integer(n_platforms, "n_platforms", minimum=1)
+    phase = validation.in_range(rso_phase, "rso_phase", 0.0, 1.0)
+    n = validation.integer(n_samples, "n_samples", minimum=10)
+    m, o = scenario.model, scenario.orbit
+    _, x = o.sample(n)
+    tp = np.arange(k) * o.period / k
+    platforms = m.planar(propagate(m.system, o.x0, np.r_[tp, o.period]).x[:k]) if k > 1 else m.planar(o.x0[None])
+    ro = resonant_orbit(scenario.model.system, int(rso[0]), int(rso[1]), float(rso[2]))
+    _, xr = ro.sample(n)
+    r_at = m.planar(propagate(m.system, ro.x0, [0.0, phase * ro.period + 1e-9]).x[-1])
+    return Fig1Scene(m.planar(x), platforms, m.planar(xr), r_at,
+                     (f"platform orbit ({o.p}:{o.q} resonant)", f"RSO orbit ({ro.p}:{ro.q} resonant)"))

@@ -73,7 +73,9 @@ CLAIMS = {
         reason="a white-noise intensity, not a per-sample angle"),
     "h2_per_sample": Claim(
         "allowable theta1 noise, H2, per sample", "0.1 deg", Within(0.1, printed_tolerance("0.1")),
-        source="§IV-B, Eq. 24", tuned="sampling interval chosen to match the paper's number (paper states none)"),
+        source="§IV-B, Eq. 24",
+        tuned="holds only at the one sampling interval shown, on the 2:1 orbit (one of the eight orbits of Section 9); "
+              "the paper states neither"),
     "hinf_noise": Claim(
         "allowable theta1 noise, Hinf, gamma = 0.0013", "0.08 deg", Within(0.08, printed_tolerance("0.08")),
         source="§IV-B, Eq. 24",

@@ -1,0 +1,115 @@
+"""The robust designs of notebook 12 (cislunar.papers.nychka_bhattacharya.robust): the exact error decomposition,
+the widened polytope, the robust LMI's bound on sampled parameters and the 233-min re-run, on small sizes."""
+
+import numpy as np
+import pytest
+
+from cislunar.estimation import lpv
+from cislunar.papers.nychka_bhattacharya import observer_simulation as obs
+from cislunar.papers.nychka_bhattacharya import robust as rb
+from cislunar.papers.nychka_bhattacharya.scenarios import fig1_scene, paper_scenario
+
+DT_233 = 0.0373  # TU, about the interval at which the H2 design allows 0.1 deg per sample
+
+
+@pytest.fixture(scope="module")
+def setup():
+    sc = paper_scenario(n_samples=300)
+    od = obs.observer_designs(sc, 3, np.random.default_rng(0))
+    se = rb.scheduling_error(sc, 0.1, 4, np.random.default_rng(1))
+    rd = rb.robust_designs(sc, se, DT_233, 10, np.random.default_rng(2), iters=4)
+    return sc, od, se, rd
+
+
+def test_error_decomposition_is_exact():
+    """e' of the observer scheduled on rho_hat equals (A(rho_hat) + L C(rho_hat)) e + delta_f + L (delta_y + n),
+    checked against the two vector fields at random states, estimates, parameters and gains (no linearisation)."""
+    m = lpv.CR3BPLPV()
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        x = np.r_[rng.uniform(-0.8, 0.8, 2) + [0.1, 0.3], rng.uniform(-1, 1, 2)]
+        xh = x + 0.05 * rng.standard_normal(4)
+        rho_hat = m.rho(x[:2] + 0.02 * rng.standard_normal(2)) * (1 + 0.01 * rng.standard_normal(6))
+        L = rng.standard_normal((4, 6))
+        n = 1e-3 * rng.standard_normal(6)
+        y = m.measure(x) + n
+        xdot = m.f(x)
+        xhdot = (m.A(rho_hat) + L @ m.C(rho_hat)) @ xh - L @ y + m.b(rho_hat) + L @ m.d(rho_hat)
+        df, dy = rb.parameter_errors(m, x, rho_hat)
+        pred = (m.A(rho_hat) + L @ m.C(rho_hat)) @ (x - xh) + df + L @ (dy + n)
+        assert np.allclose(xdot - xhdot, pred, rtol=1e-10, atol=1e-12)
+        assert np.allclose(df[:2], 0.0)  # the gravity error is an acceleration
+
+
+def test_widened_box_contains_true_and_triangulated_parameters(setup):
+    sc, _, se, _ = setup
+    assert np.all(se.box.contains(sc.rho))  # the true parameters along the orbit
+    assert np.all(se.box.lower <= sc.box.lower) and np.all(se.box.upper >= sc.box.upper)
+    # fresh triangulations (another seed) fall inside about as often as the coverage says (per parameter 99.9 %)
+    m, x = sc.model, sc.states
+    t1, t2 = m.angles(x)
+    rng = np.random.default_rng(11)
+    th1, th2 = t1 + np.radians(0.1) * rng.standard_normal(t1.size), t2 + np.radians(0.1) * rng.standard_normal(t2.size)
+    ok = np.abs(np.sin(th1 + th2)) >= 0.04
+    assert np.mean(se.box.contains(m.rho_from_angles(th1[ok], th2[ok]))) > 0.97
+    assert se.inside > 0.97 and 0.9 < se.triangulated <= 1.0
+    # the gravity error the nominal design ignores is far above its disturbance level (1e-3 LU/TU^2)
+    assert se.s_f > 10 * 1e-3 and se.s_y > np.radians(0.1)
+
+
+def test_robust_bound_holds_on_sampled_parameters_inside_the_box(setup):
+    """Frozen-parameter check of the robust LMI without the solver: at random parameters in the widened box (and its
+    vertices), A + LC is Hurwitz and the norm from the normalised input (noise at the sensor's precision and the two
+    scheduling-error inputs) to the position error stays below gamma*."""
+    sc, _, se, rd = setup
+    m = sc.model
+    for n, d in rd.designs.items():
+        v = lpv.verify_observer(m, d, se.box, 40, np.random.default_rng(3))
+        assert v.hurwitz and v.worst < rd.gamma_star[n] * (1 + 1e-5), (n, v.worst, rd.gamma_star[n])
+        # the sensor is precise enough: the design's required precision does not exceed the sensor's
+        assert np.max(d.kappa[:2]) <= rd.kappa_sensor[n] * (1 + 1e-9)
+        assert rd.guarantee[n] == pytest.approx(np.sqrt(3) * rd.gamma_star[n])
+        # the bisection ends at the least bound: a tenth below it the sensor no longer suffices
+        lower = d.gamma * 0.9
+        lmi = lpv.PrecisionLMI.for_cr3bp(m, se.box.vertices(), n, disturbance=(
+            np.hstack([lpv.default_disturbance()[0], np.vstack([np.zeros((2, 4)), np.c_[np.eye(2), np.zeros((2, 2))]])]),
+            np.diag([1e-3, 1e-3] + [se.s_f * (np.sqrt(DT_233) if n == "h2" else 1.0) / np.sqrt(2)] * 2
+                    + [se.s_y * (np.sqrt(DT_233) if n == "h2" else 1.0) / np.sqrt(2)] * 2),
+            np.c_[np.zeros((6, 4)), np.vstack([np.eye(2), np.zeros((4, 2))])]), sensors=[0, 1],
+            **({"pole_radius": 1000.0} if n == "hinf" else {}))
+        try:
+            k_low = np.max(lmi.solve(lower).kappa[:2])
+        except lpv.InfeasibleLMIError:
+            k_low = np.inf
+        assert k_low > rd.kappa_sensor[n]
+
+
+def test_window_study_runs_and_guarantees(setup):
+    sc, od, _, rd = setup
+    ws = rb.simulate_window(sc, od, rd, 0.3, np.random.default_rng(4))
+    km_keys = {(d, n, s) for d in ("nominal", "nominal, exact rho", "robust") for n in ("h2", "hinf")
+               for s in ("large", "small")}
+    assert set(ws.errors) == km_keys
+    assert ws.e0["small"] == pytest.approx(rb.SMALL_E0_SCALE * ws.e0["large"])
+    for key, e in ws.errors.items():
+        assert e.shape == ws.t.shape and np.isclose(e[0], ws.e0[key[2]])
+    # at dt_233 the nominal H2 guarantee is gamma kappa sigma sqrt(dt), the robust one sqrt(3) gamma*
+    h2 = od.designs["h2"]
+    assert ws.guarantee[("nominal", "h2")] == pytest.approx(lpv.guaranteed_error_rms(h2, 0.1, DT_233))
+    assert ws.guarantee[("robust", "hinf")] == rd.guarantee["hinf"]
+    assert ws.holds("robust", "h2") == (ws.rms("robust", "h2") <= rd.guarantee["h2"])
+    assert 0.0 <= ws.inside <= 1.0 and all(p > 0 for p in ws.posterior.values())
+    rr = ws.as_rerun()
+    assert rr.n == ws.t.size and set(rr.median) == {"h2", "hinf"}
+    with pytest.raises(ValueError, match="design, norm, start"):
+        ws.rms("robust", "h3")
+
+
+def test_fig1_scene_places_platforms_on_the_orbit():
+    sc = paper_scenario(n_samples=200)
+    scene = fig1_scene(sc, 4, n_samples=50)
+    assert scene.platforms.shape == (4, 4) and scene.rso.shape == (4,)
+    # every platform lies on the platform orbit (Jacobi constant of the orbit) and the first one at its start
+    jac = sc.model.system.jacobi(sc.model.spatial(scene.platforms))
+    assert np.allclose(jac, sc.model.system.jacobi(sc.orbit.x0), atol=1e-9)
+    assert np.allclose(scene.platforms[0], sc.model.planar(sc.orbit.x0))
