@@ -194,10 +194,14 @@ print(typical.report())
 # distributed: mean 6, and above the 99.9% quantile (22.5) at 0.1% of epochs. We call a run **diverged** when more
 # than 5% of its epochs exceed that quantile, or when the filter fails numerically. Each Monte Carlo run draws its
 # own measurement noise and hand-off error (`tracking.filter_trial`), from child $i$ of its set's seed, so a run's
-# result does not depend on where it runs; the runs go to the executor opened at the top (`WORKERS` processes, or
-# the Dask cluster at `SCHEDULER`). The helper below fixes what every set of this chapter shares (the system, the
-# control weight, the seed, the sizes and the executor) and leaves the measurement type, the noise, the cadences
-# and the orbits to each call.
+# result does not depend on where it runs. The runs of a set share their epochs and observers, so they are
+# filtered together, in lockstep (`tracking.filter_trials`: one batched OCBE, `cislunar.estimation.batched_ocbe`,
+# whose heyoka integrator carries one run per SIMD lane); each run's numbers equal those of its own single-trial
+# filter to round-off, and a run that fails numerically is flagged at the epoch where the single-trial filter would
+# have failed, without stopping the others (`tests/estimation/test_batched_ocbe.py`). These batches are the tasks
+# of the executor opened at the top (`WORKERS` processes, or the Dask cluster at `SCHEDULER`). The helper below
+# fixes what every set of this chapter shares (the system, the control weight, the seed, the sizes and the
+# executor) and leaves the measurement type, the noise, the cadences and the orbits to each call.
 
 # %%
 def study(rates, sigma=sigma_angle, cadences=cadences_h, orbits_=ORBITS, **kw):

@@ -1,12 +1,18 @@
 r"""The batched OCBE: the SRI OCBE filter and smoother of :mod:`cislunar.estimation.ocbe` for B trials in lockstep.
 
-All trials share the epochs, observers, measurement model and noise; the transitions of every trial come from one
-heyoka batch integrator of the three non-zero 6x6 blocks of the state/costate transition
-(:func:`cislunar.estimation.ocbe.block_integrator`), and the square-root-information updates are the stacked kernels
-of :mod:`cislunar.estimation.srif` (the same functions the single-trial filter calls, with a leading trial axis).
-The result equals the single-trial filter (:func:`cislunar.estimation.ocbe.ocbe_filter_smoother`) to round-off, and
-so does the first batched implementation, which integrated the full 12x12 variational system and is kept as a test
-oracle in ``tests/estimation/reference_batched_ocbe.py``.
+All trials share the epochs, observers (one or several, with the same availability mask), measurement model and
+noise; the transitions of every trial come from one heyoka batch integrator of the three non-zero 6x6 blocks of the
+state/costate transition (:func:`cislunar.estimation.ocbe.block_integrator`), and the square-root-information
+updates are the stacked kernels of :mod:`cislunar.estimation.srif` (the same functions the single-trial filter
+calls, with a leading trial axis).  The result equals the single-trial filter
+(:func:`cislunar.estimation.ocbe.ocbe_filter_smoother`) to round-off, and so does the first batched implementation,
+which integrated the full 12x12 variational system and is kept as a test oracle in
+``tests/estimation/reference_batched_ocbe.py``.
+
+A trial that fails numerically (a diverged filter) either stops the whole batch (``on_failure="raise"``, the
+default) or is flagged and dropped while the others go on (``on_failure="flag"``): then each trial ends exactly as
+the single-trial filter would, with results or with the :class:`cislunar.estimation.ocbe.FilterDivergenceError`
+that filter raises (same epoch).
 
 Frames and units: rotating barycentric frame, non-dimensional (LU, TU); controls in LU/TU^2, Eq. 33 in LU/TU.
 """
@@ -31,6 +37,10 @@ from cislunar.utils import validation
 
 __all__ = ["BatchOCBEResult", "ocbe_batch"]
 
+#: What counts as a numerical failure of a filter (the exceptions :func:`cislunar.estimation.ocbe.ocbe_filter_smoother`
+#: turns into :class:`cislunar.estimation.ocbe.FilterDivergenceError`).
+_DIVERGENCE = (np.linalg.LinAlgError, ValueError, RuntimeError, FloatingPointError)
+
 
 @dataclass(frozen=True)
 class BatchOCBEResult:
@@ -39,35 +49,52 @@ class BatchOCBEResult:
     Attributes
     ----------
     x_pred, x_filt, x_smooth : ndarray, shape (B, N, 6)
+        ``x_smooth`` and ``P_smooth`` are None in the filter-only mode (``smooth=False``).
     P_filt, P_smooth : ndarray, shape (B, N, 6, 6)
     t_sub : ndarray, shape (N-1, n_sub)
     control_step, control_smooth : ndarray, shape (B, N-1, n_sub, 3)
-        Estimated control (Eq. 32), LU/TU^2.
+        Estimated control (Eq. 32), LU/TU^2 (both None in the filter-only mode, ``smooth=False``).
     z_step, z_smooth : ndarray, shape (B,)
-        Eq. 33, LU/TU.
+        Eq. 33, LU/TU (both None in the filter-only mode).
     residual_norms : ndarray, shape (B, N)
+    failure_epoch : ndarray of int, shape (B,)
+        Epoch at which each trial failed numerically (``on_failure="flag"``), -1 for a trial that did not; the
+        epoch of the :class:`cislunar.estimation.ocbe.FilterDivergenceError` the single-trial filter raises.  A
+        failed trial's arrays are NaN.
+    failure : ndarray of str, shape (B,)
+        The failure's message (``str`` of that error), "" for a trial that did not fail.
     """
 
     x_pred: np.ndarray
     x_filt: np.ndarray
     P_filt: np.ndarray
-    x_smooth: np.ndarray
-    P_smooth: np.ndarray
+    x_smooth: np.ndarray | None
+    P_smooth: np.ndarray | None
     t_sub: np.ndarray
     control_step: np.ndarray
-    control_smooth: np.ndarray
+    control_smooth: np.ndarray | None
     z_step: np.ndarray
-    z_smooth: np.ndarray
+    z_smooth: np.ndarray | None
     residual_norms: np.ndarray
+    failure_epoch: np.ndarray | None = None
+    failure: np.ndarray | None = None
+
+    @property
+    def failed(self) -> np.ndarray:
+        """Which trials failed numerically, shape (B,) bool."""
+        if self.failure_epoch is None:
+            return np.zeros(self.x_filt.shape[0], dtype=bool)
+        return self.failure_epoch >= 0
 
 
 def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *, n_sub: int = 9,
-               tol: float = DEFAULT_TOL) -> BatchOCBEResult:
+               tol: float = DEFAULT_TOL, available=None, smooth: bool = True,
+               on_failure: str = "raise") -> BatchOCBEResult:
     """The extended SRI OCBE filter and full smoother of :func:`cislunar.estimation.ocbe.ocbe_filter_smoother` for B trials.
 
     Same algorithm, step for step (Eqs. 17, 21-32 and the backward SRI smoother with costates
     :math:`\\mathbf p_{n|N} = \\Phi_{xp}^{-1}\\hat{\\mathbf w}_n`), with all trials sharing the epochs, observers,
-    measurement model and noise; the transition blocks of all trials come from heyoka batch integrators
+    availability, measurement model and noise; the transition blocks of all trials come from heyoka batch integrators
     (:func:`cislunar.estimation.ocbe.block_integrator`, :data:`_LANES` trials each) and the square-root-information
     updates are the stacked kernels of :mod:`cislunar.estimation.srif`.  Each trial's result does not depend on the
     other trials of the batch.
@@ -77,12 +104,14 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
     system : CR3BP
     t : array_like, shape (N,)
         Strictly increasing epochs, TU.
-    y : array_like, shape (B, N, m)
-        Measurements of each trial.
-    observer_states : array_like, shape (N, 6)
+    y : array_like, shape (B, N, m) or (B, N, K, m)
+        Measurements of each trial (angles in rad, rates per TU), from one observer or from K observers; entries
+        where an observer is not ``available`` are ignored (NaN allowed there).
+    observer_states : array_like, shape (N, 6) or (N, K, 6)
+        Observer states at the epochs (shared by all trials).
     model : cislunar.sensing.measurements.MeasurementModel
-    meas_cov : array_like, shape (m, m)
-        Measurement covariance (shared by all epochs and trials).
+    meas_cov : array_like, shape (m, m) or (N, m, m)
+        Covariance of one observer's measurement (shared by all trials and observers; observers independent).
     x0 : array_like, shape (B, 6)
         Prior means.
     P0 : array_like, shape (6, 6) or (B, 6, 6)
@@ -93,19 +122,53 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
         Control evaluation points per interval (>= 2).
     tol : float
         Integrator tolerance.
+    available : array_like of bool, shape (N, K) or (N,), optional
+        Which observers measured at each epoch (shared by all trials; default all).  An epoch without any
+        measurement is a pure time update.
+    smooth : bool
+        Run the single-step and full smoothers and estimate the control (``False``: the filter only, faster; the
+        smoothed and control fields are None).
+    on_failure : {"raise", "flag"}
+        A trial failing numerically raises (:class:`cislunar.estimation.ocbe.FilterDivergenceError` for a failed
+        propagation, the numerical error otherwise) or is flagged in ``failure_epoch`` / ``failure`` with the
+        epoch and message of the single-trial filter's error, its arrays NaN, while the others go on.
     """
     check_system(system)
     model = ocbe.check_model(model)
     t = validation.time_grid(t, "t", increasing=True)
     N = t.size
-    y = validation.as_array(y, "y", ndim=(3,), min_size=1)
-    B, m = y.shape[0], model.dim
-    if y.shape[1:] != (N, m):
-        raise ValueError(f"y must have shape (B, {N}, {m}); got {y.shape}")
-    obs = validation.as_array(observer_states, "observer_states", shape=(N, 6))
-    R = validation.spd(meas_cov, "meas_cov", n=m)
+    m = model.dim
+    obs = validation.as_array(observer_states, "observer_states", ndim=(2, 3), last=6)
+    if obs.shape[0] != N:
+        raise ValueError(f"observer_states must have {N} epochs (shape ({N}, 6) or ({N}, K, 6)); got {obs.shape}")
+    multi = obs.ndim == 3
+    obs = obs if multi else obs[:, None, :]
+    K = obs.shape[1]
+    y = validation.as_array(y, "y", ndim=(4,) if multi else (3,), min_size=1, finite=False)
+    B = y.shape[0]
+    if y.shape[1:] != ((N, K, m) if multi else (N, m)):
+        raise ValueError(f"y must have shape (B, {N}, {f'{K}, ' if multi else ''}{m}) to match observer_states and "
+                         f"the model; got {y.shape}")
+    y = y if multi else y[:, :, None, :]
+    if available is None:
+        avail = np.ones((N, K), dtype=bool)
+    else:
+        avail = np.asarray(available)
+        if avail.dtype != bool:
+            raise validation.ArgumentTypeError(f"available must be an array of bool; got dtype {avail.dtype}")
+        if avail.shape != (N, K) and not (K == 1 and avail.shape == (N,)):
+            raise ValueError(f"available must have shape ({N}, {K}); got {avail.shape}")
+        avail = avail.reshape(N, K)
+    if not np.all(np.isfinite(y[:, avail])):
+        raise ValueError("y contains NaN or infinite values where measurements are available")
+    R = validation.as_array(meas_cov, "meas_cov", ndim=(2, 3))
+    if R.shape not in ((m, m), (N, m, m)):
+        raise ValueError(f"meas_cov must have shape ({m}, {m}) or ({N}, {m}, {m}); got {R.shape}")
+    R = validation.spd(R, "meas_cov", n=m, batch=True)
+    validation.choice(on_failure, "on_failure", ("raise", "flag"))
     x = validation.as_array(x0, "x0", shape=(B, 6)).copy()
-    check_outside_primaries(system, x, "x0", t0=t[0])
+    if on_failure == "raise":  # flagged: a prior mean inside a primary fails its trial at epoch 1, as in ocbe.py
+        check_outside_primaries(system, x, "x0", t0=t[0])
     P0 = validation.spd(P0, "P0", n=6, batch=True)
     if P0.shape not in ((6, 6), (B, 6, 6)):
         raise ValueError(f"P0 must have shape (6, 6) or ({B}, 6, 6); got {P0.shape}")
@@ -113,7 +176,8 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
     qs = ocbe.control_weights(control_weight, N - 1, batch=B)
     n_sub = validation.integer(n_sub, "n_sub", minimum=2, maximum=10_000)
     tol = _check_tol(tol)
-    return _ocbe_batch(system, t, y, obs, model, R, x, P0, qs, n_sub, tol)
+    smooth = validation.boolean(smooth, "smooth")
+    return _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smooth, on_failure == "flag")
 
 
 #: Trials per heyoka batch integrator (larger lockstep batches are integrated in groups of
@@ -123,20 +187,91 @@ _LANES = 16
 
 def _check_start_outside(system, x, n, time):
     """Raise :class:`ocbe.FilterDivergenceError` (cause: an ImpactError) if a trial's estimate ``x`` (B, 6) lies
-    inside a primary at the start of interval ``n``."""
+    inside a primary at the start of interval ``n`` (ValueError if it is not finite)."""
+    if np.all(np.isfinite(x)) and not _inside_primaries(system, x):  # the common case, without the checks' cost
+        return
     try:
         check_outside_primaries(system, x, "the reference", t0=time)
     except ImpactError as exc:
         raise ocbe.FilterDivergenceError(n, time, f"ImpactError: {exc}") from exc
 
 
-def _ocbe_batch(system, t, y, obs, model, R, x, P0, qs, n_sub, tol) -> BatchOCBEResult:
+def _process_noise_per_trial(phi_xx, phi_xp):
+    """:func:`ocbe._process_noise` with its symmetry check made trial by trial (each against its own scale)."""
+    Q = -phi_xp @ np.swapaxes(phi_xx, -1, -2)
+    asym = np.max(np.abs(Q - np.swapaxes(Q, -1, -2)), axis=(-2, -1))
+    if np.any(asym > 1e-8 * np.maximum(np.max(np.abs(Q), axis=(-2, -1)), 1e-300)):
+        raise ValueError(f"phi is not an OCBE transition matrix: -Phi_xp Phi_xx^T is not symmetric "
+                         f"({np.max(asym):.2e})")
+    return 0.5 * (Q + np.swapaxes(Q, -1, -2))
+
+
+class _Failures:
+    """The flagged trials of a batch: the epoch and message of each failure, and which trial each slot computes
+    (a failed trial's slot repeats a live trial, so that the lockstep keeps its size and its compiled integrators)."""
+
+    def __init__(self, t, B):
+        self.t = t
+        self.epoch = np.full(B, -1)
+        self.message = [""] * B
+        self.src = np.arange(B)
+
+    @property
+    def alive(self) -> np.ndarray:
+        return np.flatnonzero(self.epoch < 0)
+
+    def flag(self, b, epoch, exc):
+        """Trial ``b`` failed at ``epoch`` with ``exc``: recorded as the single-trial filter's error would be."""
+        cause = exc.cause if isinstance(exc, ocbe.FilterDivergenceError) else f"{type(exc).__name__}: {exc}"
+        self.epoch[b] = epoch
+        self.message[b] = str(ocbe.FilterDivergenceError(epoch, float(self.t[epoch]), cause))
+
+    def donate(self):
+        """Point every failed trial's slot at the first live trial; returns the live trials (None: none left)."""
+        alive = self.alive
+        if alive.size == 0:
+            return None
+        self.src = np.arange(self.epoch.size)
+        self.src[self.epoch >= 0] = alive[0]
+        return alive
+
+
+def _per_trial(fn, B, failures, epoch, *, replicate):
+    """After a batch call ``fn(failures.src)`` raised: run each live trial alone, flag those that fail.
+
+    ``fn(idx)`` computes the trials ``idx`` (indices into the batch) and returns a tuple of arrays (or None) with
+    that leading axis.  ``replicate``: the trial fills all ``B`` slots and its own slot's values are kept (the heyoka
+    integrators are compiled per group size, so the lanes stay those of the batch); else it runs as a batch of one.
+    Returns the tuple for all ``B`` slots (a failed trial's slot repeats a live trial), None if every trial failed.
+    """
+    parts = {}
+    for b in failures.alive:
+        idx = np.full(B, b) if replicate else np.array([b])
+        try:
+            out = fn(idx)
+        except _DIVERGENCE as exc:
+            failures.flag(b, epoch, exc)
+            continue
+        k = b if replicate else 0
+        parts[b] = [None if o is None else np.array(o[k]) for o in out]
+    alive = failures.donate()
+    if alive is None:
+        return None
+    first = parts[alive[0]]
+    return tuple(None if first[i] is None else np.stack([parts[failures.src[b]][i] for b in range(B)])
+                 for i in range(len(first)))
+
+
+def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smooth, flag) -> BatchOCBEResult:
     """:func:`ocbe_batch` after its argument checks: the loop of the single-trial filter with a trial axis.
 
     The SRI algebra is that of :func:`cislunar.estimation.ocbe.ocbe_filter_smoother` step for step, on the same
     :mod:`cislunar.estimation.srif` kernels; what the lockstep adds is where the transitions come from (the three
     non-zero 6x6 blocks of every trial from one batch integrator per :data:`_LANES` trials) and bookkeeping: the
-    sub-grids and the integrators' initial state are allocated once.
+    sub-grids and the integrators' initial state are allocated once.  Each stage (the first update, each interval,
+    the closing smoother) is a function of the trials it computes; with ``flag``, a stage that raises is rerun
+    trial by trial (:func:`_per_trial`) so that only the failing trials are dropped, at the epoch where the
+    single-trial filter would have raised (0 for the first update, n+1 for interval n, N-1 for the smoother).
     """
     B, N = y.shape[0], t.size
     lay = ocbe.BLOCK_LAYOUT
@@ -148,37 +283,72 @@ def _ocbe_batch(system, t, y, obs, model, R, x, P0, qs, n_sub, tol) -> BatchOCBE
     out = np.empty((n_sub, s_pp.stop, B))
     start[s_xx] = start[s_pp] = np.eye(6).ravel()[:, None]
     zero, eye = np.zeros(6), np.eye(6)
+    visible = [np.flatnonzero(avail[k]) for k in range(N)]
+    process_noise = _process_noise_per_trial if flag else ocbe._process_noise
+    mu = system.mu
 
-    def update(S, x_ref, k):  # Eqs. 24-28 about the reference x_ref (the deviation's prior mean is zero)
+    whiten = {}
+
+    def whitening(k, n_vis):  # S_y of the stacked observers' covariance (independent observers), Eq. 26
+        key = (k if R.ndim == 3 else -1, n_vis)
+        if key not in whiten:
+            Rk = R[k] if R.ndim == 3 else R
+            whiten[key] = srif._sri_of_cov(Rk if n_vis == 1 else np.kron(np.eye(n_vis), Rk))
+        return whiten[key]
+
+    def update(S, x_ref, k, yk):  # Eqs. 24-28 about the reference x_ref (the deviation's prior mean is zero)
+        vis = visible[k]
+        if vis.size == 0:  # no measurement: a pure time update
+            return S, x_ref.copy(), np.zeros(x_ref.shape[0])
         if not np.all(np.isfinite(x_ref)):  # a diverged estimate (was refused by model.evaluate's check)
             raise ValueError("target contains NaN or infinite values")
-        val, _, Ht = model._evaluate(obs[k], x_ref)  # arrays checked above: the unchecked kernels
-        S_new, b, e = srif._measurement_update(S, zero, Ht, model._residual(y[:, k], val), R)
-        return S_new, x_ref + srif._solve_upper(S_new, b), e
+        val, _, Ht = model._evaluate(obs[k, vis], x_ref[:, None, :])  # arrays checked above: the unchecked kernels
+        nb = x_ref.shape[0]
+        dy = model._residual(yk[:, vis], val).reshape(nb, -1)
+        # srif._measurement_update with the whitening computed once: triangularise [S 0; W H  W dy]
+        W = whitening(k, vis.size)
+        U = srif._triangularize(np.concatenate([np.concatenate([S, np.zeros((nb, 6, 1))], axis=-1),
+                                                np.concatenate([W @ Ht.reshape(nb, -1, 6), (W @ dy[..., None])],
+                                                               axis=-1)], axis=-2))
+        S_new, b = U[..., :6, :6], U[..., :6, 6]
+        return S_new, x_ref + srif._solve_upper(S_new, b), np.abs(U[..., 6, 6])
 
-    x_pred = np.empty((B, N, 6))
-    x_filt = np.empty((B, N, 6))
-    S_filt = np.empty((B, N, 6, 6))
-    resid = np.empty((B, N))
-    phi_xx = np.empty((B, N - 1, 6, 6))
-    phi_xp = np.empty((B, N - 1, 6, 6))
-    Rw, Rwx, zw = np.empty((B, N - 1, 6, 6)), np.empty((B, N - 1, 6, 6)), np.empty((B, N - 1, 6))  # smoother terms
-    phi_pp_sub = np.empty((B, N - 1, n_sub, 6, 6))
-    p_step = np.empty((B, N - 1, 6))
-    x_pred[:, 0] = x
-    S, x, resid[:, 0] = update(srif._sri_of_cov(P0), x, 0)
-    x_filt[:, 0], S_filt[:, 0] = x, S
-    mu = system.mu
-    for n in range(N - 1):
+    nan = np.nan
+    x_pred = np.full((B, N, 6), nan)
+    x_filt = np.full((B, N, 6), nan)
+    S_filt = np.full((B, N, 6, 6), nan)
+    resid = np.full((B, N), nan)
+    if smooth:  # what the single-step and full smoothers need
+        phi_xx = np.full((B, N - 1, 6, 6), nan)
+        phi_xp = np.full((B, N - 1, 6, 6), nan)
+        Rw, Rwx, zw = np.full((B, N - 1, 6, 6), nan), np.full((B, N - 1, 6, 6), nan), np.full((B, N - 1, 6), nan)
+        phi_pp_sub = np.full((B, N - 1, n_sub, 6, 6), nan)
+        p_step = np.full((B, N - 1, 6), nan)
+    failures = _Failures(t, B)
+    x_cur, S_cur = x, None
+
+    def stage(fn, epoch, replicate):
+        if not flag:
+            return fn(failures.src)
+        try:
+            return fn(failures.src)
+        except _DIVERGENCE:
+            return _per_trial(fn, B, failures, epoch, replicate=replicate)
+
+    def first(idx):
+        return update(srif._sri_of_cov(P0[idx]), x[idx], 0, y[idx, 0])
+
+    def interval(idx, n):
+        xs, S = x_cur[idx], S_cur[idx]
         grid = t_sub[n]
-        start[:6] = x.T
-        _check_start_outside(system, x, n, float(grid[0]))  # a measurement update may move an estimate inside
+        start[:6] = xs.T
+        _check_start_outside(system, xs, n, float(grid[0]))  # a measurement update may move an estimate inside
         ok = True
         for (a, b), tb in zip(lanes, integrators):  # SIMD-sized groups of trials (one lane each)
             tb.set_time(np.full(b - a, grid[0]))
             tb.state[:] = start[:, a:b]
             tb.pars[0] = mu
-            tb.pars[1] = qs[a:b, n]
+            tb.pars[1] = qs[idx[a:b], n]
             out[:, :, a:b] = tb.propagate_grid(np.repeat(grid[:, None], b - a, axis=1))[-1]  # (n_sub, 114, lanes)
             ok = ok and bool(np.all(np.abs(tb.time - grid[-1]) <= 1e-12))
         if not ok or not np.all(np.isfinite(out)):
@@ -190,40 +360,71 @@ def _ocbe_batch(system, t, y, obs, model, R, x, P0, qs, n_sub, tol) -> BatchOCBE
         try:
             if _inside_primaries(system, ref):
                 inside = [b for b in range(B) if _inside_primaries(system, ref[:, b])][0]
-                check_outside_primaries(system, ref[:, inside], f"the reference of trial {inside}",
+                check_outside_primaries(system, ref[:, inside], f"the reference of trial {idx[inside]}",
                                         t0=float(grid[0]))
             _check_arcs_outside_primaries(system, grid, ref, tol)
         except ImpactError as exc:
             raise ocbe.FilterDivergenceError(n, float(grid[0]), f"ImpactError: {exc}") from exc
         end = out[-1].T  # (B, 114)
-        Phi_xx = phi_xx[:, n] = end[:, s_xx].reshape(B, 6, 6)
-        phi_xp[:, n] = end[:, s_xp].reshape(B, 6, 6)
-        phi_pp_sub[:, n] = np.moveaxis(out[:, s_pp], -1, 0).reshape(B, n_sub, 6, 6)
-        Q = ocbe._process_noise(Phi_xx, phi_xp[:, n])  # Eq. 17
+        Phi_xx = np.array(end[:, s_xx].reshape(B, 6, 6))
+        Phi_xp = np.array(end[:, s_xp].reshape(B, 6, 6))
+        Q = process_noise(Phi_xx, Phi_xp)  # Eq. 17
         S_bar, _, term = srif._time_update(S, zero, Phi_xx, eye, Q)  # Eq. 23 with Gamma = I, b_x = 0
-        Rw[:, n], Rwx[:, n], zw[:, n] = term
-        x_prior = end[:, :6]
-        x_pred[:, n + 1] = x_prior
-        S_new, x_new, resid[:, n + 1] = update(S_bar, x_prior, n + 1)  # Eqs. 24-28
+        x_prior = np.array(end[:, :6])
+        S_new, x_new, e = update(S_bar, x_prior, n + 1, y[idx, n + 1])  # Eqs. 24-28
+        if not smooth:  # filter only: no single-step smoother, no control estimate
+            return x_prior, S_new, x_new, e
+        pp_sub = np.moveaxis(out[:, s_pp], -1, 0).reshape(B, n_sub, 6, 6)  # a copy (not a view of out)
         # single-step smoother (Eqs. 29-30) and costate (Eq. 31)
         S1, b1 = srif._smoother_step(S_new, (S_new @ (x_new - x_prior)[..., None])[..., 0], Phi_xx, eye, term)
-        p_step[:, n] = -((np.swapaxes(S, -1, -2) @ S) @ srif._solve_upper(S1, b1)[..., None])[..., 0]
-        S, x = S_new, x_new
-        x_filt[:, n + 1], S_filt[:, n + 1] = x, S
-    control_step = -qs[:, :, None, None] * np.einsum("bnkij,bnj->bnki", phi_pp_sub, p_step)[..., 3:6]  # Eq. 32
-    # full SRI smoother (backward)
-    x_s = np.empty((B, N, 6))
-    P_s = np.empty((B, N, 6, 6))
-    Rs, bs = S_filt[:, -1], np.zeros((B, 6))
-    x_s[:, -1], P_s[:, -1] = x_filt[:, -1], srif._cov_of_sri(Rs)
-    for n in range(N - 2, -1, -1):
-        z_next = bs + (Rs @ (x_filt[:, n + 1] - x_pred[:, n + 1])[..., None])[..., 0]
-        Rs, bs = srif._smoother_step(Rs, z_next, phi_xx[:, n], eye, (Rw[:, n], Rwx[:, n], zw[:, n]))
-        x_s[:, n] = x_filt[:, n] + srif._solve_upper(Rs, bs)
-        P_s[:, n] = srif._cov_of_sri(Rs)
-    w = (x_s[:, 1:] - x_pred[:, 1:]) - (phi_xx @ (x_s[:, :-1] - x_filt[:, :-1])[..., None])[..., 0]
-    p_s = np.linalg.solve(phi_xp, w[..., None])[..., 0]
-    control_s = -qs[:, :, None, None] * np.einsum("bnkij,bnj->bnki", phi_pp_sub, p_s)[..., 3:6]
-    return BatchOCBEResult(x_pred, x_filt, srif._cov_of_sri(S_filt), x_s, P_s, t_sub, control_step, control_s,
-                           ocbe._control_integral(t_sub, control_step), ocbe._control_integral(t_sub, control_s),
-                           resid)
+        p = -((np.swapaxes(S, -1, -2) @ S) @ srif._solve_upper(S1, b1)[..., None])[..., 0]
+        return (x_prior, S_new, x_new, e, Phi_xx, Phi_xp, pp_sub, *term, p)
+
+    res = stage(first, 0, False)
+    if res is not None:
+        S_cur, x_cur, resid[:, 0] = res
+        x_pred[:, 0], x_filt[:, 0], S_filt[:, 0] = x, x_cur, S_cur
+        for n in range(N - 1):
+            res = stage(lambda idx: interval(idx, n), n + 1, True)  # noqa: B023 - called at once
+            if res is None:
+                break
+            x_pred[:, n + 1], S_cur, x_cur, resid[:, n + 1] = res[:4]
+            x_filt[:, n + 1], S_filt[:, n + 1] = x_cur, S_cur
+            if smooth:
+                phi_xx[:, n], phi_xp[:, n], phi_pp_sub[:, n], Rw[:, n], Rwx[:, n], zw[:, n], p_step[:, n] = res[4:]
+
+    def closing(idx):  # covariances, controls (Eq. 32) and the full SRI smoother (backward) of the trials idx
+        nb = idx.size
+        P_f = srif._cov_of_sri(S_filt[idx])
+        if not smooth:
+            return P_f, None, None, None, None, None, None
+        q = qs[idx]
+        control_step = -q[:, :, None, None] * np.einsum("bnkij,bnj->bnki", phi_pp_sub[idx], p_step[idx])[..., 3:6]
+        z_step = ocbe._control_integral(t_sub, control_step)
+        xf, xp, pxx = x_filt[idx], x_pred[idx], phi_xx[idx]
+        x_s = np.empty((nb, N, 6))
+        P_s = np.empty((nb, N, 6, 6))
+        Rs, bs = S_filt[idx, -1], np.zeros((nb, 6))
+        x_s[:, -1], P_s[:, -1] = xf[:, -1], P_f[:, -1]
+        for n in range(N - 2, -1, -1):
+            z_next = bs + (Rs @ (xf[:, n + 1] - xp[:, n + 1])[..., None])[..., 0]
+            Rs, bs = srif._smoother_step(Rs, z_next, pxx[:, n], eye, (Rw[idx, n], Rwx[idx, n], zw[idx, n]))
+            x_s[:, n] = xf[:, n] + srif._solve_upper(Rs, bs)
+            P_s[:, n] = srif._cov_of_sri(Rs)
+        w = (x_s[:, 1:] - xp[:, 1:]) - (pxx @ (x_s[:, :-1] - xf[:, :-1])[..., None])[..., 0]
+        p_s = np.linalg.solve(phi_xp[idx], w[..., None])[..., 0]
+        control_s = -q[:, :, None, None] * np.einsum("bnkij,bnj->bnki", phi_pp_sub[idx], p_s)[..., 3:6]
+        return P_f, control_step, z_step, x_s, P_s, control_s, ocbe._control_integral(t_sub, control_s)
+
+    done = stage(closing, N - 1, False) if res is not None else None
+    if done is None:  # every trial failed
+        full = (np.full((B, N, 6, 6), nan), np.full((B, N - 1, n_sub, 3), nan), np.full(B, nan))
+        done = (full + (np.full((B, N, 6), nan),) + full) if smooth else (full[0],) + (None,) * 6
+    P_f, control_step, z_step, x_s, P_s, control_s, z_s = done
+    dead = failures.epoch >= 0
+    if dead.any():
+        for arr in (x_pred, x_filt, resid, P_f, control_step, z_step, x_s, P_s, control_s, z_s):
+            if arr is not None:
+                arr[dead] = nan
+    return BatchOCBEResult(x_pred, x_filt, P_f, x_s, P_s, t_sub, control_step, control_s, z_step, z_s, resid,
+                           failures.epoch.copy(), np.array(failures.message, dtype=str))

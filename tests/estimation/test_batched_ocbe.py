@@ -1,4 +1,5 @@
-"""The batched OCBE: equal to the single-trial filter, to the full-12x12 oracle, and independent of the lockstep split."""
+"""The batched OCBE: equal to the single-trial filter (one or several observers, availability masks, filter only, failing
+trials flagged as the single-trial filter flags them), to the full-12x12 oracle, and independent of the lockstep split."""
 
 import numpy as np
 import pytest
@@ -6,9 +7,10 @@ from reference_batched_ocbe import ocbe_batch_reference
 
 from cislunar.cr3bp import orbits
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
-from cislunar.cr3bp.propagation import propagate
+from cislunar.cr3bp.propagation import ImpactError, propagate
 from cislunar.estimation import batched_ocbe, ocbe
 from cislunar.sensing import measurements, sites
+from cislunar.utils import validation
 
 Q_WEIGHT = 3.5e-6  # LU^2/TU^3 (1e-11 km^2/s^3)
 
@@ -82,6 +84,110 @@ def test_block_integrator_equals_the_full_12x12_oracle_and_trials_are_independen
     assert np.max(np.abs(split.x_smooth - fast.x_smooth)) < 1e-12 * np.max(np.abs(fast.x_smooth))
 
 
+def _two_observers(t, truth, model, rng, Rm):
+    """The L2 observer and the DRO observer, with a mask: epoch 2 unseen by both, epochs 1, 4 and 6 by one only."""
+    dro = sites.dro_observer_orbit(em)
+    obs = np.stack([np.tile(sites.l2_observer_state(em), (t.size, 1)), propagate(em, dro.x0, t).x], axis=1)
+    avail = np.ones((t.size, 2), dtype=bool)
+    avail[2] = False
+    avail[[1, 6], 0] = False
+    avail[4, 1] = False
+    y = model(obs[None], truth[:, :, None, :]) + rng.standard_normal(truth.shape[:2] + (2, model.dim)) * np.sqrt(
+        np.diag(Rm))
+    y[:, ~avail] = np.nan  # ignored where unavailable
+    return obs, avail, y
+
+
+@pytest.mark.parametrize("smooth", [True, False])
+def test_several_observers_masks_and_filter_only_equal_the_single_trial_filter(smooth):
+    t, _, _, model, Rm, x0, P0, q = _trials(3)
+    truth = np.repeat(propagate(em, orbits.nrho_9_2(em).x0, t).x[None], 3, axis=0)
+    obs, avail, y = _two_observers(t, truth, model, np.random.default_rng(5), Rm)
+    batch = batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, n_sub=3, available=avail, smooth=smooth,
+                                    on_failure="flag")
+    assert not batch.failed.any() and list(batch.failure) == [""] * 3
+    for name in ("x_smooth", "P_smooth", "control_step", "control_smooth", "z_step", "z_smooth"):
+        assert (getattr(batch, name) is None) == (not smooth), name  # filter only: no smoother, no control
+    for b in range(3):
+        one = ocbe.ocbe_filter_smoother(em, t, y[b], obs, model, Rm, x0[b], P0, q, n_sub=3, available=avail,
+                                        smooth=smooth)
+        names = ("x_pred", "x_filt", "P_filt") + (("x_smooth", "P_smooth") if smooth else ())
+        for name in names:
+            assert _rel(getattr(batch, name)[b], getattr(one, name)) < 1e-10, (b, name)
+        assert np.array_equal(batch.residual_norms[b] == 0, one.residual_norms == 0)  # the unseen epoch: no update
+        assert _rel(batch.residual_norms[b], one.residual_norms) < 1e-8
+        if smooth:
+            assert abs(batch.z_step[b] / one.z_step - 1) < 1e-8 and abs(batch.z_smooth[b] / one.z_smooth - 1) < 1e-8
+    # the mask matters: with every observer used at every epoch the filter differs
+    y_all = model(obs[None], truth[:, :, None, :])
+    every = batched_ocbe.ocbe_batch(em, t, y_all, obs, model, Rm, x0, P0, q, n_sub=3, smooth=False)
+    assert _rel(every.P_filt[:, 2], batch.P_filt[:, 2]) > 1e-3
+
+
+def _falling_and_degenerate_trials():
+    """Four trials of :func:`_trials`; trial 1 tracks a fall onto the Moon (impact between epochs 2 and 3), trial 3
+    starts at the observer (the first measurement update is undefined)."""
+    t, y, obs, model, Rm, x0, P0, q = _trials(4)
+    moon = em.secondary_position
+    above = np.r_[moon + [em.km_to_lu(em.secondary_radius_km + 100.0), 0.0, 0.0],
+                  np.array([-2.0, 0.3, 0.0]) / em.velocity_unit_km_s]  # 100 km up, falling at 2 km/s
+    x_fall = propagate(em, above, [0.0, -float(em.days_to_tu(5.0 / 24.0))]).x[-1]  # 5 h earlier
+    fall = propagate(em, x_fall, t[:3]).x
+    y, x0 = y.copy(), x0.copy()
+    y[1] = model(obs, np.r_[fall, np.repeat(fall[-1:], t.size - 3, axis=0)])
+    x0[1] = x_fall
+    x0[3] = sites.l2_observer_state(em)
+    return t, y, obs, model, Rm, x0, P0, q
+
+
+def test_failing_trials_are_flagged_as_the_single_trial_filter_flags_them_and_the_others_go_on():
+    args = _falling_and_degenerate_trials()
+    t, y, obs, model, Rm, x0, P0, q = args
+    batch = batched_ocbe.ocbe_batch(em, *args, n_sub=5, on_failure="flag")
+    assert list(batch.failed) == [False, True, False, True]
+    for b in range(4):
+        try:
+            one = ocbe.ocbe_filter_smoother(em, t, y[b], obs, model, Rm, x0[b], P0, q, n_sub=5)
+        except ocbe.FilterDivergenceError as exc:
+            assert batch.failure_epoch[b] == exc.epoch, b
+            assert batch.failure[b].startswith(f"OCBE failed numerically at epoch {exc.epoch} (t = {exc.time:.6g} TU)")
+            assert exc.cause.split(":")[0] in batch.failure[b]  # the same kind of error
+            for name in ("x_filt", "P_filt", "x_smooth", "control_step", "z_smooth", "residual_norms"):
+                assert np.all(np.isnan(getattr(batch, name)[b])), (b, name)
+            continue
+        assert batch.failure_epoch[b] == -1 and batch.failure[b] == ""
+        for name in ("x_filt", "P_filt", "x_smooth", "P_smooth"):
+            assert _rel(getattr(batch, name)[b], getattr(one, name)) < 1e-10, (b, name)
+    assert list(batch.failure_epoch) == [-1, 3, -1, 0]  # impact during interval 2; undefined first update
+    # the same trials alone, and raised without flagging (the first failure stops the batch)
+    alone = batched_ocbe.ocbe_batch(em, t, y[[0, 2]], obs, model, Rm, x0[[0, 2]], P0, q, n_sub=5)
+    assert _rel(alone.x_smooth, batch.x_smooth[[0, 2]]) < 1e-12
+    with pytest.raises(ValueError, match="coincide"):
+        batched_ocbe.ocbe_batch(em, *args, n_sub=5)
+
+
+def test_a_prior_inside_the_moon_is_flagged_at_epoch_1_as_in_the_single_trial_filter():
+    t, y, obs, model, Rm, x0, P0, q = _trials(2, n_meas=3)
+    x0 = x0.copy()
+    x0[1, :3] = em.secondary_position + em.km_to_lu(500.0)
+    P0 = np.eye(6) * 1e-20  # the first update keeps the estimate inside
+    with pytest.raises(ocbe.FilterDivergenceError) as single:
+        ocbe.ocbe_filter_smoother(em, t, y[1], obs, model, Rm, x0[1], P0, q, n_sub=2, smooth=False)
+    batch = batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, n_sub=2, smooth=False, on_failure="flag")
+    assert list(batch.failure_epoch) == [-1, single.value.epoch] == [-1, 1]
+    assert "ImpactError" in batch.failure[1] and "ImpactError" in single.value.cause
+    with pytest.raises(ImpactError):  # without flagging, refused at the boundary
+        batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, n_sub=2)
+
+
+def test_every_trial_failing_leaves_nan_and_flags():
+    t, y, obs, model, Rm, x0, P0, q = _falling_and_degenerate_trials()
+    batch = batched_ocbe.ocbe_batch(em, t, y[[1, 3]], obs, model, Rm, x0[[1, 3]], P0, q, n_sub=5, smooth=False,
+                                    on_failure="flag")
+    assert list(batch.failure_epoch) == [3, 0]
+    assert np.all(np.isnan(batch.x_filt)) and batch.x_smooth is None
+
+
 def test_batched_ocbe_bad_input():
     t, y, obs, model, Rm, x0, P0, q = _trials(2, n_meas=3)
     with pytest.raises(ValueError, match="y"):
@@ -90,6 +196,20 @@ def test_batched_ocbe_bad_input():
         batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, np.stack([P0] * 3), q)
     with pytest.raises(TypeError, match="engine"):
         batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, engine="fast")  # one engine, no choice
+    with pytest.raises(validation.ArgumentTypeError, match="available"):
+        batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, available=np.ones((3, 1)))
+    with pytest.raises(ValueError, match="available"):
+        batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, available=np.ones((3, 2), dtype=bool))
+    with pytest.raises(ValueError, match="on_failure"):
+        batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, on_failure="ignore")
+    y_nan = y.copy()
+    y_nan[0, 1, 0] = np.nan
+    with pytest.raises(ValueError, match="y contains NaN"):
+        batched_ocbe.ocbe_batch(em, t, y_nan, obs, model, Rm, x0, P0, q)
+    mask = np.array([True, False, True])
+    assert batched_ocbe.ocbe_batch(em, t, y_nan, obs, model, Rm, x0, P0, q, available=mask).residual_norms[0, 1] == 0
+    with pytest.raises(ValueError, match="y must have 4 dimensions"):  # two observers need (B, N, K, m)
+        batched_ocbe.ocbe_batch(em, t, y, np.stack([obs, obs], axis=1), model, Rm, x0, P0, q)
 
 
 def test_control_integral_is_eq_33_per_trial():

@@ -27,11 +27,11 @@ from scipy import stats
 
 from cislunar.cr3bp.dynamics import CR3BP, check_system
 from cislunar.cr3bp.orbits import PeriodicOrbit
-from cislunar.estimation import consistency, ocbe
+from cislunar.estimation import batched_ocbe, consistency, ocbe
 from cislunar.papers.greaves_scheeres_2021 import tracking
 from cislunar.publish.claims import Claim
 from cislunar.utils import validation
-from cislunar.utils.montecarlo import run_monte_carlo
+from cislunar.utils.montecarlo import map_tasks, trial_rng
 
 __all__ = [
     "ONSETS",
@@ -351,14 +351,47 @@ def flagged_cells(rows, limit: float = 0.10) -> list:
     return [(name, cad, div) for name, cad, div, *_ in rows if div > limit]
 
 
+#: Most trials per executor task; a task's trials run in lockstep through the batched OCBE
+#: (:func:`tracking.filter_trials`).
+LOCKSTEP_TRIALS = 64
+
+
+def _trial_batch(task):
+    """One executor task (module level, picklable): ``(scenario, control_weight, draws)`` with ``draws`` a list of
+    ``(seed, i, handoff_scale)``; trial ``i`` of the Monte Carlo set ``seed`` draws from the generator
+    :func:`cislunar.utils.montecarlo.run_monte_carlo` would give it (:func:`cislunar.utils.montecarlo.trial_rng`), and
+    all run in one lockstep (:func:`tracking.filter_trials`).  Returns their :class:`tracking.TrialSummary`."""
+    scenario, control_weight, draws = task
+    return tracking.filter_trials([trial_rng(sd, i) for sd, i, _ in draws], scenario, control_weight,
+                                  handoff_scale=[h for _, _, h in draws])
+
+
+def _run_sets(sets, control_weight, executor, desc, progress=True):
+    """Monte Carlo sets ``[(scenario, [(seed, i, handoff), ...]), ...]`` as lockstep tasks of at most
+    :data:`LOCKSTEP_TRIALS` trials (the executor's tasks); returns one tuple of summaries per set."""
+    tasks, sizes = [], []
+    for scn, draws in sets:
+        sizes.append(len(draws))
+        tasks += [(scn, control_weight, draws[a:a + LOCKSTEP_TRIALS]) for a in range(0, len(draws), LOCKSTEP_TRIALS)]
+    flat = [r for part in map_tasks(_trial_batch, tasks, executor=executor, desc=desc, progress=progress)
+            for r in part]
+    out, a = [], 0
+    for n in sizes:
+        out.append(tuple(flat[a:a + n]))
+        a += n
+    return out
+
+
 def strategy_study(system: CR3BP, orbits_: dict, cadences, control_weight: float, *, rates: bool, n_runs: int,
                    seed: int, n_runs_one_minute: int | None = None, observers: str = "L2",
                    sigma_angle_rad: float = tracking.DEFAULT_SIGMA_ANGLE_RAD, handoff_scale: float = 1.0,
                    executor=None) -> StrategyStudy:
     """Monte Carlo of :func:`tracking.filter_trial` over orbits and cadences (tracks start at apoapsis).
 
-    Cell (orbit k, cadence j) uses the seed ``(seed, k, j, int(rates))``; cadences under 0.1 h run
-    ``n_runs_one_minute`` trials (default ``n_runs``).
+    Cell (orbit k, cadence j) uses the seed ``(seed, k, j, int(rates))`` (trial ``i`` draws from its child ``i``);
+    cadences under 0.1 h run ``n_runs_one_minute`` trials (default ``n_runs``).  The trials of a cell run in
+    lockstep through the batched OCBE (:func:`tracking.filter_trials`, equal to :func:`tracking.filter_trial` to
+    round-off), one executor task per cell (or per :data:`LOCKSTEP_TRIALS` trials).
     """
     check_system(system)
     _check_orbits(orbits_)
@@ -373,16 +406,16 @@ def strategy_study(system: CR3BP, orbits_: dict, cadences, control_weight: float
     sigma_angle_rad = validation.positive(sigma_angle_rad, "sigma_angle_rad")
     handoff_scale = validation.positive(handoff_scale, "handoff_scale")
     _check_executor(executor)
-    results = {}
+    keys, sets = [], []
     for k, (name, orb) in enumerate(orbits_.items()):
         for j, cad in enumerate(cadences):
             scn = tracking.make_scenario(system, orb, cad, start="apoapsis", rates=rates, observers=observers,
                                          sigma_angle_rad=sigma_angle_rad)
-            results[name, cad] = tuple(run_monte_carlo(
-                tracking.filter_trial, n_one if cad < 0.1 else n_runs, (seed, k, j, int(rates)),
-                args=(scn, control_weight), kwargs={"handoff_scale": handoff_scale}, executor=executor,
-                desc=f"{'angles+rates' if rates else 'angles'} {name} {cad:g} h"))
-    return StrategyStudy(results, rates)
+            keys.append((name, cad))
+            sets.append((scn, [((seed, k, j, int(rates)), i, handoff_scale)
+                               for i in range(n_one if cad < 0.1 else n_runs)]))
+    runs = _run_sets(sets, control_weight, executor, f"{'angles+rates' if rates else 'angles'} {observers}")
+    return StrategyStudy(dict(zip(keys, runs)), rates)
 
 
 def _names(value, name: str) -> tuple:
@@ -612,7 +645,10 @@ def regime_map(system: CR3BP, orbits_: dict, cadences, sigmas, handoffs, rate_mo
     ----------
     rate_models : dict of str -> float
         Name of each rate model and the differencing baseline of Eq. 13 it uses, s.
-    Cell indices ``(io, ic, isg, im, ih)`` seed run sets as ``(seed, 77, io, ic, isg, im, ih)``.
+    Cell indices ``(io, ic, isg, im, ih)`` seed run sets as ``(seed, 77, io, ic, isg, im, ih)`` (run ``i`` draws
+    from its child ``i``).  The runs of all hand-offs of an (orbit, cadence, noise, model) share a scenario and run
+    in lockstep through the batched OCBE (:func:`tracking.filter_trials`), one executor task per
+    :data:`LOCKSTEP_TRIALS` runs.
     """
     check_system(system)
     _check_orbits(orbits_)
@@ -629,6 +665,7 @@ def regime_map(system: CR3BP, orbits_: dict, cadences, sigmas, handoffs, rate_mo
     _check_executor(executor)
     cells, onsets = {}, {}
     models = [("angles", False, 1.0)] + [(m, True, b) for m, b in rate_models.items()]
+    keys, sets = [], []
     for io, (oname, orb) in enumerate(orbits_.items()):
         for ic, cad in enumerate(cadences):
             for isg, sig in enumerate(sigmas):
@@ -636,14 +673,14 @@ def regime_map(system: CR3BP, orbits_: dict, cadences, sigmas, handoffs, rate_mo
                     scn = tracking.make_scenario(system, orb, cad, start="apoapsis", rates=rates, sigma_angle_rad=sig)
                     if rates:
                         scn = dataclasses.replace(scn, meas_cov=tracking.angles_rates_covariance(system, sig, base))
-                    for ih, h in enumerate(handoffs):
-                        runs = run_monte_carlo(tracking.filter_trial, n_runs, (seed, 77, io, ic, isg, im, ih),
-                                               args=(scn, control_weight), kwargs={"handoff_scale": h},
-                                               executor=executor,
-                                               desc=f"map {oname} {cad:g} h {sig * 1e6:g} urad {mname} x{h:g}")
-                        cells[oname, cad, sig, mname, h] = float(np.mean([r.diverged for r in runs]))
-                        onsets[oname, cad, sig, mname, h] = [_onset_class(r, scn.t, orb.period / 2)
-                                                             for r in runs if r.diverged]
+                    keys += [((oname, cad, sig, mname, h), scn.t, orb.period / 2) for h in handoffs]
+                    sets.append((scn, [((seed, 77, io, ic, isg, im, ih), i, h) for ih, h in enumerate(handoffs)
+                                       for i in range(n_runs)]))
+    flat = [r for runs in _run_sets(sets, control_weight, executor, "regime map") for r in runs]
+    for j, (key, t, t_peri) in enumerate(keys):
+        runs = flat[j * n_runs:(j + 1) * n_runs]
+        cells[key] = float(np.mean([r.diverged for r in runs]))
+        onsets[key] = [_onset_class(r, t, t_peri) for r in runs if r.diverged]
     return RegimeMap(cells, onsets, tuple(m[0] for m in models), tuple(orbits_), tuple(cadences), tuple(sigmas),
                      tuple(handoffs), n_runs)
 
@@ -725,7 +762,11 @@ class DivergenceExample:
 def divergence_example(system: CR3BP, orbit: PeriodicOrbit, rmap: RegimeMap, cell, control_weight: float, *,
                        seed: int, n_draws: int = 10) -> DivergenceExample:
     """Rerun ``n_draws`` fresh draws (seeds ``[seed, 404, k]``) of an angles-only map ``cell`` and keep the diverged
-    one with the largest mean NEES."""
+    one with the largest mean NEES.
+
+    The draws are filtered in one lockstep (:func:`cislunar.estimation.batched_ocbe.ocbe_batch`, filter only, a
+    numerical failure dropping the draw); the chosen draw is rerun with the single-trial filter
+    (:func:`cislunar.estimation.ocbe.ocbe_filter_smoother`), whose result and summary are kept."""
     check_system(system)
     validation.instance(orbit, "orbit", PeriodicOrbit, "a cislunar.cr3bp.orbits.PeriodicOrbit")
     validation.instance(rmap, "rmap", RegimeMap, "a RegimeMap (regime_map)")
@@ -737,21 +778,27 @@ def divergence_example(system: CR3BP, orbit: PeriodicOrbit, rmap: RegimeMap, cel
     _, cad, sig, _, h = cell
     scn = tracking.make_scenario(system, orbit, cad, start="apoapsis", rates=False, sigma_angle_rad=sig)
     truth = tracking.simulate_truth(system, scn.x_start, scn.t)
-    best = None
+    ys, x0s = [], []
     for k in range(n_draws):
         rng = np.random.default_rng([seed, 404, k])
-        y = tracking.simulate_measurements(scn, truth, rng)
+        ys.append(tracking.simulate_measurements(scn, truth, rng))
         x0, P0 = tracking.initial_estimate(system, scn.x_start, rng, scale=h)
-        try:
-            run = ocbe.ocbe_filter_smoother(system, scn.t, y, scn.observers, scn.model, scn.meas_cov, x0, P0,
-                                            control_weight, available=scn.available, smooth=False)
-        except ocbe.FilterDivergenceError:
-            continue
-        summ = tracking.summarize(system, run.x_filt, run.P_filt, truth)
-        if summ.diverged and (best is None or summ.nees_mean > best[1].nees_mean):
-            best = (run, summ, k)
-    run, summ, k = best if best is not None else (None, None, -1)
-    return DivergenceExample(tuple(cell), scn, truth, run, summ, k, rmap[cell])
+        x0s.append(x0)
+    res = batched_ocbe.ocbe_batch(system, scn.t, np.array(ys), scn.observers, scn.model, scn.meas_cov,
+                                  np.array(x0s), P0, control_weight, available=scn.available, smooth=False,
+                                  on_failure="flag")
+    best = None
+    for k in np.flatnonzero(~res.failed):
+        summ = tracking.summarize(system, res.x_filt[k], res.P_filt[k], truth)
+        if summ.diverged and (best is None or summ.nees_mean > best[1]):
+            best = (int(k), summ.nees_mean)
+    if best is None:
+        return DivergenceExample(tuple(cell), scn, truth, None, None, -1, rmap[cell])
+    k = best[0]
+    run = ocbe.ocbe_filter_smoother(system, scn.t, ys[k], scn.observers, scn.model, scn.meas_cov, x0s[k], P0,
+                                    control_weight, available=scn.available, smooth=False)
+    return DivergenceExample(tuple(cell), scn, truth, run, tracking.summarize(system, run.x_filt, run.P_filt, truth),
+                             k, rmap[cell])
 
 
 def figure_divergence(example: DivergenceExample, what: str):

@@ -1,11 +1,14 @@
 """Chapter 09 studies: Monte Carlo aggregation, seeding, the regime-map analysis and the stable-candidate
 comparison (small sizes and synthetic cells; invariants, not snapshots)."""
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 import pytest
 
 from cislunar.cr3bp import orbits
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.estimation import ocbe
 from cislunar.papers.greaves_scheeres_2021 import observation_strategy as obs
 from cislunar.papers.greaves_scheeres_2021 import tracking
 from cislunar.papers.greaves_scheeres_2021.claims.observation_strategy import CLAIMS
@@ -16,6 +19,15 @@ Q = 1e-20 * em.time_unit_s**3 / em.length_unit_km**2
 
 def _summary(diverged, sigma_pos=1.0, nees=6.0):
     return tracking.TrialSummary(sigma_pos, 1e-3, 0.1, 1e-4, 1.0, nees, 0.2 if diverged else 0.0, diverged)
+
+
+def same_run(a, b, rtol=1e-7):
+    """Two TrialSummary of the same draws (lockstep and single-trial path): flags, counts and epochs identical,
+    numbers equal to round-off."""
+    assert (a.diverged, a.first_inconsistent_epoch, a.inconsistent_fraction, a.failure == "") == \
+        (b.diverged, b.first_inconsistent_epoch, b.inconsistent_fraction, b.failure == "")
+    for name in ("final_sigma_pos_km", "final_sigma_vel_m_s", "final_error_pos_km", "max_error_pos_km", "nees_mean"):
+        assert abs(getattr(a, name) / getattr(b, name) - 1) < rtol, name
 
 
 @pytest.fixture(scope="module")
@@ -45,11 +57,46 @@ def test_study_rows_are_fractions_and_medians():
 def test_strategy_study_seeds_each_cell_independently_of_the_executor(nrho):
     st = obs.strategy_study(em, {"9:2 NRHO": nrho}, [12.0], Q, rates=True, n_runs=2, seed=3)
     scn = tracking.make_scenario(em, nrho, 12.0, start="apoapsis", rates=True)
-    direct = tracking.filter_trial(trial_rng((3, 0, 0, 1), 1), scn, Q)
-    assert st.runs["9:2 NRHO", 12.0][1] == direct
+    direct = tracking.filter_trial(trial_rng((3, 0, 0, 1), 1), scn, Q)  # the single-trial path
+    same_run(st.runs["9:2 NRHO", 12.0][1], direct)
     assert len(st.rows) == 1 and st.rows[0][6] == 2
+    with ThreadPoolExecutor(2) as pool:  # the lockstep tasks through an executor: the same numbers
+        pooled = obs.strategy_study(em, {"9:2 NRHO": nrho}, [12.0], Q, rates=True, n_runs=2, seed=3, executor=pool)
+    assert pooled.runs == st.runs
     with pytest.raises(ValueError, match="n_runs"):
         obs.strategy_study(em, {"9:2 NRHO": nrho}, [12.0], Q, rates=True, n_runs=0, seed=3)
+
+
+def test_regime_map_runs_each_cell_with_its_own_seed_and_handoff(nrho, monkeypatch):
+    """Hand-offs share a lockstep task, yet each cell's runs are those of its own seed and hand-off; tasks are cut
+    at LOCKSTEP_TRIALS runs without changing them."""
+    args = (em, {"9:2 NRHO": nrho}, [12.0], [10e-6], [1.0, 1000.0], {"angles + rates (1 s)": 1.0}, Q)
+    rm = obs.regime_map(*args, n_runs=2, seed=4)
+    scn = tracking.make_scenario(em, nrho, 12.0, start="apoapsis", rates=False)
+    for ih, h in enumerate((1.0, 1000.0)):
+        runs = [tracking.filter_trial(trial_rng((4, 77, 0, 0, 0, 0, ih), i), scn, Q, handoff_scale=h) for i in range(2)]
+        assert rm["9:2 NRHO", 12.0, 10e-6, "angles", h] == np.mean([r.diverged for r in runs])
+    assert rm["9:2 NRHO", 12.0, 10e-6, "angles", 1000.0] == 1.0 and rm["9:2 NRHO", 12.0, 10e-6, "angles", 1.0] == 0.0
+    monkeypatch.setattr(obs, "LOCKSTEP_TRIALS", 3)
+    cut = obs.regime_map(*args, n_runs=2, seed=4)
+    assert cut.cells == rm.cells and cut.onsets == rm.onsets
+
+
+def test_divergence_example_picks_the_worst_diverged_draw(nrho):
+    rm = obs.RegimeMap({("9:2 NRHO", 12.0, 10e-6, "angles", 1000.0): 1.0}, {}, ("angles",), ("9:2 NRHO",), (12.0,),
+                       (10e-6,), (1000.0,), 2)
+    ex = obs.divergence_example(em, nrho, rm, ("9:2 NRHO", 12.0, 10e-6, "angles", 1000.0), Q, seed=0, n_draws=3)
+    scn, truth = ex.scenario, ex.truth
+    nees = []
+    for k in range(3):  # the single-trial path, draw by draw
+        rng = np.random.default_rng([0, 404, k])
+        y = tracking.simulate_measurements(scn, truth, rng)
+        x0, P0 = tracking.initial_estimate(em, scn.x_start, rng, scale=1000.0)
+        run = ocbe.ocbe_filter_smoother(em, scn.t, y, scn.observers, scn.model, scn.meas_cov, x0, P0, Q,
+                                        available=scn.available, smooth=False)
+        nees.append(tracking.summarize(em, run.x_filt, run.P_filt, truth))
+    assert all(s.diverged for s in nees) and ex.draw == int(np.argmax([s.nees_mean for s in nees]))
+    assert ex.summary == nees[ex.draw]  # the chosen draw rerun with the single-trial filter
 
 
 def _synthetic_map():

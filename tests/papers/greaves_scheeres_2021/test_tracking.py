@@ -6,8 +6,9 @@ import pytest
 from cislunar.cr3bp import orbits
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.cr3bp.propagation import propagate
-from cislunar.estimation import consistency
+from cislunar.estimation import batched_ocbe, consistency
 from cislunar.papers.greaves_scheeres_2021 import tracking
+from cislunar.utils.montecarlo import spawn_rngs
 
 
 @pytest.fixture(scope="module")
@@ -102,3 +103,61 @@ def test_summary_counts_inconsistent_epochs_and_dates_the_first():
     s0 = tracking.summarize(em, np.tile(x[0], (N, 1)), P, truth)
     assert s0.first_inconsistent_epoch == -1 and s0.inconsistent_fraction == 0 and not s0.diverged
     assert s0.nees_mean == pytest.approx(1.0, rel=1e-12)
+
+
+def same_run(a, b, rtol=1e-7):
+    """Two TrialSummary of the same draws: flags, counts and epochs identical, numbers equal to round-off."""
+    assert (a.diverged, a.first_inconsistent_epoch, a.inconsistent_fraction, a.failure == "") == \
+        (b.diverged, b.first_inconsistent_epoch, b.inconsistent_fraction, b.failure == "")
+    for name in ("final_sigma_pos_km", "final_sigma_vel_m_s", "final_error_pos_km", "final_error_vel_m_s",
+                 "max_error_pos_km", "nees_mean"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert (np.isnan(x) and np.isnan(y)) or abs(x / y - 1) < rtol, (name, x, y)
+
+
+def test_filter_trials_equal_filter_trial_draw_by_draw_with_five_observers_and_mixed_handoffs():
+    """The lockstep path against the single-trial path on the same generators: five observers with their
+    visibility mask (surface stations come and go), angles only, hand-offs 10 km to 10,000 km (the large ones
+    diverge)."""
+    sc = tracking.make_scenario(em, orbits.nrho_9_2(em), 6.0, start="apoapsis", rates=False, observers="all")
+    assert not sc.available.all()
+    q = 1e-20 * em.time_unit_s**3 / em.length_unit_km**2
+    scales = [1.0, 1000.0, 0.1, 1000.0, 1.0]
+    single = [tracking.filter_trial(r, sc, q, handoff_scale=h) for r, h in zip(spawn_rngs(11, 5), scales)]
+    batch = tracking.filter_trials(spawn_rngs(11, 5), sc, q, handoff_scale=scales)
+    for a, b in zip(single, batch):
+        same_run(a, b)
+    assert [r.diverged for r in batch] == [False, True, False, True, False]
+    one_scale = tracking.filter_trials(spawn_rngs(11, 5)[2:3], sc, q, handoff_scale=0.1)
+    same_run(one_scale[0], batch[2])
+
+
+def test_filter_trials_reports_a_flagged_trial_as_filter_trial_reports_a_failure(scenario, monkeypatch):
+    real = batched_ocbe.ocbe_batch
+
+    def flag_second(*args, **kwargs):
+        res = real(*args, **kwargs)
+        epoch, text = res.failure_epoch.copy(), res.failure.astype(object)
+        epoch[1], text[1] = 4, "OCBE failed numerically at epoch 4 (t = 0.2 TU): LinAlgError: x" + "y" * 300
+        return batched_ocbe.BatchOCBEResult(**{**res.__dict__, "failure_epoch": epoch, "failure": text})
+
+    monkeypatch.setattr(tracking, "ocbe_batch", flag_second)
+    out = tracking.filter_trials(spawn_rngs(0, 3), scenario, 1e-8)
+    assert out[1].diverged and out[1].inconsistent_fraction == 1.0 and np.isnan(out[1].nees_mean)
+    assert out[1].first_inconsistent_epoch == -1 and out[1].failure.startswith("OCBE failed numerically at epoch 4")
+    assert len(out[1].failure) == 200 and not out[0].failure and not out[2].failure
+
+
+def test_filter_trials_bad_input(scenario):
+    with pytest.raises(TypeError, match="rngs"):
+        tracking.filter_trials(np.random.default_rng(0), scenario, 1e-8)
+    with pytest.raises(ValueError, match="rngs"):
+        tracking.filter_trials([], scenario, 1e-8)
+    with pytest.raises(TypeError, match=r"rngs\[1\]"):
+        tracking.filter_trials([np.random.default_rng(0), 3], scenario, 1e-8)
+    with pytest.raises(ValueError, match="handoff_scale"):
+        tracking.filter_trials(spawn_rngs(0, 2), scenario, 1e-8, handoff_scale=[1.0, 2.0, 3.0])
+    with pytest.raises(ValueError, match="handoff_scale"):
+        tracking.filter_trials(spawn_rngs(0, 2), scenario, 1e-8, handoff_scale=[1.0, -2.0])
+    with pytest.raises(ValueError, match="control_weight"):
+        tracking.filter_trials(spawn_rngs(0, 2), scenario, -1.0)

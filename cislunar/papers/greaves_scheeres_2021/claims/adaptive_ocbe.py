@@ -23,14 +23,18 @@ CLAIMS = {
         "Adaptive filter without a maneuver", "not stated (implied by the 99 % limit and three strikes)",
         Equals(0), kind="derived", source=_SOURCE,
         reason="derived false-reset probability < 1e-4 per track"),
+    # The paper shows one 3 m/s run (Fig. 6); one favourable draw of ours cannot reproduce a statement about what
+    # such a burn does, so both rows are judged over the 3 m/s runs the chapter's studies already have, with the
+    # thresholds of the "1 m/s and more" rows (the Fig. 6 draw is quoted beside them).
     "3 m/s prompt": Claim(
-        "3 m/s burn (Fig. 6 run): detected promptly (within two epochs of the burn)",
-        "detected, uncertainty raised at the burn (Fig. 6)", AtMost(2), source="Fig. 6",
-        reason="late or no detection"),
+        "3 m/s burn (Fig. 6 setting): detected promptly (within two epochs of the burn)",
+        "detected, uncertainty raised at the burn (Fig. 6, one run)", AtLeast(0.95),
+        source="Fig. 6 (fraction of the delay study's 3 m/s runs dated within two epochs of the burn)",
+        reason="some 3 m/s burns are detected late"),
     "3 m/s consistent": Claim(
-        "3 m/s burn (Fig. 6 run): forward filter consistent after the reset", "consistent (Fig. 6)",
-        AtMost(0.05), source="Fig. 6 (fraction of forward epochs after the burn above the 99.9 % NEES quantile; "
-        "notebook 09's divergence test)", reason="inconsistent"),
+        "3 m/s burn (Fig. 6 setting): forward filter consistent after the reset", "consistent (Fig. 6, one run)",
+        AtMost(0.10), source="Fig. 6 (fraction of the reset-rule study's 3 m/s runs inconsistent after the burn, "
+        "paper's reset rule; notebook 09's flag)", reason="the paper's reset rule leaves some 3 m/s runs inconsistent"),
     "large prompt": Claim(
         "Burns of 1 m/s and more detected at once", _NEAR_OPTIMAL, AtLeast(0.95),
         source=f"{_SOURCE} (fraction of runs dated within two epochs of the burn)",
