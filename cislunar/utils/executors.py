@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import multiprocessing
+import time
 from concurrent.futures import ProcessPoolExecutor
 
 __all__ = ["open_executor", "describe_executor"]
@@ -30,7 +31,8 @@ def open_executor(workers: int = 1, scheduler: str = ""):
     -------
     context manager
         Entering it gives a ``concurrent.futures.Executor``, a ``dask.distributed.Client`` or ``None``; leaving it
-        shuts the pool down or closes the client.  Arguments are checked when it is called.
+        shuts the pool down or closes the client.  Left by Ctrl-C (``KeyboardInterrupt``), the pool's worker
+        processes are terminated at once instead of being waited for.  Arguments are checked when it is called.
     """
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ValueError(f"workers must be an int >= 1 (1 runs serially); got {workers!r}")
@@ -61,8 +63,38 @@ def _executor(workers: int, scheduler: str):
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
     try:
         yield pool
+    except KeyboardInterrupt:  # Ctrl-C: end the workers now instead of waiting for the tasks they are running
+        _end_process_pool(pool)
+        raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _end_process_pool(pool, timeout: float = 5.0) -> None:
+    """Terminate the worker processes of a ``ProcessPoolExecutor`` and wait for them (after Ctrl-C).
+
+    A worker process cannot be interrupted from outside, so this is the only prompt way to stop the tasks it is
+    running.  Every pending future of the pool then fails with ``BrokenProcessPool`` and the pool cannot be used
+    again.  Workers that ignore SIGTERM are killed after ``timeout`` seconds.
+
+    Parameters
+    ----------
+    pool : concurrent.futures.ProcessPoolExecutor
+    timeout : float
+        Seconds to wait for the workers to end after SIGTERM before SIGKILL (> 0).
+    """
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    for proc in procs:
+        try:
+            proc.terminate()
+        except Exception:  # noqa: BLE001 - already gone
+            pass
+    deadline = time.monotonic() + timeout
+    for proc in procs:
+        proc.join(timeout=max(0.0, deadline - time.monotonic()))
+        if proc.exitcode is None:  # pragma: no cover - a worker that ignored SIGTERM
+            proc.kill()
+            proc.join(timeout=1.0)
 
 
 def describe_executor(executor) -> str:

@@ -47,3 +47,37 @@ def test_bad_scheduler_is_refused_by_name():
     with pytest.raises(TypeError, match="scheduler"):
         with open_executor(1, 8786):
             pass
+
+
+def _long_task(folder):
+    import os
+    import time
+    from pathlib import Path
+
+    Path(folder, f"start-{os.getpid()}").touch()
+    time.sleep(90.0)
+    return 1
+
+
+def test_ctrl_c_inside_open_executor_ends_its_workers_at_once(tmp_path):
+    """Leaving the block by KeyboardInterrupt while both workers run a 90-s task: the block is left within 30 s
+    (not after the tasks) and no worker process survives.  Synchronised on files the tasks write, not on sleeps."""
+    import time
+
+    import psutil
+
+    with pytest.raises(KeyboardInterrupt):
+        with open_executor(2) as ex:
+            futures = [ex.submit(_long_task, str(tmp_path)) for _ in range(3)]
+            end = time.monotonic() + 120
+            while len(list(tmp_path.glob("start-*"))) < 2 and time.monotonic() < end:
+                time.sleep(0.02)
+            pids = set(ex._processes)
+            raised = time.monotonic()
+            raise KeyboardInterrupt
+    left = time.monotonic()
+    assert len(list(tmp_path.glob("start-*"))) == 2 and len(pids) == 2
+    assert left - raised < 30.0
+    alive = [p for p in pids if psutil.pid_exists(p) and psutil.Process(p).status() != psutil.STATUS_ZOMBIE]
+    assert not alive, f"workers survived: {alive}"
+    assert all(f.done() for f in futures)
