@@ -13,6 +13,15 @@ every repeated evaluation of one window (SCvx) and cold (cache cleared before ea
 relative error; its 2026-11-21 version, with a covariance-form forward pass, gave the 10x of that day), a reference
 for ratios measured under different machine load.  Then the SCvx planning model of test case 2.
 
+Then **old path vs new at both test-case sizes** (:func:`window_kernel`), in one interleaved run: the dense
+reference; the public ``mutual_information_gradient`` as the SCvx information model called it before 2026-11-26
+(every call re-checks F, H, dF, dH and looks P0, Q, R up in the module's checked-noise cache, the noise roots in
+its root cache); and :class:`cislunar.sensing.information.InformationKernel`, which the information model now
+builds once per window (P0, Q, R checked, R factored and Q's square roots taken once; bit-for-bit the same value
+and gradient).  Test-case-2 size is the window above; test-case-1 size is the window of
+:func:`cislunar.papers.wolf_jones.scenarios.test_case_1` (observer and one target, relative position, 13 daily
+epochs, 12 states).
+
 ``python -m benchmarks information`` prints the times per evaluation and the ratios; ``main()`` returns them.
 """
 
@@ -117,6 +126,49 @@ def main() -> dict:
           f"{out['ratio_value_grad_forward']:.1f}x, dense / covariance adjoint "
           f"{out['ratio_value_grad_adjoint']:.1f}x")
     out.update(planning_model())
+    out.update(window_kernel("case2", lin))
+    out.update(window_kernel("case1", case1_window()))
+    return out
+
+
+def case1_window():
+    """Linearisation (with derivatives) of test case 1's window along the ballistic observer."""
+    from cislunar.papers.wolf_jones import scenarios as W
+    sc = W.test_case_1()
+    x = propagate(sc.system, sc.observer_x0, np.array([0.0, sc.window[0]])).x[-1]
+    return sc.information_model().linearization(x, derivatives=True)
+
+
+def window_kernel(label: str, lin) -> dict:
+    """Dense vs the old public path vs the per-window kernel (value + gradient), interleaved best-of-9."""
+    P0, F, Q, H, R = lin.arrays
+    dF, dH = lin.dF, lin.dH
+    kernel = I.InformationKernel(P0, Q, R, H.shape[0])
+    v_k, g_k = kernel.value_gradient(F, H, dF, dH)
+    v_p, g_p = I.mutual_information_gradient(P0, F, Q, H, R, dF, dH)
+    v_d, g_d = I.mutual_information_gradient_dense(P0, F, Q, H, R, dF, dH)
+    t_dense, t_public, t_kernel, t_value_public, t_value_kernel = I._interleaved_best([
+        lambda: I.mutual_information_gradient_dense(P0, F, Q, H, R, dF, dH),
+        lambda: I.mutual_information_gradient(P0, F, Q, H, R, dF, dH),
+        lambda: kernel.value_gradient(F, H, dF, dH),
+        lambda: I.mutual_information(P0, F, Q, H, R),
+        lambda: kernel.value(F, H)], 9, 0.1)
+    N, M_, n = H.shape
+    p = f"{label}_kernel_"
+    out = {p + "shape": (int(N), int(M_), int(n)), p + "bit_identical_to_public": bool(v_k == v_p and np.array_equal(g_k, g_p)),
+           p + "grad_rel_diff_dense": _rel(g_k, g_d), p + "mi_rel_diff_dense": abs(v_k - v_d) / abs(v_d),
+           p + "dense_value_grad_ms": 1e3 * t_dense, p + "public_value_grad_ms": 1e3 * t_public,
+           p + "kernel_value_grad_ms": 1e3 * t_kernel, p + "public_value_ms": 1e3 * t_value_public,
+           p + "kernel_value_ms": 1e3 * t_value_kernel,
+           p + "ratio_dense_over_public": t_dense / t_public, p + "ratio_dense_over_kernel": t_dense / t_kernel,
+           p + "ratio_public_over_kernel": t_public / t_kernel}
+    print(f"{label} size ({N} times x {M_} measurements, {n} states), MI + gradient: dense {1e3 * t_dense:.3f} ms, "
+          f"old path (public, re-checking) {1e3 * t_public:.3f} ms, InformationKernel {1e3 * t_kernel:.3f} ms "
+          f"(bit-identical to the old path: {out[p + 'bit_identical_to_public']}; gradient vs dense "
+          f"{out[p + 'grad_rel_diff_dense']:.1e})")
+    print(f"  ratios: dense / old {t_dense / t_public:.1f}x, dense / kernel {t_dense / t_kernel:.1f}x, old / kernel "
+          f"{t_public / t_kernel:.2f}x; MI alone: old {1e3 * t_value_public:.3f} ms, kernel "
+          f"{1e3 * t_value_kernel:.3f} ms")
     return out
 
 

@@ -1,20 +1,34 @@
-"""SCvx on Wolf & Jones test cases 1 and 2: where an iteration's time goes, re-solve vs rebuild, a full alpha_h
-sweep per case.
+"""SCvx on Wolf & Jones test cases 1 and 2: the sweeps of notebooks 05 and 06 by the old path and the new, in one
+run; where an iteration's time goes; re-solve vs rebuild of the convex subproblem.
 
-Scenario: :func:`cislunar.papers.wolf_jones.scenarios.test_case_1` (observer and one target on DROs, relative position 100 m, two
-periods, zero thrust in [3P/4, 3P/2]) on 40 Sundman nodes, the information model with fixed process noise.
+Scenario: :func:`cislunar.papers.wolf_jones.scenarios.test_case_1` (observer and one target on DROs, relative
+position 100 m, two periods, zero thrust in [3P/4, 3P/2]) on 40 Sundman nodes, the information model with fixed
+process noise; :func:`~cislunar.papers.wolf_jones.scenarios.test_case_2` (three targets, range and range rate, the
+minimum-range keep-out) on 30 nodes.
 
-1. **Per iteration**: the nonlinear evaluation splits into the first-order-hold discretisation
-   (:func:`cislunar.guidance.discretization.foh_discretize`), the information model (value, gradient, Hessian) and the
-   convex solve (cvxpy + Clarabel); measured both in isolation at the ballistic reference and averaged over an
-   SCvx run at alpha_h = 5e-3 (the Hessian is refreshed only when the window-start state moved, see
-   ``SCvxSettings.hessian_refresh``).
-2. **Re-solve vs rebuild**: the subproblem built once with ``cvxpy.Parameter`` objects (DPP, canonicalised once)
+1. **Old path vs new, one run** (:func:`compare_sweeps`): the alpha_h grid of notebook 05 (9 values, test case 1)
+   and of notebook 06 (8 values, test case 2) swept upward and downward (serially,
+   :func:`~cislunar.papers.wolf_jones.scenarios.sweep_both_ways`) by
+
+   * ``old``: the path before 2026-11-26, rebuilt here: a fresh subproblem canonicalised for every run, with one
+     cvxpy Parameter per matrix (3 (N-1) for the FOH model, :class:`_PerIntervalSubproblem`), and the information
+     model checking P0, Q and R (and the whole window) at every evaluation through the public
+     ``assemble_augmented`` and ``mutual_information[_gradient]`` (:class:`_RecheckingInformation`, no Hessian
+     cache), and the FOH interval propagation rebuilding its parameter and initial arrays on every call
+     (:func:`_old_foh_interval`);
+   * ``new``: :class:`~cislunar.papers.wolf_jones.scenarios.ScenarioSolver` as the notebooks call it (one
+     :class:`~cislunar.guidance.scvx.SCvxWorkspace`: canonicalised once per sweep, stacked FOH Parameters; the
+     window's fixed ingredients checked once; no gradient or Hessian on the converged step; the FOH parameters
+     set in place).
+
+   Both paths visit the same iterates (the solutions are compared bit for bit and the iteration counts printed);
+   one saving is not rebuilt in the old path (the gradient and Hessian it computed on the converged step of every
+   run), so the ratio understates the gain by about one Hessian per run.  CPU time (``time.process_time``) and wall
+   time are both printed: on a shared machine the CPU ratio is the robust one.
+2. **Per iteration** (new path): the FOH discretisation, the information model (value, gradient, Hessian) and the
+   convex solve, in isolation and averaged over an SCvx run at alpha_h = 5e-3.
+3. **Re-solve vs rebuild**: the subproblem built once with ``cvxpy.Parameter`` objects (DPP, canonicalised once)
    and re-solved with new values, against building and solving a fresh problem each time.
-3. **Sweep**: the alpha_h grid of notebook 05 (9 values) swept upward and downward, best kept.
-4. **Test case 2 sweep**: observer and three targets, range and range-rate, the minimum-range keep-out, 30 Sundman
-   nodes and the 8-value alpha_h grid of notebook 06, both directions serially (the notebook runs them in two
-   processes).
 
 ``python -m benchmarks scvx`` prints the numbers; ``main()`` returns them.  Ratios are within one run.
 """
@@ -29,6 +43,8 @@ from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.guidance import discretization as D
 from cislunar.guidance import scvx
 from cislunar.papers.wolf_jones import scenarios as wolf_jones
+from cislunar.sensing import covariance as cov
+from cislunar.sensing import information as info_mod
 
 N_NODES = 40
 ALPHAS = [0.0, 1e-3, 2e-3, 3e-3, 5e-3, 7e-3, 1e-2, 1.5e-2, 2e-2]
@@ -36,22 +52,196 @@ N_NODES_CASE_2 = 30
 ALPHAS_CASE_2 = [0.0, 5e-4, 1e-3, 2e-3, 5e-3, 7e-3, 1e-2, 2e-2]
 
 
-def sweep_case_2() -> dict:
-    """Test case 2: the notebook-06 alpha_h grid swept up and down (serial), with the keep-out."""
-    sc = wolf_jones.test_case_2()
-    t, k_ws, _ = sc.node_times(N_NODES_CASE_2, 1.0)
+# ------------------------------------------------------------------------------------------------------------------
+# the old path, rebuilt (reference implementations; same numbers, the old costs)
+# ------------------------------------------------------------------------------------------------------------------
+class _PerIntervalSubproblem(scvx._Subproblem):
+    """The subproblem as built before 2026-11-26: one Parameter per A_k, B-_k, B+_k (117 at 40 nodes)."""
+
+    def __init__(self, n, has_terminal, k_star, con_specs, coast=None):
+        import cvxpy as cp
+
+        self.n = n
+        self.x = cp.Variable((n, 6))
+        self.u = cp.Variable((n, 3))
+        self.nu = cp.Variable((n - 1, 6))
+        self.A = [cp.Parameter((6, 6)) for _ in range(n - 1)]
+        self.Bm = [cp.Parameter((6, 3)) for _ in range(n - 1)]
+        self.Bp = [cp.Parameter((6, 3)) for _ in range(n - 1)]
+        self.r = cp.Parameter((n - 1, 6))
+        self.xbar = cp.Parameter((n, 6))
+        self.ubar = cp.Parameter((n, 3))
+        self.eta = cp.Parameter(nonneg=True)
+        self.umax = cp.Parameter(n, nonneg=True)
+        self.x_ic = cp.Parameter(6)
+        self.x_tc = cp.Parameter(6)
+        self.w_u = cp.Parameter(n, nonneg=True)
+        self.lam = cp.Parameter((n - 1, 6))
+        self.half_w = cp.Parameter(nonneg=True)
+        self.gamma_dt = cp.Parameter(n - 1, nonneg=True)
+        cons = [self.x[0] == self.x_ic]
+        if has_terminal:
+            cons.append(self.x[n - 1] == self.x_tc)
+        for k in range(n - 1):
+            cons.append(self.x[k + 1] == self.A[k] @ self.x[k] + self.Bm[k] @ self.u[k] + self.Bp[k] @ self.u[k + 1]
+                        + self.r[k] + self.nu[k])
+        unorm = cp.norm(self.u, 2, axis=1)
+        cons.append(unorm <= self.umax)
+        if coast is not None and np.any(coast):
+            cons.append(self.u[np.flatnonzero(coast)] == 0)
+        self.step = cp.norm(self.x - self.xbar, 2, axis=1) + cp.norm(self.u - self.ubar, 2, axis=1)
+        cons.append(self.step <= self.eta)
+        objective = (self.w_u @ unorm + cp.sum(cp.multiply(self.lam, self.nu)) + self.half_w * cp.sum_squares(self.nu)
+                     + self.gamma_dt @ cp.norm(self.nu, 1, axis=1))
+        self.k_star = k_star
+        if k_star is not None:
+            self.g = cp.Parameter(6)
+            self.L = cp.Parameter((6, 6))
+            self.dxs = cp.Variable(6)
+            cons.append(self.dxs == self.x[k_star] - self.xbar[k_star])
+            objective = objective - self.g @ self.dxs + 0.5 * cp.sum_squares(self.L.T @ self.dxs)
+        self.con = []
+        for node, m in con_specs:
+            c = cp.Parameter(m)
+            C = cp.Parameter((m, 6))
+            mu = cp.Parameter(m)
+            s = cp.Variable(m, nonneg=True)
+            dx = cp.Variable(6)
+            cons += [dx == self.x[node] - self.xbar[node], c + C @ dx <= s]
+            gam = cp.Parameter(nonneg=True)
+            objective = objective + mu @ s + self.half_w * cp.sum_squares(s) + gam * cp.sum(s)
+            self.con.append(dict(c=c, C=C, mu=mu, s=s, gamma=gam, node=node))
+        self.problem = cp.Problem(cp.Minimize(objective), cons)
+
+    def set_model(self, model):
+        for k in range(self.n - 1):
+            self.A[k].value, self.Bm[k].value, self.Bp[k].value = model.A[k], model.Bm[k], model.Bp[k]
+        self.r.value = model.r
+
+
+class _FreshWorkspace(scvx.SCvxWorkspace):
+    """The old path's subproblem handling: a new (per-interval) problem, canonicalised, for every run."""
+
+    def _subproblem(self, n, has_terminal, k_star, con_specs, coast):
+        self.builds += 1
+        return _PerIntervalSubproblem(n, has_terminal, k_star, con_specs, coast=coast)
+
+
+class _RecheckingInformation(wolf_jones.WindowInformation):
+    """The information model before 2026-11-26: every evaluation goes through the public, re-checking functions."""
+
+    def linearization(self, x, derivatives: bool = False):
+        from cislunar.utils import validation
+        x = validation.as_state(x, "x", batch=False)
+        key = (x.tobytes(), validation.boolean(derivatives, "derivatives"))
+        if key in self._cache:
+            return self._cache[key]
+        arcs = cov.propagate_arcs(self.system, x, self.t, order=2 if derivatives else 1)
+        lin = cov.assemble_augmented(self.model, self.noise, self.P0, arcs, self._targets, Q=self.Q)
+        if len(self._cache) >= 8:
+            self._cache.pop(next(iter(self._cache)))
+        self._cache[key] = lin
+        return lin
+
+    def __call__(self, x, order: int = 0):
+        if order == 0:
+            return info_mod.mutual_information(*self.linearization(x).arrays)
+        lin = self.linearization(x, derivatives=True)
+        value, grad = info_mod.mutual_information_gradient(*lin.arrays, lin.dF, lin.dH)
+        return float(value), grad
+
+    def hessian(self, x):
+        from cislunar.utils import validation
+        x = validation.as_state(x, "x", batch=False)
+        h = self.hessian_step
+        X0 = np.concatenate([x + h * np.eye(6), x - h * np.eye(6)], axis=0)
+        arcs = cov.propagate_arcs(self.system, X0, self.t, order=2)
+        G = np.empty((12, 6))
+        for j in range(12):
+            lin = cov.assemble_augmented(self.model, self.noise, self.P0, arcs, self._targets, Q=self.Q, index=j)
+            G[j] = info_mod.mutual_information_gradient(*lin.arrays, lin.dF, lin.dH)[1]
+        Hm = (G[:6] - G[6:]).T / (2.0 * h)
+        return 0.5 * (Hm + Hm.T)
+
+
+def _old_foh_interval(system, x0, uk, uk1, t0, t1, tol):
+    """The FOH interval propagation before 2026-11-26 (parameters and variational state built with ``np.r_`` and
+    ``np.concatenate`` on every call; same numbers)."""
+    ta = D.thread_local_copy(("foh", tol), lambda: D._foh_template(tol)[0])
+    _, index = D._foh_template(tol)
+    ta.pars[:] = np.r_[system.mu, uk, uk1, np.zeros(6), t0, t1, system.secondary_radius, system.primary_radius]
+    ta.time = t0
+    ta.state[:6] = x0
+    ta.state[6:] = np.concatenate([np.eye(6), np.zeros((6, 12))], axis=1).ravel()
+    res = ta.propagate_until(t1)
+    D._check_outcome(res[0], t1, ta.time)
+    return ta.state[:6].copy(), ta.state[index]
+
+
+def _old_solver(new: wolf_jones.ScenarioSolver) -> wolf_jones.ScenarioSolver:
+    m = new.information
+    old_info = _RecheckingInformation(m.system, m.t, m.targets_x0, m.model, m.noise, m.P0, q=m.q,
+                                      x_reference=m.x_reference, hessian_step=m.hessian_step)
+    old = wolf_jones.ScenarioSolver(new.scenario, new.t, new.k_window, information=old_info,
+                                    keep_out=bool(new.constraints), settings=new.settings)
+    old.constraints = new.constraints
+    old.workspace = _FreshWorkspace()
+    return old
+
+
+def _timed_sweep(solver, alphas, x0, u0, old: bool = False):
+    fast = D._foh_interval
+    if old:  # the old FOH interval code for this sweep only (module attribute looked up at every call)
+        D._foh_interval = _old_foh_interval
+    try:
+        p0, t0 = time.process_time(), time.perf_counter()
+        sweep = wolf_jones.sweep_both_ways(solver, alphas, x0, u0)
+        return sweep, time.process_time() - p0, time.perf_counter() - t0
+    finally:
+        D._foh_interval = fast
+
+
+def compare_sweeps(case: int) -> dict:
+    """Old path vs new on the notebook sweep of test case ``case`` (1 or 2); same iterates, times and ratios."""
+    if case == 1:
+        sc = wolf_jones.test_case_1()
+        t, k_ws, _ = sc.node_times(N_NODES)
+        alphas, keep_out, settings = ALPHAS, False, None
+    else:
+        sc = wolf_jones.test_case_2()
+        t, k_ws, _ = sc.node_times(N_NODES_CASE_2, 1.0)
+        alphas, keep_out, settings = ALPHAS_CASE_2, True, scvx.SCvxSettings(max_iter=150)
     x0, u0 = sc.ballistic_guess(t)
-    solver = wolf_jones.ScenarioSolver(sc, t, k_ws, information=sc.information_model(), keep_out=True,
-                                       settings=scvx.SCvxSettings(max_iter=150))
-    t0 = time.perf_counter()
-    sweep = wolf_jones.sweep_both_ways(solver, ALPHAS_CASE_2, x0, u0)
-    seconds = time.perf_counter() - t0
-    n_it = int(sum(a["iterations"] for a in sweep.attempts))
-    return dict(case2_nodes=N_NODES_CASE_2, case2_alphas=len(ALPHAS_CASE_2), case2_runs=len(sweep.attempts),
-                case2_converged=int(sum(a["converged"] for a in sweep.attempts)), case2_iterations=n_it,
-                case2_sweep_s=seconds, case2_per_iteration_s=seconds / max(n_it, 1))
+    new = wolf_jones.ScenarioSolver(sc, t, k_ws, information=sc.information_model(), keep_out=keep_out,
+                                    settings=settings)
+    old = _old_solver(new)
+    old.information(x0[k_ws], 1)  # warm the integrators of both paths
+    new.information(x0[k_ws], 1)
+    s_old, cpu_old, wall_old = _timed_sweep(old, alphas, x0, u0, old=True)
+    s_new, cpu_new, wall_new = _timed_sweep(new, alphas, x0, u0)
+    same = all((a is None and b is None) or (a is not None and b is not None and np.array_equal(a.x, b.x)
+                                             and np.array_equal(a.u, b.u)) for a, b in zip(s_old.best, s_new.best))
+    it_old = int(sum(a["iterations"] for a in s_old.attempts))
+    it_new = int(sum(a["iterations"] for a in s_new.attempts))
+    p = f"case{case}_"
+    out = {p + "nodes": int(t.size), p + "alphas": len(alphas), p + "runs": len(s_new.attempts),
+           p + "converged": int(sum(a["converged"] for a in s_new.attempts)), p + "iterations_old": it_old,
+           p + "iterations_new": it_new, p + "solutions_bit_identical": bool(same),
+           p + "canonicalisations_old": old.workspace.builds, p + "canonicalisations_new": new.workspace.builds,
+           p + "cpu_old_s": cpu_old, p + "cpu_new_s": cpu_new, p + "wall_old_s": wall_old, p + "wall_new_s": wall_new,
+           p + "cpu_ratio_new_over_old": cpu_new / cpu_old, p + "wall_ratio_new_over_old": wall_new / wall_old}
+    print(f"test case {case}, {t.size} nodes, {len(alphas)} alpha_h up and down: {out[p + 'converged']}/"
+          f"{out[p + 'runs']} converged; iterations old {it_old}, new {it_new}; solutions bit-identical: {same}; "
+          f"canonicalisations old {old.workspace.builds}, new {new.workspace.builds}")
+    print(f"  CPU old {cpu_old:.1f} s, new {cpu_new:.1f} s: new / old = {cpu_new / cpu_old:.2f} "
+          f"({100 * (1 - cpu_new / cpu_old):.0f} % less); wall old {wall_old:.1f} s, new {wall_new:.1f} s: "
+          f"{wall_new / wall_old:.2f}")
+    return out
 
 
+# ------------------------------------------------------------------------------------------------------------------
+# per iteration, re-solve vs rebuild (new path)
+# ------------------------------------------------------------------------------------------------------------------
 def _best_time(fn, repeat=5):
     best = np.inf
     for _ in range(repeat):
@@ -70,9 +260,7 @@ def _setup():
 
 def _load(sub, model, x, u, eta, alpha, grad, L):
     n = x.shape[0]
-    for k in range(n - 1):
-        sub.A[k].value, sub.Bm[k].value, sub.Bp[k].value = model.A[k], model.Bm[k], model.Bp[k]
-    sub.r.value = model.r
+    sub.set_model(model)
     sub.xbar.value, sub.ubar.value, sub.eta.value = x, u, eta
     sub.lam.value = np.zeros((n - 1, 6))
     sub.half_w.value = 500.0
@@ -82,7 +270,8 @@ def _load(sub, model, x, u, eta, alpha, grad, L):
 
 
 def resolve_vs_rebuild(t, k_ws, x0, u0, u_max, x_final, info, repeat=3):
-    """Seconds per solve: parameterised re-solve, first solve (includes canonicalisation), rebuild + solve."""
+    """Seconds per solve: parameterised re-solve (stacked and per-interval Parameters), first solve (includes
+    canonicalisation), rebuild + solve."""
     model = D.foh_discretize(em, t, x0, u0)
     _, grad = info(x0[k_ws], 1)
     L = scvx.concave_part(info.hessian(x0[k_ws]))
@@ -93,8 +282,8 @@ def resolve_vs_rebuild(t, k_ws, x0, u0, u_max, x_final, info, repeat=3):
     w_u[1:] += dt / 2
     opts = dict(tol_gap_abs=1e-10, tol_gap_rel=1e-10, tol_feas=1e-10)
 
-    def build():
-        sub = scvx._Subproblem(n, True, k_ws, [], coast=u_max == 0)
+    def build(cls=scvx._Subproblem):
+        sub = cls(n, True, k_ws, [], coast=u_max == 0)
         sub.x_ic.value, sub.x_tc.value, sub.umax.value = x0[0], x_final, u_max
         sub.w_u.value = 0.995 * w_u
         return sub
@@ -104,28 +293,37 @@ def resolve_vs_rebuild(t, k_ws, x0, u0, u_max, x_final, info, repeat=3):
     _load(sub, model, x0, u0, 0.05, 5e-3, grad, L)
     sub.problem.solve(solver="CLARABEL", **opts)
     first = time.perf_counter() - t0
+    old = build(_PerIntervalSubproblem)
+    _load(old, model, x0, u0, 0.05, 5e-3, grad, L)
+    old.problem.solve(solver="CLARABEL", **opts)
     etas = iter(np.geomspace(0.05, 0.01, 100))
 
-    def resolve():
-        _load(sub, model, x0, u0, next(etas), 5e-3, grad, L)
-        sub.problem.solve(solver="CLARABEL", **opts)
+    def resolve(s=sub):
+        _load(s, model, x0, u0, next(etas), 5e-3, grad, L)
+        s.problem.solve(solver="CLARABEL", **opts)
 
     def rebuild():
         s2 = build()
         _load(s2, model, x0, u0, next(etas), 5e-3, grad, L)
         s2.problem.solve(solver="CLARABEL", **opts)
 
-    return _best_time(resolve, repeat), first, _best_time(rebuild, repeat)
+    set_new = _best_time(lambda: _load(sub, model, x0, u0, 0.05, 5e-3, grad, L), 20)
+    set_old = _best_time(lambda: _load(old, model, x0, u0, 0.05, 5e-3, grad, L), 20)
+    return (_best_time(resolve, repeat), _best_time(lambda: resolve(old), repeat), first, _best_time(rebuild, repeat),
+            set_new, set_old)
 
 
 def main() -> dict:
+    out = {}
+    out.update(compare_sweeps(1))
+    out.update(compare_sweeps(2))
     sc, t, k_ws, x0, u0, u_max, info = _setup()
     xw = x0[k_ws]
     D.foh_discretize(em, t, x0, u0)  # compile / warm the integrators
     info(xw, 1)
     rng = np.random.default_rng(0)
 
-    def fresh():  # a new point each call: the information model caches its last linearisations
+    def fresh():  # a new point each call: the information model caches its last linearisations and Hessians
         return xw + 1e-9 * rng.standard_normal(6)
 
     pieces = {
@@ -134,25 +332,20 @@ def main() -> dict:
         "mi_gradient_s": _best_time(lambda: info(fresh(), 1)),
         "mi_hessian_s": _best_time(lambda: info.hessian(fresh()), 3),
     }
-    resolve, first, rebuild = resolve_vs_rebuild(t, k_ws, x0, u0, u_max, sc.observer_xf, info)
-
+    resolve, resolve_old, first, rebuild, set_new, set_old = resolve_vs_rebuild(t, k_ws, x0, u0, u_max,
+                                                                                sc.observer_xf, info)
     t0 = time.perf_counter()
     res = scvx.solve_scvx(em, t, x0, u0, u_max, x_final=sc.observer_xf, info=info, info_node=k_ws, alpha=5e-3)
     run_s = time.perf_counter() - t0
     H = res.history
     per_iter = {k: float(np.mean([h[k] for h in H])) for k in ("t_discretize", "t_info", "t_hessian", "t_solve")}
-
-    def solve(a, x, u):
-        return scvx.solve_scvx(em, t, x, u, u_max, x_final=sc.observer_xf, info=info, info_node=k_ws, alpha=a)
-
-    t0 = time.perf_counter()
-    sweep = scvx.homotopy_sweep(solve, ALPHAS, x0, u0)
-    sweep_s = time.perf_counter() - t0
-    n_it = sum(a["iterations"] for a in sweep.attempts)
-    out = dict(
+    out.update(
         n_nodes=N_NODES,
         **pieces,
         subproblem_resolve_s=resolve,
+        subproblem_resolve_per_interval_parameters_s=resolve_old,
+        parameter_setting_stacked_s=set_new,
+        parameter_setting_per_interval_s=set_old,
         subproblem_first_solve_s=first,
         subproblem_rebuild_s=rebuild,
         rebuild_over_resolve=rebuild / resolve,
@@ -161,30 +354,18 @@ def main() -> dict:
         run_per_iteration_s=run_s / res.iterations,
         **{f"run_mean_{k}_s": v for k, v in per_iter.items()},
         run_hessian_refreshes=int(sum(h["t_hessian"] > 0 for h in H)),
-        sweep_alphas=len(ALPHAS),
-        sweep_runs=len(sweep.attempts),
-        sweep_converged=int(sum(a["converged"] for a in sweep.attempts)),
-        sweep_iterations=int(n_it),
-        sweep_s=sweep_s,
-        sweep_per_iteration_s=sweep_s / max(n_it, 1),
     )
-    print(f"test case 1, {N_NODES} nodes")
+    print(f"test case 1, {N_NODES} nodes (new path)")
     print(f"  in isolation: FOH discretisation {1e3 * pieces['discretize_s']:.1f} ms, MI value "
           f"{1e3 * pieces['mi_value_s']:.1f} ms, MI gradient {1e3 * pieces['mi_gradient_s']:.1f} ms, MI Hessian "
           f"{1e3 * pieces['mi_hessian_s']:.1f} ms")
-    print(f"  convex subproblem: re-solve {1e3 * resolve:.1f} ms, first solve (canonicalisation) {1e3 * first:.0f} ms, "
-          f"rebuild + solve {1e3 * rebuild:.0f} ms ({rebuild / resolve:.1f} x re-solve)")
+    print(f"  convex subproblem: re-solve {1e3 * resolve:.1f} ms (per-interval Parameters {1e3 * resolve_old:.1f} ms; "
+          f"setting the Parameters {1e3 * set_new:.2f} vs {1e3 * set_old:.2f} ms), first solve (canonicalisation) "
+          f"{1e3 * first:.0f} ms, rebuild + solve {1e3 * rebuild:.0f} ms ({rebuild / resolve:.1f} x re-solve)")
     print(f"  SCvx alpha_h = 5e-3 from the ballistic DRO: {res.iterations} iterations, {run_s:.2f} s "
           f"({run_s / res.iterations:.3f} s/iteration: discretisation {per_iter['t_discretize']:.3f}, MI value + "
           f"gradient {per_iter['t_info']:.3f}, Hessian {per_iter['t_hessian']:.3f} "
           f"({out['run_hessian_refreshes']} refreshes), solve {per_iter['t_solve']:.3f})")
-    print(f"  alpha_h sweep up and down over {len(ALPHAS)} values: {out['sweep_converged']}/{out['sweep_runs']} "
-          f"converged, {n_it} iterations, {sweep_s:.1f} s ({out['sweep_per_iteration_s']:.3f} s/iteration)")
-    c2 = sweep_case_2()
-    out.update(c2)
-    print(f"test case 2, {c2['case2_nodes']} nodes, keep-out: alpha_h sweep up and down over {c2['case2_alphas']} "
-          f"values: {c2['case2_converged']}/{c2['case2_runs']} converged, {c2['case2_iterations']} iterations, "
-          f"{c2['case2_sweep_s']:.1f} s ({c2['case2_per_iteration_s']:.3f} s/iteration)")
     return out
 
 

@@ -242,13 +242,25 @@ class FOHModel:
         return out
 
 
+_FOH_VARIATIONAL_IC = np.concatenate([np.eye(6), np.zeros((6, 12))], axis=1).ravel()  # d x / d (x0, uk, uk1, eps)
+_FOH_VARIATIONAL_IC.flags.writeable = False
+
+
 def _foh_interval(system, x0, uk, uk1, t0, t1, tol):
     ta = thread_local_copy(("foh", tol), lambda: _foh_template(tol)[0])
     _, index = _foh_template(tol)
-    ta.pars[:] = np.r_[system.mu, uk, uk1, np.zeros(6), t0, t1, system.secondary_radius, system.primary_radius]
+    pars = ta.pars
+    pars[0] = system.mu
+    pars[1:4] = uk
+    pars[4:7] = uk1
+    pars[7:13] = 0.0
+    pars[13] = t0
+    pars[14] = t1
+    pars[15] = system.secondary_radius
+    pars[16] = system.primary_radius
     ta.time = t0
     ta.state[:6] = x0
-    ta.state[6:] = np.concatenate([np.eye(6), np.zeros((6, 12))], axis=1).ravel()
+    ta.state[6:] = _FOH_VARIATIONAL_IC
     res = ta.propagate_until(t1)
     _check_outcome(res[0], t1, ta.time)
     return ta.state[:6].copy(), ta.state[index]

@@ -51,6 +51,13 @@ value computed alongside a gradient may carry different round-off).  An optional
 (6, 6) Hessian.
 :class:`cislunar.papers.wolf_jones.scenarios.WindowInformation` implements it for the paper's test cases.
 
+Cost of a run
+-------------
+The subproblem is built once per structure with cvxpy Parameters (DPP; the FOH model of every interval in one
+stacked Parameter) and re-solved with new values; :class:`SCvxWorkspace` keeps it between runs, so a homotopy sweep
+canonicalises once (bit-for-bit the solutions of fresh problems).  The gradient and Hessian at a new reference are
+computed only when the iteration goes on (not on the converged step).
+
 Extra nonconvex inequality constraints (e.g. a keep-out) are objects with ``node``, ``size`` and
 ``__call__(x) -> (c, C)`` (values that must be :math:`\le 0` and their Jacobian with respect to the state at
 ``node``); they are linearised with a non-negative slack that is penalised like the defects.
@@ -58,6 +65,7 @@ Extra nonconvex inequality constraints (e.g. a keep-out) are objects with ``node
 
 from __future__ import annotations
 
+import threading
 import time
 import warnings
 from dataclasses import dataclass, field, fields
@@ -70,7 +78,7 @@ from cislunar.guidance.discretization import _check_outside, _foh_discretize
 from cislunar.utils import validation
 from cislunar.utils.progress import progress as _progress
 
-__all__ = ["SCvxSettings", "SCvxResult", "SCvxError", "solve_scvx", "concave_part", "finite_difference_hessian",
+__all__ = ["SCvxSettings", "SCvxResult", "SCvxError", "SCvxWorkspace", "solve_scvx", "concave_part", "finite_difference_hessian",
            "SweepResult", "homotopy_sweep", "impulse"]
 
 METHODS = ("augmented_lagrangian", "penalty")
@@ -273,8 +281,13 @@ def impulse(t, u) -> float:
     """Trapezoid total impulse of node accelerations ``u`` (N, 3) on node times ``t`` (N,), LU/TU."""
     t = validation.time_grid(t, "t", increasing=True)
     u = validation.as_array(u, "u", shape=(t.size, 3))
+    return _impulse(np.diff(t), u)
+
+
+def _impulse(dt, u) -> float:
+    """Unchecked kernel of :func:`impulse` (``dt`` the node intervals (N-1,), ``u`` (N, 3))."""
     nrm = np.linalg.norm(u, axis=1)
-    return float(np.sum(np.diff(t) * (nrm[:-1] + nrm[1:]) / 2.0))
+    return float(np.sum(dt * (nrm[:-1] + nrm[1:]) / 2.0))
 
 
 def concave_part(H, floor: float = 0.0) -> np.ndarray:
@@ -345,9 +358,9 @@ class _Subproblem:
         self.x = cp.Variable((n, 6))
         self.u = cp.Variable((n, 3))
         self.nu = cp.Variable((n - 1, 6))
-        self.A = [cp.Parameter((6, 6)) for _ in range(n - 1)]
-        self.Bm = [cp.Parameter((6, 3)) for _ in range(n - 1)]
-        self.Bp = [cp.Parameter((6, 3)) for _ in range(n - 1)]
+        # [A_k | B-_k | B+_k] of every interval stacked in one Parameter (rows 6k..6k+5): one value assignment per
+        # iteration instead of 3 (N-1), the same canonicalised coefficients
+        self.AB = cp.Parameter((6 * (n - 1), 12))
         self.r = cp.Parameter((n - 1, 6))
         self.xbar = cp.Parameter((n, 6))
         self.ubar = cp.Parameter((n, 3))
@@ -363,7 +376,8 @@ class _Subproblem:
         if has_terminal:
             cons.append(self.x[n - 1] == self.x_tc)
         for k in range(n - 1):
-            cons.append(self.x[k + 1] == self.A[k] @ self.x[k] + self.Bm[k] @ self.u[k] + self.Bp[k] @ self.u[k + 1]
+            blk = self.AB[6 * k:6 * k + 6]
+            cons.append(self.x[k + 1] == blk[:, 0:6] @ self.x[k] + blk[:, 6:9] @ self.u[k] + blk[:, 9:12] @ self.u[k + 1]
                         + self.r[k] + self.nu[k])
         unorm = cp.norm(self.u, 2, axis=1)
         cons.append(unorm <= self.umax)
@@ -393,6 +407,51 @@ class _Subproblem:
             self.con.append(dict(c=c, C=C, mu=mu, s=s, gamma=gam, node=node))
         self.problem = cp.Problem(cp.Minimize(objective), cons)
 
+    def set_model(self, model):
+        """Load the FOH model's ``A``, ``Bm``, ``Bp`` (N-1, 6, {6, 3, 3}) and ``r`` (N-1, 6)."""
+        self.AB.value = np.concatenate([model.A, model.Bm, model.Bp], axis=2).reshape(6 * (self.n - 1), 12)
+        self.r.value = model.r
+
+
+class SCvxWorkspace:
+    """Convex subproblems of :func:`solve_scvx` kept between runs, so that a sweep canonicalises once.
+
+    :func:`solve_scvx` builds its subproblem with cvxpy Parameters (DPP) and re-solves it with new values at every
+    iteration; the first solve of a problem canonicalises it (the cost of 15-45 re-solves at 40 nodes).
+    Passing one workspace to every run of a sweep (same node count, terminal constraint, window node, extra
+    constraints and coast pattern) reuses the canonicalised problem across runs.  Every Parameter is assigned
+    before each solve and the first solve of every run starts a new Clarabel solver (later ones update its data,
+    as within a run on a new problem), so a run gives the same solution whether its problem is new or reused (a
+    test checks it bit for bit).
+
+    Problems are kept per thread (two threads never share one) and dropped when the workspace is pickled (a
+    process builds its own).
+
+    Parameters
+    ----------
+    max_problems : int
+        Most problem structures kept (least recently used dropped first; >= 1).
+    """
+
+    def __init__(self, max_problems: int = 4):
+        self.max_problems = validation.integer(max_problems, "max_problems", minimum=1)
+        self._problems: dict = {}
+        self.builds = 0  # problems built (canonicalised) so far
+
+    def __getstate__(self):
+        return {"max_problems": self.max_problems, "_problems": {}, "builds": 0}
+
+    def _subproblem(self, n, has_terminal, k_star, con_specs, coast) -> "_Subproblem":
+        key = (threading.get_ident(), n, has_terminal, k_star, tuple(con_specs), np.asarray(coast).tobytes())
+        sub = self._problems.pop(key, None)
+        if sub is None:
+            sub = _Subproblem(n, has_terminal, k_star, con_specs, coast=coast)
+            self.builds += 1
+        self._problems[key] = sub  # most recently used last
+        while len(self._problems) > self.max_problems:
+            self._problems.pop(next(iter(self._problems)))
+        return sub
+
 
 def _check_constraint(obj, i, n):
     name = f"constraints[{i}]"
@@ -408,7 +467,7 @@ def _check_constraint(obj, i, n):
 
 def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None, info=None, info_node=None,
                constraints=(), alpha: float = 0.0, settings: SCvxSettings | None = None, solver: str = "CLARABEL",
-               progress: bool = False) -> SCvxResult:
+               progress: bool = False, workspace: SCvxWorkspace | None = None) -> SCvxResult:
     """Solve the observer trajectory problem by SCvx (see the module docstring for the algorithm).
 
     Parameters
@@ -437,6 +496,9 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
         cvxpy solver name (the tolerances of ``settings.solver_tol`` are passed to Clarabel only).
     progress : bool
         Progress bar over the iterations (:func:`cislunar.utils.progress.progress`).
+    workspace : SCvxWorkspace, optional
+        Keeps the canonicalised convex subproblem for the next run with the same structure (a sweep passes one
+        workspace to all its runs); default: a subproblem built for this run only.
 
     Returns
     -------
@@ -478,6 +540,8 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
         raise validation.ArgumentTypeError(f"constraints must be a list or tuple; got {type(constraints).__name__}")
     con_specs = [_check_constraint(c, i, n) for i, c in enumerate(constraints)]
     validation.boolean(progress, "progress")
+    if workspace is not None:
+        validation.instance(workspace, "workspace", SCvxWorkspace)
     if not isinstance(solver, str) or solver.upper() not in cp.installed_solvers():
         raise ValueError(f"solver must be the name of an installed cvxpy solver {cp.installed_solvers()}; got "
                          f"{solver!r}")
@@ -494,7 +558,8 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
     use_info = info is not None and alpha > 0
     al = st.method == "augmented_lagrangian"
 
-    sub = _Subproblem(n, x_tc is not None, info_node if use_info else None, con_specs, coast=umax == 0)
+    structure = (n, x_tc is not None, info_node if use_info else None, con_specs, umax == 0)
+    sub = _Subproblem(*structure[:4], coast=structure[4]) if workspace is None else workspace._subproblem(*structure)
     sub.x_ic.value = x_ref[0]
     sub.x_tc.value = x_ref[-1] if x_tc is None else x_tc
     sub.umax.value = umax
@@ -539,7 +604,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
 
     def cost_of(x, u, ev):
         viol = [np.maximum(c, 0.0) for c, _ in ev["cons"]]
-        obj = (1.0 - alpha) * impulse(t, u) - (alpha * ev["info"] if use_info else 0.0)
+        obj = (1.0 - alpha) * _impulse(dt, u) - (alpha * ev["info"] if use_info else 0.0)
         return obj + penalty(ev["model"].defects, viol), obj
 
     def feasibility(ev):
@@ -568,10 +633,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
     bar = _progress(range(st.max_iter), desc=f"SCvx alpha={alpha:g}", enabled=progress)
     try:
         for it in bar:
-            model = ev["model"]
-            for k in range(n - 1):
-                sub.A[k].value, sub.Bm[k].value, sub.Bp[k].value = model.A[k], model.Bm[k], model.Bp[k]
-            sub.r.value = model.r
+            sub.set_model(ev["model"])
             sub.xbar.value = x_ref
             sub.ubar.value = u_ref
             sub.eta.value = eta
@@ -586,7 +648,9 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
             try:
                 with warnings.catch_warnings():  # "inaccurate" is recorded in the history and judged by rho
                     warnings.simplefilter("ignore", UserWarning)
-                    sub.problem.solve(solver=solver, **solve_opts)
+                    # Clarabel reuses its solver object (data update) from the second solve of a run on; the first
+                    # solve of every run starts a new one, so a reused (workspace) problem solves as a fresh one
+                    sub.problem.solve(solver=solver, warm_start=it > 0, **solve_opts)
             except cp.error.SolverError as exc:
                 raise SCvxError(f"convex subproblem failed at iteration {it}: {exc}", history) from exc
             t_solve = time.perf_counter() - t0
@@ -603,7 +667,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
             info_model = (ev["info"] + ev["grad"] @ dxs - 0.5 * float(np.sum((Lfac.T @ dxs) ** 2))) if use_info else 0.0
             slack = [np.maximum(c["s"].value, 0.0) for c in sub.con]
             pen_model = penalty(nu, slack)
-            L_new = (1.0 - alpha) * impulse(t, u_new) - alpha * info_model + pen_model
+            L_new = (1.0 - alpha) * _impulse(dt, u_new) - alpha * info_model + pen_model
             ev_new = evaluate(x_new, u_new, 0)
             J_new, obj_new = cost_of(x_new, u_new, ev_new)
             pen_new = J_new - obj_new
@@ -624,7 +688,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
                        model_error_defect=pen_new - pen_model,
                        model_error_info=(-alpha * (ev_new["info"] - info_model)) if use_info else 0.0,
                        penalty_weight=w, multiplier_update=False, information=ev_new["info"],
-                       impulse=impulse(t, u_new), t_discretize=ev_new["t_discretize"], t_info=ev_new["t_info"],
+                       impulse=_impulse(dt, u_new), t_discretize=ev_new["t_discretize"], t_info=ev_new["t_info"],
                        t_solve=t_solve, t_hessian=0.0, status=str(sub.problem.status))
             history.append(rec)
             if rho < st.rho1:
@@ -639,24 +703,25 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
                 x_hess = x_ref[info_node].copy()
                 rec["t_hessian"] = t_hess
             if accepted:
-                t0 = time.perf_counter()
-                t_hess = 0.0
-                if use_info:  # gradient (and Hessian) at the new reference; the value is info(x, 0)'s
-                    ev_new["grad"] = validation.as_array(info(x_new[info_node], 1)[1], "info(x, 1) gradient",
-                                                      shape=(6,))
-                    if poor_model or np.linalg.norm(x_new[info_node] - x_hess) > st.hessian_refresh:
-                        Lfac, t_hess = hessian_factor(x_new[info_node], ev_new["grad"])
-                        x_hess = x_new[info_node].copy()
-                    rec["t_hessian"] = t_hess
-                rec["t_info"] += time.perf_counter() - t0 - t_hess
                 x_ref, u_ref, ev = x_new, u_new, ev_new
                 obj_change = abs(obj_new - obj_ref)
                 obj_ref = obj_new
                 small = obj_change <= st.tol * scale
                 feasible = max_def_new <= st.defect_tol and viol_new <= st.defect_tol
                 if small and feasible and not tr_active:
-                    return SCvxResult(t, x_ref, u_ref, alpha, obj_ref, impulse(t, u_ref),
+                    return SCvxResult(t, x_ref, u_ref, alpha, obj_ref, _impulse(dt, u_ref),
                                       ev["info"] if info is not None else float("nan"), max_def_new, history)
+                # the iteration goes on: gradient (and Hessian) at the new reference (not computed on the converged
+                # step, where nothing would use them); the value is info(x, 0)'s
+                t0 = time.perf_counter()
+                t_hess = 0.0
+                if use_info:
+                    ev["grad"] = validation.as_array(info(x_ref[info_node], 1)[1], "info(x, 1) gradient", shape=(6,))
+                    if poor_model or np.linalg.norm(x_ref[info_node] - x_hess) > st.hessian_refresh:
+                        Lfac, t_hess = hessian_factor(x_ref[info_node], ev["grad"])
+                        x_hess = x_ref[info_node].copy()
+                    rec["t_hessian"] = t_hess
+                rec["t_info"] += time.perf_counter() - t0 - t_hess
                 if al and (abs(actual) <= threshold * scale or (not tr_active and abs(actual) <= 1e2 * st.tol * scale)):
                     lam = lam + w * ev["model"].defects
                     mus = [np.maximum(mu + w * c, 0.0) for mu, (c, _) in zip(mus, ev["cons"])]

@@ -73,6 +73,7 @@ __all__ = [
     "cholesky_spd",
     "logdet_spd",
     "block_diag",
+    "WindowAssembler",
     "state_covariance",
     "augment_states",
     "augmented_covariance",
@@ -625,7 +626,22 @@ def _check_linear_system(P0, F, Q, H, R, *, chol_R: bool = False):
     if N == 1 and F.size == 0:
         F = np.zeros((0, n, n))
     F = _as_sequence(F, "F", N - 1, (n, n), ctx)
-    Q = _as_sequence(Q, "Q", N - 1, (n, n), ctx) if np.size(Q) else np.zeros((0, n, n))
+    Q, R, LR = _check_q_r(Q, R, N, M, n, ctx, f" (N, M from H {H.shape})")
+    if all(a is not None for a in raw):
+        out = (P0, np.array(Q, copy=True), R, LR)
+        for a in out:
+            a.flags.writeable = False
+        _CHECKED_NOISE.insert(0, ((N, M), raw, out))
+        del _CHECKED_NOISE[_CHECKED_NOISE_SIZE:]
+        P0, Q, R, LR = out
+    return (P0, F, Q, H, R, LR) if chol_R else (P0, F, Q, H, R)
+
+
+def _check_q_r(Q, R, N: int, M: int, n: int, ctx_q: str = "", ctx_r: str = ""):
+    """The process- and measurement-noise checks of :func:`_check_linear_system` for N times, M measurements and n
+    states: ``Q`` (N-1, n, n) or (n, n) symmetric PSD, ``R`` (N, M, M) or (M, M) SPD.  Returns ``(Q, R, LR)``
+    (symmetric parts as sequences, LR the lower Cholesky factors of R)."""
+    Q = _as_sequence(Q, "Q", N - 1, (n, n), ctx_q) if np.size(Q) else np.zeros((0, n, n))
     if N > 1:
         Qs = _sym(Q)
         if np.max(np.abs(Q - Qs)) > 1e-8 * max(np.max(np.abs(Q)), 1e-300):
@@ -640,18 +656,11 @@ def _check_linear_system(P0, F, Q, H, R, *, chol_R: bool = False):
         except np.linalg.LinAlgError as exc:
             raise ValueError("Q must be positive semi-definite") from exc
         Q = Qs
-    R = _as_sequence(R, "R", N, (M, M), f" (N, M from H {H.shape})")
+    R = _as_sequence(R, "R", N, (M, M), ctx_r)
     _spd(R[0] if R.strides[0] == 0 else R, "R")  # a broadcast (M, M) R is checked once
     R = _sym(R)
     LR = _cholesky(R, "R")
-    if all(a is not None for a in raw):
-        out = (P0, np.array(Q, copy=True), R, LR)
-        for a in out:
-            a.flags.writeable = False
-        _CHECKED_NOISE.insert(0, ((N, M), raw, out))
-        del _CHECKED_NOISE[_CHECKED_NOISE_SIZE:]
-        P0, Q, R, LR = out
-    return (P0, F, Q, H, R, LR) if chol_R else (P0, F, Q, H, R)
+    return Q, R, LR
 
 
 def position_sigma_km(P, index: int, system: CR3BP, *, axes=(0, 1, 2)) -> np.ndarray:
@@ -847,6 +856,50 @@ def assemble_augmented(model: MeasurementModel, noise, P0, observer: ObjectArcs,
     if not callable(noise):
         noise = _spd(validation.as_array(noise, "noise", shape=(m, m)), "noise")
     return _assemble(model, noise, P0, observer, targets, Q, i)
+
+
+class WindowAssembler:
+    """:func:`assemble_augmented` for many observer candidates of one window, the fixed ingredients checked once.
+
+    An optimiser that moves only the observer (the SCvx information models of Wolf & Jones) re-linearises the same
+    window many times with the same measurement model, noise, prior, target arcs and fixed process noise; here
+    those are validated once, at construction, and each call checks only the observer arcs.  Calls return exactly
+    (bit for bit) what :func:`assemble_augmented` returns for the same arguments.
+
+    Parameters
+    ----------
+    model : MeasurementModel
+    noise : array_like (m, m) or callable
+        As in :func:`assemble_augmented` (a callable's output is checked on every call).
+    P0 : array_like (n, n)
+        Augmented covariance at ``t[0]`` (SPD), n = 6 (N_T + 1).
+    targets : ObjectArcs
+        Arcs of the N_T targets (their grid is the window's).
+    Q : array_like (N-1, n, n) or (n, n), optional
+        Fixed augmented process noise (symmetric PSD); default: block diagonal of the arcs' own ``Q``.
+    """
+
+    def __init__(self, model: MeasurementModel, noise, P0, targets: ObjectArcs, *, Q=None):
+        self.model = validation.instance(model, "model", MeasurementModel)
+        self.targets = validation.instance(targets, "targets", ObjectArcs)
+        NT, N, m = targets.x.shape[0], targets.t.size, model.dim
+        n = 6 * (NT + 1)
+        self.P0 = check_spd(validation.as_array(P0, "P0", shape=(n, n)), "P0")
+        self.P0.flags.writeable = False  # shared by every linearisation
+        if Q is not None:
+            Q = _as_sequence(Q, "Q", N - 1, (n, n))
+            check_psd(Q, "Q")
+        self.Q = Q
+        self.noise = noise if callable(noise) else _spd(validation.as_array(noise, "noise", shape=(m, m)), "noise")
+
+    def __call__(self, observer: ObjectArcs, index: int = 0) -> AugmentedLinearization:
+        """The :class:`AugmentedLinearization` of observer arc ``index`` of ``observer`` (on the targets' grid)."""
+        validation.instance(observer, "observer", ObjectArcs)
+        t = self.targets.t
+        if observer.t.shape != t.shape or not np.array_equal(observer.t, t):
+            raise ValueError("observer and targets arcs must share the same time grid")
+        i = validation.integer(index, "index", minimum=0, maximum=observer.x.shape[0] - 1)
+        return _assemble(self.model, self.noise, self.P0, observer, self.targets, self.Q, i)
 
 
 def _assemble(model, noise, P0, observer, targets, Q, i) -> AugmentedLinearization:

@@ -63,10 +63,12 @@ from scipy.linalg import lapack as _lapack
 from cislunar.sensing.covariance import (
     AugmentedLinearization,
     _check_linear_system,
+    _check_q_r,
     _cholesky,
     _logdet,
     _spd,
     _sym,
+    check_spd,
 )
 from cislunar.utils import validation
 
@@ -77,6 +79,7 @@ __all__ = [
     "mutual_information",
     "mutual_information_gradient_dense",
     "mutual_information_gradient",
+    "InformationKernel",
     "window_information",
     "gaussian_kl",
     "monte_carlo_mutual_information",
@@ -532,7 +535,7 @@ def _gradient_sqrt(P0, F, Q, H, LR, dF, dH):
     return total, grad
 
 
-def _gradient_sqrt_reverse(P0, F, Q, H, LR, dF, dH):
+def _gradient_sqrt_reverse(P0, F, Q, H, LR, dF, dH, LQ=None):
     """Reverse-mode (adjoint) derivative of the square-root recursion: value and gradient, cost independent of p.
 
     Notation (whitened :math:`\\hat H_k = L_{R_k}^{-1}H_k`): prior and posterior factors :math:`U_k, V_k`,
@@ -577,12 +580,15 @@ def _gradient_sqrt_reverse(P0, F, Q, H, LR, dF, dH):
     eps-sized perturbation of the posterior factors alone moves the gradient by ~1e-7 there, so ~1e-8 is the
     double-precision floor of any square-root recursion and the two modes agree to ~4e-8 (1e-12 on
     well-conditioned windows).  Returns as in :func:`mutual_information_gradient_dense`; arguments checked by
-    :func:`mutual_information_gradient` (``LR``: Cholesky factors of R), no checks here.
+    :func:`mutual_information_gradient` (``LR``: Cholesky factors of R; ``LQ``: square roots of Q, default
+    :func:`_noise_roots`), no checks here.
     """
     Hw = np.linalg.solve(LR, H)
     N, M, n = H.shape
     p = dH.shape[-1]
-    terms, T, Bi, Vt = _sqrt_sweep(P0, F, _noise_roots(Q) if N > 1 else None, Hw, keep=True)
+    if LQ is None and N > 1:
+        LQ = _noise_roots(Q)
+    terms, T, Bi, Vt = _sqrt_sweep(P0, F, LQ, Hw, keep=True)
     info = float(np.sum(terms))
     swap = np.swapaxes
     Gam = swap(Bi[:, :M], 1, 2) @ Hw  # B^{-1}[Hw; I]: B^{-1} = Bi^T, lower triangular
@@ -635,6 +641,77 @@ def mutual_information_gradient(P0, F, Q, H, R, dF, dH, *, method: str = "sqrt")
     dF, dH = _check_derivatives(F, H, dF, dH)
     kernel = {"sqrt": _gradient_sqrt_reverse, "sqrt-forward": _gradient_sqrt, "adjoint": _gradient_adjoint}[method]
     return kernel(P0, F, Q, H, LR, dF, dH)
+
+
+class InformationKernel:
+    """Mutual information and its gradient for many windows that share ``P0``, ``Q`` and ``R``, checked once.
+
+    An optimiser that moves the observer re-evaluates the same window with new ``F``, ``H`` (and their
+    derivatives) and the same noise: here ``P0``, ``Q`` and ``R`` are validated once, the Cholesky factors of R
+    and the square roots of Q are computed once, and each evaluation checks only the shapes and finiteness of
+    its arrays.  Values and gradients are bit-for-bit those of :func:`mutual_information` and
+    :func:`mutual_information_gradient` (``method="sqrt"``, the same kernels on the same checked arrays).
+
+    Parameters
+    ----------
+    P0 : array_like (n, n)
+        Covariance at ``t_0`` (SPD).
+    Q : array_like (N-1, n, n) or (n, n)
+        Process noise over each interval (symmetric PSD).
+    R : array_like (N, M, M) or (M, M)
+        Measurement noise covariances (SPD).
+    n_times : int
+        Number of measurement times N (>= 1).
+    """
+
+    def __init__(self, P0, Q, R, n_times: int):
+        N = validation.integer(n_times, "n_times", minimum=1)
+        P0 = check_spd(P0, "P0")
+        if P0.ndim != 2:
+            raise ValueError(f"P0 must be a single (n, n) matrix; got {P0.shape}")
+        n = P0.shape[0]
+        Rv = validation.as_array(R, "R", ndim=(2, 3), min_size=1)
+        M = Rv.shape[-1]
+        Q, R, LR = _check_q_r(Q, Rv, N, M, n, f" (N - 1 = {N - 1} intervals, n from P0 {P0.shape})",
+                              f" (N = {N} times)")
+        self.P0, self.Q, self.R, self.LR = P0, Q, R, LR
+        self.LQ = _sqrt_psd(Q) if N > 1 else None
+        for a in (self.P0, self.Q, self.R, self.LR) + ((self.LQ,) if N > 1 else ()):
+            if a.flags.owndata:
+                a.flags.writeable = False
+        self.shape = (N, M, n)
+
+    def _check(self, F, H):
+        N, M, n = self.shape
+        F = np.asarray(F, dtype=float)
+        H = np.asarray(H, dtype=float)
+        if F.shape != (N - 1, n, n):
+            raise ValueError(f"F must have shape {(N - 1, n, n)}; got {F.shape}")
+        if H.shape != (N, M, n):
+            raise ValueError(f"H must have shape {(N, M, n)}; got {H.shape}")
+        if not (np.isfinite(F).all() and np.isfinite(H).all()):
+            raise ValueError("F and H must be finite (no NaN or inf)")
+        return F, H
+
+    def value(self, F, H) -> float:
+        """:func:`mutual_information` of the window with transitions ``F`` (N-1, n, n) and Jacobians ``H`` (N, M, n),
+        nats."""
+        F, H = self._check(F, H)
+        return float(np.sum(_sqrt_sweep(self.P0, F, self.LQ, np.linalg.solve(self.LR, H))))
+
+    def value_gradient(self, F, H, dF, dH):
+        """:func:`mutual_information_gradient` (reverse mode): ``(info, grad (p,))`` for derivatives ``dF``
+        (N-1, n, n, p) and ``dH`` (N, M, n, p)."""
+        F, H = self._check(F, H)
+        dF = np.asarray(dF, dtype=float)
+        dH = np.asarray(dH, dtype=float)
+        if dH.ndim != 4 or dH.shape[:3] != H.shape or dH.shape[-1] < 1:
+            raise ValueError(f"dH must have shape {H.shape} + (p,) with p >= 1; got {dH.shape}")
+        if dF.shape != F.shape + dH.shape[-1:]:
+            raise ValueError(f"dF must have shape {F.shape + dH.shape[-1:]}; got {dF.shape}")
+        if not (np.isfinite(dF).all() and np.isfinite(dH).all()):
+            raise ValueError("dF and dH must be finite (no NaN or inf)")
+        return _gradient_sqrt_reverse(self.P0, F, self.Q, H, self.LR, dF, dH, self.LQ)
 
 
 def window_information(lin: AugmentedLinearization, *, method: str = "structured", gradient: bool = False):

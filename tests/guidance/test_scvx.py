@@ -351,3 +351,101 @@ def test_stops_on_the_first_step_meeting_all_three_convergence_tests(run, reques
     assert st.tol <= 1e-8
     if run == "transfer_run":
         assert near >= 1
+
+
+def _run_or_error(**kw):
+    """A solve's (x, u, cost, history costs), or its error's history costs (a run that does not converge)."""
+    try:
+        res = scvx.solve_scvx(**kw)
+    except scvx.SCvxError as exc:
+        return None, [h["new_cost"] for h in exc.history]
+    return res, [h["new_cost"] for h in res.history]
+
+
+def test_runs_reusing_one_workspace_equal_runs_on_fresh_problems():
+    """A sweep that passes one SCvxWorkspace to all its runs (one canonicalisation) gives, run by run, the solutions
+    and iterates of runs that build their own subproblem: bit for bit, across warm starts, homotopy weights and
+    both defect methods (every Parameter is reassigned; the first solve of a run starts a new Clarabel solver)."""
+    sc = wolf_jones.test_case_1()
+    t = np.linspace(0.0, sc.period, 16)
+    g = 5.0 * np.eye(6)[0]
+
+    def info(x, order=0):
+        return g @ x if order == 0 else (g @ x, g)
+
+    x0 = propagate(em, sc.observer_x0, t).x
+    ws = scvx.SCvxWorkspace()
+    guess = (x0, np.zeros((t.size, 3)))
+    runs = [(0.02, "penalty", 12), (0.05, "augmented_lagrangian", 150), (0.1, "augmented_lagrangian", 150)]
+    converged = solves = 0
+    for alpha, method, max_iter in runs:
+        kw = dict(system=em, t_nodes=t, x_guess=guess[0], u_guess=guess[1], u_max=np.full(t.size, A_MAX),
+                  info=info, info_node=5, alpha=alpha, settings=scvx.SCvxSettings(method=method, max_iter=max_iter))
+        fresh, costs_fresh = _run_or_error(**kw)
+        reused, costs_reused = _run_or_error(**kw, workspace=ws)
+        assert costs_fresh == costs_reused, (alpha, method)
+        solves += len(costs_fresh)
+        if fresh is not None:
+            converged += 1
+            assert reused is not None and reused.iterations == fresh.iterations
+            assert np.array_equal(reused.x, fresh.x) and np.array_equal(reused.u, fresh.u)
+            assert reused.cost == fresh.cost
+            guess = (fresh.x, fresh.u)
+    assert converged >= 2 and solves >= 10
+    assert ws.builds == 1  # one structure: canonicalised once for the three runs
+    # pickling drops the built problems (a process builds its own); the workspace stays usable
+    clone = pickle.loads(pickle.dumps(ws))
+    assert clone.builds == 0 and clone._problems == {} and clone.max_problems == ws.max_problems
+
+
+def test_workspace_keeps_one_problem_per_structure_and_thread():
+    import threading
+
+    ws = scvx.SCvxWorkspace(max_problems=2)
+    coast = np.zeros(5, bool)
+    a = ws._subproblem(5, True, None, [], coast)
+    assert ws._subproblem(5, True, None, [], coast) is a and ws.builds == 1
+    b = ws._subproblem(5, False, None, [], coast)  # another structure: another problem
+    assert b is not a and ws.builds == 2
+    other = []
+    th = threading.Thread(target=lambda: other.append(ws._subproblem(5, True, None, [], coast)))
+    th.start()
+    th.join()
+    assert other[0] is not a  # never shared between threads
+    assert len(ws._problems) == 2  # least recently used dropped beyond max_problems
+    with pytest.raises(ValueError, match="max_problems"):
+        scvx.SCvxWorkspace(max_problems=0)
+    with pytest.raises(TypeError, match="workspace"):
+        scvx.solve_scvx(em, np.linspace(0, 1, 3), propagate(em, wolf_jones.test_case_1().observer_x0,
+                                                           np.linspace(0, 1, 3)).x, np.zeros((3, 3)),
+                        np.full(3, A_MAX), workspace=object())
+
+
+def test_no_gradient_or_hessian_on_the_converged_step():
+    """The gradient and Hessian at a new reference are computed only when the iteration goes on: never at the
+    converged solution (nothing would use them), and once per accepted step before it."""
+    sc = wolf_jones.test_case_1()
+    t = np.linspace(0.0, sc.period, 16)
+    g = 5.0 * np.eye(6)[0]
+    calls = []
+
+    class Info:
+        def __call__(self, x, order=0):
+            if order == 1:
+                calls.append(("gradient", np.array(x)))
+            return g @ x if order == 0 else (g @ x, g)
+
+        def hessian(self, x):
+            calls.append(("hessian", np.array(x)))
+            return np.zeros((6, 6))
+
+    x0 = propagate(em, sc.observer_x0, t).x
+    res = scvx.solve_scvx(em, t, x0, np.zeros((t.size, 3)), np.full(t.size, A_MAX), info=Info(), info_node=5,
+                          alpha=0.05, settings=scvx.SCvxSettings(hessian_refresh=0.0))
+    grads = [x for kind, x in calls if kind == "gradient"]
+    hessians = [x for kind, x in calls if kind == "hessian"]
+    accepted = sum(h["accepted"] for h in res.history)
+    assert accepted >= 3
+    assert len(grads) == accepted  # the initial reference and every accepted step but the last
+    assert len(hessians) >= accepted  # hessian_refresh = 0: at every reference (and after poor-model rejections)
+    assert not any(np.array_equal(x, res.x[5]) for x in grads + hessians)

@@ -359,3 +359,33 @@ def test_position_sigma_axes_split_the_trace():
             C.position_sigma_km(P, 0, EARTH_MOON, axes=bad)
     with pytest.raises(TypeError, match="axes"):
         C.position_sigma_km(P, 0, EARTH_MOON, axes="xy")
+
+
+def test_window_assembler_equals_assemble_augmented(dro_window):
+    """WindowAssembler (model, noise, P0, targets and a fixed Q checked once) returns, for every observer candidate
+    of a batch, exactly what assemble_augmented returns; it refuses arcs on another grid and bad fixed ingredients."""
+    lin = dro_window
+    R = M.range_range_rate_noise(0.1, 0.01, EARTH_MOON)
+    q = C.psd_to_nondimensional(1e-11, EARTH_MOON)
+    tgt = C.propagate_arcs(EARTH_MOON, TARGETS[:2], lin.t, q=q)
+    obs = C.propagate_arcs(EARTH_MOON, OBSERVER + np.array([[0.0] * 6, [1e-4, 0, 0, 0, 0, 1e-4]]), lin.t, q=q,
+                           order=2)
+    for Q in (None, lin.Q):
+        asm = C.WindowAssembler(M.RANGE_RANGE_RATE, R, lin.P0, tgt, Q=Q)
+        for i in range(2):
+            a = asm(obs, i)
+            b = C.assemble_augmented(M.RANGE_RANGE_RATE, R, lin.P0, obs, tgt, Q=Q, index=i)
+            for name in ("t", "observer", "targets", "P0", "F", "Q", "H", "R", "dF", "dH", "observer_stm"):
+                assert np.array_equal(getattr(a, name), getattr(b, name)), (name, i)
+    assert not np.array_equal(asm(obs, 0).H, asm(obs, 1).H)  # the index selects the candidate
+    short = C.propagate_arcs(EARTH_MOON, OBSERVER, lin.t[:-1], q=q)
+    with pytest.raises(ValueError, match="time grid"):
+        asm(short)
+    with pytest.raises(ValueError, match="index"):
+        asm(obs, 2)
+    with pytest.raises(ValueError, match="P0"):
+        C.WindowAssembler(M.RANGE_RANGE_RATE, R, -lin.P0, tgt)
+    with pytest.raises(ValueError, match="noise"):
+        C.WindowAssembler(M.RANGE_RANGE_RATE, -R, lin.P0, tgt)
+    with pytest.raises(ValueError, match="Q"):
+        C.WindowAssembler(M.RANGE_RANGE_RATE, R, lin.P0, tgt, Q=-lin.Q)

@@ -359,3 +359,60 @@ def test_process_noise_roots_cache_follows_values():
     assert I.mutual_information_gradient(P0, F, Q, H, R, dF, dH)[0] == fresh
     assert I.mutual_information(P0, F[:2], Q[:2], H[:3], R[:3]) == pytest.approx(
         I.mutual_information_dense(P0, F[:2], Q[:2], H[:3], R[:3]), rel=1e-12)  # other shape: no false hit
+
+
+@given(seed=st.integers(0, 2**32 - 1), N=st.integers(1, 7), M=st.integers(1, 4), n=st.integers(1, 6),
+       logcond=st.floats(-3, 6))
+def test_information_kernel_equals_public_functions_bit_for_bit(seed, N, M, n, logcond):
+    """InformationKernel (P0, Q, R checked once, Q's roots and R's factors kept) returns exactly the value and the
+    gradient of mutual_information / mutual_information_gradient, and agrees with dense Eq. 18 and Eqs. 47-48."""
+    P0, F, Q, H, R, dF, dH = random_system(seed, N, M, n, 2, 10.0**logcond)
+    K = I.InformationKernel(P0, Q, R, N)
+    I._ROOT_CACHE.clear()  # the kernel does not rely on the module's caches
+    assert K.value(F, H) == I.mutual_information(P0, F, Q, H, R)
+    info_k, g_k = K.value_gradient(F, H, dF, dH)
+    info_p, g_p = I.mutual_information_gradient(P0, F, Q, H, R, dF, dH)
+    assert info_k == info_p and np.array_equal(g_k, g_p)
+    info_d, g_d = I.mutual_information_gradient_dense(P0, F, Q, H, R, dF, dH)
+    assert info_k == pytest.approx(info_d, rel=1e-10, abs=1e-12)
+    np.testing.assert_allclose(g_k, g_d, rtol=1e-7, atol=1e-8 * max(1.0, np.max(np.abs(g_d))))
+
+
+def test_information_kernel_on_case2_sized_window(case2_sized_window):
+    """Test-case-2 size: the kernel is the public reverse mode bit for bit (whose gradient the finite-difference
+    tests above check); a broadcast (M, M) R and (n, n) Q give the numbers of their sequences."""
+    lin = case2_sized_window
+    P0, F, Q, H, R = lin.arrays
+    K = I.InformationKernel(P0, Q, R, H.shape[0])
+    info_k, g_k = K.value_gradient(F, H, lin.dF, lin.dH)
+    info_p, g_p = I.mutual_information_gradient(*lin.arrays, lin.dF, lin.dH)
+    assert info_k == info_p == K.value(F, H) and np.array_equal(g_k, g_p)
+    K1 = I.InformationKernel(P0, Q[0], R[0], H.shape[0])
+    Qc = np.broadcast_to(Q[0], Q.shape)
+    assert K1.value(F, H) == I.mutual_information(P0, F, Qc, H, R[0])
+
+
+def test_information_kernel_refuses_bad_input_by_name():
+    P0, F, Q, H, R, dF, dH = random_system(3, N=4, M=2, n=3)
+    with pytest.raises(ValueError, match="P0"):
+        I.InformationKernel(-P0, Q, R, 4)
+    with pytest.raises(ValueError, match="Q"):
+        I.InformationKernel(P0, -Q, R, 4)
+    with pytest.raises(ValueError, match="R"):
+        I.InformationKernel(P0, Q, R[:2], 4)
+    with pytest.raises(ValueError, match="n_times"):
+        I.InformationKernel(P0, Q, R, 0)
+    K = I.InformationKernel(P0, Q, R, 4)
+    with pytest.raises(ValueError, match="F"):
+        K.value(F[:2], H)
+    with pytest.raises(ValueError, match="H"):
+        K.value(F, H[:, :1])
+    Hn = H.copy()
+    Hn[1, 0, 0] = np.nan
+    with pytest.raises(ValueError, match="finite"):
+        K.value(F, Hn)
+    with pytest.raises(ValueError, match="dF"):
+        K.value_gradient(F, H, dF[..., :1], dH)
+    with pytest.raises(ValueError, match="dH"):
+        K.value_gradient(F, H, dF, dH[:2])
+    assert K.value(F, H) == I.mutual_information(P0, F, Q, H, R)  # the checked arrays were not changed

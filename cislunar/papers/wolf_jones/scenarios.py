@@ -60,6 +60,7 @@ from cislunar.guidance.discretization import propagate_foh, sundman_nodes
 from cislunar.guidance.scvx import (
     SCvxError,
     SCvxSettings,
+    SCvxWorkspace,
     SweepResult,
     impulse,  # noqa: F401 - re-exported: the trapezoid impulse of Eq. 42 has one home (scvx)
     solve_scvx,
@@ -418,8 +419,13 @@ class WindowInformation:
     Notes
     -----
     The targets are propagated once; each call propagates only the observer (with its STT for ``order=1``).
-    The last few linearisations are cached by the bytes of ``x`` (SCvx asks for value, gradient and Hessian at the
-    same point).
+    The window's fixed ingredients (measurement model and noise, P0, target arcs, the fixed Q, and the P0, Q, R of
+    Eq. 18 with R's Cholesky factors and Q's square roots) are checked once, at construction
+    (:class:`cislunar.sensing.covariance.WindowAssembler`, :class:`cislunar.sensing.information.InformationKernel`);
+    values and gradients are bit-for-bit those of the public ``assemble_augmented`` and
+    ``mutual_information[_gradient]``.  The last few linearisations and Hessians are cached by the bytes of ``x``
+    (SCvx asks for value, gradient and Hessian at the same point; the upward and downward sweeps start from the
+    same guess).
     """
 
     def __init__(self, system: CR3BP, t, targets_x0, model, noise, P0, *, q: float, x_reference,
@@ -445,7 +451,14 @@ class WindowInformation:
         self._targets = cov.propagate_arcs(system, self.targets_x0, self.t, q=self.q)
         ref = cov.propagate_arcs(system, self.x_reference, self.t, q=self.q)
         self.Q = cov.block_diag(np.moveaxis(np.concatenate([ref.Q, self._targets.Q], axis=0), 0, 1))
+        # the window's fixed ingredients (model, noise, P0, target arcs, Q; and P0, Q, R of Eq. 18) are checked
+        # once here; each evaluation checks only what depends on x (bit-for-bit the values of the public
+        # assemble_augmented and mutual_information[_gradient], which re-check them on every call)
+        self._assemble = cov.WindowAssembler(self.model, self.noise, self.P0, self._targets, Q=self.Q)
+        lin = self._assemble(ref)
+        self._kernel = info.InformationKernel(lin.P0, lin.Q, lin.R, self.t.size)
         self._cache: dict = {}
+        self._hessians: dict = {}
 
     # ---------------------------------------------------------------- linearisations
     def linearization(self, x, derivatives: bool = False) -> cov.AugmentedLinearization:
@@ -455,7 +468,7 @@ class WindowInformation:
         if key in self._cache:
             return self._cache[key]
         arcs = cov.propagate_arcs(self.system, x, self.t, order=2 if derivatives else 1)
-        lin = cov.assemble_augmented(self.model, self.noise, self.P0, arcs, self._targets, Q=self.Q)
+        lin = self._assemble(arcs)
         if len(self._cache) >= 8:
             self._cache.pop(next(iter(self._cache)))
         self._cache[key] = lin
@@ -465,9 +478,10 @@ class WindowInformation:
         """``order=0``: MI (nats); ``order=1``: (MI, gradient (6,)) in nats per LU and per LU/TU."""
         order = validation.integer(order, "order", minimum=0, maximum=1)
         if order == 0:
-            return info.mutual_information(*self.linearization(x).arrays)
+            lin = self.linearization(x)
+            return self._kernel.value(lin.F, lin.H)
         lin = self.linearization(x, derivatives=True)
-        value, grad = info.mutual_information_gradient(*lin.arrays, lin.dF, lin.dH)
+        value, grad = self._kernel.value_gradient(lin.F, lin.H, lin.dF, lin.dH)
         return float(value), grad
 
     def hessian(self, x) -> np.ndarray:
@@ -479,19 +493,26 @@ class WindowInformation:
         perturbed observers are propagated in one batch (heyoka batch mode).
         """
         x = validation.as_state(x, "x", batch=False)
+        key = x.tobytes()
+        if key in self._hessians:  # e.g. the up and down sweeps both start from the ballistic guess
+            return self._hessians[key].copy()
         h = self.hessian_step
         central = self.hessian_scheme == "central"
         X0 = np.concatenate([x + h * np.eye(6), x - h * np.eye(6)], axis=0) if central else x + h * np.eye(6)
         arcs = cov.propagate_arcs(self.system, X0, self.t, order=2)
         G = np.empty((X0.shape[0], 6))
         for j in range(X0.shape[0]):
-            lin = cov.assemble_augmented(self.model, self.noise, self.P0, arcs, self._targets, Q=self.Q, index=j)
-            G[j] = info.mutual_information_gradient(*lin.arrays, lin.dF, lin.dH)[1]
+            lin = self._assemble(arcs, j)
+            G[j] = self._kernel.value_gradient(lin.F, lin.H, lin.dF, lin.dH)[1]
         if central:
             Hm = (G[:6] - G[6:]).T / (2.0 * h)  # column i: d grad / d x_i
         else:
             Hm = (G - self(x, 1)[1]).T / h
-        return 0.5 * (Hm + Hm.T)
+        Hs = 0.5 * (Hm + Hm.T)
+        if len(self._hessians) >= 4:
+            self._hessians.pop(next(iter(self._hessians)))
+        self._hessians[key] = Hs
+        return Hs.copy()
 
     def concave_model(self, x) -> tuple[float, np.ndarray, np.ndarray]:
         """``(I, g, H_-)``: value, gradient and the concave part of the Hessian (eigenvalues clipped to <= 0).
@@ -651,13 +672,15 @@ class ScenarioSolver:
             validation.instance(settings, "settings", SCvxSettings)
         self.settings = settings
         self.u_max = scenario.control_bounds(self.t)
+        # every run of this solver has the same subproblem structure: canonicalised once per thread and process
+        self.workspace = SCvxWorkspace()
 
     def __call__(self, alpha: float, x_guess, u_guess):
 
         sc = self.scenario
         return solve_scvx(sc.system, self.t, x_guess, u_guess, self.u_max, x_final=sc.observer_xf,
                           info=self.information, info_node=self.k_window, constraints=self.constraints,
-                          alpha=float(alpha), settings=self.settings)
+                          alpha=float(alpha), settings=self.settings, workspace=self.workspace)
 
 
 def _chain(solver, alphas, x_guess, u_guess, direction):
