@@ -36,7 +36,7 @@ MAP_COAST_H = None  # coast of the surrogate check, the direction map and the ti
 LEAD_DAYS = None  # the burn happens this long before the target's apolune, days (None: 1.0)
 APOLUNE_RANGE_KM = None  # agent-target range at the target's apolune, km (None: 215.0, the paper's scale)
 PRE_ARC_H = None  # tracking arc before the burn in section 4, whole hours (None: 24)
-PRE_ARC_SWEEP_H = None  # tracking arcs swept, whole hours (None: 6, 12, 24, 48; PRE_ARC_H is added if missing)
+PRE_ARC_SWEEP_H = None  # tracking arcs swept, whole hours (None: 12, 24 quick; 6, 12, 24, 48 full; PRE_ARC_H added)
 RING_ANGLES_DEG = None  # initial ring angles of the agent on the QPO, deg, must include 0 (None: 0, 45, 90, 135)
 TIMING_REPEAT = None  # runs of the true minimiser timed, best kept (None: 2 quick, 1 full)
 WORKERS = 1  # local processes for the sweeps (1: serial)
@@ -44,8 +44,8 @@ SCHEDULER = ""  # address of a Dask scheduler to run the sweeps on ("" = none; t
 
 # %% [markdown]
 # **Changing the chapter.** Every size and setting of this chapter is a parameter of the cell above. A parameter
-# left at `None` is chosen in the next cell, from `QUICK` for the sizes (quick mode: a 600-direction sphere and five
-# coast times) and from the paper's scale for the scenario (215 km at apolune, burn 1 day before it); a value you
+# left at `None` is chosen in the next cell, from `QUICK` for the sizes (quick mode: a 600-direction sphere, five
+# coast times and two tracking arcs) and from the paper's scale for the scenario (215 km at apolune, burn 1 day before it); a value you
 # give, in Jupyter or with `-p NAME=VALUE` on the command line, is used as given in either mode. The three sweeps
 # of sections 3 and 4 (burn sizes, tracking arcs, ring angles on the torus) run one task per case on the executor
 # that `WORKERS` local processes or a Dask `SCHEDULER` provide; every task is deterministic, so the numbers do not
@@ -62,7 +62,8 @@ MAP_COAST_H = MAP_COAST_H if MAP_COAST_H is not None else 12
 LEAD_DAYS = LEAD_DAYS if LEAD_DAYS is not None else 1.0
 APOLUNE_RANGE_KM = APOLUNE_RANGE_KM if APOLUNE_RANGE_KM is not None else 215.0
 PRE_ARC_H = PRE_ARC_H if PRE_ARC_H is not None else 24
-PRE_ARC_SWEEP_H = sorted(set(PRE_ARC_SWEEP_H if PRE_ARC_SWEEP_H is not None else (6, 12, 24, 48)) | {PRE_ARC_H})
+PRE_ARC_SWEEP_H = sorted(set(PRE_ARC_SWEEP_H if PRE_ARC_SWEEP_H is not None else
+                             ((12, 24) if QUICK else (6, 12, 24, 48))) | {PRE_ARC_H})
 RING_ANGLES_DEG = tuple(RING_ANGLES_DEG if RING_ANGLES_DEG is not None else (0.0, 45.0, 90.0, 135.0))
 TIMING_REPEAT = TIMING_REPEAT if TIMING_REPEAT is not None else (2 if QUICK else 1)
 WORKERS = WORKERS if WORKERS is not None else 1
@@ -75,7 +76,7 @@ from cislunar.cr3bp.torus import qpo_for_mean_range
 from cislunar.guidance import ssat
 from cislunar.papers.greaves_scheeres_2023 import figures
 from cislunar.papers.greaves_scheeres_2023 import guidance_study as gs
-from cislunar.papers.greaves_scheeres_2023.claims.ssat_guidance import CLAIMS
+from cislunar.papers.greaves_scheeres_2023.claims.ssat_guidance import CLAIMS, NEAR_OPTIMAL_PERCENT, SHORT_COAST_HOURS
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
 from cislunar.utils.executors import open_executor
@@ -412,13 +413,21 @@ print(f"over all QPO pairs and coasts: median percentile {np.median(pct_all):.0f
 # - **MMD is the eigenvector.** Both brute-force maximisers of the surrogate (the quadratic form and the nonlinear
 #   change of the final angles) must lie within one spacing of the Fibonacci sphere from the eigenvector, which is
 #   as close as a grid of that size can resolve.
-# - **The perpendicular heuristic of Ref. [8]** is judged at the shortest coast, where it is meant to hold: the
-#   best direction of the perpendicular circle within 2 % of the true minimiser's $\sqrt{J_\rho}$.
+# - **The perpendicular heuristic of Ref. [8]** is stated "for short coasting periods", without a length: the best
+#   direction of the perpendicular circle must be within 2 % of the true minimiser's $\sqrt{J_\rho}$ at every coast
+#   read as short. The sweep over coast times (section 4) shows that it holds at the 1-h coast only, so "short" is
+#   read as 1 h, a reading made after seeing the sweep: the row is *tuned*, and it prints where the heuristic holds
+#   and by how much it misses at every longer coast.
 # - **"Nearly optimal".** Within 5 % of the true minimiser's $\sqrt{J_\rho}$, for every coast (the worst coast is
 #   what is compared). Four settings: the burn at the start of tracking (the first pair), the same on the torus
 #   (the median over ring angles and coasts, a *beyond paper* check that turns to *differs* when it fails), and the
 #   mid-arc burn split into the leading run of coasts within the tolerance and the rest. The mid-arc setting was
 #   adopted after the first comparison missed, so its rows are *tuned* however they come out.
+# - **Where MMD is near-optimal.** The paper's "nearly optimal" carries no condition, so one summary row counts,
+#   over every case swept with the larger burn (the burn at the start of tracking at each coast, the burn after
+#   each tracking arc at each coast, the agent on the torus at each ring angle and coast), the share in which MMD
+#   is within 5 % of the true minimiser; a general property would hold in at least 90 % of them. The row prints
+#   the cases where it holds and the spread of the excess where it does not.
 # - **The sign choice and the computation time** are measured, not compared: the paper asks for the sign check
 #   and gives no timing number.
 #
@@ -452,6 +461,24 @@ if n_ok < exc.size:
              f"timing (start of tracking, previous rows; tracking arc before the burn {arc_list} h: every arc length "
              f"fails beyond {max(map(arcs.within_hours, PRE_ARC_SWEEP_H)):.0f} h, worst excess "
              f"{arcs.worst_excess_percent.min():.0f}-{arcs.worst_excess_percent.max():.0f} %) and geometry (QPO row)"))
+# where MMD is within the tolerance: every (setting, coast) case swept with the larger burn
+case_sets = {"start of tracking": (r1.coast_hours, r1.mmd_excess_percent),
+             **{f"{h:g}-h arc": (r.coast_hours, r.mmd_excess_percent) for h, r in arcs.results.items()},
+             **{f"QPO {a:g} deg": (r.coast_hours, r.mmd_excess_percent) for a, r in qp.results.items()}}
+tol_near = NEAR_OPTIMAL_PERCENT
+n_cases = sum(e.size for _, e in case_sets.values())
+n_near = sum(int(np.sum(e <= tol_near)) for _, e in case_sets.values())
+near_where = "; ".join(f"{k}: {np.sum(e <= tol_near)} of {e.size}"
+                       + (f" (coasts {', '.join(f'{x:g}' for x in h[e <= tol_near])} h)" if np.any(e <= tol_near) else "")
+                       for k, (h, e) in case_sets.items())
+far = np.concatenate([e[e > tol_near] for _, e in case_sets.values()])
+# the perpendicular heuristic over every coast swept (the larger burn)
+short = r1.coast_hours <= SHORT_COAST_HOURS + 1e-6  # coasts read as "short" (the shortest swept if none is)
+short[0] = True
+perp_excess = 100 * (r1.perp_best / r1.optimum - 1)
+long_h = r1.coast_hours[~short]
+perp_sweep = (f"; at {long_h.min():g}-{long_h.max():g} h the best direction of the circle is "
+              f"{perp_excess[~short].min():.0f}-{perp_excess[~short].max():.0f} % above the optimum" if long_h.size else "")
 table.add(
     CLAIMS["eq7_identity"].judge(cc.covariance_round_trip, shown=f"{cc.covariance_round_trip:.1e} rel. error"),
     CLAIMS["agent_based_equivalent"].judge(max(cc.relative_block, cc.range_variance_spread),
@@ -465,11 +492,13 @@ table.add(
         shown=f"{sur.angle_quadratic_deg:.2f} deg (u^T Q u) / {sur.angle_nonlinear_deg:.2f} deg (nonlinear angle change)",
         note=f"{MAP_COAST_H}-h coast, {N_GRID}-direction sphere (spacing {sur.spacing_deg:.1f} deg); Eq. 23 as printed is the "
              "eigenvalue (a scalar); the text ('solution to an eigen-problem') means the unit eigenvector of that eigenvalue"),
-    CLAIMS["perpendicular_contains_optimum"].judge(100 * (r1.perp_best[0] / r1.optimum[0] - 1),
-        shown=f"best on circle {r1.perp_best[0]:.2f} vs optimum {r1.optimum[0]:.2f} km ({r1.coast_hours[0]:.0f} h, "
-              f"{DV_M_S[-1]} m/s)",
-        note=f"optimum off the perpendicular plane by {r1.optimum_perp_angle_deg[0]:.1f} deg. Holds only for the "
-             f"shortest coast: tolerance met for coasts <= {perp_h[DV_M_S[-1]]:.0f} h ({DV_M_S[-1]} m/s); optimum "
+    CLAIMS["perpendicular_contains_optimum"].judge(float(np.max(perp_excess[short])),
+        shown=f"{np.max(perp_excess[short]):.1f} % at {r1.coast_hours[short].max():g} h (best on circle "
+              f"{r1.perp_best[0]:.2f} vs optimum {r1.optimum[0]:.2f} km, {DV_M_S[-1]} m/s); holds for coasts <= "
+              f"{perp_h[DV_M_S[-1]]:.0f} h only" + perp_sweep,
+        note=f"optimum off the perpendicular plane by {r1.optimum_perp_angle_deg[0]:.1f} deg at {r1.coast_hours[0]:.0f} h. "
+             f"Tolerance met for coasts <= {perp_h[DV_M_S[-1]]:.0f} h ({DV_M_S[-1]} m/s; coasts swept "
+             f"{', '.join(f'{h:g}' for h in r1.coast_hours)} h); optimum "
              f"within 5 deg of the plane at {in_plane_h} h only, and at 12 h {dmap.los_angle_deg:.0f} deg from the line "
              f"of sight ({'towards' if dmap.towards_target else 'away from'} the target). At {DV_M_S[0]} m/s the 2 % is "
              f"met up to {perp_h[DV_M_S[0]]:.0f} h with the optimum up to {off_plane_small:.0f} deg out of the plane: "
@@ -490,6 +519,11 @@ table.add(
              f"Antipodal ring angles are not independent cases: 180 deg gives the sqrt(J_rho) of 0 deg within "
              f"{anti_opt:.1f} % (optimum) and {anti_mmd:.1f} % (MMD)"),
     *arc_rows,
+    CLAIMS["mmd_near_optimal_cases"].judge(100 * n_near / n_cases,
+        shown=f"{n_near} of {n_cases} cases ({100 * n_near / n_cases:.0f} %); elsewhere {far.min():.0f}-{far.max():.0f} % "
+              f"above the optimum (median {np.median(far):.0f} %)" if far.size else f"{n_near} of {n_cases} cases",
+        note=f"{DV_M_S[-1]} m/s; within {tol_near:g} %: {near_where}. With the burn at the start of tracking MMD is "
+             f"{r1.mmd_excess_percent.min():.0f}-{r1.mmd_excess_percent.max():.0f} % above the optimum"),
     CLAIMS["sign_choice"].judge(study.sign_percent(DV_M_S[-1]).max(),
         shown="; ".join(f"rejected sign worse by {study.sign_percent(dv).min():.1f}-{study.sign_percent(dv).max():.1f} "
                         f"% ({dv} m/s)" for dv in DV_M_S[::-1]),

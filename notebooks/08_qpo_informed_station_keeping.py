@@ -18,7 +18,9 @@
 # that choice really lands in the valley of range uncertainty and avoids the largest fuel costs, checked with numbers
 # over the full surface of maneuvers, each with its own covariance analysis. Eq. 25 as printed needs a reading: read
 # as an angle, its answer depends on how finely the set is sampled; read as a projection, it does not, and it finds
-# the paper's valley at the price of fuel (section 5b). Beyond the paper (its own future work),
+# the paper's valley at the price of fuel (section 5b). Whether $\mathbf u^*$ "significantly improves" range
+# knowledge is tested against baselines a poor pick fails, the best maneuver of its slice and uninformed random
+# picks (section 5c), not against doing nothing, which every maneuver beats. Beyond the paper (its own future work),
 # a full-filter Monte Carlo with maneuver execution errors tells us how much of the predicted range information
 # survives.
 #
@@ -28,13 +30,15 @@
 
 # %% tags=["parameters"]
 QUICK = False  # quick mode: coarser surface, fewer sweep points, fewer Monte Carlo trials (the default sizes below)
-SEED = 0  # root seed of the Monte Carlo (streams [SEED, k]) and of the offset directions (stream [SEED, 8])
+SEED = 0  # root seed: Monte Carlo streams [SEED, k], offset directions [SEED, 8], random picks [SEED, 20] and [SEED, 21]
 OUTPUT_DIR = ""  # folder for the figures (empty: build-scratch/ by hand, the build under the runner)
 N_SURF = None  # ring angles = arrival times of the station-keeping surface (None: 14 quick, 40 full; paper: not given)
-N_SWEEP = None  # arrival times in the sweep over the unstated scenario inputs (None: 10 quick, 16 full)
+N_SWEEP = None  # arrival times in the sweep over the unstated scenario inputs (None: 5 quick, 16 full)
 N_GRID = None  # ring-angle counts of the resolution study of section 5b (None: 10, 20, 40 quick; 16 ... 640 full)
 N_GRID_SLICES = None  # arrival times in the resolution study (None: 3 quick, 5 full)
-N_TRIALS = None  # Monte Carlo trials per policy and execution-error level (None: 6 quick, 40 full)
+N_TRIALS = None  # Monte Carlo trials per policy and execution-error level (None: 4 quick, 40 full)
+N_RANDOM = None  # uninformed picks per arrival slice, ring angles uniform on [0, 2 pi) (None: 16 quick, 64 full)
+MEMBER_CHECK = None  # re-solve the torus for two other readings of "average range" (None: False quick, True full)
 WORKERS = None  # local processes for the sweeps and the Monte Carlo, 1 = serial (None: 1 quick, 2 full)
 SCHEDULER = ""  # address of a Dask scheduler to run them on ("" = none; then WORKERS applies)
 MEAN_RANGE_KM = None  # mean agent-target range that selects the torus member, km (None: 215.0, the paper's number)
@@ -52,7 +56,7 @@ EXEC_REL = None  # execution error, part proportional to the burn, fraction 1 si
 # %% [markdown]
 # **Changing the chapter.** Every size and every scenario choice the paper leaves open is a parameter of the cell
 # above. A parameter left at `None` is chosen in the next cell, from `QUICK` for the sizes (quick mode: a 14 x 14
-# surface, 6 Monte Carlo trials) and from our stated baseline for the scenario (first burn 24 h before apoapsis,
+# surface, 4 Monte Carlo trials, the two extra torus members of section 6 skipped) and from our stated baseline for the scenario (first burn 24 h before apoapsis,
 # arrivals within 12 h of it, read-out 24 h after it, agent at ring angle 0); a value you give, in Jupyter or with
 # `-p NAME=VALUE` on the command line, is used as given in either mode. The sweeps of sections 5b and 6 (one
 # surface per task) and the Monte Carlo of section 7 (one filter run per trial, trial streams `[SEED, k]`) run on
@@ -62,10 +66,12 @@ EXEC_REL = None  # execution error, part proportional to the burn, fraction 1 si
 # %%
 # Every parameter left at None is picked here (sizes from QUICK); a value the reader gave is used as given.
 N_SURF = N_SURF if N_SURF is not None else (14 if QUICK else 40)
-N_SWEEP = N_SWEEP if N_SWEEP is not None else (10 if QUICK else 16)
+N_SWEEP = N_SWEEP if N_SWEEP is not None else (5 if QUICK else 16)
 N_GRID = tuple(N_GRID if N_GRID is not None else ((10, 20, 40) if QUICK else (16, 40, 80, 160, 320, 640)))
 N_GRID_SLICES = N_GRID_SLICES if N_GRID_SLICES is not None else (3 if QUICK else 5)
-N_TRIALS = N_TRIALS if N_TRIALS is not None else (6 if QUICK else 40)
+N_TRIALS = N_TRIALS if N_TRIALS is not None else (4 if QUICK else 40)
+N_RANDOM = N_RANDOM if N_RANDOM is not None else (16 if QUICK else 64)
+MEMBER_CHECK = MEMBER_CHECK if MEMBER_CHECK is not None else not QUICK
 WORKERS = WORKERS if WORKERS is not None else (1 if QUICK else 2)
 # Scenario choices the paper leaves open (stated, then swept in section 6):
 MEAN_RANGE_KM = MEAN_RANGE_KM if MEAN_RANGE_KM is not None else 215.0
@@ -90,7 +96,11 @@ from cislunar.cr3bp.torus import qpo_for_mean_range
 from cislunar.papers.greaves_scheeres_2023 import figures
 from cislunar.papers.greaves_scheeres_2023 import station_keeping as sk
 from cislunar.papers.greaves_scheeres_2023 import station_keeping_study as study
-from cislunar.papers.greaves_scheeres_2023.claims.informed_station_keeping import CLAIMS
+from cislunar.papers.greaves_scheeres_2023.claims.informed_station_keeping import (
+    CLAIMS,
+    PROJECTION_VALLEY_PHASES,
+    QUARTER_TURN_PHASES,
+)
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
 from cislunar.utils.executors import open_executor
@@ -188,12 +198,20 @@ print(f"sqrt(J_rho) at t_f: {S.range_sigma_km.min() * 1e3:.1f} m to {S.range_sig
       f"(no maneuver: {S.range_sigma_km[0, 0]:.2f} km; largest over the maneuvers "
       f"{S.range_sigma_km[S.fuel_m_s > 1e-9].max() * 1e3:.0f} m)")
 
+# %% [markdown]
+# The figure draws the first and the second burn over the set, with $\mathbf u^*$ under both readings of Eq. 25
+# discussed below: the magenta line (the paper's colour) reads Eq. 25 as an angle, the dashed red line as a
+# projection (section 5b); `S.reselect("projection")` chooses $\mathbf u^*$ again on the same maneuvers.
+
 # %%
-_ = plotting.save_figure(figures.surfaces(S, "burns"), "08_fig3_burn_surfaces", output_dir=out)
+S_proj = S.reselect("projection")  # same maneuvers and covariance analyses, u* chosen by the projection reading
+_ = plotting.save_figure(figures.surfaces(S, "burns", projection=S_proj), "08_fig3_burn_surfaces", output_dir=out)
 
 # %% [markdown]
 # The first burn vanishes along phase 0 (the agent's own torus trajectory) and grows with the phase distance; it
-# also grows as the coast gets shorter (earlier arrival). The magenta line is $\mathbf u^*$: for each arrival time,
+# also grows as the coast gets shorter (earlier arrival). The angle reading's line hugs phase 0 (the smallest
+# burns), the projection reading's sits on the flank of the first-burn hill, at several metres per second. The
+# magenta line is $\mathbf u^*$: for each arrival time,
 # the MMD direction $\mathbf u_y$ of the coast $t_b\to t_a$ is computed on the unmaneuvered trajectory, the two
 # maneuvers with $\theta_u$ closest to 0 and to $\pi$ (Eq. 25) are the candidates, and the one with the smaller
 # $J_\rho$ wins.
@@ -214,16 +232,20 @@ _ = plotting.save_figure(figures.surfaces(S, "burns"), "08_fig3_burn_surfaces", 
 # ## 4 · Fig. 4: range uncertainty over all maneuvers, and Fig. 5: fuel
 
 # %%
-_ = plotting.save_figure(figures.surfaces(S, "range_fuel"), "08_fig4_fig5_range_sigma_and_fuel", output_dir=out)
+_ = plotting.save_figure(figures.surfaces(S, "range_fuel", projection=S_proj), "08_fig4_fig5_range_sigma_and_fuel",
+                         output_dir=out)
 
 # %% [markdown]
 # The 3-D views follow the paper's Figs. 4 and 5 and are an illustration: perspective makes heights hard to compare
 # (in the left panel the no-maneuver wall at phase 0, printed above, is clipped at the largest maneuver value so
-# that the relief of the maneuvers shows). The same data as maps, with the colour scale of the range map set by the
-# maneuvers alone (the phase-0 column, where the agent does not maneuver, is hatched):
+# that the relief of the maneuvers shows). Both readings of Eq. 25 are drawn, as in Fig. 3: on the fuel surface
+# (Fig. 5) the angle reading runs along the floor next to phase 0, the projection reading climbs the flank. The
+# same data as maps, with the colour scale of the range map set by the maneuvers alone (the phase-0 column, where
+# the agent does not maneuver, is hatched; magenta circles the angle reading, red crosses the projection reading):
 
 # %%
-_ = plotting.save_figure(figures.range_and_fuel_maps(S), "08_maps_range_sigma_fuel", output_dir=out)
+_ = plotting.save_figure(figures.range_and_fuel_maps(S, projection=S_proj), "08_maps_range_sigma_fuel",
+                         output_dir=out)
 
 # %% [markdown]
 # ## 5 · The paper's claims, with numbers
@@ -344,12 +366,17 @@ print(f"tracking from {T_BURN_H - PRE_ARC_H:.0f} h: sqrt(J_rho) of u* with both 
 # ring angles on `N_GRID_SLICES` arrival slices, and chooses $\mathbf u^*$ under both readings on the same
 # maneuvers and covariance analyses. The table gives medians over the slices: the percentile of $\mathbf u^*$ in
 # its slice, its $\sqrt{J_\rho}$ at $t_f$, its fuel, the share of maneuvers using more fuel, and the best
-# $\sqrt{J_\rho}$ of the slice (a property of the set, which should settle as the grid is refined).
+# $\sqrt{J_\rho}$ of the slice (a property of the set, which should settle as the grid is refined). The last three
+# columns are used by the closing table: $\sqrt{J_\rho}$ of $\mathbf u^*$ over the slice's best (median over
+# slices), the percentage of slices where $\mathbf u^*$ uses at most the slice's median fuel, and the percentage
+# of `N_RANDOM` uninformed picks per slice (target ring angles uniform on $[0, 2\pi)$, stream `[SEED, 21]`; section
+# 5c) that $\mathbf u^*$ beats.
 
 # %%
 t_grid = np.linspace(*T_ARRIVAL_H, N_GRID_SLICES) * HR
 with open_executor(WORKERS, SCHEDULER) as executor:
-    grid = study.grid_resolution_study(em, torus, N_GRID, t_grid, T_BURN_H * HR, T_FINAL_H * HR, executor=executor)
+    grid = study.grid_resolution_study(em, torus, N_GRID, t_grid, T_BURN_H * HR, T_FINAL_H * HR,
+                                       rng=np.random.default_rng([SEED, 21]), n_random=N_RANDOM, executor=executor)
 print(f"{N_GRID_SLICES} arrival slices from {T_ARRIVAL_H[0]:+.0f} h to {T_ARRIVAL_H[1]:+.0f} h; medians over the slices")
 print(grid.format())
 _ = plotting.save_figure(figures.grid_resolution(grid, S.range_sigma_km[0, 0] * 1e3), "08_eq25_readings_vs_grid",
@@ -360,7 +387,6 @@ _ = plotting.save_figure(figures.grid_resolution(grid, S.range_sigma_km[0, 0] * 
 # choice of $\mathbf u^*$ changes):
 
 # %%
-S_proj = S.reselect("projection")
 st_proj = study.slice_statistics(S_proj)
 second_effect_proj = S_proj.informed_range_sigma_km / sk.first_burn_only_range_sigma_km(em, S_proj, nrho.x0)
 print(f"projection reading: u* at median phase {st_proj.informed_phase:.3f} (valley at {st.valley_phase:.3f}); median "
@@ -378,6 +404,35 @@ fig = figures.map_with_percentiles(S_proj, "projection reading: u* on the range 
 _ = plotting.save_figure(fig, "08_projection_reading", output_dir=out)
 
 # %% [markdown]
+# ### The "single point raised by a small local peak"
+#
+# The paper sees one point of its $\mathbf u^*$ line raised above its neighbours in Fig. 4 and blames the second
+# burn. `study.slice_statistics` lists the *raised slices* of a line: interior arrival slices whose
+# $\sqrt{J_\rho}$ of $\mathbf u^*$ exceeds that of both neighbouring slices by more than 10 %. Below, for both
+# readings: the raised slices, and for each the neighbours' values, the phase of $\mathbf u^*$ there and next to
+# it (a jump means another ring angle was picked), and the ratio of $\sqrt{J_\rho}$ with both burns to the first
+# burn only (above 1 would mean the second burn raised it, the paper's explanation).
+
+# %%
+for name, surf, slice_st, effect in (("angle", S, st, second_effect),
+                                    ("projection", S_proj, st_proj, second_effect_proj)):
+    sig_u = surf.informed_range_sigma_km * 1e3
+    print(f"{name} reading: {len(slice_st.raised_slices)} raised slice(s) of {surf.t_arrival.size}")
+    for j in slice_st.raised_slices:
+        print(f"   arrival {surf.t_arrival_hours[j]:+.1f} h: {sig_u[j]:.1f} m against {sig_u[j - 1]:.1f} / "
+              f"{sig_u[j + 1]:.1f} m; u* phase {surf.phase[surf.informed[j]]:.3f} (neighbours "
+              f"{surf.phase[surf.informed[j - 1]]:.3f} / {surf.phase[surf.informed[j + 1]]:.3f}); both burns / first "
+              f"only {effect[j]:.4f}")
+
+# %% [markdown]
+# Where the projection line has its raised point (in the full run one slice, 6.5 h after apoapsis), the pick jumps
+# to a neighbouring ring angle: the slice's most aligned burn changes, and the one chosen there is a worse maneuver
+# than its neighbours'. The second burn is not the cause: without it the same maneuver is far worse (the ratio
+# printed is well below 1, as in every slice, because in this baseline the second burn is where the range
+# information comes from). So the paper's picture, a valley line with one raised point, is what the projection
+# reading gives; the paper's explanation of the point is not.
+
+# %% [markdown]
 # **Reading.** The angle reading is what Eq. 25's symbols say (a cosine), but on this set it has no limit: refining
 # the grid drives $\mathbf u^*$ towards the agent's own phase and, for the baseline agent, its range uncertainty
 # towards the no-maneuver value (the table above: the median $\sqrt{J_\rho}$ of $\mathbf u^*$ roughly doubles with
@@ -391,6 +446,53 @@ _ = plotting.save_figure(fig, "08_projection_reading", output_dir=out)
 # is made while looking at the paper's figure, the valley row of the projection reading is *consistent (tuned)*, not
 # reproduced. Neither reading gives both of the paper's statements (in the valley *and* away from the fuel peak,
 # with "away" read as "at or below the slice's median fuel") at once.
+
+# %% [markdown]
+# ## 5c · Does $\mathbf u^*$ improve range knowledge? Two baselines that can fail
+#
+# The paper concludes that the informed maneuver "significantly improves" range knowledge. Against doing nothing
+# that cannot fail here: in the linear covariance analysis every maneuver of the set cuts $\sqrt{J_\rho}$ from
+# about 24 km to metres or tens of metres (section 3), so "better than no maneuver" says nothing about the choice.
+# Two comparisons that a poor choice does fail:
+#
+# - **Against the best maneuver of its slice:** $\sqrt{J_\rho}$ of $\mathbf u^*$ over the slice's best,
+#   the median over the slices; "in the valley" read as within 50 % of its floor (at most 1.5). The verdicts below do
+#   not hang on the 50 %: the angle reading's ratio grows far beyond any such bound as the grid is refined, the
+#   projection reading's stays within a few percent of 1.
+# - **Against an uninformed pick:** the station keeping the informed choice replaces picks a point of the torus
+#   without regard to information. `study.random_pick_study` draws `N_RANDOM` target ring angles uniformly on
+#   $[0, 2\pi)$ (stream `[SEED, 20]`; the same angles for every arrival slice; continuous, so the baseline does not
+#   depend on the ring-angle grid), flies the two-burn transfer to each (its direction and size follow from the
+#   point drawn) and runs its covariance analysis. The criterion: $\mathbf u^*$ beats at least 75 % of the random
+#   picks, three in four over all (slice, pick) pairs. A pick at random beats half of them on average.
+#
+# The grid study of section 5b applies both comparisons at every ring-angle grid (its own random picks, stream
+# `[SEED, 21]`, on its slices), because the angle reading's answer depends on the grid.
+
+# %%
+rand = study.random_pick_study(em, torus, t_arr, T_BURN_H * HR, T_FINAL_H * HR, np.random.default_rng([SEED, 20]),
+                               n_draws=N_RANDOM, agent_theta=AGENT_THETA)
+print(f"{N_RANDOM} random picks per slice: sqrt(J_rho) {rand.range_sigma_km.min() * 1e3:.1f}-"
+      f"{rand.range_sigma_km.max() * 1e3:.0f} m (median {np.median(rand.range_sigma_km) * 1e3:.1f} m), fuel "
+      f"{rand.fuel_m_s.min():.2f}-{rand.fuel_m_s.max():.2f} m/s")
+vs_best, vs_rand = {}, {}
+for name, surf in (("angle", S), ("projection", S_proj)):
+    vs_best[name] = float(np.median(surf.informed_range_sigma_km / surf.best_range_sigma_km))
+    vs_rand[name] = rand.beaten_percent(surf)
+    print(f"{name} reading: u* / slice best {vs_best[name]:.2f} (median over slices); u* beats {vs_rand[name]:.0f} % "
+          f"of the random picks; at every grid of section 5b ({'/'.join(str(n) for n in N_GRID)} ring angles): "
+          f"u* / best {'/'.join(f'{v:.2f}' for v in grid.series(0.0, name, 'ratio_best'))}, beats "
+          f"{'/'.join(f'{v:.0f}' for v in grid.series(0.0, name, 'beats_random'))} % of random picks")
+print(f"for scale: random picks better than doing nothing ({S.range_sigma_km[0, 0] * 1e3:.0f} m): "
+      f"{np.mean(rand.range_sigma_km < S.range_sigma_km[0, 0]) * 100:.0f} %")
+
+# %% [markdown]
+# **Reading.** The angle reading's $\mathbf u^*$ beats at most about half of the random picks on the coarsest
+# grid and almost none on the finest (it tends to no maneuver), and its distance from the slice's best grows with
+# the grid; the projection reading's $\mathbf u^*$ is within a few percent of the slice's best and beats about nine
+# random picks in ten or more, on every grid. So "significantly improves" holds in a form that could have failed
+# for the projection reading (tuned, since that reading was chosen looking at the paper's Fig. 4), not for the
+# angle reading.
 
 # %% [markdown]
 # ## 6 · In which regime does the "valley" claim hold? A sweep over the unstated inputs
@@ -426,6 +528,14 @@ print(study.format_sweep(sweep))
 n_valley_angle, n_valley_proj = sum(r.pct_tf < 25 for r in sweep), sum(r.pct_proj < 25 for r in sweep)
 print(f"settings with the median percentile below 25 % (the valley tolerance): angle reading {n_valley_angle} of "
       f"{len(sweep)}, projection reading {n_valley_proj} of {len(sweep)}")
+# the projection reading by agent phase: at phase 0 or 1/2, and a quarter turn away (1/4 or 3/4)
+at_phase = lambda phases: [r for r in sweep if np.any(np.isclose(r.agent_phase, phases))]
+sw_valley, sw_quarter = at_phase(PROJECTION_VALLEY_PHASES), at_phase(QUARTER_TURN_PHASES)
+for label, rows in (("0 or 1/2", sw_valley), ("1/4 or 3/4", sw_quarter)):
+    if rows:
+        print(f"projection reading, agent phase {label}: median percentile {min(r.pct_proj for r in rows):.0f}-"
+              f"{max(r.pct_proj for r in rows):.0f} %, in the valley in {sum(r.pct_proj <= 25 for r in rows)} of "
+              f"{len(rows)} settings")
 s_h = sk.station_keeping_surface(em, torus, theta, t_arr_s, T_BURN_H * HR, T_FINAL_H * HR, agent_theta=AGENT_THETA,
                                  mmd_horizon="final", progress=False)
 pct_horizon = np.median(s_h.informed_percentile)
@@ -443,11 +553,15 @@ print(f"\nmost favourable setting for the angle reading: pre-arc {best_setting.p
 # %% [markdown]
 # The last unstated input is the paper's one number, "the average range ... is 215 km". Our member matches the
 # torus average over ring angle and one period; the same member has a different mean over the apolune ring alone
-# and a different RMS (section 1). Members chosen so that those two readings equal 215 km instead:
+# and a different RMS (section 1). Members chosen so that those two readings equal 215 km instead (each a torus
+# solved again by continuation, the costliest check of quick mode, where `MEMBER_CHECK` skips it):
 
 # %%
-member_check = study.member_study(em, nrho, theta, t_arr, T_BURN_H * HR, T_FINAL_H * HR, target_km=MEAN_RANGE_KM,
-                                  agent_theta=AGENT_THETA)
+member_check = (study.member_study(em, nrho, theta, t_arr, T_BURN_H * HR, T_FINAL_H * HR, target_km=MEAN_RANGE_KM,
+                                   agent_theta=AGENT_THETA) if MEMBER_CHECK else {})
+member_note = lambda reading: (f"members matching {MEAN_RANGE_KM:g} km as ring mean / RMS: "
+                               f"{member_check['ring_mean_km'][reading][0]:.0f} / {member_check['rms_km'][reading][0]:.0f} %"
+                               if member_check else "other members not solved (MEMBER_CHECK = False)")
 for stat, row in member_check.items():
     print(f"member with {stat[:-3]} = {MEAN_RANGE_KM:g} km: torus mean {row['mean_km']:.0f} km, ring size {row['size_km']:.0f} km; "
           f"u* median percentile angle {row['angle'][0]:.1f} % / projection {row['projection'][0]:.1f} %; "
@@ -549,16 +663,34 @@ _ = plotting.save_figure(figures.monte_carlo_range_errors(mcs), "08_monte_carlo_
 # - **The valley (Fig. 4).** The median over the arrival slices of the percentile of $\mathbf u^*$ within its slice
 #   (the share of the slice's maneuvers with a smaller $\sqrt{J_\rho}$ at $t_f$) must be at most 25 %, the best
 #   quartile; a random pick sits at 50 % on average. The angle reading of Eq. 25 is the independent prediction; the
-#   projection reading was adopted while looking at the paper's Fig. 4, so its row is *tuned*.
+#   projection reading was adopted while looking at the paper's Fig. 4, so its rows are *tuned*. The projection
+#   reading holds only for some agent phases (section 6), so it has two rows that name the condition: the agent at
+#   ring phase 0 or 1/2 (the worst of the baseline and the sweep settings there) and a quarter turn away (the best
+#   sweep setting at phase 1/4 or 3/4).
 # - **The fuel peak (Fig. 5).** $\mathbf u^*$ must use at most its slice's median fuel in at least 90 % of the
-#   slices ("avoids the peak" read as "in the cheaper half").
+#   slices ("avoids the peak" read as "in the cheaper half"), at every ring-angle grid of section 5b, and its fuel
+#   must settle as the grid is refined (change by less than 25 % from the coarsest to the finest grid): a statement about the
+#   set of maneuvers, not about how finely it was sampled. The angle reading passed the first half alone only as a
+#   grid artefact (its pick tends to no maneuver).
 # - **The second burn's local peak.** The paper says the second burn raises $\sqrt{J_\rho}$ at one point of the
 #   $\mathbf u^*$ line; the criterion asks for a ratio (both burns over first burn only) above 1 in some slice.
-# - **"Significantly improves".** The median $\sqrt{J_\rho}$ of $\mathbf u^*$ must be at most half the
-#   no-maneuver value; for the angle reading at every ring-angle grid of section 5b as well, since its answer
-#   depends on the grid.
+#   The raised point itself is tested on the projection line: exactly one slice whose $\sqrt{J_\rho}$ exceeds both
+#   neighbours' by more than 10 %.
+# - **"Significantly improves"**, against baselines that can fail (section 5c): $\sqrt{J_\rho}$ of
+#   $\mathbf u^*$ at most 1.5 times the slice's best (median over slices), and $\mathbf u^*$ better than at least
+#   75 % of uninformed picks (ring angles uniform on $[0, 2\pi)$, seeded); both at every ring-angle grid of section
+#   5b as well (the worst grid is compared). Against doing nothing every maneuver passes, so that comparison is
+#   printed in section 5c but is not a row.
 # - **The full-filter rows** are beyond the paper (its future work) and carry no criterion: they report what the
 #   filter achieves.
+#
+# The cell first gathers what the rows compare: `fuel_test` applies the Fig. 5 criterion to one reading (the
+# baseline surface and every grid of section 5b, then whether the median fuel of $\mathbf u^*$ settles from the
+# coarsest to the finest grid); `worst_best` and `worst_rand` take the least favourable of the baseline surface and the
+# grids for the two "improves" comparisons of section 5c; `raised` lists the raised slices of the projection line,
+# each with its neighbours, the phases picked there and the second burn's ratio; the quarter-turn row is built only
+# when the sweep of section 6 has agent phases 1/4 or 3/4, and the projection row at phase 0 or 1/2 takes the worst
+# of the baseline and the sweep settings at those phases.
 
 # %%
 ia, ipa, ua = summary[(INF, "exec")], summary[(INFP, "exec")], summary[(UNI, "exec")]
@@ -568,6 +700,35 @@ grids = "/".join(str(n) for n in N_GRID)
 series = lambda crit, key, f: "/".join(f.format(v) for v in grid.series(0.0, crit, key))
 none_km = S.range_sigma_km[0, 0]
 sweep_range = lambda key: f"{min(getattr(r, key) for r in sweep):.0f}-{max(getattr(r, key) for r in sweep):.0f}"
+
+
+def fuel_test(reading, stats):
+    """The Fig. 5 criterion: at or below the median fuel in >= 90 % of slices on this surface and at every grid of
+    section 5b, with a median fuel of u* that changes by less than 25 % from the coarsest to the finest grid."""
+    shares, fuel = grid.series(0.0, reading, "below_median_share"), grid.series(0.0, reading, "fuel_m_s")
+    settles = fuel.size >= 2 and abs(fuel[-1] / fuel[0] - 1) < 0.25
+    return bool(stats.below_median_fuel * 100 >= 90 and np.all(shares >= 90) and settles), shares, fuel
+
+
+fuel_ok = {"angle": fuel_test("angle", st), "projection": fuel_test("projection", st_proj)}
+worst_best = {name: max(vs_best[name], *grid.series(0.0, name, "ratio_best")) for name in vs_best}
+worst_rand = {name: min(vs_rand[name], *grid.series(0.0, name, "beats_random")) for name in vs_rand}
+raised = st_proj.raised_slices
+raised_txt = "; ".join(f"{S_proj.t_arrival_hours[j]:+.1f} h: {S_proj.informed_range_sigma_km[j] * 1e3:.1f} m vs "
+                       f"{S_proj.informed_range_sigma_km[j - 1] * 1e3:.1f} / {S_proj.informed_range_sigma_km[j + 1] * 1e3:.1f} m, "
+                       f"u* phase {S_proj.phase[S_proj.informed[j]]:.3f} (neighbours "
+                       f"{S_proj.phase[S_proj.informed[j - 1]]:.3f} / {S_proj.phase[S_proj.informed[j + 1]]:.3f}), both "
+                       f"burns / first only {second_effect_proj[j]:.4f}" for j in raised)
+quarter_rows = []  # the projection reading a quarter turn away (absent if the sweep has no such agent phase)
+if sw_quarter:
+    best_q = min(sw_quarter, key=lambda r: r.pct_proj)
+    quarter_rows.append(CLAIMS["valley_projection_quarter"].judge(best_q.pct_proj,
+        shown=f"{best_q.pct_proj:.0f} % (best of {len(sw_quarter)} settings; worst "
+              f"{max(r.pct_proj for r in sw_quarter):.0f} %)",
+        note=f"best setting: tracking from {best_q.pre_h:.0f} h before the first burn, lead {best_q.lead_h:.0f} h, agent "
+             f"phase {best_q.agent_phase:.2f}; in the valley in {sum(r.pct_proj <= 25 for r in sw_quarter)} of "
+             f"{len(sw_quarter)} settings at agent phase 1/4 or 3/4 (section 6)"))
+valley_proj_worst = max([st_proj.median_percentile] + [r.pct_proj for r in sw_valley])
 table.add(
     CLAIMS["mean_range"].judge(stats.mean_km, shown=f"{stats.mean_km:.2f} km",
         note=f"the {MEAN_RANGE_KM:g} km was used to SELECT the member (torus average over ring angle and one period); an input, not a "
@@ -589,43 +750,60 @@ table.add(
              f"(next to the agent's own phase 0, the smallest burns); rank correlation of fuel and sqrt(J_rho) within "
              f"slices {st.rank_correlation:.2f}. MMD coast to t_f instead of the arrival: {pct_horizon:.0f} %. Agent "
              f"drifted 1-50 km off the torus (3 directions each): {pct_offset_all.min():.0f}-{pct_offset_all.max():.0f} %. "
-             f"Tolerance met in {n_valley_angle} of {len(sweep)} sweep settings. Members matching {MEAN_RANGE_KM:g} km as ring mean / "
-             f"RMS: {member_check['ring_mean_km']['angle'][0]:.0f} / {member_check['rms_km']['angle'][0]:.0f} %. "
+             f"Tolerance met in {n_valley_angle} of {len(sweep)} sweep settings. {member_note('angle')[0].upper() + member_note('angle')[1:]}. "
              f"Grid-dependent: with {grids} ring angles (section 5b) {series('angle', 'percentile', '{:.1f}')} %, "
              "tending to 100 % (u* tends to no maneuver)"),
-    CLAIMS["valley_projection"].judge(st_proj.median_percentile,
-        shown=f"{st_proj.median_percentile:.0f} % (best quartile in {st_proj.best_quartile_share:.0f} % of slices)",
-        note=f"Grid-independent: with {grids} ring angles {series('projection', 'percentile', '{:.0f}')} %. Sweep "
-             f"(section 6): {sweep_range('pct_proj')} %, tolerance met in {n_valley_proj} of {len(sweep)} settings; "
-             f"members matching {MEAN_RANGE_KM:g} km as ring mean / RMS: {member_check['ring_mean_km']['projection'][0]:.0f} / "
-             f"{member_check['rms_km']['projection'][0]:.0f} %"),
-    CLAIMS["fuel_angle"].judge(st.below_median_fuel * 100,
-        shown=f"u* below the slice median fuel in {st.below_median_fuel * 100:.0f} % of slices; median "
-              f"{np.median(st.fuel_percentile):.0f} % of maneuvers cost more",
-        note="It does, but because Eq. 25 read as an angle picks maneuvers next to the agent's own phase, i.e. the "
-             f"smallest burns; on finer grids even smaller (median fuel of u* {series('angle', 'fuel_m_s', '{:.2f}')} "
-             f"m/s with {grids} ring angles)"),
-    CLAIMS["fuel_projection"].judge(st_proj.below_median_fuel * 100,
-        shown=f"u* below the slice median fuel in {st_proj.below_median_fuel * 100:.0f} % of slices; median "
-              f"{np.median(st_proj.fuel_percentile):.0f} % of maneuvers cost more",
-        note=f"median {np.median(S_proj.informed_fuel_m_s):.2f} m/s against at most {S.fuel_m_s.max():.2f} m/s in the "
-             "set, i.e. near the middle of the fuel distribution, below the peak but not below the median; neither "
-             "reading gives the valley and low fuel together"),
+    CLAIMS["valley_projection"].judge(valley_proj_worst,
+        shown=f"{valley_proj_worst:.0f} % (baseline {st_proj.median_percentile:.0f} %, best quartile in "
+              f"{st_proj.best_quartile_share:.0f} % of slices)",
+        note=f"Tolerance met in {sum(r.pct_proj <= 25 for r in sw_valley)} of {len(sw_valley)} sweep settings at agent "
+             f"phase 0 or 1/2 and {sum(r.pct_proj <= 25 for r in sw_quarter)} of {len(sw_quarter)} at 1/4 or 3/4 "
+             f"({n_valley_proj} of {len(sweep)} in all, section 6). Grid-independent: with {grids} ring angles "
+             f"{series('projection', 'percentile', '{:.0f}')} %; {member_note('projection')}"),
+    *quarter_rows,
+    CLAIMS["fuel_angle"].judge(fuel_ok["angle"][0],
+        shown=f"u* at or below the slice median fuel in {st.below_median_fuel * 100:.0f} % of slices "
+              f"({'/'.join(f'{v:.0f}' for v in fuel_ok['angle'][1])} % with {grids} ring angles); its median fuel "
+              f"{'/'.join(f'{v:.2f}' for v in fuel_ok['angle'][2])} m/s",
+        note="Below the median at every grid, but only because Eq. 25 read as an angle picks a burn next to the "
+             "agent's own phase, whose fuel falls with the grid spacing (u* tends to no maneuver): a grid artefact; median {np.median(st.fuel_percentile):.0f} % of maneuvers cost more on the "
+             f"{N_SURF}-angle surface"),
+    CLAIMS["fuel_projection"].judge(fuel_ok["projection"][0],
+        shown=f"u* at or below the slice median fuel in {st_proj.below_median_fuel * 100:.0f} % of slices "
+              f"({'/'.join(f'{v:.0f}' for v in fuel_ok['projection'][1])} % with {grids} ring angles); its median "
+              f"fuel {'/'.join(f'{v:.2f}' for v in fuel_ok['projection'][2])} m/s",
+        note=f"The fuel settles with the grid (a property of the set), near the middle of the fuel distribution "
+             f"(median {np.median(st_proj.fuel_percentile):.0f} % of maneuvers cost more; at most {S.fuel_m_s.max():.2f} "
+             "m/s in the set): below the peak but not below the median; neither reading gives the valley and low fuel "
+             "together"),
     CLAIMS["second_burn_peak"].judge(bool(second_effect.max() > 1),
         shown=f"ratio both burns / first only {second_effect.min():.3f}-{second_effect.max():.3f}",
         note=f"Tracking 24 h before the first burn: {second_effect_pre.min():.2f}-{second_effect_pre.max():.2f} (raised "
              f"by > 10 % in {np.sum(second_effect_pre > 1.1)} of {S.t_arrival.size} slices); projection reading: "
-             f"{second_effect_proj.min():.3f}-{second_effect_proj.max():.3f}. The paper's peak location is not given"),
-    CLAIMS["improves_angle"].judge(max(np.median(S.informed_range_sigma_km), *grid.series(0.0, "angle", "sigma_m") / 1e3)
-                                   / none_km,
-        shown=f"{np.median(S.informed_range_sigma_km) * 1e3:.1f} m vs {none_km * 1e3:.0f} m",
-        note="criterion applied at every ring-angle grid of section 5b; any maneuver does this in the linear analysis. "
-             f"Grid-dependent: {series('angle', 'sigma_m', '{:.0f}')} m with {grids} ring angles, tending to the "
-             "no-maneuver value as the grid is refined"),
-    CLAIMS["improves_projection"].judge(np.median(S_proj.informed_range_sigma_km) / none_km,
-        shown=f"{np.median(S_proj.informed_range_sigma_km) * 1e3:.1f} m vs {none_km * 1e3:.0f} m",
-        note=f"grid-independent ({series('projection', 'sigma_m', '{:.0f}')} m with {grids} ring angles); the best "
-             f"maneuver of a slice reaches {np.median(S.best_range_sigma_km) * 1e3:.1f} m"),
+             f"{second_effect_proj.min():.4f}-{second_effect_proj.max():.4f}, including its raised point (next row)"),
+    CLAIMS["raised_point_projection"].judge(len(raised),
+        shown=f"{len(raised)} raised slice(s) of {S_proj.t_arrival.size}" + (f" ({raised_txt})" if raised else ""),
+        note=f"angle reading: {len(st.raised_slices)} raised slice(s). The point is raised because u* jumps to another "
+             "ring angle there, not by the second burn (ratio well below 1: without it the same maneuver is far worse)"),
+    CLAIMS["vs_best_angle"].judge(worst_best["angle"],
+        shown=f"{worst_best['angle']:.2f} (u* {np.median(S.informed_range_sigma_km) * 1e3:.1f} m vs best "
+              f"{np.median(S.best_range_sigma_km) * 1e3:.1f} m, median over slices)",
+        note=f"{vs_best['angle']:.2f} on the {N_SURF}-angle surface; {series('angle', 'ratio_best', '{:.2f}')} with {grids} "
+             f"ring angles, growing as the grid is refined. Doing nothing: {none_km * 1e3:.0f} m (every maneuver beats it)"),
+    CLAIMS["vs_best_projection"].judge(worst_best["projection"],
+        shown=f"{worst_best['projection']:.2f} (u* {np.median(S_proj.informed_range_sigma_km) * 1e3:.1f} m vs best "
+              f"{np.median(S.best_range_sigma_km) * 1e3:.1f} m, median over slices)",
+        note=f"{vs_best['projection']:.2f} on the {N_SURF}-angle surface; {series('projection', 'ratio_best', '{:.2f}')} "
+             f"with {grids} ring angles (grid-independent)"),
+    CLAIMS["vs_random_angle"].judge(worst_rand["angle"],
+        shown=f"{worst_rand['angle']:.0f} % (worst grid)",
+        note=f"{vs_rand['angle']:.0f} % of {N_RANDOM} random picks per slice on the {N_SURF}-angle surface (stream "
+             f"[SEED, 20]); {series('angle', 'beats_random', '{:.0f}')} % with {grids} ring angles ({N_RANDOM} picks per "
+             "slice, stream [SEED, 21]); a random pick beats 50 % on average"),
+    CLAIMS["vs_random_projection"].judge(worst_rand["projection"],
+        shown=f"{worst_rand['projection']:.0f} % (worst grid)",
+        note=f"{vs_rand['projection']:.0f} % of {N_RANDOM} random picks per slice on the {N_SURF}-angle surface; "
+             f"{series('projection', 'beats_random', '{:.0f}')} % with {grids} ring angles"),
     CLAIMS["filter_nees"].judge(ia["nees"], shown=f"{ia['nees']:.2f} / {ipa['nees']:.2f} (band {lo:.1f}-{hi:.1f})",
         note=f"iterated EKF, {N_TRIALS} runs; perfect burns: {ip['nees']:.2f} / {ipp['nees']:.2f}"),
     CLAIMS["filter_no_maneuver"].judge(nm["nees"], shown=f"{nm['nees']:.1f}; {nm['rms'] / 1e3:.1f} vs {nm['fsig'] / 1e3:.1f} km",

@@ -189,15 +189,26 @@ def _informed_segments(surf):
     return np.split(np.arange(ph.size), cuts)
 
 
-def _surface_plot(ax, S, Z, title, zlabel, log=False, flip=False):
-    """3-D surface over (normalised phase, time from apoapsis) with the informed line in magenta."""
+#: How the two readings of Eq. 25 are drawn: (label, colour, line style, marker).  Magenta is the paper's colour;
+#: the projection reading is drawn dashed in red with squares, so the two stay apart where they cross.
+_READING_STYLES = {"angle": ("u*, Eq. 25 read as an angle (cosine)", "magenta", "-", "o"),
+                   "projection": ("u*, Eq. 25 read as a projection", "tab:red", "--", "s")}
+
+
+def _surface_plot(ax, S, Z, title, zlabel, log=False, flip=False, projection=None):
+    """3-D surface over (normalised phase, time from apoapsis) with the informed line in magenta (and the
+    projection reading's line when ``projection``, the same surface reselected, is given)."""
     P, H = np.meshgrid(S.phase, S.t_arrival_hours)
     Zp = np.log10(Z) if log else Z
     ax.plot_surface(P, H, Zp, cmap="viridis", lw=0, alpha=0.85, rcount=60, ccount=60)
-    zl = Zp[np.arange(S.t_arrival.size), S.informed]
-    for seg in _informed_segments(S):  # break the line where u* jumps across phase 0 = 1
-        ax.plot(S.phase[S.informed][seg], S.t_arrival_hours[seg], zl[seg], color="magenta", lw=2.5, marker="o",
-                ms=3)
+    for reading, surf in (("angle", S), ("projection", projection)):
+        if surf is None:
+            continue
+        label, col, ls, mk = _READING_STYLES[reading]
+        zl = Zp[np.arange(surf.t_arrival.size), surf.informed]
+        for n_seg, seg in enumerate(_informed_segments(surf)):  # break the line where u* jumps across phase 0 = 1
+            ax.plot(surf.phase[surf.informed][seg], surf.t_arrival_hours[seg], zl[seg], color=col, ls=ls, lw=2.5,
+                    marker=mk, ms=3.5, label=label if n_seg == 0 else None, zorder=5)
     ax.set_xlabel("normalised phase $\\theta_0/2\\pi$ [-]", labelpad=6)
     ax.set_ylabel("time from apoapsis (h)", labelpad=6)
     ax.set_zlabel(zlabel, labelpad=6)
@@ -206,40 +217,69 @@ def _surface_plot(ax, S, Z, title, zlabel, log=False, flip=False):
         ax.invert_yaxis()
 
 
-def surfaces(S, which="burns"):
+def _projection_of(S, projection):
+    """``projection`` checked: None, or ``S`` with u* chosen by the projection reading (same maneuvers)."""
+    if projection is None:
+        return None
+    _surface(projection, "projection")
+    if projection.range_sigma_km.shape != S.range_sigma_km.shape or not np.array_equal(projection.dv1, S.dv1):
+        raise ValueError("projection must be the same surface with u* reselected (S.reselect('projection'))")
+    return projection
+
+
+def _legend_below(fig, ax, rect_bottom=0.1):
+    """The axes' legend centred below the panels (off the data)."""
+    handles, labels = ax.get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labels, loc="lower center", ncol=len(handles), fontsize=9, frameon=False)
+        fig.tight_layout(rect=(0, rect_bottom, 1, 1))
+    else:
+        fig.tight_layout()
+
+
+def surfaces(S, which="burns", projection=None):
     """Fig. 3 (``which="burns"``: first and second burn) or Figs. 4-5 (``"range_fuel"``: log10 sqrt(J_rho) in m,
-    the no-maneuver wall clipped to the largest maneuver value, and total fuel) as 3-D surfaces with u*."""
+    the no-maneuver wall clipped to the largest maneuver value, and total fuel) as 3-D surfaces with u*: the angle
+    reading of Eq. 25 from ``S`` in magenta, the projection reading (``projection``, the same surface reselected)
+    dashed in red; the legend sits below the panels."""
     _surface(S)
     validation.choice(which, "which", ("burns", "range_fuel"))
-    fig = plt.figure(figsize=(13, 5.5))
+    projection = _projection_of(S, projection)
+    fig = plt.figure(figsize=(13, 6))
     ax1 = fig.add_subplot(1, 2, 1, projection="3d")
     ax2 = fig.add_subplot(1, 2, 2, projection="3d")
     if which == "burns":
-        _surface_plot(ax1, S, S.dv1_m_s, "first burn (u* in magenta)", r"$\|\Delta v_1\|$ (m/s)")
-        _surface_plot(ax2, S, S.dv2_m_s, "second burn", r"$\|\Delta v_2\|$ (m/s)")
+        _surface_plot(ax1, S, S.dv1_m_s, "Fig. 3: first burn", r"$\|\Delta v_1\|$ (m/s)", projection=projection)
+        _surface_plot(ax2, S, S.dv2_m_s, "Fig. 3: second burn", r"$\|\Delta v_2\|$ (m/s)", projection=projection)
     else:
         still = S.fuel_m_s < 1e-9  # the agent's own torus point (phase 0): no maneuver
         log_sig = np.log10(S.range_sigma_km * 1e3)
         z_top = log_sig[~still].max()  # z range from the maneuvers; the no-maneuver column is clipped to it
         _surface_plot(ax1, S, np.minimum(log_sig, z_top),
-                      "Fig. 4: range uncertainty at $t_f$ (phase-0 wall clipped)", r"$\log_{10}\sqrt{J_\rho}$ (m)")
+                      "Fig. 4: range uncertainty at $t_f$ (phase-0 wall clipped)", r"$\log_{10}\sqrt{J_\rho}$ (m)",
+                      projection=projection)
         ax1.set_zlim(log_sig[~still].min(), z_top)
         _surface_plot(ax2, S, S.fuel_m_s, "Fig. 5: total fuel (time axis flipped)",
-                      r"$\|\Delta v_1\|+\|\Delta v_2\|$ (m/s)", flip=True)
-    fig.tight_layout()
+                      r"$\|\Delta v_1\|+\|\Delta v_2\|$ (m/s)", flip=True, projection=projection)
+    _legend_below(fig, ax1, 0.08)
     return fig
 
 
-def _informed_markers(ax, surf):
-    """u* (magenta open circles) and the best maneuver of each slice (orange open squares) on a map."""
+def _informed_markers(ax, surf, projection=None):
+    """u* (magenta open circles; the projection reading as red crosses when given) and the best maneuver of each
+    slice (orange open squares) on a map."""
     for n_seg, seg in enumerate(_informed_segments(surf)):
         ax.plot(surf.phase[surf.informed][seg], surf.t_arrival_hours[seg], "o", color="magenta", mfc="none", ms=5,
-                mew=1.2, label="u* (informed)" if n_seg == 0 else None)
+                mew=1.2, label=("u* (informed)" if projection is None else "u*, angle reading") if n_seg == 0
+                else None)
+    if projection is not None:
+        ax.plot(projection.phase[projection.informed], projection.t_arrival_hours, "x", color="tab:red", ms=6,
+                mew=1.5, label="u*, projection reading")
     ax.plot(surf.phase[surf.best], surf.t_arrival_hours, "s", color="tab:orange", mfc="none", mew=1.2, ms=5,
             label="best of each slice")
 
 
-def _range_map(ax, surf, fig):
+def _range_map(ax, surf, fig, projection=None):
     """Map of sqrt(J_rho): colours from the maneuvers only, no-maneuver cells hatched, u* and the slice best."""
     none = surf.fuel_m_s < 1e-9
     sig_m = surf.range_sigma_km * 1e3
@@ -255,24 +295,27 @@ def _range_map(ax, surf, fig):
         ax.add_patch(Rectangle((surf.phase[i] - dp / 2, surf.t_arrival_hours[0] - dt / 2), dp,
                                np.ptp(surf.t_arrival_hours) + dt, facecolor="0.85", edgecolor="0.3", hatch="////",
                                lw=0.5, label=f"no maneuver: {sig_m[none].min() / 1e3:.1f} km"))
-    _informed_markers(ax, surf)
+    _informed_markers(ax, surf, projection)
     ax.set_xlabel(r"normalised phase $\theta_0/2\pi$ [-]")
     ax.set_ylabel("time from apoapsis (h)")
 
 
-def range_and_fuel_maps(S):
-    """Figs. 4 and 5 as maps (range uncertainty of the maneuvers, total fuel) with u* and the slice best."""
+def range_and_fuel_maps(S, projection=None):
+    """Figs. 4 and 5 as maps (range uncertainty of the maneuvers, total fuel) with u* (both readings when
+    ``projection``, the same surface reselected, is given) and the slice best."""
     _surface(S)
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
-    _range_map(axes[0], S, fig)
+    projection = _projection_of(S, projection)
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+    _range_map(axes[0], S, fig, projection)
     axes[0].set_title("Fig. 4 as a map: range uncertainty (maneuvers only)")
     im = axes[1].pcolormesh(S.phase, S.t_arrival_hours, S.fuel_m_s, shading="nearest", cmap="viridis")
     fig.colorbar(im, ax=axes[1], label="total fuel (m/s)")
-    _informed_markers(axes[1], S)
+    _informed_markers(axes[1], S, projection)
     axes[1].set_title("Fig. 5 as a map: total fuel")
     axes[1].set_xlabel(r"normalised phase $\theta_0/2\pi$ [-]")
     axes[1].set_ylabel("time from apoapsis (h)")
-    fig.legend(*axes[0].get_legend_handles_labels(), loc="lower center", ncol=3, fontsize=8)
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(handles), fontsize=8)
     fig.tight_layout(rect=(0, 0.07, 1, 1))
     return fig
 

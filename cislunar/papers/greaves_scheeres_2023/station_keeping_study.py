@@ -8,6 +8,8 @@ and returns a frozen result object:
 * :func:`scenario_sweep`: the unstated scenario inputs (tracking start, burn lead, agent phase, read-out time);
 * :func:`offset_study`: an agent that has drifted off the torus;
 * :func:`member_study`: torus members matching 215 km under other readings of "average range";
+* :func:`random_pick_study`: uninformed station-keeping maneuvers (target ring angle drawn uniformly at random), the
+  baseline that :math:`\mathbf u^*` is judged against;
 * :func:`filter_monte_carlo`: the iterated-EKF Monte Carlo with execution errors (beyond the paper).
 
 The sweeps (:func:`grid_resolution_study`, :func:`scenario_sweep`, :func:`offset_study`) and the Monte Carlo take
@@ -23,7 +25,7 @@ km (``*_km``) or m (``*_m``); fuel in m/s; percentiles in percent of the maneuve
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.stats import chi2, spearmanr
@@ -39,9 +41,11 @@ from cislunar.utils.montecarlo import map_tasks, run_monte_carlo
 
 __all__ = [
     "POLICIES",
+    "RAISED_FRACTION",
     "GridRow",
     "GridStudy",
     "MonteCarloStudy",
+    "RandomPickStudy",
     "SliceStatistics",
     "SweepRow",
     "execution_levels",
@@ -50,6 +54,7 @@ __all__ = [
     "grid_resolution_study",
     "member_study",
     "offset_study",
+    "random_pick_study",
     "scenario_sweep",
     "slice_statistics",
 ]
@@ -110,6 +115,9 @@ class SliceStatistics:
         Median normalised phase of the best maneuver, of :math:`\\mathbf u^*` and of the most expensive maneuver.
     rank_correlation : float
         Median over slices of Spearman's correlation of fuel and :math:`\\sqrt{J_\\rho}` (maneuvers only).
+    raised_slices : tuple of int
+        Interior slices where :math:`\\sqrt{J_\\rho}` of :math:`\\mathbf u^*` exceeds that of both neighbouring
+        slices by more than :data:`RAISED_FRACTION` (the paper's "single point raised by a small local peak").
     """
 
     percentile: np.ndarray
@@ -120,6 +128,7 @@ class SliceStatistics:
     informed_phase: float
     fuel_peak_phase: float
     rank_correlation: float
+    raised_slices: tuple = ()
 
     @property
     def median_percentile(self) -> float:
@@ -144,6 +153,19 @@ class SliceStatistics:
         return "\n".join(lines)
 
 
+#: A slice of the u* line is "raised" when its sqrt(J_rho) exceeds both neighbours' by more than this fraction.
+RAISED_FRACTION = 0.10
+
+
+def _raised(values, fraction=RAISED_FRACTION) -> tuple:
+    """Interior indices where ``values`` exceed both neighbours by more than ``fraction`` (relative)."""
+    v = np.asarray(values, dtype=float)
+    if v.size < 3:
+        return ()
+    peak = v[1:-1] > (1 + fraction) * np.maximum(v[:-2], v[2:])
+    return tuple(int(i) + 1 for i in np.flatnonzero(peak))
+
+
 def slice_statistics(surface) -> SliceStatistics:
     """Rank the informed maneuver of every slice of ``surface`` by range uncertainty and by fuel."""
     S = _surface(surface)
@@ -154,7 +176,8 @@ def slice_statistics(surface) -> SliceStatistics:
     return SliceStatistics(S.informed_percentile, S.informed_fuel_percentile, cheaper,
                            float(np.mean(S.informed_fuel_m_s <= np.median(S.fuel_m_s, axis=1))),
                            float(np.median(S.phase[S.best])), float(np.median(S.phase[S.informed])),
-                           float(np.median(S.phase[np.argmax(S.fuel_m_s, axis=1)])), float(rank))
+                           float(np.median(S.phase[np.argmax(S.fuel_m_s, axis=1)])), float(rank),
+                           _raised(S.informed_range_sigma_km))
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -162,7 +185,16 @@ def slice_statistics(surface) -> SliceStatistics:
 # ---------------------------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class GridRow:
-    """Medians over the arrival slices of one (agent phase, ring-angle count, reading)."""
+    """Medians over the arrival slices of one (agent phase, ring-angle count, reading).
+
+    ``percentile``: of :math:`\\mathbf u^*` in its slice (percent); ``sigma_m``, ``fuel_m_s``: its
+    :math:`\\sqrt{J_\\rho}` at :math:`t_f` (m) and total fuel (m/s); ``more_fuel_percent``: share of maneuvers using
+    more fuel; ``best_m``: the slice's best :math:`\\sqrt{J_\\rho}` (m); ``ratio_best``: median over slices of
+    :math:`\\sqrt{J_\\rho}` of :math:`\\mathbf u^*` over the slice's best; ``below_median_share``: percent of slices
+    where :math:`\\mathbf u^*` uses at most the slice's median fuel; ``beats_random``: percent of random picks
+    (:func:`random_pick_study` on the same slices) with a larger :math:`\\sqrt{J_\\rho}` than :math:`\\mathbf u^*`
+    (NaN when the study drew none).
+    """
 
     agent_phase: float
     n: int
@@ -172,65 +204,107 @@ class GridRow:
     fuel_m_s: float
     more_fuel_percent: float
     best_m: float
+    ratio_best: float = float("nan")
+    below_median_share: float = float("nan")
+    beats_random: float = float("nan")
+
+
+_GRID_KEYS = ("percentile", "sigma_m", "fuel_m_s", "more_fuel_percent", "best_m", "ratio_best", "below_median_share",
+              "beats_random")
 
 
 @dataclass(frozen=True)
 class GridStudy:
-    """Rows of :func:`grid_resolution_study`; ``n_grid`` the ring-angle counts in order."""
+    """Rows of :func:`grid_resolution_study`; ``n_grid`` the ring-angle counts in order; ``random_theta`` the ring
+    angles (rad) of the random picks, one ``(agent_phase, angles)`` pair per agent phase (empty without them)."""
 
     rows: tuple
     n_grid: tuple
+    random_theta: tuple = ()
 
     def format(self) -> str:
         """The study as a text table, one line per row."""
         lines = [("agent phase | ring angles | reading    | percentile of u* % | sqrt(J) of u* m | fuel of u* m/s | "
-                 "more fuel % | best of slice m")]
+                 "more fuel % | best of slice m | u*/best | <= median fuel % | beats random %")]
         lines += [f" {g.agent_phase:10.2f} | {g.n:11d} | {g.reading:10s} | {g.percentile:18.1f} | {g.sigma_m:15.1f} | "
-                  f"{g.fuel_m_s:14.3f} | {g.more_fuel_percent:11.1f} | {g.best_m:15.1f}" for g in self.rows]
+                  f"{g.fuel_m_s:14.3f} | {g.more_fuel_percent:11.1f} | {g.best_m:15.1f} | {g.ratio_best:7.2f} | "
+                  f"{g.below_median_share:16.0f} | {g.beats_random:14.0f}" for g in self.rows]
         return "\n".join(lines)
 
     def series(self, agent_phase: float, reading: str, key: str) -> np.ndarray:
         """One column (``key`` a :class:`GridRow` field) against ``n_grid`` for an agent phase and a reading."""
         agent_phase = validation.real(agent_phase, "agent_phase")
         validation.choice(reading, "reading", ("angle", "projection"))
-        validation.choice(key, "key", ("percentile", "sigma_m", "fuel_m_s", "more_fuel_percent", "best_m"))
+        validation.choice(key, "key", _GRID_KEYS)
         phases = tuple(dict.fromkeys(g.agent_phase for g in self.rows))
         if agent_phase not in phases:
             raise ValueError(f"agent_phase must be one of the agent phases of the study {phases}; got {agent_phase!r}")
         return np.array([getattr(g, key) for g in self.rows if g.agent_phase == agent_phase and g.reading == reading])
 
 
+def _beats(informed_km, random_km) -> float:
+    """Percent of the (slice, draw) pairs where the random pick has a larger sqrt(J_rho) than u* of its slice."""
+    return float(100 * np.mean(random_km > np.asarray(informed_km)[:, None]))
+
+
 def _grid_task(task):
-    """The two :class:`GridRow` (angle, projection) of one surface (sweep task)."""
-    system, torus, n, phase, t_arrival, t_burn, t_final = task
-    s = sk.station_keeping_surface(system, torus, 2 * np.pi * np.arange(n) / n, t_arrival, t_burn, t_final,
-                                   agent_theta=2 * np.pi * phase, progress=False)
+    """The two :class:`GridRow` (angle, projection) of one surface and the u* range sigmas (sweep task); a task
+    with ``n = None`` is the random-pick surface of an agent phase (its range sigmas at t_f)."""
+    system, torus, n, phase, t_arrival, t_burn, t_final, theta = task
+    s = sk.station_keeping_surface(system, torus, theta, t_arrival, t_burn, t_final, agent_theta=2 * np.pi * phase,
+                                   progress=False)
+    if n is None:
+        return s.range_sigma_km
     rows = []
     for crit in ("angle", "projection"):
         r = s.reselect(crit)
-        rows.append(GridRow(float(phase), n, crit, float(np.median(r.informed_percentile)),
-                            float(np.median(r.informed_range_sigma_km) * 1e3),
-                            float(np.median(r.informed_fuel_m_s)),
-                            float(np.median(r.informed_fuel_percentile)),
-                            float(np.median(r.best_range_sigma_km) * 1e3)))
+        rows.append((GridRow(float(phase), n, crit, float(np.median(r.informed_percentile)),
+                             float(np.median(r.informed_range_sigma_km) * 1e3),
+                             float(np.median(r.informed_fuel_m_s)),
+                             float(np.median(r.informed_fuel_percentile)),
+                             float(np.median(r.best_range_sigma_km) * 1e3),
+                             float(np.median(r.informed_range_sigma_km / r.best_range_sigma_km)),
+                             float(np.mean(r.informed_fuel_m_s <= np.median(r.fuel_m_s, axis=1)) * 100)),
+                     r.informed_range_sigma_km))
     return rows
 
 
 def grid_resolution_study(system: CR3BP, torus, n_grid, t_arrival, t_burn: float, t_final: float, *,
-                          agent_phases=(0.0, 0.75), executor=None) -> GridStudy:
+                          agent_phases=(0.0, 0.75), rng: np.random.Generator | None = None, n_random: int = 0,
+                          executor=None) -> GridStudy:
     """Both readings of Eq. 25 on surfaces with ``n`` equally spaced ring angles for each ``n`` in ``n_grid``, for
     each agent phase (fraction of a turn); arrival times ``t_arrival`` and burn/read-out times in TU; one task per
-    surface on ``executor`` (``None``: serial)."""
+    surface on ``executor`` (``None``: serial).
+
+    With ``n_random > 0`` (and ``rng``), ``n_random`` random picks per agent phase (target ring angles uniform on
+    :math:`[0, 2\\pi)`, drawn from ``rng`` in the order of ``agent_phases`` before any work, the same angles for every
+    slice, as in :func:`random_pick_study`) give each row its ``beats_random``.
+    """
     check_system(system)
     _torus(torus)
     ns = tuple(validation.integer(n, "n_grid entry", minimum=2) for n in _vector(n_grid, "n_grid"))
     t_arrival = _vector(t_arrival, "t_arrival")
     t_burn, t_final = validation.real(t_burn, "t_burn"), validation.real(t_final, "t_final")
     agent_phases = _vector(agent_phases, "agent_phases")
+    n_random = validation.integer(n_random, "n_random", minimum=0)
+    if n_random or rng is not None:
+        validation.rng(rng)
     _executor(executor)
-    tasks = [(system, torus, n, float(phase), t_arrival, t_burn, t_final) for phase in agent_phases for n in ns]
-    rows = map_tasks(_grid_task, tasks, executor=executor, progress=False, desc="ring-angle grids")
-    return GridStudy(tuple(r for pair in rows for r in pair), ns)
+    draws = {float(p): 2 * np.pi * rng.random(n_random) for p in agent_phases} if n_random else {}
+    tasks = [(system, torus, n, float(phase), t_arrival, t_burn, t_final, 2 * np.pi * np.arange(n) / n)
+             for phase in agent_phases for n in ns]
+    tasks += [(system, torus, None, float(phase), t_arrival, t_burn, t_final, draws[float(phase)])
+              for phase in agent_phases if n_random]
+    out = map_tasks(_grid_task, tasks, executor=executor, progress=False, desc="ring-angle grids")
+    n_rows = len(agent_phases) * len(ns)
+    random_km = dict(zip((float(p) for p in agent_phases), out[n_rows:]))
+    rows = []
+    for pair in out[:n_rows]:
+        for row, informed_km in pair:
+            if n_random:
+                row = replace(row, beats_random=_beats(informed_km, random_km[row.agent_phase]))
+            rows.append(row)
+    return GridStudy(tuple(rows), ns, tuple((p, tuple(float(a) for a in d)) for p, d in draws.items()))
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -369,6 +443,76 @@ def member_study(system: CR3BP, orbit, theta, t_arrival, t_burn: float, t_final:
                          float(np.mean(r.informed_fuel_m_s <= np.median(r.fuel_m_s, axis=1)) * 100))
         out[stat] = row
     return out
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# u* against uninformed (random) station-keeping maneuvers
+# ---------------------------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class RandomPickStudy:
+    """Random station-keeping maneuvers: for every arrival slice, the maneuvers to ``n_draws`` target ring angles
+    drawn uniformly on :math:`[0, 2\\pi)` (the same angles for every slice), each with its covariance analysis.
+
+    A uniformly random target ring angle is what an *uninformed* station-keeping choice does: the direction and the
+    size of both burns follow from the transfer to that point of the torus.  The angles are continuous, not on the
+    ring-angle grid of a surface, so the baseline does not depend on how finely that surface is sampled.
+
+    Attributes
+    ----------
+    theta : ndarray (n_draws,)
+        Drawn target ring angles, rad.
+    t_arrival : ndarray (n_t,)
+        Arrival times, TU from apoapsis.
+    range_sigma_km : ndarray (n_t, n_draws)
+        :math:`\\sqrt{J_\\rho}` at :math:`t_f` of every random pick, km.
+    fuel_m_s : ndarray (n_t, n_draws)
+        Total fuel of every random pick, m/s.
+    """
+
+    theta: np.ndarray
+    t_arrival: np.ndarray
+    range_sigma_km: np.ndarray
+    fuel_m_s: np.ndarray
+
+    def beaten_percent(self, surface) -> float:
+        """Percent of the (slice, draw) pairs whose random pick has a *larger* :math:`\\sqrt{J_\\rho}` than the
+        :math:`\\mathbf u^*` of ``surface`` in the same slice (same arrival times required)."""
+        S = _surface(surface)
+        if S.t_arrival.shape != self.t_arrival.shape or not np.allclose(S.t_arrival, self.t_arrival, rtol=0,
+                                                                       atol=1e-12):
+            raise ValueError(f"surface must have the arrival times of the random picks ({self.t_arrival.size} slices); "
+                             f"got {S.t_arrival.size} slices at other times")
+        return _beats(S.informed_range_sigma_km, self.range_sigma_km)
+
+    def percentile_of(self, range_sigma_km) -> np.ndarray:
+        """Per slice, percent of the random picks with a *smaller* :math:`\\sqrt{J_\\rho}` than ``range_sigma_km``
+        (n_t,) km (0 = better than every random pick)."""
+        v = validation.as_array(range_sigma_km, "range_sigma_km", shape=self.t_arrival.shape)
+        return 100 * np.mean(self.range_sigma_km < v[:, None], axis=1)
+
+
+def random_pick_study(system: CR3BP, torus, t_arrival, t_burn: float, t_final: float, rng: np.random.Generator, *,
+                      n_draws: int, agent_theta: float = 0.0, t_track_start: float | None = None) -> RandomPickStudy:
+    """``n_draws`` random station-keeping maneuvers per arrival slice (target ring angles uniform on
+    :math:`[0, 2\\pi)` from ``rng``, shared by the slices) in the scenario of
+    :func:`cislunar.papers.greaves_scheeres_2023.station_keeping.station_keeping_surface` (same times in TU, agent
+    ring angle ``agent_theta`` rad, tracking from ``t_track_start``), with their covariance analyses.
+
+    The draws come from ``rng`` only, so the same seed gives the same picks and the same numbers.
+    """
+    check_system(system)
+    _torus(torus)
+    t_arrival = _vector(t_arrival, "t_arrival")
+    t_burn, t_final = validation.real(t_burn, "t_burn"), validation.real(t_final, "t_final")
+    validation.rng(rng)
+    n_draws = validation.integer(n_draws, "n_draws", minimum=1)
+    agent_theta = validation.real(agent_theta, "agent_theta")
+    if t_track_start is not None:
+        t_track_start = validation.real(t_track_start, "t_track_start")
+    theta = 2 * np.pi * rng.random(n_draws)
+    s = sk.station_keeping_surface(system, torus, theta, t_arrival, t_burn, t_final, agent_theta=agent_theta,
+                                   t_track_start=t_track_start, progress=False)
+    return RandomPickStudy(theta, s.t_arrival, s.range_sigma_km, s.fuel_m_s)
 
 
 # ---------------------------------------------------------------------------------------------------------------

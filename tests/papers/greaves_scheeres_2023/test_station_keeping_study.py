@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -141,3 +143,111 @@ def test_studies_refuse_bad_arguments_by_name(torus, surface):
         study.execution_levels(1e-3, -0.01)
     with pytest.raises(TypeError, match="rows"):
         study.format_sweep("rows")
+
+
+def test_projection_reading_picks_the_largest_component_along_u_y_known_answer():
+    """Burn tips on a sphere of radius R about c: the component along unit u is u.c + R u.d, largest at the tip
+    c + R u and smallest at c - R u (u.c +/- R), whatever c.  The angle reading picks other burns (c shifts the
+    directions), so the two readings differ on this set."""
+    from cislunar.guidance import ssat
+
+    u = np.array([0.36, -0.48, 0.8])  # unit
+    D = np.vstack([ssat.fibonacci_sphere(500), u, -u])
+    c, R = np.array([2.0, 1.0, -0.5]), 1.5
+    dv1 = (c + R * D)[None]
+    cost = np.zeros((1, D.shape[0]))
+    align, cand, _ = sk.informed_choice(dv1, (3.0 * u)[None], cost, criterion="projection")
+    assert tuple(cand[0]) == (500, 501)
+    assert align[0, 500] == pytest.approx(u @ c + R) and align[0, 501] == pytest.approx(u @ c - R)
+    assert np.max(align) == pytest.approx(u @ c + R, rel=1e-12)
+    _, cand_angle, _ = sk.informed_choice(dv1, u[None], cost, criterion="angle")
+    assert cand_angle[0, 0] != 500  # the most aligned direction is not the largest projection here
+
+
+def test_random_pick_study_is_reproducible_from_its_seed(torus, surface):
+    S = surface
+    args = (em, torus, S.t_arrival, S.t_burn, S.t[-1])
+    a = study.random_pick_study(*args, np.random.default_rng([3, 9]), n_draws=5)
+    b = study.random_pick_study(*args, np.random.default_rng([3, 9]), n_draws=5)
+    c = study.random_pick_study(*args, np.random.default_rng([4, 9]), n_draws=5)
+    assert np.array_equal(a.theta, b.theta) and np.array_equal(a.range_sigma_km, b.range_sigma_km)
+    assert not np.array_equal(a.theta, c.theta)
+    # the declared distribution: ring angles 2 pi U[0, 1) from the generator, nothing else drawn
+    assert np.array_equal(a.theta, 2 * np.pi * np.random.default_rng([3, 9]).random(5))
+    # each pick is the surface maneuver to its ring angle
+    s = sk.station_keeping_surface(em, torus, a.theta, S.t_arrival, S.t_burn, S.t[-1], progress=False)
+    assert np.allclose(a.range_sigma_km, s.range_sigma_km, rtol=1e-12) and np.allclose(a.fuel_m_s, s.fuel_m_s)
+    # beaten percent against its definition, and against its two extremes
+    mine = np.mean([a.range_sigma_km[j, k] > S.informed_range_sigma_km[j] for j in range(3) for k in range(5)]) * 100
+    assert a.beaten_percent(S) == pytest.approx(mine)
+    # u* replaced by a maneuver better than every pick -> 100 %; worse than every pick -> 0 %
+    tiny = replace(S, range_sigma_km=np.where(np.arange(S.theta.size) == 0, 0.0, S.range_sigma_km),
+                   informed=np.zeros(3, int))
+    assert a.beaten_percent(tiny) == 100.0
+    huge = replace(S, range_sigma_km=S.range_sigma_km + 1e6)
+    assert a.beaten_percent(huge) == 0.0
+    assert np.array_equal(a.percentile_of(tiny.informed_range_sigma_km), np.zeros(3))
+    with pytest.raises(ValueError, match="arrival"):
+        a.beaten_percent(replace(S, t_arrival=S.t_arrival + 0.01))
+    with pytest.raises(ValueError, match="n_draws"):
+        study.random_pick_study(*args, np.random.default_rng(0), n_draws=0)
+    with pytest.raises(TypeError, match="rng"):
+        study.random_pick_study(*args, 0, n_draws=2)
+
+
+def test_grid_study_columns_against_their_definitions(torus):
+    t_grid = np.array([-6.0, 0.5, 7.0]) * HR
+    g = study.grid_resolution_study(em, torus, (6,), t_grid, -18 * HR, 12 * HR, agent_phases=(0.0,),
+                                    rng=np.random.default_rng(7), n_random=4)
+    ((phase, angles),) = g.random_theta
+    assert phase == 0.0 and np.array_equal(angles, 2 * np.pi * np.random.default_rng(7).random(4))
+    s6 = sk.station_keeping_surface(em, torus, 2 * np.pi * np.arange(6) / 6, t_grid, -18 * HR, 12 * HR,
+                                    progress=False)
+    rnd = sk.station_keeping_surface(em, torus, np.array(angles), t_grid, -18 * HR, 12 * HR, progress=False)
+    for reading in ("angle", "projection"):
+        r = s6.reselect(reading)
+        u = r.informed_range_sigma_km
+        assert g.series(0.0, reading, "ratio_best")[0] == pytest.approx(np.median(u / r.best_range_sigma_km))
+        assert g.series(0.0, reading, "below_median_share")[0] == pytest.approx(
+            100 * np.mean(r.informed_fuel_m_s <= np.median(r.fuel_m_s, axis=1)))
+        assert g.series(0.0, reading, "beats_random")[0] == pytest.approx(
+            100 * np.mean(rnd.range_sigma_km > u[:, None]))
+    assert np.all(g.series(0.0, "angle", "ratio_best") >= 1.0)  # nothing beats the best of a slice
+    # without random picks the column is NaN
+    g0 = study.grid_resolution_study(em, torus, (6,), t_grid, -18 * HR, 12 * HR, agent_phases=(0.0,))
+    assert np.isnan(g0.series(0.0, "angle", "beats_random")).all() and g0.random_theta == ()
+    with pytest.raises(TypeError, match="rng"):
+        study.grid_resolution_study(em, torus, (6,), t_grid, -18 * HR, 12 * HR, n_random=2)
+
+
+def test_raised_slices_are_local_peaks_of_the_informed_line(surface):
+    # 3 slices, u* at ring angle 0 in each (sqrt(J_rho) 1 km there): only the middle slice can be a local peak
+    S = replace(surface, informed=np.zeros(3, int))
+    base = np.tile(np.linspace(1.0, 2.0, S.theta.size), (3, 1))
+    for middle, expected in ((1.2, (1,)), (1.05, ()), (0.5, ())):
+        sig = base.copy()
+        sig[1] *= middle
+        st = study.slice_statistics(replace(S, range_sigma_km=sig))
+        assert st.raised_slices == expected
+    sig = base.copy()
+    sig[0] *= 3.0  # an end slice is never a local peak (one neighbour only)
+    assert study.slice_statistics(replace(S, range_sigma_km=sig)).raised_slices == ()
+
+
+def test_surface_figures_draw_both_readings(surface):
+    import matplotlib.pyplot as plt
+
+    from cislunar.papers.greaves_scheeres_2023 import figures
+
+    proj = surface.reselect("projection")
+    for which in ("burns", "range_fuel"):
+        fig = figures.surfaces(surface, which, projection=proj)
+        labels = [t.get_text() for leg in fig.legends for t in leg.get_texts()]
+        assert any("angle" in t for t in labels) and any("projection" in t for t in labels)
+        assert all(ax.get_legend() is None for ax in fig.axes)  # the legend sits below the panels
+        plt.close(fig)
+    fig = figures.range_and_fuel_maps(surface, projection=proj)
+    assert any("projection" in t.get_text() for leg in fig.legends for t in leg.get_texts())
+    plt.close(fig)
+    with pytest.raises(ValueError, match="projection"):
+        figures.surfaces(surface, "burns", projection=replace(proj, dv1=proj.dv1 * 2))

@@ -3,13 +3,25 @@ Figs. 2-5).
 
 Declarations only: each closing-table row of the chapter, its criterion fixed before comparing.  Valley rows: the
 median over the arrival slices of the percentile of u* (percent of a slice's maneuvers with a smaller sqrt(J_rho) at
-t_f; 0 = best), at most 25 (the best quartile).  Fuel rows: percent of slices where u* uses at most the slice's
-median fuel, at least 90.  Improvement rows: sqrt(J_rho) of u* over the no-maneuver value, at most 0.5.
+t_f; 0 = best), at most 25 (the best quartile).  Fuel rows: u* at or below the slice's median fuel in at least 90 %
+of the slices at every ring-angle grid, with a fuel that settles as the grid is refined (changes by less than 25 %
+from the coarsest to the finest grid: a property of the set, not of its sampling).  "Improves" rows, against two baselines that a pick can fail against (doing nothing cannot: any
+maneuver beats it in the linear analysis): sqrt(J_rho) of u* over the best of its slice (median over slices) at most
+1.5, and u* better than at least 75 % of uninformed picks (target ring angle uniform on [0, 2 pi) from a seeded
+generator, every slice).
 """
 
 from __future__ import annotations
 
-from cislunar.publish.claims import AtLeast, AtMost, Claim, Holds, Within
+from cislunar.publish.claims import AtLeast, AtMost, Claim, Equals, Holds, Within
+
+#: The agent ring phases (fractions of a turn) at which the projection reading puts u* in the valley in the sweep of
+#: section 6, and those a quarter turn away, where it does not.
+PROJECTION_VALLEY_PHASES = (0.0, 0.5)
+QUARTER_TURN_PHASES = (0.25, 0.75)
+_TUNED_PROJECTION = "this reading of Eq. 25 was chosen because it matches the paper's Fig. 4"
+_FUEL_TEST = ("u* at or below its slice's median fuel in at least 90 % of the slices at every ring-angle grid, and "
+              "its median fuel changing by less than 25 % from the coarsest to the finest grid")
 
 CLAIMS = {
     "mean_range": Claim(
@@ -36,17 +48,26 @@ CLAIMS = {
                "or pi) picks maneuvers next to the agent's own phase, the smallest burns, far from the valley (a "
                "random pick sits at the 50th percentile on average)"),
     "valley_projection": Claim(
-        "Fig. 4: u* in the valley, Eq. 25 read as the projection of the burn on u_y", "in the valley",
-        AtMost(25.0), source="Sec. 5, Fig. 4",
-        tuned="this reading of Eq. 25 was chosen because it matches the paper's Fig. 4",
-        reason="the projection reading's u* is outside the best quartile of its slices"),
+        "Fig. 4: u* in the valley, Eq. 25 read as the projection of the burn on u_y, agent starting at ring phase 0 "
+        "or 1/2 only (worst of the baseline and the sweep settings at those phases)", "in the valley",
+        AtMost(25.0), source="Sec. 5, Fig. 4", tuned=_TUNED_PROJECTION,
+        reason="the projection reading's u* is outside the best quartile of its slices at agent phase 0 or 1/2"),
+    "valley_projection_quarter": Claim(
+        "Fig. 4: u* in the valley, projection reading, agent a quarter turn away (ring phase 1/4 or 3/4; best sweep "
+        "setting)", "in the valley", AtMost(25.0), source="Sec. 5, Fig. 4", tuned=_TUNED_PROJECTION,
+        reason="with the agent a quarter turn from phase 0 the projection reading's u* is outside the best quartile "
+               "in every sweep setting: the paper's valley is reached for half of the agent phases only (the paper "
+               "does not give the agent's phase)"),
     "fuel_angle": Claim(
-        "Fig. 5: guidance avoids the largest fuel costs (angle reading)", "avoids the peak", AtLeast(90.0),
-        source="Sec. 5, Fig. 5",
-        reason="u* uses more than its slice's median fuel in more than 10 % of the slices"),
+        "Fig. 5: guidance avoids the largest fuel costs (angle reading), at every ring-angle grid and with a fuel "
+        "that settles as the grid is refined", "avoids the peak", Holds(_FUEL_TEST), source="Sec. 5, Fig. 5",
+        reason="u* avoids the peak only as an artefact of the grid: Eq. 25 read as an angle picks a burn next to "
+               "the agent's own phase, whose fuel falls with the spacing of the ring-angle grid (u* tends to no "
+               "maneuver), so where it sits on the fuel surface is set by the sampling, not by the set"),
     "fuel_projection": Claim(
-        "Fig. 5: guidance avoids the largest fuel costs (projection reading)", "avoids the peak", AtLeast(90.0),
-        source="Sec. 5, Fig. 5",
+        "Fig. 5: guidance avoids the largest fuel costs (projection reading), at every ring-angle grid and with a "
+        "fuel that settles as the grid is refined", "avoids the peak", Holds(_FUEL_TEST), source="Sec. 5, Fig. 5",
+        tuned=_TUNED_PROJECTION,
         reason="u* uses at most its slice's median fuel in fewer than 90 % of the slices: the projection reading "
                "buys its place in the valley with a large burn along u_y"),
     "second_burn_peak": Claim(
@@ -55,13 +76,34 @@ CLAIMS = {
         source="Sec. 5",
         reason="rerun of u* without its second burn: when tracking starts at the first burn, the second burn (a kink "
                "in a tracked arc) is where the range information comes from, so it lowers sqrt(J_rho) everywhere"),
-    "improves_angle": Claim(
-        "u* improves range knowledge vs no maneuver (covariance analysis, angle reading)", "'significantly improves'",
-        AtMost(0.5), source="Sec. 6 (conclusions)",
-        reason="sqrt(J_rho) of u* is not below half the no-maneuver value at every ring-angle grid"),
-    "improves_projection": Claim(
-        "u* improves range knowledge vs no maneuver (projection reading)", "'significantly improves'", AtMost(0.5),
-        source="Sec. 6 (conclusions)", reason="sqrt(J_rho) of u* is not below half the no-maneuver value"),
+    "raised_point_projection": Claim(
+        "Fig. 4: a single point of the u* line raised by a small local peak, projection reading (slices whose "
+        "sqrt(J_rho) of u* exceeds both neighbours' by more than 10 %)", "one point", Equals(1), source="Sec. 5",
+        tuned=_TUNED_PROJECTION,
+        reason="the projection reading's u* line does not have exactly one slice raised above both neighbours"),
+    "vs_best_angle": Claim(
+        "u* against the best maneuver of its slice: sqrt(J_rho) of u* / slice best (median over slices; angle "
+        "reading, every ring-angle grid)", "'significantly improves' (in the valley)", AtMost(1.5),
+        source="Secs. 5-6",
+        reason="u* is not within 50 % of the slice's best maneuver at every ring-angle grid: the ratio grows as the "
+               "grid is refined (u* tends to no maneuver)"),
+    "vs_best_projection": Claim(
+        "u* against the best maneuver of its slice: sqrt(J_rho) of u* / slice best (median over slices; projection "
+        "reading, every ring-angle grid)", "'significantly improves' (in the valley)", AtMost(1.5),
+        source="Secs. 5-6", tuned=_TUNED_PROJECTION,
+        reason="u* is not within 50 % of the slice's best maneuver"),
+    "vs_random_angle": Claim(
+        "u* against an uninformed pick: percent of random station-keeping maneuvers (target ring angle uniform on "
+        "[0, 2 pi), seeded) with a larger sqrt(J_rho) than u* (angle reading, worst over the ring-angle grids)",
+        "'significantly improves'", AtLeast(75.0), source="Secs. 5-6",
+        reason="u* beats fewer than three random picks in four at some ring-angle grid: Eq. 25 read as an angle "
+               "picks a burn next to the agent's own phase, which most random picks beat, the more so the finer the "
+               "grid"),
+    "vs_random_projection": Claim(
+        "u* against an uninformed pick: percent of random station-keeping maneuvers (target ring angle uniform on "
+        "[0, 2 pi), seeded) with a larger sqrt(J_rho) than u* (projection reading, worst over the ring-angle grids)",
+        "'significantly improves'", AtLeast(75.0), source="Secs. 5-6", tuned=_TUNED_PROJECTION,
+        reason="u* beats fewer than three random picks in four"),
     "filter_nees": Claim(
         "full filter: NEES at t_f, informed (angle / projection), execution errors", "future work",
         kind="beyond paper", source="Sec. 6 (future work)"),
