@@ -80,7 +80,7 @@ LU^2/TU^3.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 from scipy import linalg, optimize, stats
@@ -455,15 +455,16 @@ def reset_factor(system: CR3BP, t, k: int, x_filt_prev, P_filt_prev, y_k, observ
     target = float(H.shape[0]) if target is None else validation.positive(target, "target")
     validation.choice(rule, "rule", RESET_RULES)
 
-    def update(log_alpha):
-        S_bar = srif.time_update(S, np.zeros(6), Phi, eye, np.exp(log_alpha) * Q)[0]
-        S_new, _, e = srif.measurement_update(S_bar, np.zeros(6), H, dy, Rk)
-        return S_bar, S_new, e**2
+    zero = np.zeros(6)
+    # alpha = 1 through the public updates (they check Phi, Q and Rk by name), every other alpha through their
+    # unchecked kernels: the same arithmetic
+    S_bar = srif.time_update(S, zero, Phi, eye, Q)[0]
+    m1 = srif.measurement_update(S_bar, zero, H, dy, Rk)[2] ** 2
 
     def metric(log_alpha):
-        return update(log_alpha)[2]
+        S_bar = srif._time_update(S, zero, Phi, eye, np.exp(log_alpha) * Q)[0]
+        return float(srif._measurement_update(S_bar, zero, H, dy, Rk)[2]) ** 2
 
-    m1 = metric(0.0)
     hi = np.log(validation.positive(max_factor, "max_factor"))
     if rule == "likelihood":
         # The innovation covariance C(alpha) is m x m and R keeps it SPD for every alpha, so its Cholesky factor gives
@@ -596,13 +597,25 @@ def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0,
     return AdaptiveOCBEResult(res, q, metric, dof, limit, first, sm, tuple(detections), len(detections) + 1)
 
 
+def _reset_rules(reset, B: int) -> list:
+    """``reset`` (one rule, or one per trial) as a list of B rules, refused by name when malformed."""
+    if not isinstance(reset, (list, tuple, np.ndarray)):
+        return [validation.choice(reset, "reset", RESET_RULES)] * B
+    rules = list(np.asarray(reset, dtype=object).reshape(-1))
+    if len(rules) != B:
+        raise ValueError(f"reset must name one rule or {B} rules (one per trial); got {len(rules)}")
+    return [validation.choice(r, f"reset[{i}]", RESET_RULES) for i, r in enumerate(rules)]
+
+
 def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *,
                         probability: float = DETECTION_PROBABILITY, consecutive: int = CONSECUTIVE_EPOCHS,
-                        reset: str = "mean", n_sub: int = 9, tol: float = DEFAULT_TOL, max_resets: int = 50):
+                        reset: str | list = "mean", n_sub: int = 9, tol: float = DEFAULT_TOL, max_resets: int = 50,
+                        smooth: bool = True, on_failure: str = "raise"):
     """The adaptive OCBE for B trials in lockstep on :func:`cislunar.estimation.batched_ocbe.ocbe_batch` (one observer).
 
-    Same rule and reset as :func:`adaptive_ocbe`, trial by trial; each pass re-runs the whole batch with the
-    updated per-trial weights (trials without a new detection reproduce their previous pass).
+    Same rule and reset as :func:`adaptive_ocbe`, trial by trial; each pass re-runs, as one batch, only the trials
+    with a new detection (each trial's result does not depend on the other trials of a batch, so the others keep
+    their previous pass).
 
     Parameters
     ----------
@@ -610,12 +623,23 @@ def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x
     x0 : array_like, shape (B, 6)
     P0 : array_like, shape (6, 6) or (B, 6, 6)
     control_weight : scalar or array_like, shape (N-1,) or (B, N-1)
+    reset : str or sequence of str
+        Reset rule (:func:`reset_factor`), for all trials or one per trial (B entries).
+    smooth : bool
+        Run the smoother in every pass (``False``: the forward filter only, as ``adaptive_ocbe(..., smooth=False)``;
+        the detections use the forward metric only, so they do not depend on it).
+    on_failure : {"raise", "flag"}
+        A trial that fails, numerically (as in :func:`cislunar.estimation.batched_ocbe.ocbe_batch`) or in its reset
+        (:class:`ResetError`: the reset cannot reach its target, or more than ``max_resets`` resets), stops the whole
+        batch (``"raise"``) or is flagged and dropped while the others go on (``"flag"``): its epoch and message are
+        in the result's ``failure_epoch`` / ``failure`` (the epoch of the detection for a :class:`ResetError`, as
+        :func:`adaptive_ocbe` raises it), its arrays and metric NaN; its detections are those made before the failure.
     Others as in :func:`cislunar.estimation.batched_ocbe.ocbe_batch`.
 
     Returns
     -------
     result : cislunar.estimation.batched_ocbe.BatchOCBEResult
-        Final pass.
+        Final pass of each trial.
     control_weight : ndarray, shape (B, N-1)
     metric : ndarray, shape (B, N)
     detections : list of tuple of Detection
@@ -631,37 +655,68 @@ def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x
     obs = validation.as_array(observer_states, "observer_states", shape=(N, 6))
     consecutive = validation.integer(consecutive, "consecutive", minimum=1)
     max_resets = validation.integer(max_resets, "max_resets", minimum=0)
-    validation.choice(reset, "reset", RESET_RULES)
+    rules = _reset_rules(reset, B)
     validation.in_range(probability, "probability", 0.0, 1.0, closed=False)
+    smooth = validation.boolean(smooth, "smooth")
+    flag = validation.choice(on_failure, "on_failure", ("raise", "flag")) == "flag"
 
-    def run():
-        return ocbe_batch(system, t, yy, obs, model, meas_cov, x0, P0, q, n_sub=n_sub, tol=tol)
-
-    res = run()
+    res = ocbe_batch(system, t, yy, obs, model, meas_cov, x0, P0, q, n_sub=n_sub, tol=tol, smooth=smooth,
+                     on_failure=on_failure)  # validates every remaining argument by name
+    x0a, P0a = np.asarray(x0, float), np.asarray(P0, float)
+    out = {f.name: (None if getattr(res, f.name) is None else np.array(getattr(res, f.name)))
+           for f in fields(res) if f.name not in ("t_sub", "failure_epoch", "failure")}
+    fail_epoch = np.full(B, -1) if res.failure_epoch is None else np.array(res.failure_epoch, int)
+    fail_msg = [""] * B if res.failure is None else [str(m) for m in res.failure]
     metric, dof = forward_metric(res, model)
     limit = metric_limit(dof, probability)
     start = np.ones(B, int)
     dets = [[] for _ in range(B)]
+
+    def drop(b, k, exc):
+        fail_epoch[b], fail_msg[b] = k, str(exc)
+        for v in out.values():
+            if v is not None and v.dtype.kind == "f":
+                v[b] = np.nan
+        metric[b] = np.nan
+
     while True:
-        ks = [first_detection(metric[b], limit, start=int(start[b]), consecutive=consecutive) for b in range(B)]
-        todo = [b for b in range(B) if ks[b] is not None]
-        if not todo:
-            break
+        ks = [None if fail_epoch[b] >= 0 else
+              first_detection(metric[b], limit, start=int(start[b]), consecutive=consecutive) for b in range(B)]
         before = {}
-        for b in todo:
+        for b in (b for b in range(B) if ks[b] is not None):
             k = ks[b]
-            if len(dets[b]) >= max_resets:
-                raise ResetError(k, metric[b, k], dof[k], f"trial {b}: more than max_resets = {max_resets} resets")
-            factor, _ = reset_factor(system, t, k, res.x_filt[b, k - 1], res.P_filt[b, k - 1], yy[b, k], obs[k],
-                                     model, meas_cov, q[b, k - 1], rule=reset, n_sub=n_sub, tol=tol)
+            try:
+                if len(dets[b]) >= max_resets:
+                    raise ResetError(k, metric[b, k], dof[k], f"trial {b}: more than max_resets = {max_resets} resets")
+                factor, _ = reset_factor(system, t, k, out["x_filt"][b, k - 1], out["P_filt"][b, k - 1], yy[b, k],
+                                         obs[k], model, meas_cov, q[b, k - 1], rule=rules[b], n_sub=n_sub, tol=tol)
+            except ResetError as exc:
+                if not flag:
+                    raise
+                drop(b, k, exc)
+                continue
             q[b, k - 1] *= factor
             before[b] = (k, factor, float(metric[b, k]))
-        res = run()
-        metric = forward_metric(res, model)[0]
+        if not before:
+            break
+        idx = np.array(sorted(before))
+        sub = ocbe_batch(system, t, yy[idx], obs, model, meas_cov, x0a[idx], P0a[idx] if P0a.ndim == 3 else P0a,
+                         q[idx], n_sub=n_sub, tol=tol, smooth=smooth, on_failure=on_failure)
+        for name, v in out.items():
+            if v is not None:
+                v[idx] = getattr(sub, name)
+        metric[idx] = forward_metric(sub, model)[0]
+        if sub.failure_epoch is not None:
+            for i, b in enumerate(idx):
+                if sub.failure_epoch[i] >= 0:
+                    fail_epoch[b], fail_msg[b] = int(sub.failure_epoch[i]), str(sub.failure[i])
         for b, (k, factor, m0) in before.items():
-            dets[b].append(Detection(k, k + consecutive - 1, float(t[k]), factor, m0, float(metric[b, k])))
-            start[b] = k + 1
-    return res, q, metric, [tuple(d) for d in dets]
+            if fail_epoch[b] < 0:
+                dets[b].append(Detection(k, k + consecutive - 1, float(t[k]), factor, m0, float(metric[b, k])))
+                start[b] = k + 1
+    failures = (dict(failure_epoch=fail_epoch, failure=np.array(fail_msg, dtype=str))
+                if flag or res.failure_epoch is not None else {})
+    return replace(res, **out, **failures), q, metric, [tuple(d) for d in dets]
 
 
 def first_pass_detections(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *,
@@ -685,7 +740,7 @@ def first_pass_detections(system: CR3BP, t, y, observer_states, model, meas_cov,
     consecutive = validation.integer(consecutive, "consecutive", minimum=1)
     validation.in_range(probability, "probability", 0.0, 1.0, closed=False)
     res = ocbe_batch(system, t, y, observer_states, model, meas_cov, x0, P0, control_weight, n_sub=n_sub,
-                               tol=tol)
+                     tol=tol, smooth=False)  # the forward metric needs the filter only
     metric, dof = forward_metric(res, model)
     limit = metric_limit(dof, probability)
     out = [first_detection(m, limit, consecutive=consecutive) for m in metric]

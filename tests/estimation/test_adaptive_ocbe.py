@@ -446,3 +446,54 @@ def test_panel_figures_have_units_on_every_axis(setup, big_burn):
                                          first_pass_until=a.detections[0].declared_epoch)):
         assert axis_label_problems(fig) == []
         assert len(fig.axes) == 4
+
+
+@pytest.mark.parametrize("max_resets", [1, 5])
+def test_batched_adaptive_flagged_filter_only_equals_single_trial(setup, max_resets):
+    """The batched adaptive filter in the mode of the reset-rule study (forward only, a reset rule per trial, failures
+    flagged per trial, re-runs of only the trials with a new detection) equals the single-trial filter trial by
+    trial: detections, factors, weights, metric and estimates; a trial whose reset fails (more than max_resets) is
+    flagged at the epoch at which the single-trial filter raises, while the others go on."""
+    sc = setup.scenario
+    k2, y2, x02, P02 = _two_burns(setup, 0)  # two detections (k2, k2 + 1): fails with max_resets = 1
+    burn = det.draw_trial(np.random.default_rng(7), setup, magnitude_m_s=3.0)
+    quiet = det.draw_trial(np.random.default_rng(8), setup, None)
+    cases = [(burn.y, burn.x0, burn.P0, "mean"), (burn.y, burn.x0, burn.P0, "likelihood"),
+             (y2, x02, P02, "mean"), (quiet.y, quiet.x0, quiet.P0, "likelihood"), (y2, x02, P02, "likelihood")]
+    res, q, metric, dets = ad.adaptive_ocbe_batch(
+        em, sc.t, np.array([c[0] for c in cases]), setup.observer_states, sc.model, sc.meas_cov,
+        np.array([c[1] for c in cases]), np.array([c[2] for c in cases]), setup.control_weight,
+        reset=[c[3] for c in cases], max_resets=max_resets, smooth=False, on_failure="flag")
+    assert res.x_smooth is None
+    assert [len(d) for d in dets] == ([1, 1, 1, 0, 1] if max_resets == 1 else [1, 1, 2, 0, 2])
+    assert list(res.failed) == [False, False, max_resets == 1, False, max_resets == 1]
+    assert dets[0][0].factor != pytest.approx(dets[1][0].factor, rel=1e-3)  # the two rules differ on the same data
+    for b, (yb, x0b, P0b, rule) in enumerate(cases):
+        args = (em, sc.t, yb, setup.observer_states, sc.model, sc.meas_cov, x0b, P0b, setup.control_weight)
+        kw = dict(reset=rule, max_resets=max_resets, smooth=False)
+        if res.failed[b]:
+            with pytest.raises(ad.ResetError) as err:
+                ad.adaptive_ocbe(*args, **kw)
+            assert err.value.epoch == k2 + 1 and res.failure_epoch[b] == k2 + 1 and "max_resets" in res.failure[b]
+            assert [d.epoch for d in dets[b]] == [k2]
+            assert np.all(np.isnan(res.x_filt[b])) and np.all(np.isnan(metric[b]))
+            continue
+        one = ad.adaptive_ocbe(*args, **kw)
+        assert res.failure_epoch[b] == -1 and res.failure[b] == ""
+        assert [d.epoch for d in dets[b]] == [d.epoch for d in one.detections]
+        for d1, d2 in zip(dets[b], one.detections):
+            assert d1.factor == pytest.approx(d2.factor, rel=1e-7)
+            assert d1.metric_after == pytest.approx(d2.metric_after, rel=1e-6)
+        assert np.allclose(q[b], one.control_weight, rtol=1e-7, atol=0)
+        assert np.allclose(metric[b], one.metric, rtol=1e-6, atol=1e-9)
+        assert np.max(np.abs(res.x_filt[b] - one.result.x_filt)) < 1e-9 * np.max(np.abs(one.result.x_filt))
+        assert np.allclose(res.P_filt[b], one.result.P_filt, rtol=1e-6, atol=0)
+    if max_resets == 1:  # on_failure="raise" stops the batch at the failing trial
+        with pytest.raises(ad.ResetError, match="max_resets"):
+            ad.adaptive_ocbe_batch(em, sc.t, np.array([c[0] for c in cases[:3]]), setup.observer_states, sc.model,
+                                   sc.meas_cov, np.array([c[1] for c in cases[:3]]), P02, setup.control_weight,
+                                   max_resets=1, smooth=False)
+        with pytest.raises(ValueError, match="reset"):
+            ad.adaptive_ocbe_batch(em, sc.t, np.array([c[0] for c in cases]), setup.observer_states, sc.model,
+                                   sc.meas_cov, np.array([c[1] for c in cases]), P02, setup.control_weight,
+                                   reset=["mean"] * 4)

@@ -10,7 +10,7 @@ first and then filter them as independent tasks on an optional ``executor``
 * :func:`adaptive_run`: one single-trial adaptive run with its panels (Figs. 6-9) and consistency numbers;
 * :func:`delay_study`: when the first detection comes (before any reset, so independent of the reset rule), per burn
   size and per angle noise, sorted into four outcomes fixed in advance;
-* :func:`reset_rule_study`: the single-trial adaptive filter over burn sizes with both reset rules;
+* :func:`reset_rule_study`: the adaptive filter (batched) over burn sizes with both reset rules;
 * :func:`closing_rows`: the measured value of every row of the notebook's closing table, keyed as the claims of
   :mod:`cislunar.papers.greaves_scheeres_2021.claims.adaptive_ocbe`.
 
@@ -127,7 +127,8 @@ def null_metric_study(setup: det.DetectionSetup, n_runs: int, rng: np.random.Gen
     draws = [det.draw_trial(rng, setup, None) for _ in range(n_runs)]
     res, _, metric, dets = ad.adaptive_ocbe_batch(setup.system, sc.t, np.array([d.y for d in draws]),
                                                   setup.observer_states, sc.model, sc.meas_cov,
-                                                  np.array([d.x0 for d in draws]), draws[0].P0, setup.control_weight)
+                                                  np.array([d.x0 for d in draws]), draws[0].P0, setup.control_weight,
+                                                  smooth=False)
     pooled = metric.ravel()
     dof = int(sc.meas_cov.shape[-1])
     nees = np.array([consistency.nees(res.x_filt[b], res.P_filt[b], draws[b].truth) for b in range(n_runs)])
@@ -483,8 +484,12 @@ class ResetRuleStudy:
                 sum(self.summary(m, rule)["n_detected"] for m in self.magnitudes_m_s))
 
 
+def _failed_row(mag, rule, max_resets) -> tuple:
+    return (mag, rule, True, 1.0, True, max_resets + 1, False)
+
+
 def _reset_rule_runs(task) -> list:
-    """Both reset rules on one drawn run (a task of :func:`reset_rule_study`): one row per rule."""
+    """Both reset rules on one drawn run, single-trial filter (the reference of :func:`_reset_rule_batch`)."""
     setup, mag, inputs, max_resets = task
     lim = nees_limit()
     rows = []
@@ -492,10 +497,43 @@ def _reset_rule_runs(task) -> list:
         try:
             a = adaptive_run(setup, inputs, reset=rule, smooth=False, max_resets=max_resets)
         except (ad.ResetError, ocbe.FilterDivergenceError):
-            rows.append((mag, rule, True, 1.0, True, max_resets + 1, False))
+            rows.append(_failed_row(mag, rule, max_resets))
             continue
         rows.append((mag, rule, bool(a.detections), a.nees_f_after,
                      a.nees_f_after > tracking.DIVERGED_FRACTION, len(a.detections), bool(a.final_nees < lim)))
+    return rows
+
+
+#: Drawn runs per task of :func:`reset_rule_study` (each filtered with every rule in one batch of twice as many trials).
+RUNS_PER_TASK = 16
+
+
+def _reset_rule_batch(task) -> list:
+    """Every reset rule on a batch of drawn runs (a task of :func:`reset_rule_study`): one batched adaptive filter
+    (forward pass, failures flagged per trial) over each run once per rule, one row per run and rule, runs in order,
+    rules within.
+
+    Each row equals the one :func:`_reset_rule_runs` gives for that run (the batched filter equals the single-trial
+    one to round-off; a run whose reset or filter fails is a failed row in both)."""
+    setup, runs, max_resets = task
+    sc, lim, k_burn = setup.scenario, nees_limit(), first_seen_epoch(setup)
+    rules = ad.RESET_RULES
+    trials = [(mag, rule, d) for mag, d in runs for rule in rules]
+    res, _, _, dets = ad.adaptive_ocbe_batch(setup.system, sc.t, np.array([d.y for _, _, d in trials]),
+                                             setup.observer_states, sc.model, sc.meas_cov,
+                                             np.array([d.x0 for _, _, d in trials]),
+                                             np.array([d.P0 for _, _, d in trials]), setup.control_weight,
+                                             reset=[rule for _, rule, _ in trials], max_resets=max_resets,
+                                             smooth=False, on_failure="flag")
+    rows = []
+    for b, (mag, rule, d) in enumerate(trials):
+        if res.failed[b]:
+            rows.append(_failed_row(mag, rule, max_resets))
+            continue
+        nf = consistency.nees(res.x_filt[b], res.P_filt[b], d.truth)
+        after = float(np.mean(nf[k_burn:] > lim))
+        rows.append((mag, rule, bool(dets[b]), after, after > tracking.DIVERGED_FRACTION, len(dets[b]),
+                     bool(nf[-1] < lim)))
     return rows
 
 
@@ -505,16 +543,19 @@ def reset_rule_study(setup: det.DetectionSetup, magnitudes_m_s, n_per_magnitude:
     :data:`cislunar.estimation.adaptive_ocbe.RESET_RULES`; inconsistency as in notebook 09 (more than
     :data:`tracking.DIVERGED_FRACTION` of the epochs from the burn on above the 99.9 % NEES quantile).
 
-    All runs are drawn from ``rng`` first (sizes in order), then filtered one task per run on ``executor``
-    (serial when None); the rows come back in the order of the draws."""
+    All runs are drawn from ``rng`` first (sizes in order), then filtered by the batched adaptive filter
+    (:func:`cislunar.estimation.adaptive_ocbe.adaptive_ocbe_batch`, forward pass, a failed run flagged and counted
+    as above), :data:`RUNS_PER_TASK` runs (each with every rule) per task on ``executor`` (serial when None); the
+    rows come back in the order of the draws, the rules in the order of ``RESET_RULES`` within each run."""
     _check_setup(setup)
     mags = tuple(float(m) for m in _burn_sizes(magnitudes_m_s))
     n = validation.integer(n_per_magnitude, "n_per_magnitude", minimum=1)
     validation.rng(rng)
     max_resets = validation.integer(max_resets, "max_resets", minimum=1)
     _check_executor(executor)
-    tasks = [(setup, mag, det.draw_trial(rng, setup, magnitude_m_s=mag), max_resets) for mag in mags for _ in range(n)]
-    rows = [row for rows in map_tasks(_reset_rule_runs, tasks, executor=executor, progress=False,
+    runs = [(mag, det.draw_trial(rng, setup, magnitude_m_s=mag)) for mag in mags for _ in range(n)]
+    tasks = [(setup, runs[i:i + RUNS_PER_TASK], max_resets) for i in range(0, len(runs), RUNS_PER_TASK)]
+    rows = [row for rows in map_tasks(_reset_rule_batch, tasks, executor=executor, progress=False,
                                       desc="adaptive runs") for row in rows]
     return ResetRuleStudy(tuple(rows), mags, tuple(ad.RESET_RULES))
 

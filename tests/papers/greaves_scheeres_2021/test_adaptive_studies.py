@@ -179,3 +179,17 @@ def test_study_arguments_are_refused_by_name_before_any_run(setup, nrho):
         ads.first_detection_epochs(setup, -0.05, 1, rng)
     # none of these drew from the generator: the checks come before the draws
     assert rng.bit_generator.state == np.random.default_rng(0).bit_generator.state
+
+
+def test_batched_reset_rule_rows_equal_the_single_trial_rows(setup):
+    """The reset-rule study's batched task gives, run by run and rule by rule, the row of the single-trial adaptive
+    filter (its reference), including a run that fails (more resets than allowed)."""
+    rng = np.random.default_rng(3)
+    runs = [(m, det.draw_trial(rng, setup, magnitude_m_s=m)) for m in (3.0, 3.0, 0.3, 0.05)]
+    for max_resets in (0, 5):  # 0: every detected run fails its first reset (a failed row)
+        batched = ads._reset_rule_batch((setup, runs, max_resets))
+        single = [row for m, d in runs for row in ads._reset_rule_runs((setup, m, d, max_resets))]
+        assert batched == single
+        assert [r[:2] for r in batched] == [(m, rule) for m, _ in runs for rule in ad.RESET_RULES]
+        assert sum(r[5] == max_resets + 1 for r in batched) == (6 if max_resets == 0 else 0)
+        assert any(not r[2] for r in batched)  # the 50 mm/s run is not detected
