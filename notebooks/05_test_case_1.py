@@ -36,11 +36,11 @@ QUICK = False
 SEED = 0  # no random draws in this chapter: every computation is deterministic
 OUTPUT_DIR = ""
 N_NODES = None  # Sundman-spaced nodes over the two periods; the paper does not give its N (None: 18 quick, 40 full)
-N_NODES_ALT = None  # node count of the second grid of the mesh check, Section 5 (None: 24 quick, 28 full)
+N_NODES_ALT = None  # node count of the second grid of the mesh check, Section 5 (None: 20 quick, 28 full)
 SIGMA = 1.0  # Sundman exponent of the node spacing dt = r_m^sigma dtau (notebook 04)
 ALPHAS = None  # homotopy weights alpha_h, increasing in [0, 1], must contain 5e-3 (None: [0, 5e-3, 1e-2] quick, 9 full)
-PENALTY_ITER = None  # iterations granted to the paper's exact-penalty SCvx in Section 4 (None: 10 quick, 80 full)
-PENALTY_ITER_LONG = None  # the same at gamma = 1e3 with a larger limit (None: 20 quick, 300 full)
+PENALTY_ITER = None  # iterations granted to the paper's exact-penalty SCvx in Section 4 (None: 5 quick, 80 full)
+PENALTY_ITER_LONG = None  # the same at gamma = 1e3 with a larger limit (None: 10 quick, 300 full)
 PENALTY_GAMMAS = None  # exact-penalty weights gamma swept, unstated in the paper (None: [1e1, 1e3, 1e5] quick, 1e1-1e5 full)
 BUDGETS_EXTRA_MPS = None  # impulse budgets above the baseline's, Section 8, m/s (None: [5] quick, [1, 5, 20] full)
 BUDGET_RTOL = 0.02  # a budget counts as met within this relative tolerance (fixed before solving)
@@ -50,11 +50,11 @@ SCHEDULER = ""  # address of a Dask scheduler to run them on, e.g. "tcp://10.0.0
 
 # %%
 n_nodes = N_NODES if N_NODES is not None else (18 if QUICK else 40)
-n_nodes_alt = N_NODES_ALT if N_NODES_ALT is not None else (24 if QUICK else 28)
+n_nodes_alt = N_NODES_ALT if N_NODES_ALT is not None else (20 if QUICK else 28)
 alphas = ALPHAS if ALPHAS is not None else ([0.0, 5e-3, 1e-2] if QUICK else  # quick: the grid's top as right panels
                                             [0.0, 1e-3, 2e-3, 3e-3, 5e-3, 7e-3, 1e-2, 1.5e-2, 2e-2])
-penalty_iter = PENALTY_ITER if PENALTY_ITER is not None else (10 if QUICK else 80)
-penalty_iter_long = PENALTY_ITER_LONG if PENALTY_ITER_LONG is not None else (20 if QUICK else 300)
+penalty_iter = PENALTY_ITER if PENALTY_ITER is not None else (5 if QUICK else 80)
+penalty_iter_long = PENALTY_ITER_LONG if PENALTY_ITER_LONG is not None else (10 if QUICK else 300)
 penalty_gammas = PENALTY_GAMMAS if PENALTY_GAMMAS is not None else ([1e1, 1e3, 1e5] if QUICK else
                                                                      [1e1, 1e2, 1e3, 1e4, 1e5])
 budgets_extra_mps = BUDGETS_EXTRA_MPS if BUDGETS_EXTRA_MPS is not None else ([5.0] if QUICK else [1.0, 5.0, 20.0])
@@ -462,7 +462,7 @@ table.display()
 #    more or less impulse, and will its terminal RMS move as much? Think of what a first-order-hold control can
 #    represent on a coarser grid. Worked solution: `exercises.exercise_05_node_count`, which solves
 #    $\alpha_h = 0$ on 10, 14 and 18 nodes.
-# 2. **Patience for the printed method.** Raise `PENALTY_ITER_LONG` (20 in quick mode) to 60. Does the paper's
+# 2. **Patience for the printed method.** Raise `PENALTY_ITER_LONG` (10 in quick mode) to 60. Does the paper's
 #    exact-penalty SCvx converge if it is only given more iterations? Predict what happens to its largest defect,
 #    its best accepted cost and its trust-region radius (the long-run line of Section 4 and the row "printed SCvx
 #    at gamma 1e3 with a larger iteration limit"). Worked solution: `exercises.exercise_05_penalty_iterations`

@@ -43,8 +43,8 @@ SEED = 0  # no random draws in this chapter; kept for the common parameter inter
 OUTPUT_DIR = ""
 N_NODES = None  # Sundman nodes over the three periods, window ends moved onto nodes (None: 16 quick, 30 full)
 MAX_ITER = None  # SCvx iteration limit per run (None: 100 quick, 150 full)
-N_NODES_ALT = None  # other node grids on which the whole sweep is solved again (None: [14] quick, [24, 27] full)
-FREE_ITER = None  # iterations granted to the run without keep-out, which does not converge (None: 10 quick, 75 full)
+N_NODES_ALT = None  # other node grids on which the whole sweep is solved again (None: [12] quick, [24, 27] full)
+FREE_ITER = None  # iterations granted to the run without keep-out, which does not converge (None: 5 quick, 75 full)
 SIGMA = 1.0  # Sundman exponent of the node spacing dt = r_m^sigma dtau (notebook 04)
 ALPHAS = None  # homotopy weights alpha_h, increasing in [0, 1] (None: [0, 5e-3, 1e-2] quick; 8 values full)
 SEED_ALPHAS = None  # weights solved from +z and -z seeds, Fig. 7's pair (None: [] quick, [5e-3, 7e-3] full)
@@ -62,8 +62,8 @@ SCHEDULER = ""  # address of a Dask scheduler to run them on, e.g. "tcp://10.0.0
 # %%
 n_nodes = N_NODES if N_NODES is not None else (16 if QUICK else 30)
 max_iter = MAX_ITER if MAX_ITER is not None else (100 if QUICK else 150)
-n_nodes_alt = N_NODES_ALT if N_NODES_ALT is not None else ([14] if QUICK else [24, 27])
-free_iter = FREE_ITER if FREE_ITER is not None else (10 if QUICK else 75)
+n_nodes_alt = N_NODES_ALT if N_NODES_ALT is not None else ([12] if QUICK else [24, 27])
+free_iter = FREE_ITER if FREE_ITER is not None else (5 if QUICK else 75)
 alphas = ALPHAS if ALPHAS is not None else ([0.0, 5e-3, 1e-2] if QUICK else [0.0, 5e-4, 1e-3, 2e-3, 5e-3, 7e-3, 1e-2,
                                                                               2e-2])
 seed_alphas = SEED_ALPHAS if SEED_ALPHAS is not None else ([] if QUICK else [5e-3, 7e-3])
@@ -546,7 +546,7 @@ table.display()
 #    ten metres) and `SCAN_POINTS = 7`. Before running, use the range-rate Jacobian of Section 3, which grows like
 #    $1/\rho$, to predict how many nats each factor of 10 closer adds to the MI of the window; then read the
 #    figure `06_keep_out_motivation`. Worked solution: `exercises.exercise_06_close_pass_scan`.
-# 2. **No keep-out, more patience.** Raise `FREE_ITER` (10 in quick mode) to 30. Will SCvx without a keep-out
+# 2. **No keep-out, more patience.** Raise `FREE_ITER` (5 in quick mode) to 30. Will SCvx without a keep-out
 #    converge if it is given more iterations? Predict its best accepted cost and its largest defect (the
 #    "without the keep-out" lines of Section 11 and the row "SCvx converges for every alpha_h without a
 #    keep-out"). Worked solution: `exercises.exercise_06_free_run_iterations` (10 and 30 iterations on 12 nodes).

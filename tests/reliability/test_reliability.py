@@ -562,7 +562,12 @@ PLUGINS = _load_plugins()
 
 
 def _plugin_specs():
-    return [s for plugin in PLUGINS for s in plugin.specs(Spec, lazy)]
+    out = []
+    for plugin in PLUGINS:
+        for s in plugin.specs(Spec, lazy):
+            s.source = plugin.__name__.removeprefix("reliability_specs_")
+            out.append(s)
+    return out
 
 
 SPECS = _specs() + _plugin_specs()
@@ -570,12 +575,25 @@ SPEC_BY_LABEL = {s.label: s for s in SPECS}
 assert len(SPEC_BY_LABEL) == len(SPECS), "duplicate spec labels"
 
 
+def _grouped(label, *values, id=None):
+    """A parameter set of ``label``'s spec, in the xdist group of the table it comes from (the core table or one
+    plugin).  A plugin's valid objects (a torus, an SCvx sweep, LMI designs) are cached per process, so its baseline
+    and bad-argument tests running in one worker build them once instead of once per worker."""
+    group = getattr(SPEC_BY_LABEL[label], "source", "core")
+    return pytest.param(*values, id=id, marks=pytest.mark.xdist_group(f"reliability-{group}"))
+
+
 def _resolve(spec):
     return {k: (v() if getattr(v, "_lazy", False) else v) for k, v in spec.kwargs.items()}
 
 
 def _bad_cases():
-    """Every (spec label, argument, bad value index) triple of the deterministic sweep."""
+    """Every (spec label, argument, bad value index) triple of the deterministic sweep.
+
+    It builds every valid object of the table (the lazy ones too: SCvx sweeps, tori, LMI designs), so it serves the
+    audit counts of ``python tests/reliability/test_reliability.py`` only; the tests are collected per (spec,
+    argument) without building anything and draw each argument's bad values when they run.
+    """
     out = []
     for spec in SPECS:
         for arg, kind in spec.kinds.items():
@@ -585,12 +603,16 @@ def _bad_cases():
     return out
 
 
-def _bad_value(spec, arg, i):
-    kind = spec.kinds[arg]
+def _bad_values_of(spec, arg):
+    """The deterministic bad values of one argument (built from its valid value, lazy ones resolved now)."""
     valid = spec.kwargs[arg]
     if getattr(valid, "_lazy", False):
         valid = valid()
-    return bad_values(kind, valid)[i]
+    return bad_values(spec.kinds[arg], valid)
+
+
+def _bad_value(spec, arg, i):
+    return _bad_values_of(spec, arg)[i]
 
 
 def classify(spec, arg, bad):
@@ -606,8 +628,6 @@ def classify(spec, arg, bad):
         return f"crash: {type(exc).__name__}: {exc}"
     return "junk"
 
-
-CASES = _bad_cases()
 
 
 CORE_MODULES = (dynamics, propagation, orbits, srif, sites, measurements, tracking, detection, ocbe, batched_ocbe,
@@ -663,7 +683,7 @@ def test_every_module_is_swept_or_listed():
     assert not stale, f"modules swept but still listed as not swept: {stale}"
 
 
-@pytest.mark.parametrize("label", [s.label for s in SPECS if s.baseline])
+@pytest.mark.parametrize("label", [_grouped(s.label, s.label, id=s.label) for s in SPECS if s.baseline])
 def test_valid_baseline_calls_succeed(label):
     """The table's valid calls run, so a refused bad value is refused because of that value."""
     spec = SPEC_BY_LABEL[label]
@@ -671,16 +691,15 @@ def test_valid_baseline_calls_succeed(label):
     fn(**_resolve(spec))
 
 
-ARGS = sorted({(label, arg) for label, arg, _ in CASES}, key=lambda la: (la[0], la[1]))
+ARGS = sorted({(s.label, arg) for s in SPECS for arg in s.kinds}, key=lambda la: (la[0], la[1]))
 
 
-@pytest.mark.parametrize("label,arg", ARGS, ids=[f"{a}-{b}" for a, b in ARGS])
+@pytest.mark.parametrize("label,arg", [_grouped(a, a, b, id=f"{a}-{b}") for a, b in ARGS])
 def test_every_bad_argument_is_refused_by_name(label, arg):
     """All malformed values of one argument: each must raise ValueError/TypeError naming the argument."""
     spec = SPEC_BY_LABEL[label]
     problems = []
-    for _, _, i in (c for c in CASES if c[0] == label and c[1] == arg):
-        bad = _bad_value(spec, arg, i)
+    for bad in _bad_values_of(spec, arg):
         outcome = classify(spec, arg, bad)
         if outcome != "named":
             problems.append(f"{label}({arg}={bad!r:.60}): {outcome[:200]}")
@@ -1334,7 +1353,7 @@ if __name__ == "__main__":  # audit-style counts of the deterministic sweep
 
     counts = Counter()
     bad = []
-    for label, arg, i in CASES:
+    for label, arg, i in _bad_cases():
         spec = SPEC_BY_LABEL[label]
         out = classify(spec, arg, _bad_value(spec, arg, i))
         key = out.split(":")[0]
