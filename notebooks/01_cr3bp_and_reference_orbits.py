@@ -455,6 +455,7 @@ table.display()
 # 3. **How tightly do the tables pin $\mu$?** Set `MU_STEP = 1e-10`, then `MU_STEP = 1e-8`. Using the linear growth
 #    of the closure with $|\Delta\mu|$ (Section 3: about $2.5\times10^{-7}$ per $10^{-9}$ above the $10^{-8}$
 #    floor of nine printed digits), predict the closures printed for $\mu \pm$ `MU_STEP` and whether they pass
-#    `CLOSURE_TOL`; then check the printout of Section 3. (No separate worked solution: the notebook's own
-#    `wjt.mu_closure_study` is the check, and `tests/papers/wolf_jones/test_reference_tables.py` tests the linear
-#    growth.)
+#    `CLOSURE_TOL`; then check the printout of Section 3. Worked solution (a Wolf & Jones exercise, so in that
+#    paper's package): `cislunar.papers.wolf_jones.exercises.exercise_01_mu_step`, which turns the closures at
+#    $\mu \pm 10^{-9}$ into bounds on the slope (by the triangle inequality the closure differs from
+#    slope $\times\,|\Delta\mu|$ by at most the floor) and from them into an interval for each new step.

@@ -534,12 +534,16 @@ def build_book(build_dir=None, *, out_dir=None, quiet: bool = True, expected=Non
 
 
 def main(argv=None) -> int:
-    """Command-line entry point; returns the process exit status."""
+    """Command-line entry point; returns the process exit status (1 if the build is refused, 2 outside a checkout)."""
     parser = argparse.ArgumentParser(prog="python -m cislunar.publish.book", description=__doc__.split("\n\n")[0])
     parser.add_argument("--build-dir", default=None, help="build directory with executed notebooks (default: build/)")
     parser.add_argument("--out-dir", default=None, help="HTML output directory (default: <build>/book)")
     parser.add_argument("-v", "--verbose", action="store_true", help="show Sphinx's progress output")
     args = parser.parse_args(argv)
+    missing = runner._missing_checkout("book", "cislunar-book")
+    if missing:
+        print(missing, file=sys.stderr)
+        return 2
     start = time.perf_counter()
     try:
         index = build_book(args.build_dir, out_dir=args.out_dir, quiet=not args.verbose)

@@ -35,6 +35,7 @@ import argparse
 import ast
 import contextlib
 import functools
+import importlib.metadata
 import json
 import os
 import shutil
@@ -727,8 +728,45 @@ def _child(spec_path: str) -> int:
     return 0 if result["ok"] else 1
 
 
+#: Labels of ``[project.urls]`` in ``pyproject.toml`` that name where the repository can be cloned from.
+_REPOSITORY_LABELS = ("repository", "source", "source code", "code", "homepage")
+
+
+def _repository_url() -> str | None:
+    """The repository URL declared in the installed package's metadata (``[project.urls]``), if any."""
+    try:
+        entries = importlib.metadata.metadata("cislunar").get_all("Project-URL") or []
+    except importlib.metadata.PackageNotFoundError:
+        return None
+    for entry in entries:
+        label, _, url = entry.partition(",")
+        if label.strip().lower() in _REPOSITORY_LABELS and url.strip():
+            return url.strip()
+    return None
+
+
+def _missing_checkout(folder: str, command: str) -> str | None:
+    """``None`` if the repository's ``folder`` is reachable, else the one-line error that ``command`` prints.
+
+    The notebooks, the book's configuration and the build folders live in the repository, not in the installed
+    package: an installed wheel finds them only through ``CISLUNAR_ROOT``.
+    """
+    try:
+        root = paths.repo_root()
+    except FileNotFoundError:
+        where = "the installed package is not inside a checkout of the repository and CISLUNAR_ROOT is not set"
+    else:
+        if (root / folder).is_dir():
+            return None
+        where = f"{root} has no {folder}/ folder"
+    url = _repository_url()
+    clone = f"git clone {url}" if url else "clone the cislunar repository"
+    return (f"error: {command} needs the repository's {folder}/ folder, which the installed package does not "
+            f"include ({where}); {clone} and run it from that checkout, or set CISLUNAR_ROOT to a checkout")
+
+
 def main(argv=None) -> int:
-    """Command-line entry point; returns the process exit status."""
+    """Command-line entry point; returns the process exit status (2 on bad arguments or outside a checkout)."""
     parser = argparse.ArgumentParser(prog="python -m cislunar.publish.notebooks", description=__doc__.split("\n\n")[0])
     parser.add_argument("names", nargs="*", help="notebook number or name prefixes (default: all)")
     parser.add_argument("--quick", action="store_true", help="quick mode: smaller sizes, same science")
@@ -746,6 +784,10 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     if args.child:
         return _child(args.child)
+    missing = _missing_checkout("notebooks", "cislunar-notebooks")
+    if missing:
+        print(missing, file=sys.stderr)
+        return 2
     try:
         sources = discover(args.names)
         params = dict(parse_parameter(p) for p in args.parameter)

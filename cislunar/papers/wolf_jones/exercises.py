@@ -1,4 +1,5 @@
-r"""Worked solutions of the exercises that close the Wolf & Jones chapters (notebooks 02-06).
+r"""Worked solutions of the exercises that close the Wolf & Jones chapters (notebooks 02-06), and of notebook 01's
+exercise on Wolf & Jones' DRO tables (``MU_STEP``; the chapter's other exercises are Greaves & Scheeres').
 
 Each notebook ends with a markdown cell "Exercises": change a parameter, predict what happens, then check.  The
 functions here are the worked solutions, at sizes small enough to run in a few seconds; each returns a small frozen
@@ -15,10 +16,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cislunar.cr3bp.dynamics import EARTH_MOON
+from cislunar.cr3bp.dynamics import EARTH_MOON, check_system
 from cislunar.guidance import scvx
 from cislunar.papers.wolf_jones import _checks, nodes_study, scenarios, scvx_study
 from cislunar.papers.wolf_jones import mutual_information_study as mi_study
+from cislunar.papers.wolf_jones import reference_tables as wjt  # notebook 01
 from cislunar.papers.wolf_jones import test_case_studies as tc_studies  # notebooks 05-06
 from cislunar.sensing import information as info
 from cislunar.sensing import measurements as meas
@@ -27,10 +29,12 @@ from cislunar.utils import validation
 __all__ = [
     "ControlSizeAnswer",
     "MonteCarloSamplesAnswer",
+    "MuStepAnswer",
     "NodeCountAnswer",
     "NodeSpacingAnswer",
     "RangeNoiseAnswer",
     "ThrustBoundAnswer",
+    "exercise_01_mu_step",
     "exercise_02_monte_carlo_samples",
     "exercise_02_range_noise",
     "exercise_03_node_count",
@@ -38,6 +42,118 @@ __all__ = [
     "exercise_04_control_size",
     "exercise_04_node_count",
 ]
+
+
+# ===============================================================================================================
+# Notebook 01: how tightly Wolf & Jones' printed DRO rows pin the mass ratio
+# ===============================================================================================================
+
+
+@dataclass(frozen=True)
+class MuStepAnswer:
+    """Closures of the printed periodic DRO rows at :math:`\\mu \\pm` step, predicted from the reference step and
+    measured.
+
+    All closures are the largest :math:`\\|x(T) - x_0\\|` over the six rows periodic as printed (non-dimensional,
+    rotating frame; :func:`~cislunar.papers.wolf_jones.reference_tables.mu_closure_study`).
+
+    Attributes
+    ----------
+    steps : tuple of float
+        The trial values of ``MU_STEP`` (dimensionless), increasing.
+    reference_step : float
+        The step whose closures the reader has already seen printed (the notebook's default, 1e-9).
+    floor : float
+        Closure at the adopted :math:`\\mu` (the nine-printed-digit floor).
+    slope_bounds : (float, float)
+        Bounds on :math:`s = \\max_r \\|\\partial x_r(T)/\\partial\\mu\\|` read from the reference step's closures
+        (LU per unit of :math:`\\mu`).
+    predicted : dict of float -> (float, float)
+        Step -> interval the closure at :math:`\\mu \\pm` step must lie in, to first order in the step.
+    measured : dict of float -> (float, float)
+        Step -> closures at :math:`\\mu +` step and :math:`\\mu -` step.
+    predicted_pass : dict of float -> bool or None
+        Step -> ``True`` if the whole predicted interval is below ``tolerance``, ``False`` if it is at or above it,
+        ``None`` if the prediction cannot tell.
+    measured_pass : dict of float -> bool
+        Step -> both closures below ``tolerance`` (what the notebook prints as "closes").
+    tolerance : float
+        ``CLOSURE_TOL``.
+    """
+
+    steps: tuple
+    reference_step: float
+    floor: float
+    slope_bounds: tuple
+    predicted: dict
+    measured: dict
+    predicted_pass: dict
+    measured_pass: dict
+    tolerance: float
+    answer: str
+
+
+def exercise_01_mu_step(steps=(1e-10, 1e-8), reference_step: float = 1e-9, system=EARTH_MOON) -> MuStepAnswer:
+    """Notebook 01, exercise 3: set ``MU_STEP`` to each of ``steps`` and predict the closures printed for
+    :math:`\\mu \\pm` ``MU_STEP`` from those of ``reference_step``, and whether they pass ``CLOSURE_TOL``.
+
+    The prediction is first order in the step.  Row *r*'s miss after one period is
+    :math:`e_r + J_r\\,\\delta\\mu` with :math:`\\|e_r\\| \\le f` (the floor, the closure at the adopted value) and
+    :math:`J_r = \\partial x_r(T)/\\partial\\mu`, so by the triangle inequality the largest closure obeys
+    :math:`|c(\\delta\\mu) - s\\,|\\delta\\mu|| \\le f` with :math:`s = \\max_r\\|J_r\\|`.  The reference step's two
+    closures bound :math:`s`; the same inequality then gives an interval for every other step.
+
+    Parameters
+    ----------
+    steps : sequence of float
+        Trial values of ``MU_STEP`` (dimensionless, > 0), in any order.
+    reference_step : float
+        Step whose closures fix the slope (dimensionless, > 0; the notebook's default 1e-9).
+    system : CR3BP
+        The adopted system (Earth-Moon by default).
+    """
+    check_system(system)
+    trial_steps = tuple(sorted({validation.positive(v, "steps") for v in
+                                validation.as_array(steps, "steps", ndim=(1,), min_size=1)}))
+    ref = validation.positive(reference_step, "reference_step")
+    if ref in trial_steps:
+        raise ValueError(f"steps must not contain reference_step {ref!r}; got {steps!r}")
+    mu = system.mu
+    every = (ref, *trial_steps)
+    study = wjt.mu_closure_study(system, [mu] + [mu + sign * d for d in every for sign in (1, -1)])
+    floor = study.adopted_closure
+    measured = {d: (study.closure[mu + d], study.closure[mu - d]) for d in every}
+    # s is within f of each reference closure divided by the reference step
+    s_lo = max(0.0, *((c - floor) / ref for c in measured[ref]))
+    s_hi = min((c + floor) / ref for c in measured[ref])
+    tol = study.tolerance
+    predicted, predicted_pass, measured_pass = {}, {}, {}
+    for d in trial_steps:
+        lo, hi = max(0.0, s_lo * d - floor), s_hi * d + floor
+        predicted[d] = (lo, hi)
+        predicted_pass[d] = True if hi < tol else (False if lo >= tol else None)
+        measured_pass[d] = bool(max(measured[d]) < tol)
+    resolution = (tol - floor) / (0.5 * (s_lo + s_hi))
+    lines = []
+    for d in trial_steps:
+        (lo, hi), (cp, cm) = predicted[d], measured[d]
+        verdict = {True: "closes", False: "fails", None: "cannot tell"}[predicted_pass[d]]
+        lines.append(f"MU_STEP = {d:.0e}: predicted {lo:.1e} to {hi:.1e} ({verdict}), printed {cp:.1e} and {cm:.1e} "
+                     f"({'closes' if measured_pass[d] else 'fails'})")
+    answer = (f"At the adopted mu the rows close to {floor:.1e} (the floor of nine printed digits); at mu +- "
+              f"{ref:.0e} they miss by {measured[ref][0]:.1e} and {measured[ref][1]:.1e}. The miss of each row is the "
+              "floor plus the period map's sensitivity to mu times the step, so away from the floor the closure grows "
+              f"linearly with the step, with a slope between {s_lo:.0f} and {s_hi:.0f} LU per unit of mu, and never "
+              f"strays from slope x step by more than the floor. Hence: " + "; ".join(lines) + f". The closure reaches CLOSURE_TOL = {tol:.0e} at a step of about (CLOSURE_TOL - floor) / slope = "
+              f"{resolution:.0e}: a smaller step stays within the floor's reach and the rows still close (the tables do not resolve "
+              "it), a larger one fails. The printed rows therefore pin mu to within a few times 1e-10, which is why the "
+              f"chapter's mu row asks every trial at least {wjt.MU_PIN_OFFSET:.1e} away to fail.")
+    return MuStepAnswer(trial_steps, ref, floor, (s_lo, s_hi), predicted, measured, predicted_pass, measured_pass,
+                        tol, answer)
+
+
+# End of notebook 01
+# ===============================================================================================================
 
 
 # ===============================================================================================================
@@ -543,9 +659,11 @@ def exercise_06_free_run_iterations(max_iter=(10, 30), *, n_nodes: int = 12,
     last = tuple(float(f.ref_range_km[-1]) for f in runs)
     answer = (f"Without a keep-out, more iterations do not bring convergence: after {limits[0]} and {limits[1]} "
               f"iterations (alpha_h = {alpha:g}, {n} nodes) the run "
-              f"{'has not converged in either' if not any(conv) else 'converged in ' + str(sum(conv))}. The cost "
-              f"keeps sinking ({best[0]:.5f} -> {best[1]:.5f}) while the defects stay open ({defect[0]:.1e} -> "
-              f"{defect[1]:.1e}): every step buys information faster than it closes the dynamics, because the MI "
+              f"{'has not converged in either' if not any(conv) else 'converged in ' + str(sum(conv))}. The best "
+              f"accepted cost {'sinks further' if best[1] < best[0] else 'stops improving'} ({best[0]:.5f} -> "
+              f"{best[1]:.5f}; it cannot rise, the longer run repeats the shorter one first) while the defects stay "
+              f"open ({defect[0]:.1e} -> {defect[1]:.1e}): the steps buy information rather than close the "
+              "dynamics, because the MI "
               "rewards flying ever closer to a target (exercise 1: one nat per e-fold, without bound). The closest "
               f"approach of the last reference to a target moves from {last[0]:.0f} km to {last[1]:.0f} km. A "
               "keep-out turns the reward bounded and the problem solvable; the notebook's row 'SCvx converges "

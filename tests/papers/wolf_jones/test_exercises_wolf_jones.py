@@ -4,7 +4,47 @@ claim its answer makes (the predicted direction and size of the change), so a wr
 import numpy as np
 import pytest
 
+from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.papers.wolf_jones import exercises as X
+from cislunar.papers.wolf_jones import reference_tables as wjt
+
+# ===============================================================================================================
+# Notebook 01 (MU_STEP: how tightly the printed DRO rows pin mu)
+# ===============================================================================================================
+
+
+def test_01_closure_grows_linearly_with_the_mu_step_within_the_floor():
+    a = X.exercise_01_mu_step(steps=(1e-8, 1e-10), reference_step=1e-9)
+    assert a.steps == (1e-10, 1e-8) and a.reference_step == 1e-9 and a.tolerance == 1e-7
+    f = a.floor
+    assert 0 < f < a.tolerance  # the printed rows close at the adopted mu
+    # the slope read from the reference step brackets what the 1e-9 closures say, and is of order 100 LU
+    s_lo, s_hi = a.slope_bounds
+    assert 100 < s_lo < s_hi < 1000 and s_hi - s_lo <= 2 * f / 1e-9 * (1 + 1e-12)
+    assert s_lo == pytest.approx(max(c - f for c in a.measured[1e-9]) / 1e-9)
+    assert s_hi == pytest.approx(min(c + f for c in a.measured[1e-9]) / 1e-9)
+    for c in a.measured[1e-9]:
+        assert s_lo * 1e-9 - f <= c <= s_hi * 1e-9 + f
+    for d in a.steps:
+        lo, hi = a.predicted[d]
+        assert lo == pytest.approx(max(0.0, s_lo * d - f)) and hi == pytest.approx(s_hi * d + f)
+        for c in a.measured[d]:  # |c(d) - s |d|| <= f, whichever sign the step has
+            assert lo <= c <= hi, (d, c, lo, hi)
+    # first order: ten times the step, ten times the miss (up to the floor on each side)
+    for cp, c9 in zip(a.measured[1e-8], a.measured[1e-9]):
+        assert abs(cp - 10 * c9) <= 11 * f
+    # the measured pair is the notebook's printout for mu + d and mu - d (checked against the study itself)
+    check = wjt.mu_closure_study(em, [em.mu - 1e-8])
+    assert check.closure[em.mu - 1e-8] == a.measured[1e-8][1] and check.adopted_closure == f
+    assert all(a.measured_pass[d] == all(c < a.tolerance for c in a.measured[d]) for d in a.steps)
+    # 1e-10 is inside the floor's reach (closes), 1e-8 is not (fails); the prediction agrees with the printout
+    assert a.predicted_pass == {1e-10: True, 1e-8: False} == a.measured_pass
+    assert "closes" in a.answer and "fails" in a.answer
+    with pytest.raises(ValueError, match="reference_step"):
+        X.exercise_01_mu_step(steps=(1e-9,), reference_step=1e-9)
+    with pytest.raises(ValueError, match="steps"):
+        X.exercise_01_mu_step(steps=(-1e-9,))
+
 
 # ===============================================================================================================
 # Notebooks 02-04
@@ -107,8 +147,10 @@ def test_06_each_decade_closer_adds_ln10_nats():
 def test_06_without_keep_out_more_iterations_do_not_converge():
     a = X.exercise_06_free_run_iterations(max_iter=(10, 30))
     assert not any(a.converged)
-    assert a.best_cost[1] < a.best_cost[0]  # the cost keeps sinking ...
-    assert a.last_defect[1] > 1e-6  # ... with the defects still open
+    # the 30-iteration run repeats the 10-iteration one first, so its best cost is no higher; whether it sinks
+    # further depends on round-off (numpy 2.0: no; the lock's numpy 2.4: yes), so only the bound is asserted
+    assert a.best_cost[1] <= a.best_cost[0] < 0
+    assert min(a.last_defect) > 1e-6  # the defects stay open at both limits
     assert "more iterations do not bring convergence" in a.answer
     with pytest.raises(ValueError):
         X.exercise_06_free_run_iterations(max_iter=(10, 10))
