@@ -45,11 +45,12 @@ from scipy import optimize, stats
 
 from cislunar.cr3bp.dynamics import CR3BP, check_system
 from cislunar.cr3bp.orbits import PeriodicOrbit
-from cislunar.cr3bp.propagation import DEFAULT_TOL, _check_tol
+from cislunar.cr3bp.propagation import DEFAULT_TOL, _check_tol, propagate
 from cislunar.estimation import ocbe
 from cislunar.estimation.batched_ocbe import BatchOCBEResult, ocbe_batch
 from cislunar.estimation.consistency import _nees, nees_limit
 from cislunar.papers.greaves_scheeres_2021 import tracking
+from cislunar.sensing import measurements
 from cislunar.utils import validation
 from cislunar.utils.montecarlo import (
     MonteCarloError,
@@ -70,10 +71,12 @@ __all__ = [
     "TrialResult",
     "MonteCarloSample",
     "draw_trial",
+    "draw_trials",
     "run_trial_filter",
     "detection_trial",
     "detection_trial_batch",
     "run_detection_monte_carlo",
+    "run_detection_monte_carlos",
     "fit_pdf",
     "pdf_crossings",
     "error_rates",
@@ -85,10 +88,13 @@ __all__ = [
     "detection_accuracy",
     "PolicyStudy",
     "run_policy_study",
+    "run_policy_studies",
     "filter_trials",
+    "filter_trial_sets",
     "control_spike_contrast",
     "azimuth_contrast",
     "direction_response",
+    "direction_trials",
     "HealthLeadStudy",
     "health_lead_study",
 ]
@@ -399,29 +405,115 @@ def draw_trial(rng: np.random.Generator, setup: DetectionSetup, policy: StationK
         The burn must fall strictly inside the track.  The draws do not depend on it.
     """
     validation.rng(rng)
+    return draw_trials([rng], setup, policy, magnitude_m_s=magnitude_m_s, direction=direction,
+                       burn_offset_hours=burn_offset_hours)[0]
+
+
+def draw_trials(rngs, setup: DetectionSetup, policy: StationKeepingPolicy | None = None, *,
+                magnitude_m_s: float | None = None, direction=None, burn_offset_hours: float = 0.0) -> list:
+    """:func:`draw_trial` for several generators at once (one trial per generator, the same draws).
+
+    Each generator is consumed exactly as by :func:`draw_trial` (magnitude, pointing, measurement noise, hand-off
+    error, in that order), so trial ``b`` equals ``draw_trial(rngs[b], ...)``: the random numbers bit for bit, the
+    truth to round-off.  What is shared: the magnitudes come from one vectorised inverse CDF of the truncated
+    Gaussian (the algorithm of :meth:`scipy.stats.rv_continuous.rvs`, bit-identical), the arc before the burn is
+    propagated once, the arcs after it in one batched (SIMD) propagation, and the measurements in one call.
+
+    Parameters
+    ----------
+    rngs : sequence of numpy.random.Generator
+    setup, policy, magnitude_m_s, direction, burn_offset_hours
+        As in :func:`draw_trial`, the same for every trial.
+
+    Returns
+    -------
+    list of TrialInputs
+        One per generator, in order.
+    """
+    try:
+        rngs = list(rngs)
+    except TypeError:
+        raise validation.ArgumentTypeError(f"rngs must be a sequence of numpy.random.Generator; got "
+                                           f"{type(rngs).__name__}") from None
+    if not rngs:
+        raise ValueError("rngs must hold at least one generator")
+    for r in rngs:
+        validation.rng(r, "rngs")
     _check_setup(setup)
     _check_policy(policy, optional=True)
     em, sc = setup.system, setup.scenario
     t_burn = setup.t_maneuver + validation.real(burn_offset_hours, "burn_offset_hours") * 3600.0 / em.time_unit_s
     if not sc.t[0] < t_burn < sc.t[-1]:
         raise ValueError(f"burn_offset_hours puts the burn outside the track; got {burn_offset_hours!r}")
-    maneuvers, mag, az, el = [], 0.0, np.nan, np.nan
-    if policy is not None or magnitude_m_s is not None:
+    if magnitude_m_s is not None:
+        magnitude_m_s = validation.positive(magnitude_m_s, "magnitude_m_s", allow_zero=True)
+    if direction is not None:
+        direction = validation.as_array(direction, "direction", shape=(2,))
+    return _draw_trials(rngs, setup, policy, magnitude_m_s, direction, t_burn)
+
+
+def _draw_trials(rngs, setup, policy, magnitude_m_s, direction, t_burn) -> list:
+    """:func:`draw_trials` after its checks (``t_burn`` in TU inside the track)."""
+    em, sc = setup.system, setup.scenario
+    B, t = len(rngs), sc.t
+    maneuver = policy is not None or magnitude_m_s is not None
+    y_shape = np.broadcast_shapes(sc.observers.shape[:-1], (t.size, 1)) + (sc.model.dim,)  # simulate_measurements
+    u, az, el = np.empty(B), np.full(B, np.nan), np.full(B, np.nan)
+    noise, e0 = np.empty((B,) + y_shape), np.empty((B, 6))
+    for b, rng in enumerate(rngs):  # every generator in the order of draw_trial's calls
+        if maneuver:
+            if policy is not None:
+                u[b] = rng.uniform()  # scipy's rvs: the inverse CDF of one uniform draw
+            az[b], el[b] = rng.uniform(-np.pi, np.pi), rng.uniform(-np.pi / 2, np.pi / 2)  # Eqs. 3-4
+        noise[b] = rng.standard_normal(y_shape)  # tracking.simulate_measurements
+        e0[b] = rng.standard_normal(6)  # tracking.initial_estimate
+    mag = np.zeros(B)
+    if maneuver:
         if policy is not None:
-            mag, az, el = (float(v) for v in policy.sample(rng))
-        else:
-            az, el = (float(v) for v in StationKeepingPolicy.sample_pointing(rng))
+            mag = policy.magnitude_distribution.ppf(u)  # Eq. 5, as StationKeepingPolicy.sample_magnitude
         if magnitude_m_s is not None:
-            mag = validation.positive(magnitude_m_s, "magnitude_m_s", allow_zero=True)
+            mag = np.full(B, magnitude_m_s)
         if direction is not None:
-            az, el = (float(v) for v in validation.as_array(direction, "direction", shape=(2,)))
-        dv = pointing_vector(az, el) * mag * 1e-3 / em.velocity_unit_km_s
-        maneuvers = [(t_burn, dv)]
-    truth = tracking.simulate_truth(em, sc.x_start, sc.t, maneuvers)
-    y = tracking.simulate_measurements(sc, truth, rng)
-    y = y[:, 0] if y.ndim == 3 else y  # one observer
-    x0, P0 = tracking.initial_estimate(em, truth[0], rng)
-    return TrialInputs(mag, az, el, truth, y, x0, P0)
+            az, el = np.full(B, direction[0]), np.full(B, direction[1])
+    truth = _truths(setup, t_burn, pointing_vector(az, el) * mag[:, None] * 1e-3 / em.velocity_unit_km_s
+                    if maneuver else None)
+    y = _measurements(sc, truth, noise)
+    y = y[:, :, 0] if y.ndim == 4 else y  # one observer
+    truth = np.broadcast_to(truth, (B,) + truth.shape[1:])  # without a burn one truth serves every trial (read-only)
+    sp = em.km_to_lu(tracking.HANDOFF_3SIGMA_KM / 3.0)  # tracking.initial_estimate
+    sv = tracking.HANDOFF_3SIGMA_KM_S / 3.0 / em.velocity_unit_km_s
+    P0 = np.diag(np.r_[np.full(3, sp**2), np.full(3, sv**2)])
+    x0 = truth[:, 0] + e0 * np.sqrt(np.diag(P0))
+    return [TrialInputs(float(mag[b]), float(az[b]), float(el[b]), truth[b], y[b], x0[b], P0.copy())
+            for b in range(B)]
+
+
+def _truths(setup, t_burn, dv) -> np.ndarray:
+    """True states (B, N, 6) of :func:`tracking.simulate_truth` with one impulse ``dv`` (B, 3) at ``t_burn`` (or
+    none: ``dv=None``, one truth (1, N, 6) for every trial): the arc before the burn is propagated once, the arcs
+    after it together (batched)."""
+    em, sc = setup.system, setup.scenario
+    t = sc.t
+    if dv is None:
+        return tracking.simulate_truth(em, sc.x_start, t)[None]
+    B = dv.shape[0]
+    j = int(np.searchsorted(t, t_burn, side="right"))  # epochs up to and including the burn see the first arc
+    out = np.empty((B, t.size, 6))
+    out[:, :j] = propagate(em, sc.x_start, t[:j]).x if j > 1 else sc.x_start
+    x_burn = propagate(em, sc.x_start, [t[0], t_burn]).x[-1]
+    after = np.repeat(x_burn[None], B, axis=0)
+    after[:, 3:] += dv
+    out[:, j:] = propagate(em, after if B > 1 else after[0], np.r_[t_burn, t[j:]]).x[..., 1:, :]
+    return out
+
+
+def _measurements(sc, truth, noise) -> np.ndarray:
+    """:func:`tracking.simulate_measurements` for truths (B, N, 6) with the standard normal draws ``noise``."""
+    y = sc.model(sc.observers, truth[:, :, None, :])
+    y = y + noise * np.sqrt(np.diag(sc.meas_cov))
+    y[..., 0] = measurements.wrap_angle(y[..., 0])
+    y[:, ~sc.available] = np.nan
+    return y
 
 
 def run_trial_filter(setup: DetectionSetup, inputs: TrialInputs, control_weight=None) -> ocbe.OCBEResult:
@@ -447,6 +539,18 @@ def _result(setup, inputs, z_smooth, z_step, x_filt, P_filt, x_smooth, P_smooth)
     return TrialResult(float(z_smooth) * v, float(z_step) * v, inputs.magnitude_m_s, inputs.azimuth,
                        inputs.elevation, float(np.mean(nf > _NEES_LIMIT)), float(np.mean(ns > _NEES_LIMIT)),
                        float(np.mean(nf)), float(np.mean(ns)))
+
+
+def _results(setup, inputs, res) -> list:
+    """:func:`_result` of every trial of a batch (``res`` from :func:`ocbe_batch` on ``inputs``), the NEES of all
+    trials and epochs at once."""
+    v = setup.system.velocity_unit_km_s * 1e3
+    truth = np.array([i.truth for i in inputs])
+    nf, ns = _nees(res.x_filt, res.P_filt, truth), _nees(res.x_smooth, res.P_smooth, truth)  # (B, N)
+    cols = np.stack([res.z_smooth * v, res.z_step * v, np.mean(nf > _NEES_LIMIT, axis=1),
+                     np.mean(ns > _NEES_LIMIT, axis=1), np.mean(nf, axis=1), np.mean(ns, axis=1)], axis=1).tolist()
+    return [TrialResult(c[0], c[1], inp.magnitude_m_s, inp.azimuth, inp.elevation, *c[2:])
+            for c, inp in zip(cols, inputs)]
 
 
 def detection_trial(rng: np.random.Generator, setup: DetectionSetup,
@@ -491,13 +595,13 @@ def _detection_batches(rngs, setup, policy, batch_size) -> list:
     trial), so the results equal those of separate calls.  Returns one list of :class:`TrialResult` per generator.
     """
     B = batch_size
-    inputs = [draw_trial(child, setup, policy) for rng in rngs for child in rng.spawn(B)]
+    children = [child for rng in rngs for child in rng.spawn(B)]
+    inputs = _draw_trials(children, setup, policy, None, None, setup.t_maneuver)
     sc = setup.scenario
     res = ocbe_batch(setup.system, sc.t, np.array([i.y for i in inputs]), setup.observer_states, sc.model, sc.meas_cov,
                      np.array([i.x0 for i in inputs]), np.array([i.P0 for i in inputs]), setup.control_weight,
                      n_sub=setup.n_sub, tol=setup.tol)
-    flat = [_result(setup, inp, res.z_smooth[b], res.z_step[b], res.x_filt[b], res.P_filt[b], res.x_smooth[b],
-                    res.P_smooth[b]) for b, inp in enumerate(inputs)]
+    flat = _results(setup, inputs, res)
     return [flat[k * B:(k + 1) * B] for k in range(len(rngs))]
 
 
@@ -611,6 +715,124 @@ def run_detection_monte_carlo(setup: DetectionSetup, policy: StationKeepingPolic
             raise MonteCarloError(TrialFailure(k * B, where, f.error, f.traceback), done, n) from exc
         res = [r for chunk in chunks for r in chunk][:n]
     return MonteCarloSample.from_results(res)
+
+
+def run_detection_monte_carlos(jobs, *, batch_size: int = 8, executor=None, progress: bool = False,
+                               desc: str = "detection MC") -> list:
+    """Several :func:`run_detection_monte_carlo` runs at once, their lockstep groups pooled in one sweep.
+
+    ``jobs`` is a sequence of ``(setup, policy, n_trials, seed)``; result ``k`` equals
+    ``run_detection_monte_carlo(*jobs[k], batch_size=batch_size)`` (the same batches, seeded by the same children
+    of ``SeedSequence(seed)``, each trial computed on its own).  What changes is the scheduling: every job is cut
+    into lockstep groups of about :data:`LOCKSTEP_TRIALS` trials and all groups of all jobs go to ``executor``
+    together, so the workers do not wait at the end of each job and small jobs still filter many trials per
+    lockstep call.
+
+    Parameters
+    ----------
+    jobs : sequence of tuple
+        ``(setup, policy, n_trials, seed)``: a DetectionSetup, a StationKeepingPolicy or None (H0), a positive int
+        and an int or sequence of ints.
+    batch_size : int
+        Trials per batch (at least 1): the seeding unit, as in :func:`run_detection_monte_carlo`.
+    executor : concurrent.futures-style executor, optional
+    progress : bool
+    desc : str
+        Progress-bar label.
+
+    Returns
+    -------
+    list of MonteCarloSample
+        One per job, in order.
+
+    Raises
+    ------
+    cislunar.utils.montecarlo.MonteCarloError
+        A trial failed: the failing job is rerun alone through :func:`run_detection_monte_carlo`, whose error names
+        the trial, its batch and seed.
+    """
+    try:
+        jobs = [tuple(j) for j in jobs]
+    except TypeError:
+        raise validation.ArgumentTypeError("jobs must be a sequence of (setup, policy, n_trials, seed) tuples") from None
+    B = validation.integer(batch_size, "batch_size", minimum=1)
+    validation.boolean(progress, "progress")
+    segments = {}  # filter key -> [(job, setup, policy, root, first batch, end batch)] in job order
+    for k, job in enumerate(jobs):
+        if len(job) != 4:
+            raise ValueError(f"jobs[{k}] must be (setup, policy, n_trials, seed); got {len(job)} items")
+        setup, policy, n, seed = job
+        _check_setup(setup, f"jobs[{k}] setup")
+        _check_policy(policy, f"jobs[{k}] policy", optional=True)
+        n = validation.integer(n, f"jobs[{k}] n_trials", minimum=1)
+        root = validation.seed_entropy(seed, f"jobs[{k}] seed")
+        root = root if isinstance(root, np.random.SeedSequence) else np.random.SeedSequence(root)
+        segments.setdefault(_filter_key(setup), []).append((k, setup, policy, root, 0, -(-n // B)))
+    # lockstep groups of about LOCKSTEP_TRIALS trials; jobs that share the epochs, observer and noise share groups
+    # (the control weight is per trial), so that small jobs still fill a lockstep call
+    per_group = max(1, LOCKSTEP_TRIALS // B)
+    tasks = []
+    for segs in segments.values():
+        group, room = [], per_group
+        for k, setup, policy, root, a, end in segs:
+            while a < end:
+                b = min(end, a + room)
+                group.append((k, setup, policy, root, a, b))
+                room -= b - a
+                a = b
+                if room == 0:
+                    tasks.append((B, group))
+                    group, room = [], per_group
+        if group:
+            tasks.append((B, group))
+    try:
+        parts = map_tasks(_monte_carlo_group, tasks, executor=executor, progress=progress, desc=desc)
+    except MonteCarloError as exc:  # rerun the jobs of the failing group alone: the first to fail names its trial
+        for k in dict.fromkeys(seg[0] for seg in tasks[exc.trial_index][1]):
+            setup, policy, n, seed = jobs[k]
+            run_detection_monte_carlo(setup, policy, n, seed, batch_size=B, progress=False)
+        raise  # pragma: no cover - a failure that does not repeat alone
+    results = {k: {} for k in range(len(jobs))}
+    for (_, group), part in zip(tasks, parts):
+        for (k, _, _, _, a, _), res in zip(group, part):
+            results[k][a] = res
+    return [MonteCarloSample.from_results([r for a in sorted(results[k]) for r in results[k][a]][:job[2]])
+            for k, job in enumerate(jobs)]
+
+
+def _filter_key(setup) -> tuple:
+    """What trials must share to be filtered in one lockstep call: system, epochs, observer, measurement model and
+    noise, sub-grid and tolerance (the control weight and the truth may differ per trial)."""
+    sc, em = setup.scenario, setup.system
+    return (em.mu, em.length_unit_km, em.time_unit_s, sc.t.tobytes(), np.ascontiguousarray(setup.observer_states)
+            .tobytes(), sc.model.name, np.ascontiguousarray(sc.meas_cov).tobytes(), setup.n_sub, setup.tol)
+
+
+def _monte_carlo_group(task) -> list:
+    """One lockstep group of :func:`run_detection_monte_carlos`: for each segment ``(job, setup, policy, root, a,
+    b)`` the batches ``a`` to ``b - 1`` of that job's :func:`run_detection_monte_carlo` run, drawn on its own setup,
+    all filtered in one :func:`ocbe_batch` call; returns one list of :class:`TrialResult` per segment."""
+    B, group = task
+    inputs, setups, sizes = [], [], []
+    for _, setup, policy, root, a, b in group:
+        base, offset = tuple(root.spawn_key), root.n_children_spawned  # the children run_monte_carlo gives batch i
+        rngs = [np.random.default_rng(np.random.SeedSequence(root.entropy, spawn_key=base + (offset + i,),
+                                                             pool_size=root.pool_size)) for i in range(a, b)]
+        children = [child for rng in rngs for child in rng.spawn(B)]
+        inputs += _draw_trials(children, setup, policy, None, None, setup.t_maneuver)
+        setups.append(setup)
+        sizes.append(len(children))
+    s0, sc = setups[0], setups[0].scenario
+    q = np.concatenate([np.broadcast_to(s.control_weight, (m, s.control_weight.size)) for s, m in zip(setups, sizes)])
+    res = ocbe_batch(s0.system, sc.t, np.array([i.y for i in inputs]), s0.observer_states, sc.model, sc.meas_cov,
+                     np.array([i.x0 for i in inputs]), np.array([i.P0 for i in inputs]), q, n_sub=s0.n_sub,
+                     tol=s0.tol)
+    flat = _results(s0, inputs, res)
+    out, start = [], 0
+    for m in sizes:
+        out.append(flat[start:start + m])
+        start += m
+    return out
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -924,6 +1146,61 @@ def run_policy_study(setup: DetectionSetup, policy: StationKeepingPolicy, n_h0: 
     return PolicyStudy(h0, h1, t0, t1, th, score)
 
 
+def run_policy_studies(jobs, *, batch_size: int = 8, executor=None, bandwidth="scott", progress: bool = False,
+                       desc: str = "policy studies") -> list:
+    """Several :func:`run_policy_study` at once: every Monte Carlo of every job pooled in one sweep.
+
+    ``jobs`` is a sequence of ``(setup, policy, n_h0, n_h1, n_test, seed)``; result ``k`` equals
+    ``run_policy_study(*jobs[k], batch_size=batch_size, bandwidth=bandwidth)`` (the same seeds ``[*seed, 0..3]``,
+    the same trials), the Monte Carlo going through :func:`run_detection_monte_carlos` so that the workers of
+    ``executor`` stay busy across jobs.
+
+    Parameters
+    ----------
+    jobs : sequence of tuple
+        ``(setup, policy, n_h0, n_h1, n_test, seed)`` as the arguments of :func:`run_policy_study`.
+    batch_size : int
+        Trials per batch (at least 1).
+    executor, bandwidth, progress, desc
+        See :func:`run_detection_monte_carlos` and :func:`fit_pdf`.
+
+    Returns
+    -------
+    list of PolicyStudy
+    """
+    try:
+        jobs = [tuple(j) for j in jobs]
+    except TypeError:
+        raise validation.ArgumentTypeError("jobs must be a sequence of (setup, policy, n_h0, n_h1, n_test, seed) "
+                                           "tuples") from None
+    runs, plan = [], []
+    for k, job in enumerate(jobs):
+        if len(job) != 6:
+            raise ValueError(f"jobs[{k}] must be (setup, policy, n_h0, n_h1, n_test, seed); got {len(job)} items")
+        setup, policy, n_h0, n_h1, n_test, seed = job
+        _check_setup(setup, f"jobs[{k}] setup")
+        _check_policy(policy, f"jobs[{k}] policy")
+        base = validation.int_seed_list(seed, f"jobs[{k}] seed", why="the four sets append an index")
+        validation.integer(n_h0, f"jobs[{k}] n_h0", minimum=2)
+        validation.integer(n_h1, f"jobs[{k}] n_h1", minimum=2)
+        n_test = validation.integer(n_test, f"jobs[{k}] n_test", minimum=0)
+        sets = [(None, n_h0, 0), (policy, n_h1, 1)] + ([(None, n_test, 2), (policy, n_test, 3)] if n_test else [])
+        plan.append(len(sets))
+        runs += [(setup, pol, n, base + [i]) for pol, n, i in sets]
+    samples = iter(run_detection_monte_carlos(runs, batch_size=batch_size, executor=executor, progress=progress,
+                                              desc=desc))
+    out = []
+    for n_sets in plan:
+        h0, h1 = next(samples), next(samples)
+        th = ml_threshold(h0.z, h1.z, bandwidth=bandwidth)
+        t0 = t1 = score = None
+        if n_sets == 4:
+            t0, t1 = next(samples), next(samples)
+            score = detection_accuracy(t0.z, t1.z, th.z_lim)
+        out.append(PolicyStudy(h0, h1, t0, t1, th, score))
+    return out
+
+
 # ---------------------------------------------------------------------------------------------------------------
 # Studies beyond the paper's runs: filtering given trials, burn directions, the health-metric race (Fig. 22)
 # ---------------------------------------------------------------------------------------------------------------
@@ -967,6 +1244,96 @@ def filter_trials(setup: DetectionSetup, inputs, *, n_epochs: int | None = None)
     fields = {f: np.concatenate([getattr(p, f) for p in parts]) for f in BatchOCBEResult.__dataclass_fields__
               if f != "t_sub"}
     return BatchOCBEResult(t_sub=parts[0].t_sub, **fields)
+
+
+def filter_trial_sets(sets, *, executor=None, progress: bool = False) -> list:
+    """:func:`filter_trials` on several sets of trials, each on its own setup, in pooled lockstep groups.
+
+    ``sets`` is a sequence of ``(setup, inputs)``.  Sets whose setups share the epochs, observer, measurement
+    noise, sub-grid and tolerance are filtered together in lockstep groups of up to :data:`LOCKSTEP_TRIALS` trials,
+    each trial with its own setup's control weight (e.g. one set of burns under several tunings); the groups go
+    through ``executor`` when given.  Result ``k`` equals ``filter_trials(*sets[k])`` (each trial is computed on
+    its own).
+
+    Parameters
+    ----------
+    sets : sequence of (DetectionSetup, sequence of TrialInputs)
+    executor : concurrent.futures-style executor, optional
+    progress : bool
+
+    Returns
+    -------
+    list of BatchOCBEResult
+        One per set, trials in the order of its inputs.
+    """
+    try:
+        sets = [tuple(x) for x in sets]
+    except TypeError:
+        raise validation.ArgumentTypeError("sets must be a sequence of (setup, inputs) pairs") from None
+    validation.boolean(progress, "progress")
+    keyed = {}
+    for k, pair in enumerate(sets):
+        if len(pair) != 2:
+            raise ValueError(f"sets[{k}] must be a (setup, inputs) pair; got {len(pair)} items")
+        setup, inputs = pair
+        _check_setup(setup, f"sets[{k}] setup")
+        items = _check_inputs(inputs, f"sets[{k}] inputs")
+        if not items:
+            raise ValueError(f"sets[{k}] inputs must hold at least one trial")
+        keyed.setdefault(_filter_key(setup), []).append((k, setup, items))
+    tasks = []
+    for members in keyed.values():
+        group, room = [], LOCKSTEP_TRIALS
+        for k, setup, items in members:
+            a = 0
+            while a < len(items):
+                b = min(len(items), a + room)
+                group.append((k, a, setup, items[a:b]))
+                room -= b - a
+                a = b
+                if room == 0:
+                    tasks.append(group)
+                    group, room = [], LOCKSTEP_TRIALS
+        if group:
+            tasks.append(group)
+    parts = map_tasks(_filter_group, tasks, executor=executor, progress=progress, desc="filter sets")
+    pieces = {k: [] for k in range(len(sets))}
+    for group, part in zip(tasks, parts):
+        for (k, a, _, _), res in zip(group, part):
+            pieces[k].append((a, res))
+    return [_concat_results([r for _, r in sorted(pieces[k], key=lambda ar: ar[0])]) for k in range(len(sets))]
+
+
+def _filter_group(group) -> list:
+    """One lockstep group of :func:`filter_trial_sets`: ``[(set, first, setup, inputs), ...]`` -> one
+    BatchOCBEResult per member."""
+    s0 = group[0][2]
+    sc = s0.scenario
+    inputs = [i for *_, items in group for i in items]
+    q = np.concatenate([np.broadcast_to(s.control_weight, (len(items), s.control_weight.size))
+                        for _, _, s, items in group])
+    res = ocbe_batch(s0.system, sc.t, np.array([i.y for i in inputs]), s0.observer_states, sc.model, sc.meas_cov,
+                     np.array([i.x0 for i in inputs]), np.array([i.P0 for i in inputs]), q, n_sub=s0.n_sub,
+                     tol=s0.tol)
+    out, start = [], 0
+    for *_, items in group:
+        out.append(_slice_result(res, start, start + len(items)))
+        start += len(items)
+    return out
+
+
+def _slice_result(res, a, b) -> BatchOCBEResult:
+    fields = {f: (getattr(res, f) if f == "t_sub" else getattr(res, f)[a:b])
+              for f in BatchOCBEResult.__dataclass_fields__}
+    return BatchOCBEResult(**fields)
+
+
+def _concat_results(parts) -> BatchOCBEResult:
+    if len(parts) == 1:
+        return parts[0]
+    fields = {f: (parts[0].t_sub if f == "t_sub" else np.concatenate([getattr(p, f) for p in parts]))
+              for f in BatchOCBEResult.__dataclass_fields__}
+    return BatchOCBEResult(**fields)
 
 
 def control_spike_contrast(setup: DetectionSetup, result: BatchOCBEResult, *, half_width_hours: float = 6.0,
@@ -1062,10 +1429,34 @@ def direction_response(setup: DetectionSetup, directions, magnitude_m_s: float, 
     n_rep = validation.integer(n_repeats, "n_repeats", minimum=1)
     base = validation.int_seed_list(seed, "seed", why="repeats append an index")
     off = validation.real(burn_offset_hours, "burn_offset_hours")
-    inputs = [draw_trial(np.random.default_rng(base + [k]), setup, magnitude_m_s=mag, direction=d,
-                         burn_offset_hours=off) for k in range(n_rep) for d in dirs]
+    inputs = _direction_trials(setup, dirs, mag, n_rep, base, off)
     z = filter_trials(setup, inputs).z_smooth * setup.system.velocity_unit_km_s * 1e3
     return z.reshape(n_rep, len(dirs))
+
+
+def direction_trials(setup: DetectionSetup, directions, magnitude_m_s: float, n_repeats: int, seed, *,
+                     burn_offset_hours: float = 0.0) -> list:
+    """The trials :func:`direction_response` filters, repeat-major (repeat ``k`` of every direction draws with the
+    generator ``[*seed, k]``), e.g. to filter them under several tunings with :func:`filter_trial_sets`.
+
+    Parameters are those of :func:`direction_response`; returns a list of ``n_repeats * n`` TrialInputs.
+    """
+    _check_setup(setup)
+    dirs = validation.as_array(directions, "directions", ndim=(2,), last=2, min_size=2)
+    mag = validation.positive(magnitude_m_s, "magnitude_m_s")
+    n_rep = validation.integer(n_repeats, "n_repeats", minimum=1)
+    base = validation.int_seed_list(seed, "seed", why="repeats append an index")
+    return _direction_trials(setup, dirs, mag, n_rep, base, validation.real(burn_offset_hours, "burn_offset_hours"))
+
+
+def _direction_trials(setup, dirs, mag, n_rep, base, off) -> list:
+    """:func:`direction_trials` after its checks."""
+    t_burn = setup.t_maneuver + off * 3600.0 / setup.system.time_unit_s
+    if not setup.scenario.t[0] < t_burn < setup.scenario.t[-1]:
+        raise ValueError(f"burn_offset_hours puts the burn outside the track; got {off!r}")
+    per_dir = [_draw_trials([np.random.default_rng(base + [k]) for k in range(n_rep)], setup, None, mag,
+                            np.asarray(d, float), t_burn) for d in dirs]
+    return [per_dir[j][k] for k in range(n_rep) for j in range(len(dirs))]
 
 
 @dataclass(frozen=True)
@@ -1182,10 +1573,10 @@ def health_lead_study(setup: DetectionSetup, magnitudes_m_s, n_h0: int, n_h1: in
     ks = np.flatnonzero((hours > 0) & (hours <= horizon))
     if ks.size == 0 or ks[-1] >= sc.t.size - 1 or ks[0] != k0:
         raise ValueError(f"horizon_hours must leave the horizon inside the track; got {horizon_hours!r}")
-    cal = [draw_trial(r, setup) for r in (np.random.default_rng(base + [0]).spawn(n0))]
-    val = [draw_trial(r, setup) for r in (np.random.default_rng(base + [1]).spawn(n0))]
-    burns = [draw_trial(r, setup, magnitude_m_s=float(m))
-             for i, m in enumerate(mags) for r in np.random.default_rng(base + [2, i]).spawn(n1)]
+    cal = _draw_trials(np.random.default_rng(base + [0]).spawn(n0), setup, None, None, None, setup.t_maneuver)
+    val = _draw_trials(np.random.default_rng(base + [1]).spawn(n0), setup, None, None, None, setup.t_maneuver)
+    burns = [inp for i, m in enumerate(mags) for inp in _draw_trials(np.random.default_rng(base + [2, i]).spawn(n1),
+                                                                        setup, None, float(m), None, setup.t_maneuver)]
     everything = cal + val + burns
     tasks = [(setup, everything, int(k) + 1) for k in ks] + [(setup, everything, None)]
     arcs = map_tasks(_arc_statistics, tasks, executor=executor, progress=progress, desc="health arcs")

@@ -19,14 +19,27 @@ from cislunar.papers.greaves_scheeres_2021.claims.maneuver_detection import (
 
 
 def _binom_tol(paper, n):
-    """The Table 7 tolerance as it was fixed before the comparison (notebook 10)."""
-    return max(0.02, 2 * np.sqrt(paper * (1 - paper) / n) + 1 / (2 * n))
+    """The Table 7 tolerance (notebook 10): half a printed point plus two binomial standard errors at the end of the
+    paper's printed interval nearer one half."""
+    edge = paper - 0.005 if paper >= 0.5 else paper + 0.005
+    return 0.005 + 2 * np.sqrt(edge * (1 - edge) / n)
 
 
-@pytest.mark.parametrize("paper", [1.0, 0.97, 0.5])
+@pytest.mark.parametrize("paper", [1.0, 0.97, 0.5, 0.2])
 @pytest.mark.parametrize("n", [8, 16, 100, 200, 1000])
-def test_two_accuracy_standard_errors_are_the_fixed_tolerance(paper, n):
-    assert 2 * ds.accuracy_standard_error(paper, n) == pytest.approx(_binom_tol(paper, n), rel=1e-12)
+def test_two_accuracy_standard_errors_and_the_printed_digit_are_the_fixed_tolerance(paper, n):
+    assert ds.ACCURACY_DIGIT_TOL + 2 * ds.accuracy_standard_error(paper, n) == pytest.approx(_binom_tol(paper, n),
+                                                                                              rel=1e-12)
+
+
+def test_accuracy_tolerance_values_at_the_papers_rates():
+    # 100 % over 200 runs: 0.5 + 2 x 0.499 = 1.5 points (98.0 % is outside); 97 %: 0.5 + 2 x 1.30 = 3.1 points
+    assert _binom_tol(1.0, 200) == pytest.approx(0.005 + 2 * np.sqrt(0.995 * 0.005 / 200))
+    assert 0.0149 < _binom_tol(1.0, 200) < 0.0150 and 0.030 < _binom_tol(0.97, 200) < 0.031
+    assert CLAIMS["accuracy f_c, active"].judge(0.98, standard_error=ds.accuracy_standard_error(1.0, 200),
+                                               reason="probe").status == "differs"
+    assert CLAIMS["accuracy f_c, quiet"].judge(0.96, standard_error=ds.accuracy_standard_error(0.97, 200)
+                                              ).status == "reproduced"
 
 
 def test_accuracy_claims_flip_at_the_binomial_tolerance():
@@ -42,6 +55,8 @@ def test_accuracy_claims_flip_at_the_binomial_tolerance():
         assert CLAIMS[f"accuracy f_c, {p}"].judge(paper, standard_error=se).status == "reproduced"
     with pytest.raises(ValueError, match="rate"):
         ds.accuracy_standard_error(1.5, 10)
+    with pytest.raises(ValueError, match="fraction"):
+        ds.fraction_standard_error(-0.1, 10)
 
 
 def test_thresholds_tuned_within_25_percent_and_predicted_within_two_bootstrap_errors():
@@ -130,7 +145,11 @@ def test_spike_study_criteria_of_figs_10_and_11():
     h0 = [[1.0, 1.0], [1.0, 1.5], [1.0, 2.0], [1.0, 1.2]]  # smoothed below 2 in 3 of 4
     s = ds.SpikeStudy(_spike_cells(0.1, 12.0, h1, h0), 4)
     assert s.fig10_ok and s.fig11_h1 == 0.5 and s.fig11_h0 == 0.75
-    assert not ds.SpikeStudy(_spike_cells(0.11, 12.0, h1, h0), 4).fig10_ok  # above 10 % inconsistent
+    # the limit is 10 % plus two binomial standard errors over the cell's runs: 14.24 % for 200 runs, 40 % for 4
+    assert ds.SpikeStudy({}, 200).fig10_limit == pytest.approx(0.1 + 2 * np.sqrt(0.09 / 200))
+    assert ds.SpikeStudy(_spike_cells(0.142, 12.0, h1, h0), 200).fig10_ok  # 10.5 % .. 14.2 %: within the MC error
+    assert not ds.SpikeStudy(_spike_cells(0.143, 12.0, h1, h0), 200).fig10_ok  # above it
+    assert not ds.SpikeStudy(_spike_cells(0.41, 12.0, h1, h0), 4).fig10_ok
     assert not ds.SpikeStudy(_spike_cells(0.1, 4.0, h1, h0), 4).fig10_ok  # bound not larger than the window's
     assert "4 quiet-policy runs" in s.report()
 

@@ -7,7 +7,8 @@ weight run side by side: ``f = 0.1`` was chosen with the paper's thresholds in v
 "consistent (tuned)"; ``f_c`` follows from the paper's consistency claim by a rule fixed before the tuning map, so
 agreement there is "reproduced".  Monte Carlo tolerances are standard errors passed at judging: bootstrap standard
 errors of the threshold and of the expected error, binomial standard errors of a test accuracy
-(:func:`cislunar.papers.greaves_scheeres_2021.detection_studies.accuracy_standard_error`), single-run spreads of z.
+(:func:`cislunar.papers.greaves_scheeres_2021.detection_studies.accuracy_standard_error`, on top of half a printed
+point) and of a fraction of inconsistent runs (Fig. 10), single-run spreads of z.
 """
 
 from __future__ import annotations
@@ -33,6 +34,13 @@ _STABLE = _ORBITS[1:]
 _POLICIES = ("active", "quiet")
 _TUNED_F = "f = 0.1 chosen with the paper's thresholds in view"
 _OUTER = "; outer-band candidate (notebook 09), reduced Monte Carlo"
+#: Table 7 prints whole percent: half a point of the paper's value, plus two binomial standard errors of our test
+#: accuracy at the end of the paper's printed interval nearer one half (detection_studies.accuracy_standard_error).
+#: Fixed on 2026-11-26 in place of a rule with a one-point floor per standard error (a 2-point tolerance at 100 %
+#: that the printed digits and 200 test runs do not support).
+_ACC_DIGITS = 0.005
+_ACC_SOURCE = ("Table 7 (tolerance: half a printed point plus two binomial standard errors over our test runs at "
+               "the end of the paper's printed interval)")
 
 CLAIMS = {
     "magnitude bounds": Claim("Eq. 5 magnitude stays within mean +- 3 sd (both policies)", "by construction",
@@ -55,8 +63,9 @@ CLAIMS = {
         reason="quick mode shrinks every Monte Carlo; the full run uses the paper's sizes"),
     "fig10": Claim(
         "Fig. 10: constant tuning consistent but less certain", "consistent, less certain (one run)",
-        Holds("at most 10 % inconsistent runs in every cell (H0/H1, forward/smoothed) and a larger mean forward "
-              "3-sigma bound than the window tuning"), source="Fig. 10"),
+        Holds("at most 10 % inconsistent runs in every cell (H0/H1, forward/smoothed), widened by two binomial "
+              "standard errors of the cell's runs, and a larger mean forward 3-sigma bound than the window tuning"),
+        tuned="the constant weight is the window weight at f = 0.1, " + _TUNED_F, source="Fig. 10"),
     "fig11": Claim(
         "Fig. 11: constant tuning, control spike at the burn in the smoothed control only",
         "spike only in the smoothed system", AtLeast(0.9),
@@ -96,13 +105,11 @@ CLAIMS = {
         source="Figs. 15, 19", reason="KDE tails of the finite sample add crossings"),
     **{f"accuracy f=0.1, {p}": Claim(
         f"Detection accuracy, 9:2 NRHO, {p}, f = 0.1 (Table 7)", f"{100 * PAPER_ACCURACY[p]:.0f} %",
-        Within(PAPER_ACCURACY[p], 0.0, n_sigma=2), tuned=_TUNED_F,
-        source="Table 7 (standard error: binomial at the paper's rate with continuity correction, at least 1 point)",
+        Within(PAPER_ACCURACY[p], _ACC_DIGITS, n_sigma=2), tuned=_TUNED_F, source=_ACC_SOURCE,
         reason="see FP/MD") for p in _POLICIES},
     **{f"accuracy f_c, {p}": Claim(
         f"Detection accuracy, 9:2 NRHO, {p}, f_c (Table 7, prediction)", f"{100 * PAPER_ACCURACY[p]:.0f} %",
-        Within(PAPER_ACCURACY[p], 0.0, n_sigma=2),
-        source="Table 7 (standard error: binomial at the paper's rate with continuity correction, at least 1 point)",
+        Within(PAPER_ACCURACY[p], _ACC_DIGITS, n_sigma=2), source=_ACC_SOURCE,
         reason="beyond the tolerance") for p in _POLICIES},
     **{f"stable better, {o}, {p}": Claim(
         f"Stable NRHO marginally better than the 9:2, {o}, {p}, f_c (Table 8)",
