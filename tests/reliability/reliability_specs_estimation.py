@@ -28,6 +28,11 @@ MODULES = [covariance, information, discretization, scvx, reference, lpv, observ
 # take arguments are swept below.  Every module-level public function has a spec.  Arguments that accept any
 # square matrix (symmetrize, concave_part) or any planar state/position stack (CR3BPLPV.rho, angles, measure) are
 # swept with "arr_finite" (their shape refusals are tested in tests/test_validation_estimation.py).
+# The constructors of InformationKernel, WindowAssembler and SCvxWorkspace are swept, and WindowAssembler's call.
+# InformationKernel.value / value_gradient are not: by design they check only the shapes and finiteness of F, H,
+# dF, dH (the fast path of an optimiser), so a string, object() or a ragged list raises numpy's unnamed
+# ValueError/TypeError ("could not convert string to float", "float() argument must be ..."), and a dH whose last
+# axis disagrees with dF's is reported as a dF shape error (reported to the lead, not changed here).
 EXEMPT: dict = {}
 
 X_DRO = np.array([0.8, 0.0, 0.0, 0.0, 0.52, 0.0])
@@ -67,6 +72,12 @@ def _lin():
     return covariance.linearize_augmented(em, X_DRO, np.array([[1.1, 0.0, 0.0, 0.0, -0.2, 0.0]]), T3,
                                           AZIMUTH_ELEVATION, np.eye(2) * 1e-8, np.eye(12) * 1e-6, q=1e-10,
                                           derivatives=True)
+
+
+@functools.lru_cache(maxsize=None)
+def _assembler():
+    return covariance.WindowAssembler(AZIMUTH_ELEVATION, np.eye(2) * 1e-8, np.eye(12) * 1e-6, _arcs()[1],
+                                      Q=np.eye(12) * 1e-12)
 
 
 @functools.lru_cache(maxsize=None)
@@ -199,6 +210,12 @@ def specs(Spec, lazy):
                     Q=np.eye(12) * 1e-12, derivatives=False, n_nodes=4),
                dict(system="system", observer_x0="state", targets_x0="arr", t="grid", model="instance",
                     noise="spd", P0="spd", Q="psd_opt", derivatives="bool", n_nodes="int2")))
+    s.append(S("WindowAssembler", C.WindowAssembler,
+               dict(model=AZIMUTH_ELEVATION, noise=np.eye(2) * 1e-8, P0=np.eye(12) * 1e-6,
+                    targets=lazy(lambda: _arcs()[1]), Q=np.eye(12) * 1e-12),
+               dict(model="instance", noise="spd", P0="spd", targets="instance", Q="psd_opt")))
+    s.append(S("WindowAssembler.__call__", lazy(_assembler), dict(observer=lazy(lambda: _arcs()[0]), index=0),
+               dict(observer="instance", index="int0")))
 
     # ------------------------------------------------------------------------------------------ information
     I = information  # noqa: E741
@@ -212,6 +229,9 @@ def specs(Spec, lazy):
                dict(LIN_KINDS, **DER_KINDS)))
     s.append(S("mutual_information_gradient", I.mutual_information_gradient, dict(lin, **der, method="sqrt"),
                dict(LIN_KINDS, **DER_KINDS, method="choice")))
+    s.append(S("InformationKernel", I.InformationKernel,
+               dict(P0=lin["P0"], Q=lin["Q"], R=lin["R"], n_times=lin["H"].shape[0]),
+               dict(P0="spd", Q="psd", R="spd", n_times="int1")))
     s.append(S("window_information", I.window_information, dict(lin=lazy(_lin), method="structured", gradient=True),
                dict(lin="instance", method="choice", gradient="bool")))
     s.append(S("gaussian_kl", I.gaussian_kl, dict(mean_p=np.zeros(3), cov_p=SPD3, mean_q=np.ones(3),
@@ -256,10 +276,12 @@ def specs(Spec, lazy):
     s.append(S("solve_scvx", scvx.solve_scvx,
                dict(system=em, t_nodes=T3, x_guess=lazy(_x_ballistic), u_guess=np.zeros((3, 3)),
                     u_max=np.full(3, 1e-3), x_final=None, info=None, info_node=None, constraints=(), alpha=0.0,
-                    settings=None, solver="CLARABEL", progress=False),
+                    settings=None, solver="CLARABEL", progress=False, workspace=None),
                dict(system="system", t_nodes="grid", x_guess="arr", u_guess="arr", u_max="arr",
                     x_final="state_opt", info="callable_opt", info_node="int0_opt", constraints="instance_opt",
-                    alpha="range:0:1", settings="instance_opt", solver="choice", progress="bool")))
+                    alpha="range:0:1", settings="instance_opt", solver="choice", progress="bool",
+                    workspace="instance_opt")))
+    s.append(S("SCvxWorkspace", scvx.SCvxWorkspace, dict(max_problems=4), dict(max_problems="int1")))
     s.append(S("concave_part", scvx.concave_part, dict(H=-SPD3, floor=0.0), dict(H="arr_finite", floor="nonneg")))
     s.append(S("finite_difference_hessian", scvx.finite_difference_hessian,
                dict(gradient=lambda x: 2.0 * np.asarray(x), x=np.array([0.1, 0.2]), step=1e-5, g0=None),

@@ -211,6 +211,11 @@ def specs(S, lazy):
                dict(system="system", surface="instance", surface_projection="instance", target_apolune_state="state",
                     n_trials="int1", seed="seed", exec_abs_m_s="nonneg", exec_rel="nonneg",
                     executor="instance_opt")))
+    s.append(S("random_pick_study", sks.random_pick_study,
+               dict(system=em, torus=torus, t_arrival=T_ARRIVAL, t_burn=T_BURN, t_final=T_FINAL, rng=rng, n_draws=2,
+                    agent_theta=0.0, t_track_start=None),
+               dict(system="system", torus="instance", t_arrival="vec", t_burn="real", t_final="real", rng="rng",
+                    n_draws="int1", agent_theta="real", t_track_start="real_opt")))
 
     # ---------------------------------------------------------------------------------------------- exercises
     s.append(S("exercise_07_burn_magnitude", ex.exercise_07_burn_magnitude,

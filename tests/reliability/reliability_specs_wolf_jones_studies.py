@@ -457,6 +457,9 @@ def specs(Spec, lazy):
                     rtol="range:0:1")))
     # ------------------------------------------------------------------------------ exercises
     mark("exercises")
+    s.append(S("exercise_01_mu_step", exercises.exercise_01_mu_step,
+               dict(steps=(1e-8,), reference_step=1e-9, system=em),
+               dict(steps="vec", reference_step="pos", system="system")))
     s.append(S("exercise_02_monte_carlo_samples", exercises.exercise_02_monte_carlo_samples,
                dict(n_samples=100, factor=2, seed=0), dict(n_samples="int1", factor="int2", seed="int0")))
     s.append(S("exercise_02_range_noise", exercises.exercise_02_range_noise, dict(factor=0.5, n_days=2),
