@@ -43,6 +43,9 @@ else
 	$(PY) -m pip install --quiet --disable-pip-version-check --no-deps -e .
 endif
 	$(PY) -m ipykernel install --sys-prefix --name python3 --display-name "Python 3 (cislunar)" >/dev/null
+	# The kernel logs only errors: a notebook run by hand with papermill (TCP transport) would otherwise print
+	# ipykernel's unencrypted-TCP warning on every start (the runner uses IPC and never sees it).
+	$(PY) -c "import json, pathlib, sys; p = pathlib.Path(sys.prefix, 'share/jupyter/kernels/python3/kernel.json'); k = json.loads(p.read_text()); a = '--IPKernelApp.log_level=ERROR'; k['argv'] += [] if a in k['argv'] else [a]; p.write_text(json.dumps(k, indent=1))"
 	touch $(STAMP)
 
 # Re-resolve every dependency (newest versions within pyproject.toml's ranges) into requirements.lock.

@@ -122,6 +122,8 @@ def test_a_hand_run_writes_to_build_scratch_and_leaves_build_untouched(tmp_path)
     assert "total 1225" in text and "a long loop" in text  # the plain-text bar, on stderr
     assert not any("application/vnd.jupyter.widget-view+json" in o.get("data", {}) for o in outputs)
     assert "without encryption" not in text
+    # nor on the terminal: the bootstrap installs the kernel with --IPKernelApp.log_level=ERROR (Makefile)
+    assert "without encryption" not in proc.stderr, proc.stderr[-2000:]
 
 
 def test_the_static_check_catches_a_figure_written_into_build(tmp_path):
