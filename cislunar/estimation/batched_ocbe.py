@@ -22,6 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.linalg import expm
 
 from cislunar.cr3bp.dynamics import CR3BP, check_system
 from cislunar.cr3bp.propagation import (
@@ -89,7 +90,8 @@ class BatchOCBEResult:
 
 def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *, n_sub: int = 9,
                tol: float = DEFAULT_TOL, available=None, smooth: bool = True,
-               on_failure: str = "raise") -> BatchOCBEResult:
+               on_failure: str = "raise", wrap_azimuth: bool = True, relinearize: bool = True,
+               coarse_stm: bool = False) -> BatchOCBEResult:
     """The extended SRI OCBE filter and full smoother of :func:`cislunar.estimation.ocbe.ocbe_filter_smoother` for B trials.
 
     Same algorithm, step for step (Eqs. 17, 21-32 and the backward SRI smoother with costates
@@ -132,6 +134,25 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
         A trial failing numerically raises (:class:`cislunar.estimation.ocbe.FilterDivergenceError` for a failed
         propagation, the numerical error otherwise) or is flagged in ``failure_epoch`` / ``failure`` with the
         epoch and message of the single-trial filter's error, its arrays NaN, while the others go on.
+    wrap_azimuth : bool
+        Wrap the angle components of the residuals to :math:`[-\\pi, \\pi)` (the default, as
+        :meth:`cislunar.sensing.measurements.MeasurementModel.residual`), or use the plain difference
+        ``y - h(x)`` (``False``: a filter that mishandles the azimuth's branch cut at :math:`\\pm\\pi`, where a
+        residual across the cut is off by :math:`2\\pi`; identical to the default away from the cut).
+    relinearize : bool
+        Re-linearise about the updated estimate at every epoch (the default: the extended filter), or keep a fixed
+        reference trajectory propagated from the prior mean ``x0`` (``False``: a linearised Kalman filter in SRI
+        form; the transitions, process noise and measurement Jacobians are those of the reference, the estimated
+        deviation is carried by :math:`\\Phi_{xx}` and the measurement residual is
+        :math:`\\mathbf y - h(\\mathbf x_{ref}) - H\\,\\delta\\mathbf x^-`).  On a linear system the two are the
+        same filter; here they differ at second order in the deviation from the reference.  Filter only
+        (``smooth=False``).
+    coarse_stm : bool
+        Time update with the state/costate transition integrated along the reference (the default), or a coarse
+        one (``True``): a single step over each update interval with the Jacobian frozen at the interval's start,
+        :math:`\\Phi = \\exp(M\\Delta t)`, :math:`M = [A(\\mathbf x_n),\\ -B\\tilde QB^\\top;\\ 0,\\ -A(\\mathbf x_n)^\\top]`
+        (:func:`_frozen_transition`), which ignores how :math:`A` changes through the interval (through perilune at
+        long cadences).  The mean is still integrated.  Filter only (``smooth=False``).
     """
     check_system(system)
     model = ocbe.check_model(model)
@@ -177,7 +198,15 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
     n_sub = validation.integer(n_sub, "n_sub", minimum=2, maximum=10_000)
     tol = _check_tol(tol)
     smooth = validation.boolean(smooth, "smooth")
-    return _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smooth, on_failure == "flag")
+    wrap_azimuth = validation.boolean(wrap_azimuth, "wrap_azimuth")
+    relinearize = validation.boolean(relinearize, "relinearize")
+    coarse_stm = validation.boolean(coarse_stm, "coarse_stm")
+    if not relinearize and smooth:
+        raise ValueError("relinearize=False (the fixed-reference filter) is filter only: pass smooth=False")
+    if coarse_stm and smooth:
+        raise ValueError("coarse_stm=True (the frozen-Jacobian time update) is filter only: pass smooth=False")
+    return _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smooth, on_failure == "flag",
+                       wrap_azimuth, relinearize, coarse_stm)
 
 
 #: Trials per heyoka batch integrator (larger lockstep batches are integrated in groups of
@@ -204,6 +233,24 @@ def _process_noise_per_trial(phi_xx, phi_xp):
         raise ValueError(f"phi is not an OCBE transition matrix: -Phi_xp Phi_xx^T is not symmetric "
                          f"({np.max(asym):.2e})")
     return 0.5 * (Q + np.swapaxes(Q, -1, -2))
+
+
+def _frozen_transition(system, x, dt, q):
+    """The coarse OCBE transition of one step (``coarse_stm=True`` of :func:`ocbe_batch`): :math:`\\Phi_{xx}` and
+    :math:`\\Phi_{xp}` of :math:`\\exp(M\\Delta t)` with :math:`M = [A(\\mathbf x),\\ -B\\tilde QB^\\top;\\ 0,\\
+    -A(\\mathbf x)^\\top]`, the OCBE's 12x12 system with the Jacobian frozen at ``x`` (exact when :math:`A` is
+    constant; otherwise its one-step error is :math:`O(\\Delta t^2)`).
+
+    ``x`` (..., 6) in LU, LU/TU (rotating frame), ``dt`` in TU, ``q`` (...) or scalar in LU^2/TU^3 (unchecked: the
+    batched filter's inner kernel).  Returns ``(phi_xx, phi_xp)``, each (..., 6, 6).
+    """
+    A = system.jacobian(x)
+    M = np.zeros(A.shape[:-2] + (12, 12))
+    M[..., :6, :6] = A
+    M[..., 6:, 6:] = -np.swapaxes(A, -1, -2)
+    M[..., 3:6, 9:12] = -np.asarray(q, dtype=float)[..., None, None] * np.eye(3)
+    E = expm(M * dt)
+    return np.array(E[..., :6, :6]), np.array(E[..., :6, 6:])
 
 
 class _Failures:
@@ -262,7 +309,8 @@ def _per_trial(fn, B, failures, epoch, *, replicate):
                  for i in range(len(first)))
 
 
-def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smooth, flag) -> BatchOCBEResult:
+def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smooth, flag, wrap_azimuth=True,
+                relinearize=True, coarse_stm=False) -> BatchOCBEResult:
     """:func:`ocbe_batch` after its argument checks: the loop of the single-trial filter with a trial axis.
 
     The SRI algebra is that of :func:`cislunar.estimation.ocbe.ocbe_filter_smoother` step for step, on the same
@@ -272,6 +320,8 @@ def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smoot
     the closing smoother) is a function of the trials it computes; with ``flag``, a stage that raises is rerun
     trial by trial (:func:`_per_trial`) so that only the failing trials are dropped, at the epoch where the
     single-trial filter would have raised (0 for the first update, n+1 for interval n, N-1 for the smoother).
+    ``wrap_azimuth``, ``relinearize`` and ``coarse_stm``: see :func:`ocbe_batch` (with ``relinearize=False`` the reference of each
+    trial is carried beside its estimate; the deviation is their difference).
     """
     B, N = y.shape[0], t.size
     lay = ocbe.BLOCK_LAYOUT
@@ -296,15 +346,19 @@ def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smoot
             whiten[key] = srif._sri_of_cov(Rk if n_vis == 1 else np.kron(np.eye(n_vis), Rk))
         return whiten[key]
 
-    def update(S, x_ref, k, yk):  # Eqs. 24-28 about the reference x_ref (the deviation's prior mean is zero)
+    def update(S, x_ref, k, yk, dx=None):  # Eqs. 24-28 about the reference x_ref (the deviation's prior mean is
+        # zero; with dx, the prior deviation of a fixed reference: the residual is y - h(x_ref) - H dx)
         vis = visible[k]
         if vis.size == 0:  # no measurement: a pure time update
-            return S, x_ref.copy(), np.zeros(x_ref.shape[0])
+            return S, x_ref.copy() if dx is None else x_ref + dx, np.zeros(x_ref.shape[0])
         if not np.all(np.isfinite(x_ref)):  # a diverged estimate (was refused by model.evaluate's check)
             raise ValueError("target contains NaN or infinite values")
         val, _, Ht = model._evaluate(obs[k, vis], x_ref[:, None, :])  # arrays checked above: the unchecked kernels
         nb = x_ref.shape[0]
-        dy = model._residual(yk[:, vis], val).reshape(nb, -1)
+        dy = (model._residual(yk[:, vis], val) if wrap_azimuth else yk[:, vis] - val).reshape(nb, -1)
+        if dx is not None:
+            dy = dy - (Ht.reshape(nb, -1, 6) @ dx[..., None])[..., 0]
+            x_ref = x_ref + dx
         # srif._measurement_update with the whitening computed once: triangularise [S 0; W H  W dy]
         W = whitening(k, vis.size)
         U = srif._triangularize(np.concatenate([np.concatenate([S, np.zeros((nb, 6, 1))], axis=-1),
@@ -326,6 +380,7 @@ def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smoot
         p_step = np.full((B, N - 1, 6), nan)
     failures = _Failures(t, B)
     x_cur, S_cur = x, None
+    x_ref = x.copy()  # the fixed reference (relinearize=False): at t[0], the prior mean
 
     def stage(fn, epoch, replicate):
         if not flag:
@@ -339,7 +394,7 @@ def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smoot
         return update(srif._sri_of_cov(P0[idx]), x[idx], 0, y[idx, 0])
 
     def interval(idx, n):
-        xs, S = x_cur[idx], S_cur[idx]
+        xs, S = (x_cur[idx], S_cur[idx]) if relinearize else (x_ref[idx], S_cur[idx])
         grid = t_sub[n]
         start[:6] = xs.T
         _check_start_outside(system, xs, n, float(grid[0]))  # a measurement update may move an estimate inside
@@ -368,9 +423,15 @@ def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smoot
         end = out[-1].T  # (B, 114)
         Phi_xx = np.array(end[:, s_xx].reshape(B, 6, 6))
         Phi_xp = np.array(end[:, s_xp].reshape(B, 6, 6))
+        if coarse_stm:  # one frozen-Jacobian step over the interval instead of the integrated transition
+            Phi_xx, Phi_xp = _frozen_transition(system, xs, float(grid[-1] - grid[0]), qs[idx, n])
         Q = process_noise(Phi_xx, Phi_xp)  # Eq. 17
         S_bar, _, term = srif._time_update(S, zero, Phi_xx, eye, Q)  # Eq. 23 with Gamma = I, b_x = 0
         x_prior = np.array(end[:, :6])
+        if not relinearize:  # the deviation from the fixed reference, carried by Phi_xx
+            dx = (Phi_xx @ (x_cur[idx] - xs)[..., None])[..., 0]
+            S_new, x_new, e = update(S_bar, x_prior, n + 1, y[idx, n + 1], dx)
+            return x_prior + dx, S_new, x_new, e, x_prior
         S_new, x_new, e = update(S_bar, x_prior, n + 1, y[idx, n + 1])  # Eqs. 24-28
         if not smooth:  # filter only: no single-step smoother, no control estimate
             return x_prior, S_new, x_new, e
@@ -389,6 +450,8 @@ def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smoot
             if res is None:
                 break
             x_pred[:, n + 1], S_cur, x_cur, resid[:, n + 1] = res[:4]
+            if not relinearize:
+                x_ref = res[4]
             x_filt[:, n + 1], S_filt[:, n + 1] = x_cur, S_cur
             if smooth:
                 phi_xx[:, n], phi_xp[:, n], phi_pp_sub[:, n], Rw[:, n], Rwx[:, n], zw[:, n], p_step[:, n] = res[4:]

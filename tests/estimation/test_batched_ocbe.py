@@ -223,3 +223,113 @@ def test_control_integral_is_eq_33_per_trial():
     u[1, 1, :, 1] = np.linspace(0.0, 1.0, 4)  # a linear ramp on the second interval: trapezoid rule exact
     assert np.isclose(ocbe._control_integral(t_sub, u)[0], 2.0)
     assert not np.isclose(ocbe._control_integral(t_sub, u)[1], 4.0)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Filter-side options (issue 23): azimuth wrapping and the fixed-reference (linearised) filter
+
+
+def test_default_options_are_bit_identical_to_omitting_them():
+    t, y, obs, model, Rm, x0, P0, q = _trials(2)
+    a = batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, n_sub=2, smooth=False)
+    b = batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, n_sub=2, smooth=False, wrap_azimuth=True,
+                                relinearize=True)
+    assert np.array_equal(a.x_filt, b.x_filt) and np.array_equal(a.P_filt, b.P_filt)
+
+
+def test_unwrapped_azimuth_agrees_away_from_the_cut_and_mishandles_a_residual_across_it():
+    # the 9:2 NRHO seen from L2 starts on the azimuth's +-pi cut (the first azimuth is pi) and leaves it
+    t, y, obs, model, Rm, x0, P0, q = _trials(2)
+    az = model(obs, orbits.nrho_9_2(em).x0)[0, 0]
+    assert abs(abs(az) - np.pi) < 1e-6
+    kw = dict(n_sub=2, smooth=False)
+    # away from the cut (epochs 1-8: azimuth -3.127 to -3.027 rad, i.e. 1000+ sigma from it): the same filter
+    x1 = batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, **kw).x_filt[:, 1]
+    P1 = batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, **kw).P_filt[0, 1]
+    args = (em, t[1:], y[:, 1:], obs[1:], model, Rm, x1, P1, q[1:])
+    wrapped = batched_ocbe.ocbe_batch(*args, **kw)
+    unwrapped = batched_ocbe.ocbe_batch(*args, wrap_azimuth=False, **kw)
+    assert _rel(unwrapped.x_filt, wrapped.x_filt) < 1e-13
+    assert _rel(unwrapped.P_filt, wrapped.P_filt) < 1e-12
+    # across the cut: the measured azimuth on the other branch (y - 2 pi) is the same measurement to the wrapped
+    # filter; the unwrapped one sees a 2 pi residual (about 6e5 sigma) and its estimate is thrown off
+    y_other = y.copy()
+    y_other[:, 0, 0] += -2 * np.pi if az > 0 else 2 * np.pi
+    base = batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, **kw)
+    w2 = batched_ocbe.ocbe_batch(em, t, y_other, obs, model, Rm, x0, P0, q, **kw)
+    u2 = batched_ocbe.ocbe_batch(em, t, y_other, obs, model, Rm, x0, P0, q, wrap_azimuth=False, on_failure="flag",
+                                 **kw)
+    assert _rel(w2.x_filt, base.x_filt) < 1e-12
+    assert np.all(u2.failed) or np.nanmax(np.abs(u2.x_filt[:, 0] - base.x_filt[:, 0])) > 1e3 * np.sqrt(P0[0, 0])
+
+
+def test_fixed_reference_filter_equals_the_relinearised_one_to_second_order_in_the_deviation():
+    """On a linear system the two filters are one; here they differ by a term quadratic in the deviation from the
+    reference: scaling the prior error (noise-free data of the reference orbit) by 1/10 scales the difference of the
+    estimates by 1/100 (a mistake in the deviation bookkeeping, e.g. a dropped H dx or Phi dx, makes it 1/10)."""
+    t, _, obs, model, Rm, x0, P0, q = _trials(2)
+    nrho = orbits.nrho_9_2(em)
+    truth = propagate(em, nrho.x0, t).x
+    y = np.repeat(model(obs, truth)[None], 2, axis=0)
+    d = x0 - nrho.x0
+    diffs = []
+    for eps in (1.0, 0.1):
+        xe = nrho.x0 + eps * d
+        ekf = batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, xe, P0, q, n_sub=2, smooth=False)
+        lkf = batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, xe, P0, q, n_sub=2, smooth=False, relinearize=False)
+        assert np.array_equal(lkf.x_filt[:, 0], ekf.x_filt[:, 0])  # one reference at t[0]: the prior mean
+        assert np.max(np.abs(ekf.x_filt - truth)) > 10 * np.max(np.abs(lkf.x_filt - ekf.x_filt))
+        diffs.append(np.max(np.abs(lkf.x_filt - ekf.x_filt)))
+    assert 70 < diffs[0] / diffs[1] < 130
+
+
+def test_fixed_reference_filter_is_filter_only_and_options_are_checked():
+    t, y, obs, model, Rm, x0, P0, q = _trials(2)
+    with pytest.raises(ValueError, match="smooth=False"):
+        batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, relinearize=False)
+    for kw in ({"relinearize": "no"}, {"wrap_azimuth": 1}):
+        with pytest.raises(TypeError, match=next(iter(kw))):
+            batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, smooth=False, **kw)
+
+
+def test_frozen_transition_is_the_integrated_one_to_first_order_and_gives_a_valid_process_noise():
+    """The coarse time update (one frozen-Jacobian step): its one-step error against the integrated 12x12 transition
+    is O(dt^2) (halving the step quarters it; the relative error of Phi_xp is O(dt^3), the frozen Hessian acting
+    on the velocity columns only at second order); its process noise is symmetric positive semi-definite; with q = 0 it
+    is exp(A dt) (the costate block is zero)."""
+    x = orbits.nrho_9_2(em).x0
+    errs = []
+    for dt in (0.02, 0.01):
+        tr = ocbe.ocbe_transition(em, x, dt, Q_WEIGHT)
+        pxx, pxp = batched_ocbe._frozen_transition(em, x, dt, Q_WEIGHT)
+        errs.append((np.max(np.abs(pxx - tr.phi_xx[-1])), np.max(np.abs(pxp - tr.phi_xp[-1]))
+                     / np.max(np.abs(tr.phi_xp[-1]))))
+        Q = -pxp @ pxx.T
+        assert np.allclose(Q, Q.T, rtol=0, atol=1e-12 * np.max(np.abs(Q)))
+        assert np.min(np.linalg.eigvalsh(0.5 * (Q + Q.T))) > -1e-12 * np.max(np.abs(Q))
+    assert 3.5 < errs[0][0] / errs[1][0] < 4.5 and 6.0 < errs[0][1] / errs[1][1] < 10.0
+    # the chapter's tiny weight (1e-20 km^2/s^3) over one minute: Phi_xp keeps its relative accuracy
+    q_tiny, dt = 1e-20 * em.time_unit_s**3 / em.length_unit_km**2, 1.6e-4  # about one minute
+    tr = ocbe.ocbe_transition(em, x, dt, q_tiny)
+    pxp = batched_ocbe._frozen_transition(em, x, dt, q_tiny)[1]
+    assert np.max(np.abs(pxp - tr.phi_xp[-1])) < 1e-6 * np.max(np.abs(tr.phi_xp[-1]))
+    pxx0, pxp0 = batched_ocbe._frozen_transition(em, np.stack([x, x]), 0.1, np.zeros(2))
+    from scipy.linalg import expm
+    assert np.allclose(pxx0[1], expm(em.jacobian(x) * 0.1), rtol=0, atol=1e-14) and not np.any(pxp0)
+
+
+def test_coarse_stm_filter_approaches_the_integrated_one_as_the_interval_shrinks():
+    t, y, obs, model, Rm, x0, P0, q = _trials(2)
+    fine = batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, n_sub=2, smooth=False)
+    coarse = batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, n_sub=2, smooth=False, coarse_stm=True)
+    assert np.array_equal(coarse.x_filt[:, 0], fine.x_filt[:, 0])
+    d_2h = _rel(coarse.P_filt[:, 1:2], fine.P_filt[:, 1:2])
+    # the same first interval cut to a quarter: the covariance after it moves to the integrated one
+    tq = np.r_[t[0], t[0] + (t[1] - t[0]) / 4]
+    yq = model(obs[:2], propagate(em, x0[0], tq).x)[None].repeat(2, axis=0)
+    fq = batched_ocbe.ocbe_batch(em, tq, yq, obs[:2], model, Rm, x0, P0, q[:1], n_sub=2, smooth=False)
+    cq = batched_ocbe.ocbe_batch(em, tq, yq, obs[:2], model, Rm, x0, P0, q[:1], n_sub=2, smooth=False,
+                                 coarse_stm=True)
+    assert _rel(cq.P_filt[:, 1], fq.P_filt[:, 1]) < d_2h / 4
+    with pytest.raises(ValueError, match="smooth=False"):
+        batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, coarse_stm=True)

@@ -106,6 +106,12 @@ def study():
 
 
 @functools.lru_cache(maxsize=None)
+def axes_study():
+    return obs.filter_axes_study(em, {"9:2 NRHO": nrho()}, [24.0], Q, n_runs=1, seed=0, axes={"baseline": ({}, 1.0)},
+                                 progress=False)
+
+
+@functools.lru_cache(maxsize=None)
 def rmap():
     return obs.regime_map(em, {"9:2 NRHO": nrho()}, [24.0], [1e-5], [1.0], {"rates, 1 s": 1.0}, Q, n_runs=1,
                           seed=0)
@@ -193,6 +199,13 @@ def specs(Spec, lazy):
       dict(system="system", orbits_="instance", cadences="vec", sigmas="vec", handoffs="vec",
            rate_models="instance", control_weight="pos", n_runs="int1", seed="int0", executor="instance_opt"))
     S("figure_regime_map", _closed(obs.figure_regime_map), dict(rmap=lz(rmap)), dict(rmap="instance"))
+    S("filter_axes_study", obs.filter_axes_study,
+      dict(system=em, orbits_=lz(lambda: {"9:2 NRHO": nrho()}), cadences=[24.0], control_weight=Q, n_runs=1, seed=0,
+           n_runs_one_minute=None, axes=None, handoff_scale=1.0, sigma_angle_rad=1e-5, executor=None, progress=False),
+      dict(system="system", orbits_="instance", cadences="vec", control_weight="pos", n_runs="int1", seed="int0",
+           n_runs_one_minute="int1_opt", axes="instance_opt", handoff_scale="pos", sigma_angle_rad="pos",
+           executor="instance_opt", progress="bool"))
+    S("figure_filter_axes", _closed(obs.figure_filter_axes), dict(study=lz(axes_study)), dict(study="instance"))
     S("divergence_example", obs.divergence_example,
       dict(system=em, orbit=lz(nrho), rmap=lz(rmap), cell=lz(cell), control_weight=Q, seed=0, n_draws=1),
       dict(system="system", orbit="instance", rmap="instance", cell="instance", control_weight="pos",

@@ -8,6 +8,9 @@ functions returning frozen results (chapter 09).
 * :func:`regime_map`: the fraction of diverged runs over hand-off scale, angle noise, cadence, orbit and rate
   model (:class:`RegimeMap` analyses where the paper's contrast could hold);
 * :func:`divergence_example`: the clearest diverged draw of an angles-only map cell (the paper's Fig. 4 analogue);
+* :func:`filter_axes_study`: the regime map's key cells (the paper's hand-off, angles vs angles + rates) along
+  filter-side axes: azimuth wrapping, a fixed reference, the control weight, a coarse time update
+  (:class:`FilterAxesStudy`);
 * figure functions (``figure_*``), each returning a Matplotlib figure.
 
 A run is *diverged* when more than 5 % of its epochs have a NEES above the 99.9 % chi-square quantile, or when the
@@ -36,6 +39,8 @@ from cislunar.utils.montecarlo import map_tasks, trial_rng
 __all__ = [
     "ONSETS",
     "DivergenceExample",
+    "FILTER_AXES",
+    "FilterAxesStudy",
     "MeasurementDemo",
     "RegimeMap",
     "StableCandidates",
@@ -45,11 +50,13 @@ __all__ = [
     "compare_stable_candidates",
     "divergence_example",
     "figure_divergence",
+    "figure_filter_axes",
     "figure_final_uncertainty",
     "figure_measurements",
     "figure_regime_map",
     "figure_typical_run",
     "filled",
+    "filter_axes_study",
     "flagged_cells",
     "measurement_demo",
     "pct_span",
@@ -358,12 +365,13 @@ LOCKSTEP_TRIALS = 64
 
 def _trial_batch(task):
     """One executor task (module level, picklable): ``(scenario, control_weight, draws)`` with ``draws`` a list of
-    ``(seed, i, handoff_scale)``; trial ``i`` of the Monte Carlo set ``seed`` draws from the generator
+    ``(seed, i, handoff_scale)``, optionally followed by a dict of filter options of :func:`tracking.filter_trials`;
+    trial ``i`` of the Monte Carlo set ``seed`` draws from the generator
     :func:`cislunar.utils.montecarlo.run_monte_carlo` would give it (:func:`cislunar.utils.montecarlo.trial_rng`), and
     all run in one lockstep (:func:`tracking.filter_trials`).  Returns their :class:`tracking.TrialSummary`."""
-    scenario, control_weight, draws = task
+    scenario, control_weight, draws, *options = task
     return tracking.filter_trials([trial_rng(sd, i) for sd, i, _ in draws], scenario, control_weight,
-                                  handoff_scale=[h for _, _, h in draws])
+                                  handoff_scale=[h for _, _, h in draws], **(options[0] if options else {}))
 
 
 def _run_sets(sets, control_weight, executor, desc, progress=True):
@@ -683,6 +691,198 @@ def regime_map(system: CR3BP, orbits_: dict, cadences, sigmas, handoffs, rate_mo
         onsets[key] = [_onset_class(r, t, t_peri) for r in runs if r.diverged]
     return RegimeMap(cells, onsets, tuple(m[0] for m in models), tuple(orbits_), tuple(cadences), tuple(sigmas),
                      tuple(handoffs), n_runs)
+
+
+#: The filter-side axes of :func:`filter_axes_study`: name -> (options of :func:`tracking.filter_trials`, factor on
+#: the control weight).  The first is the chapter's filter; "unwrapped azimuth" is a deliberately mishandled branch
+#: cut (a filter bug some implementations have), the others are filters a careful implementer might choose.
+FILTER_AXES = {
+    "baseline": ({}, 1.0),
+    "unwrapped azimuth": ({"wrap_azimuth": False}, 1.0),
+    "fixed reference": ({"relinearize": False}, 1.0),
+    "control weight x0.01": ({}, 0.01),
+    "control weight x100": ({}, 100.0),
+    "control weight x1e8": ({}, 1e8),
+    "coarse STM": ({"coarse_stm": True}, 1.0),
+}
+
+
+@dataclass(frozen=True)
+class FilterAxesStudy:
+    """Diverged fractions per (filter axis, orbit, cadence h, model) at one hand-off and angle noise.
+
+    Every axis filters the same draws (common random numbers: a cell's measurements and hand-offs do not depend on
+    the filter), so differences between axes are the filters'.
+
+    Attributes
+    ----------
+    cells : dict
+        Diverged fraction per key ``(axis, orbit, cadence, model)``, model ``"angles"`` or ``"angles+rates"``.
+    onsets : dict
+        Per key, where each diverged run's inconsistency starts (one of :data:`ONSETS`).
+    axes : tuple of str
+        Names of the axes (keys of :data:`FILTER_AXES` or the caller's).
+    orbit_names : tuple of str
+    cadences : tuple of float
+    n_runs : int
+        Runs per cell (at cadences of 0.1 h and more; ``n_runs_one_minute`` below).
+    n_runs_one_minute : int
+    handoff : float
+        Hand-off scale (1: the paper's 10 km, 10 cm/s, 3 sigma).
+    sigma_angle_rad : float
+    """
+
+    cells: dict
+    onsets: dict
+    axes: tuple
+    orbit_names: tuple
+    cadences: tuple
+    n_runs: int
+    n_runs_one_minute: int
+    handoff: float
+    sigma_angle_rad: float
+
+    MODELS = ("angles", "angles+rates")
+
+    def contrast_holds(self, axis, orbit_name, cadence) -> bool:
+        """The paper's contrast in one cell: most angles-only runs diverge, at most 10 % of the runs with rates do
+        (the regime map's reading, :meth:`RegimeMap.contrast_holds`)."""
+        return (self.cells[axis, orbit_name, cadence, "angles"] > 0.5
+                and self.cells[axis, orbit_name, cadence, "angles+rates"] <= 0.10)
+
+    @property
+    def contrast(self) -> dict:
+        """Per axis, the (orbit, cadence) cells where the contrast holds."""
+        return {a: [(o, c) for o in self.orbit_names for c in self.cadences if self.contrast_holds(a, o, c)]
+                for a in self.axes}
+
+    @property
+    def axes_with_full_contrast(self) -> list:
+        """The axes whose contrast holds in every (orbit, cadence) cell (the paper: every cadence)."""
+        n = len(self.orbit_names) * len(self.cadences)
+        return [a for a, ks in self.contrast.items() if len(ks) == n]
+
+    def report(self) -> str:
+        """One line per (axis, orbit, model), one column per cadence (diverged runs, %), then the contrast."""
+        lines = [f"{'filter':>22} {'orbit':>10} {'model':>13} " + " ".join(f"{cadence_label(c):>7}"
+                                                                           for c in self.cadences)]
+        for a in self.axes:
+            for o in self.orbit_names:
+                for m in self.MODELS:
+                    lines.append(f"{a:>22} {o:>10} {m:>13} "
+                                 + " ".join(f"{100 * self.cells[a, o, c, m]:6.0f}%" for c in self.cadences))
+        n = len(self.orbit_names) * len(self.cadences)
+        for a, ks in self.contrast.items():
+            lines.append(f"contrast with {a}: {len(ks)} of {n} cells"
+                         + (": " + ", ".join(f"{o} {cadence_label(c)}" for o, c in ks) if ks else ""))
+        for a in self.axes:
+            cls = [c for k, v in self.onsets.items() if k[0] == a for c in v]
+            if cls:
+                lines.append(f"{a}: {len(cls)} diverged runs; inconsistency starts at "
+                             + ", ".join(f"{name} {100 * cls.count(name) / len(cls):.0f} %" for name in ONSETS))
+        return "\n".join(lines)
+
+
+def filter_axes_study(system: CR3BP, orbits_: dict, cadences, control_weight: float, *, n_runs: int, seed: int,
+                      n_runs_one_minute: int | None = None, axes: dict | None = None, handoff_scale: float = 1.0,
+                      sigma_angle_rad: float = tracking.DEFAULT_SIGMA_ANGLE_RAD, executor=None,
+                      progress: bool = True) -> FilterAxesStudy:
+    """The regime map's key cells (tracks from apoapsis, one hand-off, angles only vs angles + the paper's 1-s rates)
+    along filter-side axes.
+
+    Parameters
+    ----------
+    system : CR3BP
+    orbits_ : dict of str -> PeriodicOrbit
+    cadences : sequence of float
+        Measurement cadences, hours.
+    control_weight : float
+        The chapter's OCBE control weight, LU^2/TU^3 (each axis multiplies it by its factor).
+    n_runs : int
+        Runs per (axis, orbit, cadence, model) cell.
+    n_runs_one_minute : int, optional
+        Runs per cell at cadences under 0.1 h (default ``n_runs``).
+    seed : int
+        Cell ``(orbit io, cadence ic, model im)`` draws run ``i`` from child ``i`` of ``(seed, 23, io, ic, im)``,
+        the same for every axis.
+    axes : dict of str -> (dict, float), optional
+        Name -> (options of :func:`tracking.filter_trials`, control-weight factor); default :data:`FILTER_AXES`.
+    handoff_scale : float
+        Hand-off scale (1: the paper's 10 km, 10 cm/s, 3 sigma).
+    sigma_angle_rad : float
+        Angle noise (1 sigma), rad; the rates are Eq. 13's with a 1-s baseline.
+    executor : optional
+        As in :func:`strategy_study` (one task per :data:`LOCKSTEP_TRIALS` runs of a cell).
+    """
+    check_system(system)
+    _check_orbits(orbits_)
+    cadences = _positive_values(cadences, "cadences")
+    control_weight = validation.positive(control_weight, "control_weight")
+    n_runs = validation.integer(n_runs, "n_runs", minimum=1)
+    n_one = n_runs if n_runs_one_minute is None else validation.integer(n_runs_one_minute, "n_runs_one_minute",
+                                                                        minimum=1)
+    seed = validation.integer(seed, "seed", minimum=0)
+    axes = FILTER_AXES if axes is None else axes
+    validation.instance(axes, "axes", dict, "a dict of name -> (filter options dict, control-weight factor)")
+    allowed = {"wrap_azimuth", "relinearize", "coarse_stm"}
+    for name, spec in axes.items():
+        validation.instance(name, "axes", str, "a dict with str names")
+        if not (isinstance(spec, tuple) and len(spec) == 2 and isinstance(spec[0], dict)):
+            raise validation.ArgumentTypeError(f"axes[{name!r}] must be a (filter options dict, factor) pair")
+        if set(spec[0]) - allowed:
+            raise ValueError(f"axes[{name!r}] options must be among {sorted(allowed)}; got {sorted(spec[0])}")
+        validation.positive(spec[1], f"axes[{name!r}] factor")
+    handoff_scale = validation.positive(handoff_scale, "handoff_scale")
+    sigma_angle_rad = validation.positive(sigma_angle_rad, "sigma_angle_rad")
+    validation.boolean(progress, "progress")
+    _check_executor(executor)
+    keys, tasks, sizes = [], [], []
+    for io, (oname, orb) in enumerate(orbits_.items()):
+        for ic, cad in enumerate(cadences):
+            for im, rates in enumerate((False, True)):
+                scn = tracking.make_scenario(system, orb, cad, start="apoapsis", rates=rates,
+                                             sigma_angle_rad=sigma_angle_rad)
+                n = n_one if cad < 0.1 else n_runs
+                draws = [((seed, 23, io, ic, im), i, handoff_scale) for i in range(n)]
+                for name, (options, factor) in axes.items():
+                    keys.append(((name, oname, cad, FilterAxesStudy.MODELS[im]), scn.t, orb.period / 2))
+                    parts = [draws[a:a + LOCKSTEP_TRIALS] for a in range(0, n, LOCKSTEP_TRIALS)]
+                    sizes.append(len(parts))
+                    tasks += [(scn, control_weight * factor, part, dict(options)) for part in parts]
+    out = map_tasks(_trial_batch, tasks, executor=executor, desc="filter axes", progress=progress)
+    cells, onsets, a = {}, {}, 0
+    for (key, t, t_peri), n_parts in zip(keys, sizes):
+        runs = [r for part in out[a:a + n_parts] for r in part]
+        a += n_parts
+        cells[key] = float(np.mean([r.diverged for r in runs]))
+        onsets[key] = [_onset_class(r, t, t_peri) for r in runs if r.diverged]
+    return FilterAxesStudy(cells, onsets, tuple(axes), tuple(orbits_), tuple(cadences), n_runs, n_one,
+                           handoff_scale, sigma_angle_rad)
+
+
+def figure_filter_axes(study: FilterAxesStudy):
+    """Diverged runs against cadence, one row per orbit, one column per model (angles only, angles + rates), one
+    curve per filter axis; the shaded band is the 10 % a consistent filter is allowed, the dotted line 50 %."""
+    validation.instance(study, "study", FilterAxesStudy, "a FilterAxesStudy (filter_axes_study)")
+    n_orb = len(study.orbit_names)
+    fig, axes = plt.subplots(n_orb, 2, squeeze=False, figsize=(11.0, 3.8 * n_orb), sharex=True, sharey=True)
+    for io, o in enumerate(study.orbit_names):
+        for jm, m in enumerate(study.MODELS):
+            ax = axes[io, jm]
+            for ia, a in enumerate(study.axes):
+                ax.plot(study.cadences, [100 * study.cells[a, o, c, m] for c in study.cadences],
+                        ls=("-", "--", ":")[ia % 3], marker="osd^v<>"[ia % 7], mfc="none" if ia else None,
+                        color=f"C{ia}", label=a if io == jm == 0 else None)
+            ax.axhspan(-5, 10, color="0.9", zorder=0)
+            ax.axhline(50, color="0.6", lw=0.8, ls=":")
+            ax.set(xscale="log", ylim=(-5, 105), title=f"{o}, {m}, hand-off {10 * study.handoff:g} km")
+            if io == n_orb - 1:
+                ax.set_xlabel("cadence [h]")
+            if jm == 0:
+                ax.set_ylabel("diverged runs [%]")
+    fig.legend(loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, 0.0))
+    fig.tight_layout(rect=(0, 0.1, 1, 1))
+    return fig
 
 
 def figure_regime_map(rmap: RegimeMap):

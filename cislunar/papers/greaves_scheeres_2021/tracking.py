@@ -353,7 +353,8 @@ def filter_trial(rng: np.random.Generator, scenario: TrackingScenario, control_w
 
 
 def filter_trials(rngs, scenario: TrackingScenario, control_weight, *, handoff_scale=1.0,
-                  tol: float = 1e-13) -> list:
+                  tol: float = 1e-13, wrap_azimuth: bool = True, relinearize: bool = True,
+                  coarse_stm: bool = False) -> list:
     """:func:`filter_trial` for several generators at once: the same draws, the filters in one lockstep batch.
 
     Each generator draws its measurement noise and hand-off error exactly as :func:`filter_trial` does; the filters
@@ -374,6 +375,10 @@ def filter_trials(rngs, scenario: TrackingScenario, control_weight, *, handoff_s
         Hand-off scale of every trial, or one per trial (trials of several hand-offs share one lockstep).
     tol : float
         Integrator tolerance.
+    wrap_azimuth, relinearize, coarse_stm : bool
+        Filter-side options of :func:`cislunar.estimation.batched_ocbe.ocbe_batch` (defaults: residual angles
+        wrapped to :math:`[-\\pi, \\pi)`, re-linearised about each updated estimate, transition integrated through
+        each interval); the measurements and hand-offs drawn do not depend on them.
 
     Returns
     -------
@@ -398,6 +403,9 @@ def filter_trials(rngs, scenario: TrackingScenario, control_weight, *, handoff_s
     for s in scales:
         validation.positive(s, "handoff_scale")
     tol = _check_tol(tol)
+    wrap_azimuth = validation.boolean(wrap_azimuth, "wrap_azimuth")
+    relinearize = validation.boolean(relinearize, "relinearize")
+    coarse_stm = validation.boolean(coarse_stm, "coarse_stm")
     system = scenario.system
     truth = simulate_truth(system, scenario.x_start, scenario.t)
     y, x0, P0 = [], [], []
@@ -408,7 +416,8 @@ def filter_trials(rngs, scenario: TrackingScenario, control_weight, *, handoff_s
         P0.append(P)
     res = ocbe_batch(system, scenario.t, np.array(y), scenario.observers, scenario.model, scenario.meas_cov,
                      np.array(x0), np.array(P0), control_weight, available=scenario.available, smooth=False, n_sub=2,
-                     tol=tol, on_failure="flag")
+                     tol=tol, on_failure="flag", wrap_azimuth=wrap_azimuth, relinearize=relinearize,
+                     coarse_stm=coarse_stm)
     nan = float("nan")
     return [TrialSummary(nan, nan, nan, nan, nan, nan, 1.0, True, str(res.failure[b])[:200]) if res.failed[b] else
             summarize(system, res.x_filt[b], res.P_filt[b], truth) for b in range(len(rngs))]

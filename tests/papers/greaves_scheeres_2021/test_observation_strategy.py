@@ -3,6 +3,7 @@ comparison (small sizes and synthetic cells; invariants, not snapshots)."""
 
 from concurrent.futures import ThreadPoolExecutor
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
@@ -203,3 +204,71 @@ def test_public_boundary_names_the_bad_argument(nrho):
         obs.pct_span([])
     with pytest.raises(ValueError, match="cadence_h"):
         obs.cadence_label(0.0)
+
+
+def test_filter_axes_study_filters_the_same_draws_with_each_axis_options_and_weight(nrho, monkeypatch):
+    """Every axis sees the same draws (the cell's seed), its own filter options and its factor on the weight; the
+    cells are the diverged fractions of exactly those runs (checked against tracking.filter_trials called directly)."""
+    axes = {"baseline": ({}, 1.0), "fixed reference": ({"relinearize": False}, 1.0), "weight x100": ({}, 100.0)}
+    st = obs.filter_axes_study(em, {"9:2 NRHO": nrho}, [12.0], Q, n_runs=2, seed=5, axes=axes, handoff_scale=300.0,
+                               progress=False)
+    assert st.axes == tuple(axes) and set(st.cells) == {(a, "9:2 NRHO", 12.0, m) for a in axes
+                                                        for m in ("angles", "angles+rates")}
+    for im, rates in enumerate((False, True)):
+        scn = tracking.make_scenario(em, nrho, 12.0, start="apoapsis", rates=rates)
+        for a, (options, factor) in axes.items():
+            runs = tracking.filter_trials([trial_rng((5, 23, 0, 0, im), i) for i in range(2)], scn, Q * factor,
+                                          handoff_scale=300.0, **options)
+            assert st.cells[a, "9:2 NRHO", 12.0, st.MODELS[im]] == np.mean([r.diverged for r in runs])
+            assert len(st.onsets[a, "9:2 NRHO", 12.0, st.MODELS[im]]) == sum(r.diverged for r in runs)
+    calls = []
+    real = tracking.filter_trials
+
+    def spy(rngs, scenario, control_weight, **kw):
+        calls.append((control_weight, kw.get("relinearize", True), tuple(r.bit_generator.state["state"]["state"]
+                                                                          for r in rngs)))
+        return real(rngs, scenario, control_weight, **kw)
+
+    monkeypatch.setattr(tracking, "filter_trials", spy)
+    monkeypatch.setattr(obs, "LOCKSTEP_TRIALS", 1)  # one run per task: same cells
+    cut = obs.filter_axes_study(em, {"9:2 NRHO": nrho}, [12.0], Q, n_runs=2, seed=5, axes=axes, handoff_scale=300.0,
+                                progress=False)
+    assert cut.cells == st.cells and len(calls) == 2 * 3 * 2
+    angles_calls = calls[:6]  # the angles-only cell: three axes, two one-run tasks each
+    assert [c[2] for c in angles_calls[0:2]] == [c[2] for c in angles_calls[2:4]] == [c[2] for c in angles_calls[4:6]]
+    assert [(c[0] / Q, c[1]) for c in angles_calls[::2]] == [(1.0, True), (1.0, False), (100.0, True)]
+
+
+def test_filter_axes_contrast_and_claim_on_synthetic_cells():
+    cells = {}
+    for a, (ang, rat) in {"baseline": ((0.0, 0.0), (0.0, 0.0)), "x": ((0.6, 0.9), (0.1, 0.0)),
+                          "y": ((0.6, 0.5), (0.1, 0.1))}.items():
+        for c, va, vr in zip((2.0, 12.0), ang, rat):
+            cells[a, "9:2 NRHO", c, "angles"] = va
+            cells[a, "9:2 NRHO", c, "angles+rates"] = vr
+    st = obs.FilterAxesStudy(cells, {k: [] for k in cells}, ("baseline", "x", "y"), ("9:2 NRHO",), (2.0, 12.0), 10,
+                             10, 1.0, 1e-5)
+    # contrast: angles > 50 % and rates <= 10 % (0.5 is not "most")
+    assert st.contrast == {"baseline": [], "x": [("9:2 NRHO", 2.0), ("9:2 NRHO", 12.0)], "y": [("9:2 NRHO", 2.0)]}
+    assert st.axes_with_full_contrast == ["x"]
+    assert "contrast with x: 2 of 2 cells" in st.report()
+    claim = obs.filled(CLAIMS["filter_axes_contrast"], axes="baseline, x, y", cadences="2 h, 12 h")
+    assert claim.judge(bool(st.axes_with_full_contrast)).status == "reproduced"
+    assert claim.judge(False).status == "differs"
+    fig = obs.figure_filter_axes(st)
+    panels = [ax for ax in fig.axes if ax.lines]
+    assert len(panels) == 2 and [list(ln.get_ydata()) for ln in panels[0].lines[:3]] == [[0.0, 0.0], [60.0, 90.0],
+                                                                                         [60.0, 50.0]]
+    plt.close(fig)
+
+
+def test_filter_axes_study_bad_input(nrho):
+    orbits_ = {"9:2 NRHO": nrho}
+    with pytest.raises(ValueError, match="axes"):
+        obs.filter_axes_study(em, orbits_, [12.0], Q, n_runs=1, seed=0, axes={"a": ({"n_sub": 3}, 1.0)})
+    with pytest.raises(TypeError, match="axes"):
+        obs.filter_axes_study(em, orbits_, [12.0], Q, n_runs=1, seed=0, axes={"a": {"relinearize": False}})
+    with pytest.raises(ValueError, match="factor"):
+        obs.filter_axes_study(em, orbits_, [12.0], Q, n_runs=1, seed=0, axes={"a": ({}, 0.0)})
+    with pytest.raises(ValueError, match="n_runs"):
+        obs.filter_axes_study(em, orbits_, [12.0], Q, n_runs=0, seed=0)

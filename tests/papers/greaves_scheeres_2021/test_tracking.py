@@ -161,3 +161,30 @@ def test_filter_trials_bad_input(scenario):
         tracking.filter_trials(spawn_rngs(0, 2), scenario, 1e-8, handoff_scale=[1.0, -2.0])
     with pytest.raises(ValueError, match="control_weight"):
         tracking.filter_trials(spawn_rngs(0, 2), scenario, -1.0)
+
+
+@pytest.mark.parametrize("options", [{"wrap_azimuth": False}, {"relinearize": False}, {"coarse_stm": True}])
+def test_filter_trials_pass_the_filter_options_on_and_draw_the_same_data(scenario, options):
+    """A filter-side option changes the filter only: the summaries are those of ocbe_batch with that option on the
+    draws of filter_trial (same generators), and the default options give the default summaries bit for bit."""
+    q = 1e-20 * em.time_unit_s**3 / em.length_unit_km**2
+    sc = tracking.make_scenario(em, orbits.nrho_9_2(em), 12.0, start="apoapsis")
+    truth = tracking.simulate_truth(em, sc.x_start, sc.t)
+    y, x0 = [], []
+    for r in spawn_rngs(2, 2):
+        y.append(tracking.simulate_measurements(sc, truth, r))
+        x0.append(tracking.initial_estimate(em, sc.x_start, r, scale=30.0)[0])
+    P0 = tracking.initial_estimate(em, sc.x_start, np.random.default_rng(0), scale=30.0)[1]
+    res = batched_ocbe.ocbe_batch(em, sc.t, np.array(y), sc.observers, sc.model, sc.meas_cov, np.array(x0), P0, q,
+                                  available=sc.available, smooth=False, n_sub=2, tol=1e-13, on_failure="flag",
+                                  **options)
+    out = tracking.filter_trials(spawn_rngs(2, 2), sc, q, handoff_scale=30.0, **options)
+    for b in range(2):
+        assert out[b] == tracking.summarize(em, res.x_filt[b], res.P_filt[b], truth)
+    default = tracking.filter_trials(spawn_rngs(2, 2), sc, q, handoff_scale=30.0)
+    assert default == tracking.filter_trials(spawn_rngs(2, 2), sc, q, handoff_scale=30.0, wrap_azimuth=True,
+                                             relinearize=True, coarse_stm=False)
+    if "wrap_azimuth" not in options:  # whether a draw's azimuths straddle the cut is chance (tests/estimation)
+        assert default != out  # the option did change the filter
+    with pytest.raises(TypeError, match=next(iter(options))):
+        tracking.filter_trials(spawn_rngs(2, 2), sc, q, **{k: "yes" for k in options})
