@@ -45,7 +45,7 @@ PENALTY_GAMMAS = None  # exact-penalty weights gamma swept, unstated in the pape
 BUDGETS_EXTRA_MPS = None  # impulse budgets above the baseline's, Section 8, m/s (None: [5] quick, [1, 5, 20] full)
 BUDGET_RTOL = 0.02  # a budget counts as met within this relative tolerance (fixed before solving)
 FORWARD_HESSIAN = None  # forward (True) or central (False) differences for the MI Hessian (None: True quick, False full)
-WORKERS = None  # local processes for the exact-penalty runs of Section 4, 1 = serial (None: 1 quick, 2 full)
+WORKERS = None  # local processes for the exact-penalty runs of Section 4, 1 runs serially (None: 1 quick, 2 full)
 SCHEDULER = ""  # address of a Dask scheduler to run them on, e.g. "tcp://10.0.0.5:8786" ("": none; WORKERS applies)
 
 # %%

@@ -56,7 +56,7 @@ SCAN_RANGE_KM = [1e-6, 3000.0]  # closest and farthest pass distance of that sca
 BUDGET_EXTRA_MPS = 5.0  # impulse budget above the baseline's for the equal-impulse solve of Section 11, m/s
 BUDGET_RTOL = 0.02  # a budget counts as met within this relative tolerance (fixed before solving)
 SAME_PLAN_KM = 100.0  # two plans are the same if their node positions are never farther apart, km (fixed in advance)
-WORKERS = None  # local processes for the independent SCvx runs, 1 = serial (None: 1 quick, 2 full)
+WORKERS = None  # local processes for the independent SCvx runs, 1 runs serially (None: 1 quick, 2 full)
 SCHEDULER = ""  # address of a Dask scheduler to run them on, e.g. "tcp://10.0.0.5:8786" ("": none; WORKERS applies)
 
 # %%

@@ -39,7 +39,7 @@ N_GRID_SLICES = None  # arrival times in the resolution study (None: 3 quick, 5 
 N_TRIALS = None  # Monte Carlo trials per policy and execution-error level (None: 4 quick, 40 full)
 N_RANDOM = None  # uninformed picks per arrival slice, ring angles uniform on [0, 2 pi) (None: 16 quick, 64 full)
 MEMBER_CHECK = None  # re-solve the torus for two other readings of "average range" (None: False quick, True full)
-WORKERS = None  # local processes for the sweeps and the Monte Carlo, 1 = serial (None: 1 quick, 2 full)
+WORKERS = None  # local processes for the sweeps and the Monte Carlo, 1 runs serially (None: 1 quick, 2 full)
 SCHEDULER = ""  # address of a Dask scheduler to run them on ("" = none; then WORKERS applies)
 MEAN_RANGE_KM = None  # mean agent-target range that selects the torus member, km (None: 215.0, the paper's number)
 T_BURN_H = None  # first burn, hours from the target's apoapsis (None: -24.0)

@@ -52,7 +52,7 @@ N_MAP = None  # runs per regime-map cell (None: 2 quick, 10 full)
 CADENCE_AXES = None  # filter-side axes (Section 5c): cadences, hours (None: [12] quick; [1, 2, 6, 12] full)
 N_AXES = None  # runs per filter-axis cell (None: 2 quick, 10 full)
 N_DRAWS_EXAMPLE = 10  # fresh draws per Fig. 4 analogue (the clearest divergence is shown)
-WORKERS = None  # local processes for the Monte Carlo, 1 = serial (None: 1 quick, 2 full)
+WORKERS = None  # local processes for the Monte Carlo, 1 runs serially (None: 1 quick, 2 full)
 SCHEDULER = ""  # address of a Dask scheduler to run on, e.g. "tcp://10.0.0.5:8786" ("": none; WORKERS applies)
 
 # %%

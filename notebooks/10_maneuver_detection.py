@@ -61,7 +61,7 @@ N_LEAD = None  # (no-burn runs for calibration and validation, runs per burn siz
 LEAD_MAGNITUDES = None  # burn sizes of the control-versus-residual race, m/s (None: 0.05, 0.1, 0.2, 0.5)
 N_BOOT = None  # bootstrap resamples for the standard errors of z_lim and of FP + MD (None: 4 quick, 40 full)
 BATCH = None  # trials the batched OCBE filters together, epoch by epoch (None: 8); results depend on it
-WORKERS = None  # local processes for the Monte Carlo, 1 = serial (None: 1 quick, 2 full)
+WORKERS = None  # local processes for the Monte Carlo, 1 runs serially (None: 1 quick, 2 full)
 SCHEDULER = ""  # address of a Dask scheduler to run the Monte Carlo on ("" = none; then WORKERS applies)
 
 # %% [markdown]
