@@ -171,15 +171,7 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
         raise ValueError(f"y must have shape (B, {N}, {f'{K}, ' if multi else ''}{m}) to match observer_states and "
                          f"the model; got {y.shape}")
     y = y if multi else y[:, :, None, :]
-    if available is None:
-        avail = np.ones((N, K), dtype=bool)
-    else:
-        avail = np.asarray(available)
-        if avail.dtype != bool:
-            raise validation.ArgumentTypeError(f"available must be an array of bool; got dtype {avail.dtype}")
-        if avail.shape != (N, K) and not (K == 1 and avail.shape == (N,)):
-            raise ValueError(f"available must have shape ({N}, {K}); got {avail.shape}")
-        avail = avail.reshape(N, K)
+    avail = ocbe._availability(available, N, K)
     if not np.all(np.isfinite(y[:, avail])):
         raise ValueError("y contains NaN or infinite values where measurements are available")
     R = validation.as_array(meas_cov, "meas_cov", ndim=(2, 3))

@@ -77,6 +77,20 @@ class FilterDivergenceError(RuntimeError):
         return (type(self), (self.epoch, self.time, self.cause))
 
 
+def _availability(available, N: int, K: int) -> np.ndarray:
+    """The (N, K) bool mask of which observer sees the target at which epoch (``None``: all, always).
+
+    A (N,) mask is accepted for one observer.  Shared by the single-trial and the batched OCBE.
+    """
+    if available is None:
+        return np.ones((N, K), dtype=bool)
+    avail = np.asarray(available)
+    if avail.dtype != bool:
+        raise validation.ArgumentTypeError(f"available must be an array of bool; got dtype {avail.dtype}")
+    if avail.shape != (N, K) and not (K == 1 and avail.shape == (N,)):
+        raise ValueError(f"available must have shape ({N}, {K}); got {avail.shape}")
+    return avail.reshape(N, K)
+
 def check_model(model, name: str = "model"):
     """A :class:`cislunar.sensing.measurements.MeasurementModel` (e.g. ``measurements.ANGLES_AND_RATES``)."""
 
@@ -526,15 +540,7 @@ def ocbe_filter_smoother(system: CR3BP, t, y, observer_states, model, meas_cov, 
     y = y[:, None, :] if y.ndim == 2 else y
     if y.shape != (N, K, model.dim):
         raise ValueError(f"y must have shape ({N}, {model.dim}) or ({N}, {K}, {model.dim}); got {y.shape}")
-    if available is None:
-        avail = np.ones((N, K), dtype=bool)
-    else:
-        avail = np.asarray(available)
-        if avail.dtype != bool:
-            raise validation.ArgumentTypeError(f"available must be an array of bool; got dtype {avail.dtype}")
-        if avail.shape not in ((N, K), (N,) if K == 1 else (N, K)):
-            raise ValueError(f"available must have shape ({N}, {K}); got {avail.shape}")
-        avail = avail.reshape(N, K)
+    avail = _availability(available, N, K)
     if not np.all(np.isfinite(y[avail])):
         raise ValueError("y contains NaN or infinite values where measurements are available")
     R = validation.as_array(meas_cov, "meas_cov")

@@ -5,12 +5,13 @@ give results bit-identical to the serial run, in trial order, and report a faili
 Skipped only when the optional ``cluster`` extra (``dask[distributed]``) is absent; the bootstrap installs it.
 """
 
-import sys
 
 import numpy as np
 import pytest
 
 distributed = pytest.importorskip("distributed", reason="the optional 'cluster' extra (dask[distributed]) is absent")
+
+from dask_cluster import local_client  # noqa: E402
 
 from cislunar.utils import montecarlo  # noqa: E402
 
@@ -39,17 +40,8 @@ def _pid(task):
 
 @pytest.fixture(scope="module")
 def client():
-    import cloudpickle
-
-    cloudpickle.register_pickle_by_value(sys.modules[__name__])  # workers cannot import the tests directory
-    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                       silence_logs=40)
-    cl = distributed.Client(cluster)
-    try:
+    with local_client(__name__) as cl:
         yield cl
-    finally:
-        cl.close()
-        cluster.close()
 
 
 def test_monte_carlo_on_a_dask_cluster_is_bit_identical_to_serial(client):

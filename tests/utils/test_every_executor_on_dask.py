@@ -25,11 +25,11 @@ import importlib.util
 import inspect
 import pkgutil
 import re
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from dask_cluster import local_client
 
 import cislunar
 from cislunar.cr3bp import orbits
@@ -258,17 +258,8 @@ def test_the_comparison_notices_one_bit():
 # ---------------------------------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def client():
-    import cloudpickle
-
-    cloudpickle.register_pickle_by_value(sys.modules[__name__])  # workers cannot import the tests directory
-    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                       silence_logs=40)
-    cl = distributed.Client(cluster)
-    try:
+    with local_client(__name__) as cl:
         yield cl
-    finally:
-        cl.close()
-        cluster.close()
 
 
 def test_every_function_taking_an_executor_has_a_case():

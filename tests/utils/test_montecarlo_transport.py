@@ -11,7 +11,6 @@ for a guessed time, so the tests do not depend on the machine's load.
 import os
 import pickle
 import signal
-import sys
 import threading
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -21,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import psutil
 import pytest
+from dask_cluster import local_client
 
 from cislunar.utils import montecarlo
 
@@ -219,21 +219,10 @@ def test_ctrl_c_ends_a_process_pool_within_the_documented_bound(tmp_path):
 # ---------------------------------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def client():
-    distributed = pytest.importorskip("distributed", reason="the optional 'cluster' extra is absent")
-    import cloudpickle
-    import dask
-
-    cloudpickle.register_pickle_by_value(sys.modules[__name__])  # workers cannot import the tests directory
+    pytest.importorskip("distributed", reason="the optional 'cluster' extra is absent")
     # a task whose worker dies is not retried on another worker (the default retries it 3 times, killing 3 more)
-    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
-        cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                           silence_logs=50)
-        cl = distributed.Client(cluster)
-    try:
+    with local_client(__name__, silence_logs=50, config={"distributed.scheduler.allowed-failures": 0}) as cl:
         yield cl
-    finally:
-        cl.close()
-        cluster.close()
 
 
 def test_an_unpicklable_result_on_dask_fails_only_its_trial(client):
