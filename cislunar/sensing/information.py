@@ -681,16 +681,28 @@ class InformationKernel:
                 a.flags.writeable = False
         self.shape = (N, M, n)
 
+    @staticmethod
+    def _float(value, name):
+        """``np.asarray(value, dtype=float)`` (the fast path: no copy of a float array), numpy's conversion errors
+        (a string, an object, a ragged list) re-raised naming ``name``."""
+        try:
+            return np.asarray(value, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise validation.ArgumentTypeError(f"{name} must be a numeric array; got {type(value).__name__} "
+                                               f"({exc})") from None
+
     def _check(self, F, H):
         N, M, n = self.shape
-        F = np.asarray(F, dtype=float)
-        H = np.asarray(H, dtype=float)
+        F = self._float(F, "F")
+        H = self._float(H, "H")
         if F.shape != (N - 1, n, n):
             raise ValueError(f"F must have shape {(N - 1, n, n)}; got {F.shape}")
         if H.shape != (N, M, n):
             raise ValueError(f"H must have shape {(N, M, n)}; got {H.shape}")
-        if not (np.isfinite(F).all() and np.isfinite(H).all()):
-            raise ValueError("F and H must be finite (no NaN or inf)")
+        if not np.isfinite(F).all():
+            raise ValueError("F must be finite (no NaN or inf)")
+        if not np.isfinite(H).all():
+            raise ValueError("H must be finite (no NaN or inf)")
         return F, H
 
     def value(self, F, H) -> float:
@@ -703,14 +715,19 @@ class InformationKernel:
         """:func:`mutual_information_gradient` (reverse mode): ``(info, grad (p,))`` for derivatives ``dF``
         (N-1, n, n, p) and ``dH`` (N, M, n, p)."""
         F, H = self._check(F, H)
-        dF = np.asarray(dF, dtype=float)
-        dH = np.asarray(dH, dtype=float)
+        dF = self._float(dF, "dF")
+        dH = self._float(dH, "dH")
+        if dF.ndim != 4 or dF.shape[:3] != F.shape or dF.shape[-1] < 1:
+            raise ValueError(f"dF must have shape {F.shape} + (p,) with p >= 1; got {dF.shape}")
         if dH.ndim != 4 or dH.shape[:3] != H.shape or dH.shape[-1] < 1:
             raise ValueError(f"dH must have shape {H.shape} + (p,) with p >= 1; got {dH.shape}")
-        if dF.shape != F.shape + dH.shape[-1:]:
-            raise ValueError(f"dF must have shape {F.shape + dH.shape[-1:]}; got {dF.shape}")
-        if not (np.isfinite(dF).all() and np.isfinite(dH).all()):
-            raise ValueError("dF and dH must be finite (no NaN or inf)")
+        if dF.shape[-1] != dH.shape[-1]:
+            raise ValueError(f"dF and dH must have the same number p of parameters on their last axis; got dF "
+                             f"{dF.shape} (p = {dF.shape[-1]}) and dH {dH.shape} (p = {dH.shape[-1]})")
+        if not np.isfinite(dF).all():
+            raise ValueError("dF must be finite (no NaN or inf)")
+        if not np.isfinite(dH).all():
+            raise ValueError("dH must be finite (no NaN or inf)")
         return _gradient_sqrt_reverse(self.P0, F, self.Q, H, self.LR, dF, dH, self.LQ)
 
 

@@ -28,11 +28,9 @@ MODULES = [covariance, information, discretization, scvx, reference, lpv, observ
 # take arguments are swept below.  Every module-level public function has a spec.  Arguments that accept any
 # square matrix (symmetrize, concave_part) or any planar state/position stack (CR3BPLPV.rho, angles, measure) are
 # swept with "arr_finite" (their shape refusals are tested in tests/test_validation_estimation.py).
-# The constructors of InformationKernel, WindowAssembler and SCvxWorkspace are swept, and WindowAssembler's call.
-# InformationKernel.value / value_gradient are not: by design they check only the shapes and finiteness of F, H,
-# dF, dH (the fast path of an optimiser), so a string, object() or a ragged list raises numpy's unnamed
-# ValueError/TypeError ("could not convert string to float", "float() argument must be ..."), and a dH whose last
-# axis disagrees with dF's is reported as a dF shape error (reported to the lead, not changed here).
+# The constructors of InformationKernel, WindowAssembler and SCvxWorkspace are swept, WindowAssembler's call and
+# InformationKernel.value / value_gradient (their fast path converts F, H, dF, dH with one np.asarray each and
+# re-raises numpy's conversion errors naming the argument; a dF/dH pair whose last axes differ names both).
 EXEMPT: dict = {}
 
 X_DRO = np.array([0.8, 0.0, 0.0, 0.0, 0.52, 0.0])
@@ -232,6 +230,11 @@ def specs(Spec, lazy):
     s.append(S("InformationKernel", I.InformationKernel,
                dict(P0=lin["P0"], Q=lin["Q"], R=lin["R"], n_times=lin["H"].shape[0]),
                dict(P0="spd", Q="psd", R="spd", n_times="int1")))
+    kernel = lazy(lambda: I.InformationKernel(lin["P0"], lin["Q"], lin["R"], lin["H"].shape[0]))
+    s.append(S("InformationKernel.value", lazy(lambda: kernel().value), dict(F=lin["F"], H=lin["H"]),
+               dict(F="arr", H="arr")))
+    s.append(S("InformationKernel.value_gradient", lazy(lambda: kernel().value_gradient),
+               dict(F=lin["F"], H=lin["H"], **der), dict(F="arr", H="arr", **DER_KINDS)))
     s.append(S("window_information", I.window_information, dict(lin=lazy(_lin), method="structured", gradient=True),
                dict(lin="instance", method="choice", gradient="bool")))
     s.append(S("gaussian_kl", I.gaussian_kl, dict(mean_p=np.zeros(3), cov_p=SPD3, mean_q=np.ones(3),

@@ -12,10 +12,9 @@ section 6) uses a two-draw scheduling-error run whose widened box is narrowed th
 designs with one bisection step and one verification sample (about 1 s), and a 0.05-period window at the 233-min
 interval (9 samples).  Each is built once (``functools.lru_cache``).
 
-Not swept (reported, not fixed here: the functions belong to their authors): ``fig1_scene``'s ``rso`` (a
-``(p, q, perigee guess)`` tuple) is not validated as a whole: None, 3.0 or object() raise an unnamed
-``TypeError`` ("... is not subscriptable"), a 2-tuple an ``IndexError``, "abc" an unnamed ``ValueError``, and
-``(3.5, 1, 0.3)`` is accepted (truncated to 3:1).
+``fig1_scene``'s ``rso`` (a ``(p, q, perigee radius)`` tuple) is swept as an "iterable" (None, 3.0, object(),
+"abc"); its item checks (a 2-tuple, ``(3.5, 1, 0.3)``, p <= q, a perigee radius out of range) are tested in
+``tests/papers/nychka_bhattacharya/test_robust.py``.
 
 Labels are ``<function>.nb_<module>`` (the sweep matches a function by the part before the first dot): the package
 has two functions of the same name in different modules (``trade_curve``, ``allowances``, ``bandwidth``,
@@ -267,9 +266,8 @@ def specs(Spec, lazy):
                dict(design="robust", norm="h2", start="large"), dict(design="choice", norm="choice", start="choice"))
 
     # -------------------------------------------------------------------------------------- scenarios (Fig. 1)
-    # rso is not swept: see the module notes
-    add(nb_scenarios, "fig1_scene", dict(scenario=sc, n_platforms=2, rso_phase=0.3, n_samples=10),
-        dict(scenario="instance", n_platforms="int1", rso_phase="range:0:1", n_samples="int2"))
+    add(nb_scenarios, "fig1_scene", dict(scenario=sc, n_platforms=2, rso=(3, 1, 0.3), rso_phase=0.3, n_samples=10),
+        dict(scenario="instance", n_platforms="int1", rso="iterable", rso_phase="range:0:1", n_samples="int2"))
 
     # -------------------------------------------------------------------------------------------- exercises
     small = dict(n_samples=10)

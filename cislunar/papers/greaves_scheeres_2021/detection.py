@@ -449,6 +449,9 @@ def draw_trials(rngs, setup: DetectionSetup, policy: StationKeepingPolicy | None
         magnitude_m_s = validation.positive(magnitude_m_s, "magnitude_m_s", allow_zero=True)
     if direction is not None:
         direction = validation.as_array(direction, "direction", shape=(2,))
+        if policy is None and magnitude_m_s is None:
+            raise ValueError("direction is given but no burn is drawn (policy and magnitude_m_s are None), so it would "
+                             "be ignored: pass a policy or magnitude_m_s, or leave direction None")
     return _draw_trials(rngs, setup, policy, magnitude_m_s, direction, t_burn)
 
 
@@ -757,6 +760,7 @@ def run_detection_monte_carlos(jobs, *, batch_size: int = 8, executor=None, prog
         raise validation.ArgumentTypeError("jobs must be a sequence of (setup, policy, n_trials, seed) tuples") from None
     B = validation.integer(batch_size, "batch_size", minimum=1)
     validation.boolean(progress, "progress")
+    validation.instance(desc, "desc", str)
     segments = {}  # filter key -> [(job, setup, policy, root, first batch, end batch)] in job order
     for k, job in enumerate(jobs):
         if len(job) != 4:
@@ -1173,6 +1177,13 @@ def run_policy_studies(jobs, *, batch_size: int = 8, executor=None, bandwidth="s
     except TypeError:
         raise validation.ArgumentTypeError("jobs must be a sequence of (setup, policy, n_h0, n_h1, n_test, seed) "
                                            "tuples") from None
+    validation.integer(batch_size, "batch_size", minimum=1)
+    validation.boolean(progress, "progress")
+    validation.instance(desc, "desc", str)
+    if not ((isinstance(bandwidth, str) and bandwidth in ("scott", "silverman")) or (  # fit_pdf's rule, checked
+            isinstance(bandwidth, (int, float)) and not isinstance(bandwidth, bool) and np.isfinite(bandwidth)
+            and bandwidth > 0)):  # before the Monte Carlo runs rather than after them
+        raise ValueError(f"bandwidth must be 'scott', 'silverman' or a positive factor; got {bandwidth!r:.60}")
     runs, plan = [], []
     for k, job in enumerate(jobs):
         if len(job) != 6:

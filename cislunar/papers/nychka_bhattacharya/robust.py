@@ -189,20 +189,38 @@ class RobustDesigns:
     sigma_deg: float
 
 
-def _least_gamma(lmi, kappa_sensor, lo, hi, iters):
+#: Largest bound (LU) the search for gamma* tries before giving up: a guaranteed RMS position error of an Earth-Moon
+#: distance guarantees nothing.  From the default start (4 GAMMA) the search tries 0.0052, 0.021, 0.083, 0.33
+#: and 1.33 LU, then stops (five solves, about a second for an infeasible LMI).
+_GAMMA_SEARCH_MAX = 1.0
+
+
+def _least_gamma(lmi, kappa_sensor, lo, hi, iters, why):
     """Bisection (in log gamma) for the least gamma whose required theta1 precision is <= ``kappa_sensor``;
-    returns ``(gamma, design)`` at the feasible end."""
+    returns ``(gamma, design)`` at the feasible end.
+
+    The upper end grows fourfold until it is feasible; once it exceeds :data:`_GAMMA_SEARCH_MAX` a ``ValueError``
+    says why no gamma works (the LMI infeasible, or the sensor's precision never enough), followed by ``why``
+    (the caller's arguments that set the problem)."""
+    last = {}
+
     def ok(g):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
                 d = lmi.solve(g)
-            except lpv.InfeasibleLMIError:
+            except lpv.InfeasibleLMIError as exc:
+                last["failure"] = f"the {lmi.norm} LMI is infeasible ({exc.status})"
                 return None
-        return d if np.max(d.kappa[list(THETA1_SENSORS)]) <= kappa_sensor else None
+        need = float(np.max(d.kappa[list(THETA1_SENSORS)]))
+        last["failure"] = f"the {lmi.norm} design needs a theta1 precision {need:.4g} > the sensor's {kappa_sensor:.4g}"
+        return d if need <= kappa_sensor else None
 
     d_hi = ok(hi)
     while d_hi is None:
+        if hi > _GAMMA_SEARCH_MAX:
+            raise ValueError(f"no gamma up to {hi:.3g} LU makes the robust {lmi.norm} design work: at that gamma "
+                             f"{last['failure']}; {why}")
         lo, hi = hi, 4.0 * hi
         d_hi = ok(hi)
     for _ in range(iters):
@@ -231,8 +249,10 @@ def robust_designs(scenario: Scenario, serr: SchedulingError, dt: float, n_verif
     m = scenario.model
     sin_s = np.sin(np.radians(serr.sigma_deg))
     Bd0, Sd0, _ = lpv.default_disturbance()
-    designs, g_star, kap, ver = {}, {}, {}, {}
-    for norm in ("h2", "hinf"):
+    kap, found = {}, {}
+    # H-infinity first: its bandwidth bound (pole_radius) is what most often makes the problem infeasible, and it
+    # then fails before the H2 bisection; the solves are deterministic, so the order changes nothing else
+    for norm in ("hinf", "h2"):
         scale = np.sqrt(dt) if norm == "h2" else 1.0
         kap[norm] = float(1.0 / (sin_s * scale))
         Bd = np.zeros((4, 6))
@@ -245,11 +265,18 @@ def robust_designs(scenario: Scenario, serr: SchedulingError, dt: float, n_verif
         kw = {"pole_radius": R} if norm == "hinf" else {}
         lmi = lpv.PrecisionLMI.for_cr3bp(m, serr.box.vertices(), norm, disturbance=(Bd, Sd, Dd),
                                          sensors=THETA1_SENSORS, **kw)
-        g_star[norm], designs[norm] = _least_gamma(lmi, kap[norm], GAMMA, 4 * GAMMA, iters)
+        why = (f"check pole_radius={pole_radius!r} (the bandwidth bound; the nominal designs use {POLE_RADIUS:g}), "
+               if norm == "hinf" else "check ")
+        why += (f"the sensor (serr.sigma_deg={serr.sigma_deg:g} deg sampled every dt={dt:g} TU) and the scheduling "
+                f"error of serr (s_f={serr.s_f:.3g}, s_y={serr.s_y:.3g}, box {serr.box.source!r:.80})")
+        found[norm] = _least_gamma(lmi, kap[norm], GAMMA, 4 * GAMMA, iters, why)
+    designs, g_star, ver = {}, {}, {}
+    for norm in ("h2", "hinf"):  # verified in this order (rng)
+        g_star[norm], designs[norm] = found[norm]
         ver[norm] = lpv.verify_observer(m, designs[norm], serr.box, n_verify, rng)
     guarantee = {n: float(np.sqrt(N_GROUPS) * g) for n, g in g_star.items()}
-    return RobustDesigns(designs, g_star, guarantee, kap, ver, serr.box, serr.s_f, serr.s_y, float(dt),
-                         serr.sigma_deg)
+    return RobustDesigns(designs, g_star, guarantee, {n: kap[n] for n in designs}, ver, serr.box, serr.s_f, serr.s_y,
+                         float(dt), serr.sigma_deg)
 
 
 @dataclass(frozen=True)

@@ -135,17 +135,32 @@ class Fig1Scene:
 def fig1_scene(scenario: Scenario, n_platforms: int = 6, *, rso: tuple = (3, 1, 0.3), rso_phase: float = 0.3,
                n_samples: int = 400) -> Fig1Scene:
     """``n_platforms`` platforms equally spaced in time on ``scenario``'s orbit, and an RSO on the ``rso`` = (p, q,
-    perigee guess) resonant orbit at ``rso_phase`` (fraction of its period) of its own orbit; both drawn over one
-    period with ``n_samples`` points (the paper's Fig. 1 states no orbit: an illustration of the concept)."""
+    perigee radius) resonant orbit at ``rso_phase`` (fraction of its period) of its own orbit; both drawn over one
+    period with ``n_samples`` points (the paper's Fig. 1 states no orbit: an illustration of the concept).
+
+    ``rso`` holds the arguments of :func:`cislunar.estimation.lpv.resonant_orbit`: integers ``p > q >= 1`` (3.0 is
+    accepted, 3.5 is refused, not truncated) and the perigee radius in LU, in [0.05, 0.9] and below the resonance's
+    2a.  Any other value raises ``ValueError``/``TypeError`` naming ``rso``.
+    """
     scenario = validation.instance(scenario, "scenario", Scenario)
     k = validation.integer(n_platforms, "n_platforms", minimum=1)
     phase = validation.in_range(rso_phase, "rso_phase", 0.0, 1.0)
     n = validation.integer(n_samples, "n_samples", minimum=10)
+    if not isinstance(rso, (tuple, list, np.ndarray)) or (isinstance(rso, np.ndarray) and rso.ndim != 1):
+        raise validation.ArgumentTypeError(f"rso must be a (p, q, perigee radius in LU) tuple; got "
+                                           f"{type(rso).__name__} {rso!r:.60}")
+    if len(rso) != 3:
+        raise ValueError(f"rso must hold 3 items (p, q, perigee radius in LU); got {len(rso)}: {rso!r:.60}")
+    p_q_rp = (validation.integer(rso[0], "rso[0] (p)"), validation.integer(rso[1], "rso[1] (q)"),
+              validation.real(rso[2], "rso[2] (perigee radius, LU)"))
     m, o = scenario.model, scenario.orbit
+    try:  # the resonance's own rules (p > q >= 1, perigee radius range), named as the caller's rso
+        ro = resonant_orbit(m.system, *p_q_rp)
+    except ValueError as exc:
+        raise ValueError(f"rso = {rso!r:.60} is not a resonant orbit: {exc}") from None
     _, x = o.sample(n)
     tp = np.arange(k) * o.period / k
     platforms = m.planar(propagate(m.system, o.x0, np.r_[tp, o.period]).x[:k]) if k > 1 else m.planar(o.x0[None])
-    ro = resonant_orbit(scenario.model.system, int(rso[0]), int(rso[1]), float(rso[2]))
     _, xr = ro.sample(n)
     r_at = m.planar(propagate(m.system, ro.x0, [0.0, phase * ro.period + 1e-9]).x[-1])
     return Fig1Scene(m.planar(x), platforms, m.planar(xr), r_at,

@@ -106,19 +106,25 @@ def exercise_01_mu_step(steps=(1e-10, 1e-8), reference_step: float = 1e-9, syste
     Parameters
     ----------
     steps : sequence of float
-        Trial values of ``MU_STEP`` (dimensionless, > 0), in any order.
+        Trial values of ``MU_STEP`` (dimensionless, 0 < step < mu), in any order.
     reference_step : float
-        Step whose closures fix the slope (dimensionless, > 0; the notebook's default 1e-9).
+        Step whose closures fix the slope (dimensionless, 0 < step < mu; the notebook's default 1e-9).
     system : CR3BP
         The adopted system (Earth-Moon by default).
+
+    Raises
+    ------
+    ValueError
+        A step (or ``reference_step``) that is not in ``(0, mu)``: the study tries :math:`\\mu -` step, which
+        must stay a valid mass ratio; or ``steps`` containing ``reference_step``.
     """
     check_system(system)
-    trial_steps = tuple(sorted({validation.positive(v, "steps") for v in
-                                validation.as_array(steps, "steps", ndim=(1,), min_size=1)}))
-    ref = validation.positive(reference_step, "reference_step")
+    mu = system.mu
+    trial_steps = tuple(sorted({validation.in_range(v, "steps", 0.0, mu, closed=False) for v in
+                                validation.as_array(steps, "steps", ndim=(1,), min_size=1).tolist()}))
+    ref = validation.in_range(reference_step, "reference_step", 0.0, mu, closed=False)
     if ref in trial_steps:
         raise ValueError(f"steps must not contain reference_step {ref!r}; got {steps!r}")
-    mu = system.mu
     every = (ref, *trial_steps)
     study = wjt.mu_closure_study(system, [mu] + [mu + sign * d for d in every for sign in (1, -1)])
     floor = study.adopted_closure

@@ -1,6 +1,8 @@
 """The robust designs of notebook 12 (cislunar.papers.nychka_bhattacharya.robust): the exact error decomposition,
 the widened polytope, the robust LMI's bound on sampled parameters and the 233-min re-run, on small sizes."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -113,3 +115,90 @@ def test_fig1_scene_places_platforms_on_the_orbit():
     jac = sc.model.system.jacobi(sc.model.spatial(scene.platforms))
     assert np.allclose(jac, sc.model.system.jacobi(sc.orbit.x0), atol=1e-9)
     assert np.allclose(scene.platforms[0], sc.model.planar(sc.orbit.x0))
+
+
+@pytest.mark.parametrize("rso, name, kind", [
+    (None, "rso must be a", TypeError), (3.0, "rso must be a", TypeError), (object(), "rso must be a", TypeError),
+    ("abc", "rso must be a", TypeError), (np.array(3.0), "rso must be a", TypeError),
+    (np.ones((3, 2)), "rso must be a", TypeError), ((3, 1), "rso must hold 3", ValueError),
+    ((3.5, 1, 0.3), r"rso\[0\] \(p\) must be an integer", TypeError),  # refused, not truncated to 3:1
+    ((3, "1", 0.3), r"rso\[1\] \(q\) must be an integer", TypeError),
+    ((3, 1, np.nan), r"rso\[2\] \(perigee radius, LU\) must be finite", ValueError),
+    ((1, 2, 0.3), r"rso = \(1, 2, 0.3\) is not a resonant orbit", ValueError),
+    ((2, 2, 0.3), r"rso = \(2, 2, 0.3\) is not a resonant orbit: p and q", ValueError),
+    ((3, 1, 0.95), r"rso = .* perigee_radius must lie in", ValueError),
+    ((4, 1, 0.9), r"rso = .* below 2a", ValueError),  # 2a = 0.794 LU for 4:1
+])
+def test_fig1_scene_refuses_a_bad_rso_by_name(rso, name, kind):
+    sc = paper_scenario(n_samples=50)
+    with pytest.raises(kind, match=name):
+        fig1_scene(sc, 2, rso=rso, n_samples=10)
+
+
+def test_fig1_scene_takes_rso_as_the_resonance_it_names():
+    """A list, an array or integral floats give the same RSO orbit as the tuple (3, 1, 0.3)."""
+    sc = paper_scenario(n_samples=50)
+    ref = fig1_scene(sc, 2, rso=(3, 1, 0.3), n_samples=10)
+    assert ref.labels[1] == "RSO orbit (3:1 resonant)"
+    for rso in ([3, 1, 0.3], np.array([3.0, 1.0, 0.3]), (3.0, 1.0, 0.3)):
+        scene = fig1_scene(sc, 2, rso=rso, n_samples=10)
+        assert scene.labels == ref.labels and np.array_equal(scene.rso_orbit, ref.rso_orbit)
+    assert fig1_scene(sc, 2, rso=(2, 1, 0.3), n_samples=10).labels[1] == "RSO orbit (2:1 resonant)"
+
+
+@pytest.fixture(scope="module")
+def small_setup():
+    """The 2:1 orbit at 50 samples with its box (and the widened one) narrowed to 8 vertices (LMIs in ~0.1 s)."""
+    def narrowed(box):
+        lo, hi = box.lower.copy(), box.upper.copy()
+        c = 0.5 * (lo + hi)
+        lo[3:], hi[3:] = c[3:], c[3:]
+        return lpv.ParameterBox(lo, hi, source="8 vertices")
+
+    sc = paper_scenario(n_samples=50)
+    sc = dataclasses.replace(sc, box=narrowed(sc.box))
+    se = rb.scheduling_error(sc, 0.1, 2, np.random.default_rng(0))
+    return sc, dataclasses.replace(se, box=narrowed(se.box))
+
+
+def test_robust_designs_refuse_an_infeasible_pole_radius_after_a_bounded_search(small_setup, monkeypatch):
+    """pole_radius = 2.5 1/TU is below the bandwidth any observer of this box can have: the H-infinity LMI is
+    infeasible at every gamma.  The search for gamma* stops at about 1 LU (five solves) and names pole_radius;
+    before, it grew gamma fourfold until it overflowed (about 500 solves) and then complained about gamma."""
+    sc, se = small_setup
+    calls = []
+    solve = lpv.PrecisionLMI.solve
+
+    def counted(self, gamma, **kw):
+        calls.append((self.norm, gamma))
+        if len(calls) > 20:
+            raise AssertionError(f"the gamma search did not stop: {len(calls)} solves, last gamma {gamma:g}")
+        return solve(self, gamma, **kw)
+
+    monkeypatch.setattr(lpv.PrecisionLMI, "solve", counted)
+    with pytest.raises(ValueError, match=r"no gamma up to 1\.33 LU .* hinf LMI is infeasible.* pole_radius=2\.5"):
+        rb.robust_designs(sc, se, DT_233, 1, np.random.default_rng(0), pole_radius=2.5, iters=1)
+    # H-infinity is searched first, so the refusal comes before any H2 solve
+    assert [n for n, _ in calls] == ["hinf"] * 5
+    assert [g for _, g in calls] == pytest.approx([4 * rb.GAMMA * 4**k for k in range(5)])
+    # a feasible bandwidth bound still gives designs (the search then stops at the first feasible gamma)
+    calls.clear()
+    rd = rb.robust_designs(sc, se, DT_233, 1, np.random.default_rng(0), pole_radius=1000.0, iters=1)
+    assert set(rd.designs) == {"h2", "hinf"} and list(rd.kappa_sensor) == ["h2", "hinf"]
+    assert all(g <= 4 * rb.GAMMA for g in rd.gamma_star.values())
+
+
+def test_robust_designs_name_the_sensor_when_it_is_never_precise_enough(small_setup, monkeypatch):
+    """If every gamma's design needs more precision than the sensor has, the refusal names the sensor (serr's
+    sigma_deg, dt), not an internal gamma; forced here by making every solved design demand infinite precision."""
+    sc, se = small_setup
+    solve = lpv.PrecisionLMI.solve
+
+    def greedy(self, gamma, **kw):
+        d = solve(self, gamma, **kw)
+        return dataclasses.replace(d, kappa=np.full_like(d.kappa, np.inf))
+
+    monkeypatch.setattr(lpv.PrecisionLMI, "solve", greedy)
+    with pytest.raises(ValueError, match=r"no gamma up to .* needs a theta1 precision inf > the sensor's .* "
+                                         r"\(serr\.sigma_deg=0\.1 deg sampled every dt=0\.0373"):
+        rb.robust_designs(sc, se, DT_233, 1, np.random.default_rng(0), iters=1)

@@ -1,6 +1,8 @@
 """The worked solutions of the Wolf & Jones exercises (cislunar.papers.wolf_jones.exercises): each test checks the
 claim its answer makes (the predicted direction and size of the change), so a wrong solution fails."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -44,6 +46,30 @@ def test_01_closure_grows_linearly_with_the_mu_step_within_the_floor():
         X.exercise_01_mu_step(steps=(1e-9,), reference_step=1e-9)
     with pytest.raises(ValueError, match="steps"):
         X.exercise_01_mu_step(steps=(-1e-9,))
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(steps=(1e-8, em.mu)), "steps"),  # mu - step = 0: no longer a mass ratio
+    (dict(steps=(0.02,)), "steps"),
+    (dict(steps=(1e-8, 0.0)), "steps"),
+    (dict(reference_step=em.mu), "reference_step"),
+    (dict(reference_step=0.5), "reference_step"),
+    (dict(reference_step=0.0), "reference_step"),
+])
+def test_01_a_step_outside_zero_to_mu_is_refused_by_name_before_any_propagation(kwargs, name, monkeypatch):
+    """A step >= mu would try mu - step <= 0; it is refused up front, naming the argument (not the study's ``mus``)."""
+    def no_study(*a, **k):
+        raise AssertionError("the closure study ran before the steps were checked")
+
+    monkeypatch.setattr(wjt, "mu_closure_study", no_study)
+    with pytest.raises(ValueError, match=rf"^{name} must lie in \(0\.0, {em.mu}\)") as info:
+        X.exercise_01_mu_step(**kwargs)
+    assert not re.search(r"\bmus\b", str(info.value))
+    # just inside the interval is accepted by the checks (the study is reached)
+    ok = dict(steps=(1e-8,), reference_step=1e-9)
+    ok[name] = (em.mu * (1 - 1e-9),) if name == "steps" else em.mu * (1 - 1e-9)
+    with pytest.raises(AssertionError, match="closure study ran"):
+        X.exercise_01_mu_step(**ok)
 
 
 # ===============================================================================================================
