@@ -499,7 +499,7 @@ class _Child:
     log: Path
     result: Path
     started: float
-    expected: float
+    expected: float | None  # seconds of the last run of the same mode into this build; None: never run there
     workers: int
     offset: int = 0
 
@@ -591,9 +591,14 @@ def run_all(sources, *, quick: bool, seed: int = 0, output_dir=None, parameters:
     stage.mkdir(parents=True, exist_ok=True)
     (stage / "logs").mkdir(exist_ok=True)
 
-    def expected_seconds(name):
+    def last_seconds(name):
+        """This notebook's time in the last run of the same mode into this build, or None."""
         rec = previous.get(name)
-        return float(rec["seconds"]) if rec and rec.get("mode") == mode else _DEFAULT_SECONDS[mode]
+        return float(rec["seconds"]) if rec and rec.get("mode") == mode else None
+
+    def expected_seconds(name):
+        last = last_seconds(name)
+        return _DEFAULT_SECONDS[mode] if last is None else last
 
     queue = sorted(sources, key=lambda s: -expected_seconds(s.stem))
     running: list[_Child] = []
@@ -628,8 +633,9 @@ def run_all(sources, *, quick: bool, seed: int = 0, output_dir=None, parameters:
                                     env=env, start_new_session=True, cwd=str(root))
         w = _workers_asked(src, parameters, quick)
         running.append(_Child(src, proc, tmp, log, tmp / "result.json", time.monotonic(),
-                              expected_seconds(src.stem), w))
-        est = f", last run {expected_seconds(src.stem):.0f} s" if src.stem in previous else ""
+                              last_seconds(src.stem), w))
+        last = last_seconds(src.stem)
+        est = "" if last is None else f", last run {last:.0f} s"
         say(f"[{src.stem}] running ({mode}{est}; {w} process{'es' if w > 1 else ''}; log {log})")
 
     def finish(child):
@@ -668,7 +674,8 @@ def run_all(sources, *, quick: bool, seed: int = 0, output_dir=None, parameters:
                 last_beat = time.monotonic()
                 for c in running:
                     el = time.monotonic() - c.started
-                    say(f"[{c.source.stem}] {el:.0f} s of ~{c.expected:.0f} s: {_last_line(c.log)}")
+                    of = "" if c.expected is None else f" of ~{c.expected:.0f} s (last run)"
+                    say(f"[{c.source.stem}] {el:.0f} s{of}: {_last_line(c.log)}")
             if log_output:
                 for c in running:
                     _stream_new_lines(c, say)

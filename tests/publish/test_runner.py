@@ -144,3 +144,16 @@ def test_sigint_mid_notebook_ends_every_process_and_leaves_the_build(tmp_path):
     assert not left, left
     rec = provenance.read_records(tmp_path / "build-quick-incomplete")
     assert rec["93_slow"]["status"] == "interrupted"
+
+
+def test_status_lines_give_an_estimate_only_from_an_earlier_run(tmp_path):
+    src = source(tmp_path, "97_wait", body="import time\ntime.sleep(2.5)")
+    target = tmp_path / "build-quick"
+    first, second = io.StringIO(), io.StringIO()
+    assert notebooks.run_all([src], quick=True, output_dir=target, out=first, heartbeat=0.5) == 0
+    beats = [line for line in first.getvalue().splitlines() if line.startswith("[97_wait]") and " s: " in line]
+    assert beats and not any("of ~" in line or "last run" in line for line in beats)  # never run here: no guess
+    seconds = provenance.read_records(target)["97_wait"]["seconds"]
+    assert notebooks.run_all([src], quick=True, output_dir=target, out=second, heartbeat=0.5) == 0
+    assert f"last run {seconds:.0f} s" in second.getvalue()
+    assert f"of ~{seconds:.0f} s (last run)" in second.getvalue()
