@@ -33,7 +33,9 @@ nb_ipywidgets_js = {}  # never load widget renderers from the internet
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence"]
 myst_heading_anchors = 3
 myst_dmath_double_inline = True  # "$$...$$" inside a paragraph, as Jupyter renders it
-suppress_warnings = ["myst.header", "mystnb.unknown_mime_type"]
+# "ref.python": a word of a numpydoc type field ("n", "orbit", "time") that names attributes of several classes
+# is an ambiguous cross-reference; it stays plain text, and the warning (about 130 per build) is noise.
+suppress_warnings = ["myst.header", "mystnb.unknown_mime_type", "ref.python"]
 
 # MathJax 3 from a Python package, never a CDN.  The files are copied into _static/mathjax after the build.
 mathjax_path = "mathjax/tex-chtml.js"
