@@ -305,7 +305,8 @@ _ = plotting.save_figure(figures.equal_impulse(impulse_mps, term_obs, budget_row
 # every $\alpha_h$ of the grid (criterion in the row); day counts of the text within 1 day; "bounded" CRLB means a
 # window-end RMS no larger than at the 2nd measurement; "correlates well" a Spearman rank correlation below -0.8.
 # Rows resting on a reading chosen with the paper's claim in view (process noise, the slip in Table 2) are at best
-# "consistent (tuned)"; the solver rows separate the printed method from ours. The paper prints no number for test
+# "consistent (tuned)"; the growth of impulse and MI with $\alpha_h$ is "derived" (any set of global optima of a
+# weighted sum has it); the solver rows separate the printed method from ours. The paper prints no number for test
 # case 1 beyond its inputs (Tables 2-3), so the quantitative rows are "not in paper" or "beyond paper". Slips in
 # the paper are listed with what we used.
 #

@@ -5,7 +5,9 @@ Declarations only.  Tolerances fixed before comparing: the window ends to the pa
 RMS at least five times that of every alpha_h > 0; "correlates well" a Spearman rank correlation of MI against
 terminal RMS of at most -0.8; the observer "on average" better than the targets a window-mean RMS at least 10 %
 lower than the targets' mean; the front is monotone if no plan has both more impulse and a higher RMS than another;
-two plans are mirror images within 1 km and 1e-6 relative cost.
+two plans are mirror images within 1 km and 1e-6 relative cost.  The Fig. 9 and Fig. 10 rows rest on the
+process-noise reading chosen by looking at the paper's figures (tuned: the literal reading contradicts them); the
+growth of impulse and MI with alpha_h is implied by optimality (derived).
 """
 
 from __future__ import annotations
@@ -17,6 +19,17 @@ _Q_TUNED = ("the process-noise reading (q = 1e-11 LU^2/TU^3) was chosen as one t
             "bounded, the paper's own claim")
 _SLIP_TUNED = ("the x0-held reading of the Table 2/4 slip, which sets P, was first chosen with these day counts in "
                "view")
+_Q_READING_TUNED = ("holds under the adopted process-noise reading q = 1e-11 LU^2/TU^3, chosen among the readings of "
+                    "Table 5's '1e-11 km/s^3' by looking at the paper's figures (test case 1's bounded CRLB, Fig. 4); "
+                    "under the literal 1e-11 km^2/s^3 it fails: the alpha_h = 0 plan ends no worse than the "
+                    "information plans and MI and CRLB rank-correlate positively (Spearman about +0.6 on a full run); "
+                    "section 9 compares the readings")
+#: Why "impulse and MI grow with alpha_h" is no evidence for the paper: for global optima x_1, x_2 of the weighted
+#: sum J = (1 - a) impulse - a MI at a_1 < a_2 over the same feasible set, the two optimality inequalities, each
+#: divided by 1 - a and added, give MI_2 >= MI_1 and then impulse_2 >= impulse_1.  The row checks that the sweep's
+#: plans behave like global optima, not the paper.
+_OPTIMALITY_FAILS = ("the plans are not all global optima: for global optima of the weighted sum (1 - alpha_h) "
+                     "impulse - alpha_h MI, impulse and MI cannot decrease as alpha_h grows")
 _NO_KEEP_OUT = ("without a keep-out even our modified solver does not converge (convex subproblem fails or the "
                 "iteration limit is hit)")
 
@@ -74,18 +87,20 @@ CLAIMS = {
         reason="some plans stay planar"),
     "weakly_observable": Claim(
         "Fig. 9: alpha_h = 0 weakly observable (grey)", "yes",
-        Holds("terminal observer RMS at alpha_h = 0 at least 5 times that of every alpha_h > 0"), source="Fig. 9",
-        reason="the baseline is not much worse"),
+        Holds("terminal observer RMS at alpha_h = 0 at least 5 times that of every alpha_h > 0"),
+        tuned=_Q_READING_TUNED, source="Fig. 9", reason="the baseline is not much worse"),
     "observer_below_targets": Claim(
         "Fig. 9: observer RMS below the targets' on average", "yes", AtLeast(0.10), source="Fig. 9",
         reason="the observer's window-mean RMS is less than 10 % below the targets' mean (smallest relative gap)"),
     "mi_correlation": Claim(
         "Fig. 10: MI correlates with estimator performance", "'correlates well'", AtMost(-0.8),
-        source="Fig. 10; abstract",
+        tuned=_Q_READING_TUNED, source="Fig. 10; abstract",
         reason="weak rank correlation (larger of the observer's and targets' Spearman coefficients)"),
     "front_grows": Claim(
-        "Fig. 10: impulse and MI grow with alpha_h", "yes", Holds("impulse and MI non-decreasing over the grid"),
-        source="Fig. 10", reason="not monotone"),
+        "Fig. 10: impulse and MI grow with alpha_h (implied by optimality)", "yes",
+        Holds("impulse and MI non-decreasing over the grid, as for any set of global optima of the weighted sum"),
+        kind="derived", source="Fig. 10",
+        reason=_OPTIMALITY_FAILS),
     "front_monotone": Claim(
         "Fig. 10: front monotone in (impulse, RMS): more impulse, lower RMS", "a trade-off front",
         Holds("no plan has both more impulse and a higher observer terminal RMS than another"), source="Fig. 10",
