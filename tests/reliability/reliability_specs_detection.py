@@ -10,18 +10,11 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+from spec_helpers import detection_setup as _setup
 
-from cislunar.cr3bp import orbits
-from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.papers.greaves_scheeres_2021 import detection
 
 MODULES = [detection]
-
-
-@functools.lru_cache(maxsize=None)
-def _setup():
-    return detection.make_setup(em, orbits.nrho_9_2(em), 0.1 * detection.window_control_weight(detection.QUIET_POLICY),
-                                1e-18, cadence_hours=8.0, window_hours=16.0, periods=0.8, n_sub=3)
 
 
 @functools.lru_cache(maxsize=None)

@@ -19,6 +19,8 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+from spec_helpers import closed as _closed
+from spec_helpers import nrho
 
 from cislunar.cr3bp import orbits
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
@@ -35,27 +37,11 @@ SUFFIX = ".gs21_orbits"
 Q = 1e-20 * em.time_unit_s**3 / em.length_unit_km**2
 
 
-def _closed(f):
-    """Call a figure function and close the figure it returns (the sweep draws many)."""
-
-    def call(**kw):
-        import matplotlib.pyplot as plt
-
-        fig = f(**kw)
-        plt.close(fig)
-        return fig
-
-    return call
 
 
 # ---------------------------------------------------------------------------------------------------------------
 # cached valid objects
 # ---------------------------------------------------------------------------------------------------------------
-@functools.lru_cache(maxsize=None)
-def nrho():
-    return orbits.nrho_9_2(em)
-
-
 @functools.lru_cache(maxsize=None)
 def dros():
     return tuple(orbits.dro_family(em, np.array([0.78, 0.8, 0.82])))

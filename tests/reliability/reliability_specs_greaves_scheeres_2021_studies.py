@@ -19,8 +19,10 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+from spec_helpers import closed as _closed
+from spec_helpers import detection_setup as setup
+from spec_helpers import nrho
 
-from cislunar.cr3bp import orbits
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.papers.greaves_scheeres_2021 import adaptive_studies as ads
 from cislunar.papers.greaves_scheeres_2021 import detection as det
@@ -31,34 +33,11 @@ MODULES = [ads, ds, figures]
 EXEMPT: dict = {}
 
 
-def _closed(f):
-    """Call a figure function and close the figure it returns (the sweep draws many)."""
-
-    def call(**kw):
-        import matplotlib.pyplot as plt
-
-        fig = f(**kw)
-        plt.close(fig)
-        return fig
-
-    return call
 
 
 # ---------------------------------------------------------------------------------------------------------------
 # cached valid objects
 # ---------------------------------------------------------------------------------------------------------------
-@functools.lru_cache(maxsize=None)
-def nrho():
-    return orbits.nrho_9_2(em)
-
-
-@functools.lru_cache(maxsize=None)
-def setup():
-    """Quiet window tuning (f = 0.1) on a short, coarse track: 0.8 period from periapsis, 8-hour cadence."""
-    return det.make_setup(em, nrho(), 0.1 * det.window_control_weight(det.QUIET_POLICY), 1e-18, cadence_hours=8.0,
-                          window_hours=16.0, periods=0.8, n_sub=3)
-
-
 @functools.lru_cache(maxsize=None)
 def constant_setup():
     """The same track with the window weight held over the whole period."""

@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import functools
 
-import matplotlib.pyplot as plt
 import numpy as np
+from spec_helpers import closed as _drawn
 
 from cislunar.cr3bp import orbits
 from cislunar.cr3bp import torus as tm
@@ -107,17 +107,6 @@ def _mcs():
 
 def _rng():
     return np.random.default_rng(0)
-
-
-def _drawn(draw):
-    """Call a figure function and close the figure it returns (the arguments go to ``draw`` unchanged)."""
-
-    def call(**kwargs):
-        fig = draw(**kwargs)
-        plt.close(fig)
-        return fig
-
-    return call
 
 
 def specs(S, lazy):

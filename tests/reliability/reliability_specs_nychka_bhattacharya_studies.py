@@ -27,6 +27,7 @@ import dataclasses
 import functools
 
 import numpy as np
+from spec_helpers import closed as _closed
 
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.estimation import lpv
@@ -170,17 +171,6 @@ def _scene():
     return nb_scenarios.fig1_scene(_scenario(), 2, n_samples=10)
 
 
-def _closed(draw):
-    """Call a figure function and close the figure it returns (the sweep draws many)."""
-
-    def call(**kwargs):
-        import matplotlib.pyplot as plt
-
-        fig = draw(**kwargs)
-        plt.close(fig)
-        return fig
-
-    return call
 
 
 def specs(Spec, lazy):

@@ -18,6 +18,7 @@ import dataclasses
 import functools
 
 import numpy as np
+from spec_helpers import closed as _closed
 
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.guidance import scvx
@@ -39,17 +40,6 @@ MODULES = [reference_tables, mis, scvx_study, nodes_study, tcs, case_2_closing, 
 EXEMPT: dict = {}
 
 
-def _closed(f):
-    """Call a figure function and close the figure it returns (the sweep draws many)."""
-
-    def call(**kw):
-        import matplotlib.pyplot as plt
-
-        fig = f(**kw)
-        plt.close(fig)
-        return fig
-
-    return call
 
 
 # ---------------------------------------------------------------------------------------------------------------

@@ -24,6 +24,7 @@ import inspect
 import pickle
 import pkgutil
 import signal
+import sys
 import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
@@ -550,6 +551,9 @@ def _load_plugins():
     from pathlib import Path
 
     out = []
+    here = str(Path(__file__).parent)
+    if here not in sys.path:  # the plugins import their shared helpers from spec_helpers.py beside them
+        sys.path.insert(0, here)
     for path in sorted(Path(__file__).parent.glob("reliability_specs_*.py")):
         spec = importlib.util.spec_from_file_location(path.stem, path)
         mod = importlib.util.module_from_spec(spec)

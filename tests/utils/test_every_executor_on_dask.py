@@ -25,6 +25,7 @@ import importlib.util
 import inspect
 import pkgutil
 import re
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -78,6 +79,8 @@ def _lazy(f):
 def _plugin_specs() -> dict:
     """``{function: kwargs}`` from the reliability plugins' valid calls (lazy values resolved when used)."""
     out = {}
+    if str(SPEC_DIR) not in sys.path:  # the plugins import their shared helpers from spec_helpers.py beside them
+        sys.path.insert(0, str(SPEC_DIR))
     for path in sorted(SPEC_DIR.glob("reliability_specs_*.py")):
         spec = importlib.util.spec_from_file_location(f"_dask_{path.stem}", path)
         mod = importlib.util.module_from_spec(spec)
