@@ -849,6 +849,15 @@ def _monte_carlo_group(task) -> list:
 # ---------------------------------------------------------------------------------------------------------------
 
 
+def _check_bandwidth(bandwidth) -> None:
+    """A KDE bandwidth rule: ``"scott"``, ``"silverman"`` or a positive finite factor (:func:`fit_pdf`)."""
+    ok = (isinstance(bandwidth, str) and bandwidth in ("scott", "silverman")) or (
+        isinstance(bandwidth, (int, float)) and not isinstance(bandwidth, bool) and np.isfinite(bandwidth)
+        and bandwidth > 0)
+    if not ok:
+        raise ValueError(f"bandwidth must be 'scott', 'silverman' or a positive factor; got {bandwidth!r:.60}")
+
+
 def fit_pdf(samples, bandwidth="scott") -> stats.gaussian_kde:
     """Numerical PDF of a sample: Gaussian kernel density estimate.
 
@@ -863,11 +872,7 @@ def fit_pdf(samples, bandwidth="scott") -> stats.gaussian_kde:
     z = validation.as_array(samples, "samples", ndim=(1,))
     if z.size < 2 or np.std(z) == 0:
         raise ValueError("samples must hold at least two distinct values")
-    ok = (isinstance(bandwidth, str) and bandwidth in ("scott", "silverman")) or (
-        isinstance(bandwidth, (int, float)) and not isinstance(bandwidth, bool) and np.isfinite(bandwidth)
-        and bandwidth > 0)
-    if not ok:
-        raise ValueError(f"bandwidth must be 'scott', 'silverman' or a positive factor; got {bandwidth!r}")
+    _check_bandwidth(bandwidth)
     return stats.gaussian_kde(z, bw_method=bandwidth)
 
 
@@ -1134,6 +1139,7 @@ def run_policy_study(setup: DetectionSetup, policy: StationKeepingPolicy, n_h0: 
     validation.integer(n_h1, "n_h1", minimum=2)
     n_test = validation.integer(n_test, "n_test", minimum=0)
     validation.integer(batch_size, "batch_size", minimum=0)
+    _check_bandwidth(bandwidth)  # before the Monte Carlo runs rather than after them
 
     def mc(pol, n, k, what):
         return run_detection_monte_carlo(setup, pol, n, base + [k], batch_size=batch_size, executor=executor,
@@ -1180,10 +1186,7 @@ def run_policy_studies(jobs, *, batch_size: int = 8, executor=None, bandwidth="s
     validation.integer(batch_size, "batch_size", minimum=1)
     validation.boolean(progress, "progress")
     validation.instance(desc, "desc", str)
-    if not ((isinstance(bandwidth, str) and bandwidth in ("scott", "silverman")) or (  # fit_pdf's rule, checked
-            isinstance(bandwidth, (int, float)) and not isinstance(bandwidth, bool) and np.isfinite(bandwidth)
-            and bandwidth > 0)):  # before the Monte Carlo runs rather than after them
-        raise ValueError(f"bandwidth must be 'scott', 'silverman' or a positive factor; got {bandwidth!r:.60}")
+    _check_bandwidth(bandwidth)  # before the Monte Carlo runs rather than after them
     runs, plan = [], []
     for k, job in enumerate(jobs):
         if len(job) != 6:
