@@ -440,10 +440,10 @@ def _dead_workers_trials(folder, exc, executor) -> list:
             continue
         if not text:  # between chunks
             continue
-        if codes:
-            if codes.get(pid) in (None, -signal.SIGTERM):
-                continue
-        elif not _dead(pid):
+        code = codes.get(pid)
+        if code == -signal.SIGTERM:  # ended by the broken pool, not the one that broke it
+            continue
+        if code is None and not _dead(pid):  # exit code not known (yet): judge by the process itself
             continue
         out.append((int(text), pid, codes.get(pid)))
     return sorted(set(out))
@@ -463,7 +463,7 @@ def _lost_chunk(indices, exc, seed_text, culprits) -> list:
     if culprits:
         mine = [c for c in culprits if c[0] in indices]
         named, pid, code = (mine or culprits)[0]
-        code_text = f", exit code {code}" if code is not None else ""
+        code_text = f", exit code {code}" if code is not None else ", exit code unknown (not yet reaped by the pool)"
         out.append((named, False, TrialFailure(
             named, seed_text(named), RuntimeError(f"worker process {pid} died while it ran this trial{code_text} "
                                                   f"({why})"), tb, "died with its worker process")))

@@ -117,7 +117,9 @@ def test_a_worker_that_dies_names_its_trial_and_keeps_the_results(tmp_path, how)
                                        chunk_size=1, progress=False)
     err = info.value
     _check_error(err, "died with its worker process", kept=range(5))
-    assert ("exit code 3" if how == "exit" else f"exit code {-signal.SIGKILL}") in str(err)
+    # the exit code, when the pool has reaped the worker by then (it may not have: the trial is named either way)
+    code = "exit code 3" if how == "exit" else f"exit code {-signal.SIGKILL}"
+    assert code in str(err) or "exit code unknown" in str(err)
 
 
 def test_a_dead_worker_in_collect_mode_marks_the_lost_trials(tmp_path):
