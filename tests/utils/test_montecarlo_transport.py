@@ -56,6 +56,9 @@ def _dies_at_bad(rng, folder, how):
     v = _value(rng)
     if i == BAD:
         _wait_for(folder, [f"done-{k}" for k in range(6)])
+        # trials 0-4 have returned from their workers; give the parent a moment to read their results off the pipe
+        # before this worker dies (results still in flight when a pool breaks are lost by ProcessPoolExecutor itself)
+        time.sleep(1.0)
         if how == "exit":
             os._exit(3)
         os.kill(os.getpid(), signal.SIGKILL)
