@@ -105,6 +105,10 @@ def _table_row():
     return reference.load_wolf_jones_table()[0]
 
 
+def _row_check():
+    return reference.verify_table_row(em, reference.load_wolf_jones_table()[1])
+
+
 MODEL = lpv.CR3BPLPV()
 S_PLANAR = np.array([[-0.3, 0.05, 0.0, -1.5], [-0.25, 0.1, 0.2, -1.6]])
 RHO2 = MODEL.rho(S_PLANAR)
@@ -304,6 +308,8 @@ def specs(Spec, lazy):
                dict(path="instance_str_opt")))
     s.append(S("verify_table_row", reference.verify_table_row, dict(system=em, row=lazy(_table_row)),
                dict(system="system", row="instance")))
+    s.append(S("rounding_bound", reference.rounding_bound, dict(system=em, check=lazy(_row_check), half_unit=5e-10),
+               dict(system="system", check="instance", half_unit="pos")))
 
     # -------------------------------------------------------------------------------------------------- lpv
     s.append(S("CR3BPLPV", lpv.CR3BPLPV, dict(system=em), dict(system="system")))

@@ -18,10 +18,11 @@ import numpy as np
 
 from cislunar.cr3bp.dynamics import CR3BP, check_system
 from cislunar.cr3bp.orbits import PeriodicOrbit, correct_symmetric, half_period_guess
-from cislunar.cr3bp.propagation import propagate
+from cislunar.cr3bp.propagation import propagate, propagate_stm
 from cislunar.utils import validation
 
-__all__ = ["CLOSURE_TOL", "TableRow", "RowCheck", "load_wolf_jones_table", "verify_table_row"]
+__all__ = ["CLOSURE_TOL", "PRINTED_HALF_UNIT", "TableRow", "RowCheck", "RoundingBound", "load_wolf_jones_table",
+           "rounding_bound", "verify_table_row"]
 
 
 @dataclass(frozen=True)
@@ -109,3 +110,67 @@ def verify_table_row(system: CR3BP, row: TableRow) -> RowCheck:
         orb = correct_symmetric(system, seed, fix="x0", label=row.label)
     raw = float(np.linalg.norm(propagate(system, state, orb.period).x[-1] - state))
     return RowCheck(row.table, row.label, row.x0, row.vy0, raw, raw < CLOSURE_TOL, orb)
+
+
+#: Half a unit in the ninth decimal, the largest rounding of a printed ``x0`` or ``vy0`` (LU, LU/TU).
+PRINTED_HALF_UNIT = 5e-10
+
+
+@dataclass(frozen=True)
+class RoundingBound:
+    r"""How far a row printed to nine decimals may miss periodicity through rounding alone.
+
+    Attributes
+    ----------
+    family_slope : float
+        :math:`d v_{y0}^* / d x_0` along the DRO family at the corrected orbit (LU/TU per LU): a rounded ``x0``
+        moves the periodic ``vy0`` by this much per unit.
+    velocity_error : float
+        Largest :math:`|v_{y0} - v_{y0}^*(x_0)|` that rounding both printed numbers can cause, LU/TU:
+        ``half_unit * (1 + |family_slope|)``.
+    closure_gain : float
+        :math:`\|(\Phi(T) - I)\, e_{v_y}\|`: closure after one period per unit error in ``vy0`` (first order).
+    closure : float
+        ``closure_gain * velocity_error``: the largest closure rounding can explain, LU.
+    """
+
+    family_slope: float
+    velocity_error: float
+    closure_gain: float
+    closure: float
+
+
+def rounding_bound(system: CR3BP, check: RowCheck, *, half_unit: float = PRINTED_HALF_UNIT) -> RoundingBound:
+    r"""The closure a printed row may show from the rounding of its two printed numbers alone.
+
+    The row is a point ``(x0, vy0)`` near the family curve :math:`v_{y0}^*(x_0)`; its closure after one period
+    is, to first order, :math:`\|(\Phi(T) - I) e_{v_y}\| \, |v_{y0} - v_{y0}^*(x_0)|`.  Rounding ``x0`` and
+    ``vy0`` by at most ``half_unit`` each puts the row at most ``half_unit * (1 + |dv_{y0}^*/dx_0|)`` off the
+    curve.  The family slope comes from the half-period shooting conditions :math:`y(T/2) = 0`,
+    :math:`\dot x(T/2) = 0` by the implicit function theorem (the half-period STM and the state derivative at
+    :math:`T/2`), so no second orbit is corrected.  A printed row whose closure exceeds ``closure`` is not a
+    rounded periodic state.
+
+    Parameters
+    ----------
+    system : CR3BP
+    check : RowCheck
+        From :func:`verify_table_row` (its corrected, planar, x-axis-symmetric orbit is used).
+    half_unit : float
+        Largest rounding of each printed number, LU and LU/TU (default: half a unit in the ninth decimal).
+    """
+    check_system(system, "system")
+    validation.instance(check, "check", RowCheck)
+    half_unit = validation.positive(half_unit, "half_unit")
+    orb = check.corrected
+    half = propagate_stm(system, orb.x0, [0.0, orb.period / 2])
+    phi_h, x_h = half.stm[-1], half.x[-1]
+    f_h = system.eom(x_h)
+    # d/dx0 of [y, vx](T/2) = 0 with vy0 and the half period free: A [dvy0, dtau] = -b dx0
+    a = np.array([[phi_h[1, 4], f_h[1]], [phi_h[3, 4], f_h[3]]])
+    b = np.array([phi_h[1, 0], phi_h[3, 0]])
+    slope = float(np.linalg.solve(a, -b)[0])
+    full = propagate_stm(system, orb.x0, [0.0, orb.period]).stm[-1]
+    gain = float(np.linalg.norm(full[:, 4] - np.eye(6)[:, 4]))
+    dv = half_unit * (1.0 + abs(slope))
+    return RoundingBound(slope, dv, gain, gain * dv)

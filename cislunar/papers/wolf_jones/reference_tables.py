@@ -115,6 +115,9 @@ class DroTableStudy:
         DRO family members from 0.95 LU to 0.70 LU (Earth side of the Moon).
     zoom_family : tuple of PeriodicOrbit
         Twelve members across the crossings of the printed orbits, 1500 km beyond each end.
+    rounding : tuple of RoundingBound
+        Per row (order of ``checks``), the closure that rounding the printed nine decimals can explain
+        (:func:`cislunar.papers.wolf_jones.reference.rounding_bound`).
     """
 
     checks: tuple
@@ -122,6 +125,13 @@ class DroTableStudy:
     family: tuple
     zoom_family: tuple
     system: CR3BP
+    rounding: tuple = ()
+
+    @property
+    def closure_ratios(self) -> tuple:
+        """Per row, its closure as printed over the closure its rounding can explain (<= 1: a rounded periodic
+        state)."""
+        return tuple(float(c.raw_closure / b.closure) for c, b in zip(self.checks, self.rounding))
 
     @property
     def observer(self):
@@ -191,7 +201,8 @@ def dro_table_study(system: CR3BP, n_members: int, *, zoom_margin_km: float = 15
     zoom_x0 = (np.linspace(max(cross) + margin, min(cross) - margin, n_zoom) / system.length_unit_km
                + system.secondary_position[0])
     zoom = tuple(orbits.dro_family(system, zoom_x0, seed=groups[-1].orbit.x0))
-    return DroTableStudy(checks, groups, family, zoom, system)
+    rounding = tuple(reference.rounding_bound(system, c) for c in checks)
+    return DroTableStudy(checks, groups, family, zoom, system, rounding)
 
 
 # ---------------------------------------------------------------------------------------------------------------
