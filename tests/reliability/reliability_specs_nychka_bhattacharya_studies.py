@@ -251,7 +251,7 @@ def specs(Spec, lazy):
         dict(scenario=sc, nominal=od, robust=lazy(_robust), periods=0.05, rng=rng, small_scale=rb.SMALL_E0_SCALE),
         dict(scenario="instance", nominal="instance", robust="instance", periods="pos", rng="rng",
              small_scale="pos"))
-    for name in ("rms", "holds"):
+    for name in ("rms", "holds", "fix_following"):
         method(f"WindowStudy.{name}", lambda n=name: getattr(_window(), n),
                dict(design="robust", norm="h2", start="large"), dict(design="choice", norm="choice", start="choice"))
 

@@ -303,6 +303,9 @@ class WindowStudy:
     e0 : dict of str to float
         Initial position errors, LU.
     dt, period : float
+    fix_error : ndarray (m,)
+        Position error (LU) of the fix triangulated from each sample's two noisy angles alone (law of sines on the
+        Earth-Moon baseline; ``nan`` where :math:`|\\sin\\theta_3|` < the triangulation threshold).
     """
 
     t: np.ndarray
@@ -314,6 +317,26 @@ class WindowStudy:
     e0: dict
     dt: float
     period: float
+    fix_error: np.ndarray | None = None
+
+    def fix_following(self, design: str, norm: str, start: str = "large") -> tuple:
+        """How closely a run's error follows the angle-only fix of the sample before, after 10 % of the run.
+
+        A gain with :math:`\\|L\\|\\,\\Delta t \\gg 1` pulls the estimate onto the position the held angles
+        triangulate within one interval, so its error at sample k+1 is the fix error of sample k, whatever the
+        gain or the initial error.  Returns ``(correlation, rms_ratio)``: the correlation of the run's error at
+        k+1 with the fix error at k, and the run's RMS over the fixes' RMS (same samples; fixes near the
+        Earth-Moon line left out).
+        """
+        key = (design, norm, start)
+        if key not in self.errors:
+            raise ValueError(f"(design, norm, start) must be one of {sorted(self.errors)}; got {key}")
+        if self.fix_error is None:
+            raise ValueError("this WindowStudy carries no fix_error (built without simulate_window)")
+        run, fix = self.errors[key][1:], self.fix_error[:-1]
+        keep = self.settled[1:] & np.isfinite(fix)
+        run, fix = run[keep], fix[keep]
+        return float(np.corrcoef(run, fix)[0, 1]), float(np.sqrt(np.mean(run**2) / np.mean(fix**2)))
 
     @property
     def settled(self) -> np.ndarray:
@@ -377,5 +400,9 @@ def simulate_window(scenario: Scenario, nominal: ObserverDesigns, robust: Robust
     posterior = {n: float(g * np.sqrt(ms)) for n, g in robust.gamma_star.items()}
     inside = float(np.mean(robust.box.contains(rho_hat)))
     e0 = {s: float(np.hypot(*(x0 - truth[0])[:2])) for s, x0 in starts.items()}
-    return WindowStudy(t, truth, errors, guarantee, posterior, inside, e0, float(dt), float(scenario.orbit.period))
+    s3 = np.sin(meas.theta1 + meas.theta2)
+    fixes = m._rho_from_angles(meas.theta1, meas.theta2, np.where(np.abs(s3) < SIN3_THRESHOLD, 1.0, s3))[:, 4:6]
+    fix_error = np.where(np.abs(s3) < SIN3_THRESHOLD, np.nan, np.hypot(*(fixes - truth[:, :2]).T))
+    return WindowStudy(t, truth, errors, guarantee, posterior, inside, e0, float(dt), float(scenario.orbit.period),
+                       fix_error)
 

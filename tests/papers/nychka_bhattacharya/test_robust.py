@@ -107,6 +107,33 @@ def test_window_study_runs_and_guarantees(setup):
         ws.rms("robust", "h3")
 
 
+def test_fix_following_detects_a_one_sample_lag_and_nothing_else():
+    """An error that is the previous sample's fix error scores correlation 1 and RMS ratio 1; the same error without
+    the lag (or a scaled copy) does not pass as following."""
+    rng = np.random.default_rng(7)
+    t = np.linspace(0.0, 1.0, 400)
+    fix = np.abs(rng.normal(size=t.size))
+    fix[50] = np.nan  # a sample near the Earth-Moon line: left out, not propagated
+    lagged = np.concatenate([[3.0], np.nan_to_num(fix[:-1], nan=1.0)])
+    errors = {("nominal", "hinf", "large"): lagged, ("robust", "hinf", "large"): 2.0 * np.nan_to_num(fix, nan=1.0)}
+    ws = rb.WindowStudy(t, np.zeros((t.size, 4)), errors, {}, {}, 1.0, {}, 0.01, 1.0, fix)
+    c, r = ws.fix_following("nominal", "hinf")
+    assert c == pytest.approx(1.0) and r == pytest.approx(1.0)
+    c, r = ws.fix_following("robust", "hinf")
+    assert abs(c) < 0.3  # same sample, not the one before: independent draws
+    with pytest.raises(ValueError, match="design, norm, start"):
+        ws.fix_following("robust", "h2")
+
+
+def test_window_study_hinf_error_follows_the_angle_fix(setup):
+    """At 233 min the Hinf gains (||L|| dt >> 1) put the estimate on the previous sample's angle-only fix."""
+    sc, od, _, rd = setup
+    ws = rb.simulate_window(sc, od, rd, 0.3, np.random.default_rng(4))
+    assert ws.fix_error.shape == ws.t.shape and np.nanmax(ws.fix_error) > 0
+    c, r = ws.fix_following("nominal", "hinf")
+    assert c > 0.9 and 0.8 < r < 1.3
+
+
 def test_fig1_scene_places_platforms_on_the_orbit():
     sc = paper_scenario(n_samples=200)
     scene = fig1_scene(sc, 4, n_samples=50)

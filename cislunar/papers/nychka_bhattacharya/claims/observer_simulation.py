@@ -2,7 +2,7 @@
 Criteria fixed before the runs: "converges rapidly" = first below the LMI's guaranteed RMS within 5 % of a period,
 "stays accurate" = RMS after that below the guarantee; the error comparison uses medians after 10 % of the run."""
 
-from cislunar.publish.claims import Claim, Holds, Within, printed_tolerance
+from cislunar.publish.claims import AtLeast, Claim, Holds, Within, printed_tolerance
 
 _CONVERGES = ("first below the guaranteed RMS within 5 % of a period and the RMS after it (from 2 % of a period "
               "later) below the guarantee")
@@ -58,6 +58,11 @@ CLAIMS = {
         Holds("both robust observers, triangulated rho, RMS error after 10 % of the run within sqrt(3) gamma* from "
               "both initial errors, and each robust gain verified on the widened polytope"), kind="beyond paper",
         reason="a robust observer above its guarantee or a gain not verified"),
+    # Why the nominal and robust Hinf runs print the same RMS from both starts (found after the 233-min run, so a
+    # diagnosis, beyond the paper; the 0.9 correlation was fixed before measuring it).
+    "hinf_follows_fix": Claim(
+        "Hinf at 233 min: error at each sample = the angle-only fix error of the sample before", None,
+        AtLeast(0.9), kind="beyond paper", reason="the Hinf error does not follow the previous angle-only fix"),
     "ekf": Claim("EKF on same angles", None, kind="beyond paper"),
     "dt": Claim("measurement interval", "not stated", kind="not in paper",
                 reason="choice of this reproduction; continuous sensor, noise held over each interval"),
