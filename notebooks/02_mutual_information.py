@@ -150,12 +150,16 @@ print(f"sigma_theta at 215 km: "
 # ## 4 · Test case 2: the observation window and its CRLB
 #
 # Three targets on the Table 4 DROs and an observer; window $[P_{ref}, 2P_{ref}]$ with one range/range-rate pair
-# per target per day, initial errors 100 km and $10^{-2}$ km/s = 10 m/s per axis (Table 5). **Choice:** the printed
-# observer row ($\dot y_0$ = 0.528996986) does not close as a periodic orbit (notebook 01), and the paper's
-# optimised observer trajectory is not published, so the observer here coasts on the `observer_tf` DRO of Table 4
-# (which closes): a coasting stand-in, not the $\alpha_h = 0$ solution of the paper (Table 4's $x_{\mathcal S}(t_0)$ and
-# $x_{\mathcal S}(t_f)$ lie on different orbits, so even the minimum-ΔV observer flies a transfer). $P_{ref}$ is the
-# period of that DRO; the window $[P_{ref}, 2P_{ref}]$ therefore starts at half its end time.
+# per target per day, initial errors 100 km and $10^{-2}$ km/s = 10 m/s per axis (Table 5). **Choice:** the paper's
+# optimised observer trajectory is not published, so the observer here coasts on its initial reference DRO: the
+# printed first row of Table 4 ($\dot y_0$ = 0.528996986 does not close as a periodic orbit, notebook 01) with
+# $\dot y_0$ corrected holding $x_0$, exactly as in notebook 06 (`scenarios.test_case_2`). This is a coasting
+# stand-in, notebook 06's ballistic guess, not the $\alpha_h = 0$ solution of the paper (Table 4's
+# $x_{\mathcal S}(t_0)$ and $x_{\mathcal S}(t_f)$ lie on different orbits, so even the minimum-ΔV observer flies a
+# transfer). $P_{ref}$ is the period of that DRO, the paper's "reference DRO"; the window $[P_{ref}, 2P_{ref}]$
+# therefore starts at half its end time. (Until 2026-11-26 this chapter took the observer and $P_{ref}$ from the
+# `observer_tf` row instead, 16.02 d against notebook 06's 16.17 d for the same window; the two chapters now share
+# one window, and its MI on the coasting observer is the value notebook 06 prints for its ballistic guess.)
 #
 # Process noise: Table 5 prints "$Q$ [km/s³] = $10^{-11}$"; the PSD of an acceleration has units km²/s³. Read as
 # $10^{-11}$ km²/s³ the CRLB of test case 1 grows without bound, against the paper's text, so we adopt the same
@@ -356,9 +360,10 @@ print(f"chain rule faster than dense from {timing.crossover_value} for the MI, f
 # of the closed form; the gradient within $10^{-5}$ (largest relative difference) of the central differences; each
 # end of the window within 1 day of the text's "roughly 17 and 32 days"; the baseline argument when the MI gains,
 # the observer's in-plane terminal RMS drops by more than 1.5x and rebounds by less than 1.2x at the longest
-# baseline. The process-noise reading was chosen while looking at the paper's result, so its row says so; so was
-# the in-plane measure of the baseline rows (the total RMS, which includes the unobservable z, failed first), so
-# they are at best consistent (tuned).
+# baseline; the observer "on average" below the targets when its window-mean RMS is at least 10 % lower than the
+# targets' mean (notebook 06's criterion for the same sentence). The process-noise reading was chosen while
+# looking at the paper's result, so its row says so; so was the in-plane measure of the baseline rows (the total
+# RMS, which includes the unobservable z, failed first), so they are at best consistent (tuned).
 
 # %%
 table.add(claims.CLAIMS["eq11_scalar"].judge(
@@ -386,11 +391,12 @@ table.add(claims.CLAIMS["process_noise"].judge(
 table.add(claims.CLAIMS["window"].judge(
     max(abs(days[0] - 17.0), abs(days[-1] - 32.0)),
     shown=f"P_ref = {em.tu_to_days(win.P_ref):.2f} d, window {days[0]:.2f}-{days[-1]:.2f} d",
-    note="P_ref from the Table 4 observer_tf DRO. The paper's own definition forces the start to be half the end "
+    note="P_ref: period of the observer's initial reference DRO (Table 4 row 1, vy0 corrected), as in notebook 06. "
+         "The paper's own definition forces the start to be half the end "
          f"(~16 d; target DRO periods {', '.join(f'{p:.2f}' for p in win.target_periods_d)} d), so 'roughly 17' is "
          f"loose: our start is {17.0 - days[0]:.2f} d earlier"))
 table.add(claims.CLAIMS["observer_trajectory"].judge(
-    "coasting on observer_tf DRO", note="a coasting stand-in, not the alpha_h = 0 solution (Table 4's x_S(t0) and "
+    "coasting on its initial DRO (Table 4 row 1, vy0 corrected)", note="notebook 06's ballistic guess; a coasting stand-in, not the alpha_h = 0 solution (Table 4's x_S(t0) and "
     "x_S(tf) are different orbits, so alpha_h = 0 still needs a transfer)"))
 table.add(claims.CLAIMS["in_plane_growth"].judge(
     bool(crlb.transient.any()),
@@ -398,8 +404,9 @@ table.add(claims.CLAIMS["in_plane_growth"].judge(
           f"(observer {crlb.in_plane[0, 0]:.0f} -> {crlb.in_plane[0, 1]:.0f} km)",
     note="symptom only, the cause (diagonal P0) is not tested; the paper's Fig. 4 is test case 1 (notebook 05)"))
 table.add(claims.CLAIMS["observer_below_targets"].judge(
-    crlb.observer_below_targets,
-    shown=f"observer {crlb.total[0].mean():.2f} km vs targets {crlb.total[1:].mean():.2f} km (mean over window)",
+    1 - crlb.total[0].mean() / crlb.total[1:].mean(),
+    shown=f"observer {crlb.total[0].mean():.2f} km vs targets {crlb.total[1:].mean():.2f} km (mean over window, "
+          f"{100 * (1 - crlb.total[0].mean() / crlb.total[1:].mean()):.1f} % lower)",
     note="un-manoeuvred observer, so only qualitative; the total is the unobserved out-of-plane error, the same for "
          f"all four; in-plane: observer {crlb.in_plane[0].mean():.1f} km vs targets "
          f"{', '.join(f'{v:.1f}' for v in crlb.in_plane[1:].mean(axis=1))} km"))

@@ -7,7 +7,10 @@ What is here
 * :func:`constant_velocity_toy`: a 1-D constant-velocity window whose stacked matrices (Eqs. 19-23) are small
   enough to print.
 * :func:`case_2_window`: test case 2's observation window :math:`[P_{ref}, 2P_{ref}]` with the observer coasting on
-  the Table 4 ``observer_tf`` DRO, linearised with derivatives (the model the gradient needs).
+  its initial reference DRO (Table 4's first row corrected into a DRO, the scenario of notebook 06, whose period
+  is :math:`P_{ref}`: :func:`reference_period`), linearised with derivatives (the model the gradient needs).  The
+  window is notebook 06's, with the same priors, process noise and measurement times: the observer's state at the
+  window start is that of 06's ballistic guess.
 * :func:`window_crlb`: the CRLB (EKF covariance recursion) along that window, split into total, in-plane and
   out-of-plane position RMS, with the per-measurement information gains (chain rule).
 * :func:`gradient_check`, :func:`linearisation_check`: the gradient of Eqs. 44-52 against fourth-order central
@@ -30,6 +33,7 @@ import numpy as np
 from cislunar.cr3bp.dynamics import CR3BP, EARTH_MOON, check_system
 from cislunar.cr3bp.propagation import find_events, propagate
 from cislunar.papers.wolf_jones import _checks
+from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.sensing import covariance as cov
 from cislunar.sensing import information as info
 from cislunar.sensing import measurements as meas
@@ -56,6 +60,7 @@ __all__ = [
     "figure_baseline",
     "figure_crlb",
     "figure_timing",
+    "reference_period",
     "gradient_check",
     "linearisation_check",
     "observer_information",
@@ -64,7 +69,8 @@ __all__ = [
     "window_crlb",
 ]
 
-#: Table 4 ``observer_tf`` DRO (closes as a periodic orbit; the observer's coasting stand-in), LU and LU/TU.
+#: Table 4 ``observer_tf`` DRO as printed (closes as a periodic orbit), LU and LU/TU.  Until 2026-11-26 the window's
+#: coasting observer and P_ref came from it (P_ref 16.02 d against notebook 06's 16.17 d); kept for reference.
 OBSERVER_TF_X0 = np.array([7.80136159e-1, 0, 0, 0, 5.53104815e-1, 0])
 #: Table 4 target DROs of test case 2, one row each, LU and LU/TU.
 TARGETS_X0 = np.array([[7.78717734e-1, 0, 0, 0, 5.55157488e-1, 0],
@@ -190,26 +196,39 @@ class Case2Window:
         return np.asarray(self.system.tu_to_days(self.t))
 
 
+def reference_period(system: CR3BP = EARTH_MOON) -> float:
+    """P_ref of test case 2, TU: the period of the observer's initial reference DRO (Table 4's first row, its vy0
+    corrected holding x0), the same as notebook 06's ``test_case_2().period``."""
+    check_system(system)
+    return float(wj.test_case_2(system).period)
+
+
 def case_2_window(system: CR3BP = EARTH_MOON, t: np.ndarray | None = None, *,
                   range_sigma_km: float = meas.WOLF_JONES_RANGE_SIGMA_KM,
                   range_rate_sigma_km_s: float = meas.WOLF_JONES_RANGE_RATE_SIGMA_KM_S) -> Case2Window:
-    """Linearise test case 2's window ``[P_ref, 2 P_ref]`` (daily measurements unless ``t`` is given, TU) about the
-    coasting observer and the Table 4 targets; range and range rate (noise standard deviations ``range_sigma_km``,
-    km, and ``range_rate_sigma_km_s``, km/s; default Table 5's 100 m and 10 m/s), Table 5 priors, process noise of
-    the normalised reading (1e-11 LU^2/TU^3)."""
+    """Linearise test case 2's window ``[P_ref, 2 P_ref]`` about the observer coasting on its initial reference DRO
+    and the three target DROs (Table 4 rows corrected into periodic orbits, as in
+    :func:`cislunar.papers.wolf_jones.scenarios.test_case_2`; notebook 06's window and ballistic observer).
+
+    ``t`` (TU) replaces the scenario's daily measurement times; the states are those at the window start
+    ``P_ref`` and ``t[0]`` is taken as that epoch (the CR3BP is autonomous).  Range and range rate with noise
+    standard deviations ``range_sigma_km`` (km) and ``range_rate_sigma_km_s`` (km/s; default Table 5's 100 m and
+    10 m/s), Table 5 priors, the scenario's process noise (the adopted normalised reading, 1e-11 LU^2/TU^3).
+    """
     check_system(system)
     range_sigma_km = validation.positive(range_sigma_km, "range_sigma_km")
     range_rate_sigma_km_s = validation.positive(range_rate_sigma_km_s, "range_rate_sigma_km_s")
-    P_ref = _period(system, OBSERVER_TF_X0)
-    start = propagate(system, np.vstack([OBSERVER_TF_X0, TARGETS_X0]), [0.0, P_ref]).x[:, -1]
+    sc = wj.test_case_2(system)
+    P_ref = sc.period
+    start = propagate(system, np.vstack([sc.observer_x0, sc.targets_x0]), [0.0, sc.window[0]]).x[:, -1]
     day = float(system.days_to_tu(1.0))
-    t_win = P_ref + np.arange(0.0, P_ref + 1e-12, day) if t is None else np.asarray(t, dtype=float)
-    P_obj = cov.state_covariance(cov.WOLF_JONES_SIGMA_POS_KM, cov.WOLF_JONES_SIGMA_VEL_KM_S, system)
+    t_win = sc.measurement_times if t is None else np.asarray(t, dtype=float)
+    P_obj = cov.state_covariance(sc.sigma_pos_km, sc.sigma_vel_km_s, system)
     R_rr = meas.range_range_rate_noise(range_sigma_km, range_rate_sigma_km_s, system)
-    q_nd = cov.psd_to_nondimensional(cov.WOLF_JONES_PSD_KM2_S3, system)
+    q_nd = sc.q
     lin = cov.linearize_augmented(system, start[0], start[1:], t_win, meas.RANGE_RANGE_RATE, R_rr,
                                   cov.block_diag([P_obj] * 4), q=q_nd, derivatives=True)
-    periods = tuple(float(system.tu_to_days(_period(system, x))) for x in TARGETS_X0)
+    periods = tuple(float(system.tu_to_days(_period(system, x))) for x in sc.targets_x0)
     return Case2Window(system, P_ref, start, t_win, day, P_obj, R_rr, q_nd, lin, periods)
 
 

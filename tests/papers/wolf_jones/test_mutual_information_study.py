@@ -6,6 +6,7 @@ import pytest
 
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.papers.wolf_jones import mutual_information_study as S
+from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.sensing import information as info
 
 
@@ -30,8 +31,25 @@ def test_toy_window_dense_equals_chain_rule():
 
 @pytest.fixture(scope="module")
 def short_window():
-    P = float(S._period(em, S.OBSERVER_TF_X0))
+    P = S.reference_period(em)
     return S.case_2_window(em, t=P + np.arange(4) * float(em.days_to_tu(1.0)))
+
+
+def test_the_window_is_notebook_06s(short_window):
+    """Notebook 02's window is notebook 06's: the same P_ref (the corrected observer_t0 DRO, not observer_tf), the
+    same measurement times, the observer at 06's ballistic window start, and Eq. 18 equal to 06's information model
+    there (same P0, R, Q)."""
+    sc = wj.test_case_2(em)
+    assert S.reference_period(em) == sc.period
+    assert em.tu_to_days(sc.period) - em.tu_to_days(S._period(em, S.OBSERVER_TF_X0)) > 0.1  # the old P_ref differed
+    w = S.case_2_window(em)
+    assert w.P_ref == sc.period and w.t[0] == pytest.approx(sc.window[0], abs=1e-12)
+    np.testing.assert_allclose(w.t, sc.measurement_times, rtol=0, atol=1e-12)
+    x_ws = sc.ballistic_guess(np.array([0.0, sc.window[0]]))[0][-1]
+    np.testing.assert_allclose(w.start[0], x_ws, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(w.start[1:], sc.targets_at([sc.window[0]])[:, 0], rtol=0, atol=1e-10)
+    mi_02 = info.mutual_information(*w.lin.arrays)
+    assert mi_02 == pytest.approx(float(sc.information_model()(x_ws)), rel=1e-8)
 
 
 def test_window_crlb_decomposes_and_matches_eq18(short_window):

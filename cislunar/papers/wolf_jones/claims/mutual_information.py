@@ -5,14 +5,17 @@ Declarations only.  Tolerances fixed before comparing: the scalar Monte Carlo wi
 closed form; the structured gradient within 1e-5 (max relative) of central differences; each end of the
 observation window within 1 day of the text's "roughly 17 and 32 days"; the baseline argument holds when the MI
 gains, the observer's in-plane terminal RMS drops by more than 1.5x and does not rebound by 1.2x or more at the
-longest baseline (in-plane: a choice made after the total-RMS test failed, so these rows are tuned).
+longest baseline (in-plane: a choice made after the total-RMS test failed, so these rows are tuned).  The observer
+"on average" below the targets (Fig. 9) means a window-mean RMS at least 10 % below the targets' mean, the criterion
+notebook 06 fixed for the same sentence (2026-11-26: before, any margin counted; the shared window of notebooks 02
+and 06 turned this row from "differs", -0.2 %, into a pass by 1.3 %, and one sentence of the paper gets one test).
 """
 
 from __future__ import annotations
 
 import math
 
-from cislunar.publish.claims import AtMost, Claim, Holds, Within, printed_tolerance
+from cislunar.publish.claims import AtLeast, AtMost, Claim, Holds, Within, printed_tolerance
 
 #: Closed-form MI of the scalar worked example (p = 4, h = r = 1): 0.5 ln(1 + h^2 p / r), nats.
 SCALAR_CLOSED_FORM = 0.5 * math.log(1 + 4.0)
@@ -57,7 +60,8 @@ CLAIMS = {
         reason="an end of the window lies more than 1 d from the paper's (largest miss of 17 d and 32 d, days)"),
     "observer_trajectory": Claim(
         "Observer trajectory in the window", "SCvx-optimised (not published)", kind="not in paper",
-        reason="our choice; the optimised trajectory is not given and the printed observer_t0 row is not periodic"),
+        reason="our choice; the optimised trajectory is not given, so the observer coasts on its initial reference "
+               "DRO (the printed observer_t0 row, not periodic, with vy0 corrected holding x0)"),
     "in_plane_growth": Claim(
         "In-plane RMS growth after the first update (test case 2 analogue of the Fig. 4 remark)",
         "noticeable growth at the window start (attributed to a diagonal P0)",
@@ -65,8 +69,8 @@ CLAIMS = {
         source="Test Case #1 text on Fig. 4", reason="no initial growth in this geometry"),
     "observer_below_targets": Claim(
         "Observer RMS below targets on average (Fig. 9)", "yes",
-        Holds("the observer's position RMS, averaged over the window, is below the targets' average"),
-        source="Test Case #2 text on Fig. 9", reason="the observer is not better determined than the targets here"),
+        AtLeast(0.10), source="Test Case #2 text on Fig. 9",
+        reason="the observer's window-mean RMS is less than 10 % below the targets' mean (relative gap)"),
     "baseline_relative_position": Claim(
         "MI and CRLB improve with baseline (relative position (100 m))", "yes (Markley/Psiaki argument, qualitative)",
         Holds(_BASELINE_TEST), source="Introduction (Markley, Psiaki)", tuned=_BASELINE_TUNED,
