@@ -248,7 +248,7 @@ def exercise_02_range_noise(factor: float = 0.5, n_days: int | None = None) -> R
     t = None
     if n_days is not None:
         n_days = validation.integer(n_days, "n_days", minimum=1)
-        p_ref = float(mi_study._period(em, mi_study.OBSERVER_TF_X0))
+        p_ref = mi_study.reference_period(em)
         t = p_ref + np.arange(n_days) * float(em.days_to_tu(1.0))
     values, terms = [], []
     for sigma in (meas.WOLF_JONES_RANGE_SIGMA_KM, factor * meas.WOLF_JONES_RANGE_SIGMA_KM):

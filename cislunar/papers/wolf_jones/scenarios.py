@@ -50,7 +50,7 @@ to lie outside the prior 3-sigma relative-position sphere (:math:`\sigma_{rel}/\
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -90,6 +90,9 @@ __all__ = [
     "evaluate_crlb",
     "impulse",
     "node_times_with_window",
+    "CONTROL_UNITS",
+    "CONTROL_AVERAGES",
+    "control_scale",
     "ScenarioSolver",
     "sweep_both_ways",
     "ImpulseBudgetError",
@@ -633,6 +636,69 @@ def evaluate_crlb(scenario: Scenario, x_window_start, *, q: float | None = None)
 # --------------------------------------------------------------------------------------------------------------
 # solving: one alpha, homotopy sweeps (optionally in parallel), re-flight
 # --------------------------------------------------------------------------------------------------------------
+#: Units in which the control term of Eq. 42 may be measured (the paper does not say): the non-dimensional
+#: velocity unit (adopted), km/s or m/s.
+CONTROL_UNITS = ("LU/TU", "km/s", "m/s")
+#: What the control term of Eq. 42 may be (the paper does not say): the total trapezoid impulse (adopted), its
+#: average per node (total / N) or per day of the scenario (total / duration in days).
+CONTROL_AVERAGES = ("total", "node", "day")
+
+
+def control_scale(scenario: Scenario, t_nodes, *, unit: str = "LU/TU", average: str = "total") -> float:
+    """Factor :math:`c` of a reading of Eq. 42's control term: :math:`c\times` the total impulse in LU/TU.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Supplies the velocity unit and, for ``average="day"``, the duration :attr:`Scenario.duration`.
+    t_nodes : array_like (N,)
+        Node times, TU (``average="node"`` divides by N).
+    unit : {"LU/TU", "km/s", "m/s"}
+        Unit of the impulse (:data:`CONTROL_UNITS`).
+    average : {"total", "node", "day"}
+        Total impulse, impulse per node, or impulse per day of the scenario (:data:`CONTROL_AVERAGES`).
+
+    Returns
+    -------
+    float
+        :math:`c` (1.0 exactly for the adopted reading ``("LU/TU", "total")``).
+    """
+    if not isinstance(scenario, Scenario):
+        raise ValueError(f"scenario must be a Scenario; got {type(scenario).__name__}")
+    t = validation.time_grid(t_nodes, "t_nodes", increasing=True)
+    unit = validation.choice(unit, "unit", CONTROL_UNITS)
+    average = validation.choice(average, "average", CONTROL_AVERAGES)
+    return _control_scale(scenario, t.size, unit, average)
+
+
+def _control_scale(scenario: Scenario, n_nodes: int, unit: str, average: str) -> float:
+
+    vu = scenario.system.velocity_unit_km_s
+    c = {"LU/TU": 1.0, "km/s": vu, "m/s": vu * 1e3}[unit]
+    if average == "node":
+        c = c / n_nodes
+    elif average == "day":
+        c = c / float(scenario.system.tu_to_days(scenario.duration))
+    return float(c)
+
+
+class _ScaledInformation:
+    """``info / c`` in the ``info(x, order)`` / ``info.hessian(x)`` protocol of SCvx (picklable)."""
+
+    def __init__(self, information, scale: float):
+        self.information = information
+        self.scale = scale
+
+    def __call__(self, x, order: int = 0):
+        if order == 0:
+            return self.information(x, 0) / self.scale
+        value, grad = self.information(x, 1)
+        return value / self.scale, grad / self.scale
+
+    def hessian(self, x):
+        return self.information.hessian(x) / self.scale
+
+
 class ScenarioSolver:
     """``solver(alpha, x_guess, u_guess) -> SCvxResult`` for one scenario and node grid (picklable, for
     :func:`cislunar.guidance.scvx.homotopy_sweep` and process pools).
@@ -651,10 +717,24 @@ class ScenarioSolver:
     d_min_km : float, optional
         Keep-out radius, km (default :attr:`Scenario.keep_out_km`; used with ``keep_out=True``).
     settings : cislunar.guidance.scvx.SCvxSettings, optional
+    control_unit : {"LU/TU", "km/s", "m/s"}
+        Unit of the control term of Eq. 42 (keyword-only; default: LU/TU, as before).
+    control_average : {"total", "node", "day"}
+        Total impulse, or its average per node or per day (keyword-only; default: total, as before).
+
+    Notes
+    -----
+    The paper does not say how Eq. 42's control term is normalised.  With :math:`c` =
+    :func:`control_scale` of the two options the solver minimises :math:`\\mathcal J_c = (1-\\alpha_h)\\,c\\,
+    \\mathrm{impulse} - \\alpha_h\\mathcal I` (impulse in LU/TU, :math:`\\mathcal I` in nats).  SCvx is run on
+    :math:`\\mathcal J_c / c` (the information model divided by :math:`c`; same minimisers), and the returned result
+    carries ``cost`` = :math:`\\mathcal J_c` and ``information`` in nats (:meth:`cost`); its ``history`` is in the
+    units of :math:`\\mathcal J_c / c`.  With the default (:math:`c = 1`) the solve is the unscaled one, bit for bit.
     """
 
     def __init__(self, scenario: Scenario, t_nodes, k_window: int, *, information=None, keep_out: bool = False,
-                 d_min_km: float | None = None, settings=None):
+                 d_min_km: float | None = None, settings=None, control_unit: str = "LU/TU",
+                 control_average: str = "total"):
         if not isinstance(scenario, Scenario):
             raise ValueError(f"scenario must be a Scenario; got {type(scenario).__name__}")
         self.scenario = scenario
@@ -672,15 +752,35 @@ class ScenarioSolver:
             validation.instance(settings, "settings", SCvxSettings)
         self.settings = settings
         self.u_max = scenario.control_bounds(self.t)
+        self.control_unit = validation.choice(control_unit, "control_unit", CONTROL_UNITS)
+        self.control_average = validation.choice(control_average, "control_average", CONTROL_AVERAGES)
+        #: c of the control term: J_c = (1 - alpha) c impulse - alpha I (1.0 for the default reading)
+        self.control_scale = _control_scale(scenario, self.t.size, self.control_unit, self.control_average)
         # every run of this solver has the same subproblem structure: canonicalised once per thread and process
         self.workspace = SCvxWorkspace()
+
+    def cost(self, x, u, alpha: float) -> float:
+        """:math:`\\mathcal J_c = (1-\\alpha_h)\\,c\\,\\mathrm{impulse}(u) - \\alpha_h\\mathcal I(x_{k^*})` of nodes
+        ``x`` (N, 6) and ``u`` (N, 3) (the default reading's :math:`c = 1`; without information at
+        :math:`\\alpha_h = 0`, as SCvx)."""
+        x = validation.as_array(x, "x", shape=(self.t.size, 6))
+        u = validation.as_array(u, "u", shape=(self.t.size, 3))
+        a = validation.in_range(alpha, "alpha", 0.0, 1.0)
+        control = (1.0 - a) * (self.control_scale * impulse(self.t, u))
+        return float(control - a * self.information(x[self.k_window], 0)) if a > 0 else float(control)
 
     def __call__(self, alpha: float, x_guess, u_guess):
 
         sc = self.scenario
-        return solve_scvx(sc.system, self.t, x_guess, u_guess, self.u_max, x_final=sc.observer_xf,
-                          info=self.information, info_node=self.k_window, constraints=self.constraints,
-                          alpha=float(alpha), settings=self.settings, workspace=self.workspace)
+        c = self.control_scale
+        info_model = self.information if c == 1.0 else _ScaledInformation(self.information, c)
+        res = solve_scvx(sc.system, self.t, x_guess, u_guess, self.u_max, x_final=sc.observer_xf,
+                         info=info_model, info_node=self.k_window, constraints=self.constraints,
+                         alpha=float(alpha), settings=self.settings, workspace=self.workspace)
+        if c == 1.0:
+            return res
+        return replace(res, cost=self.cost(res.x, res.u, alpha),
+                       information=float(self.information(res.x[self.k_window], 0)))
 
 
 def _chain(solver, alphas, x_guess, u_guess, direction):

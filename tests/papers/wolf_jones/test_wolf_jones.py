@@ -347,3 +347,82 @@ def test_solve_for_impulse_hits_the_budget_and_reports_a_jump():
     assert len(err.value.solves) == 6 and err.value.budget == 5.0
     back = pickle.loads(pickle.dumps(err.value))
     assert back.solves == err.value.solves and back.reason == err.value.reason
+
+
+# ------------------------------------------------------------------------------------------------ control-term normalisation
+def test_control_scale_against_hand_values(case1):
+    """c of each reading of Eq. 42's control term, against numbers computed by hand from the Earth-Moon units
+    (L = 384,400 km, T = 375,190.25852 s: 1 LU/TU = 1.02454686 km/s; 2 periods of 16.1713 d = 32.3426 d)."""
+    t, _, _ = case1.node_times(12)
+    vu = 384400.0 / 375190.25852  # km/s per LU/TU, by hand
+    days = 2 * case1.period * 375190.25852 / 86400.0
+    assert days == pytest.approx(32.34, abs=0.01)
+    assert W.control_scale(case1, t) == 1.0  # the adopted reading: exactly today's cost
+    assert W.control_scale(case1, t, unit="km/s") == pytest.approx(vu, rel=1e-12)
+    assert W.control_scale(case1, t, unit="m/s") == pytest.approx(1024.5468566, rel=1e-9)
+    assert W.control_scale(case1, t, average="node") == pytest.approx(1.0 / 12, rel=1e-15)  # N nodes, not N-1
+    assert W.control_scale(case1, t, unit="m/s", average="node") == pytest.approx(1e3 * vu / 12, rel=1e-12)
+    assert W.control_scale(case1, t, unit="m/s", average="day") == pytest.approx(1e3 * vu / days, rel=1e-12)
+    with pytest.raises(ValueError, match="unit"):
+        W.control_scale(case1, t, unit="ft/s")
+    with pytest.raises(ValueError, match="control_average"):
+        W.ScenarioSolver(case1, t, case1.node_times(12)[1], control_average="mean")
+
+
+def test_normalised_cost_scales_only_the_control_term(case1):
+    """Identity: J_c - J_1 = (1 - alpha)(c - 1) impulse, for any nodes; and the m/s total against a hand sum."""
+    t, k, _ = case1.node_times(10)
+    x, _ = case1.ballistic_guess(t)
+    rng = np.random.default_rng(7)
+    u = case1.control_bounds(t)[:, None] * rng.uniform(-0.5, 0.5, size=(t.size, 3))
+    info = case1.information_model()
+    default = W.ScenarioSolver(case1, t, k, information=info)
+    mi = info(x[k], 0)
+    imp = W.impulse(t, u)
+    for unit, average in (("m/s", "total"), ("LU/TU", "node"), ("m/s", "day")):
+        s = W.ScenarioSolver(case1, t, k, information=info, control_unit=unit, control_average=average)
+        c = s.control_scale
+        for alpha in (0.0, 5e-3, 2e-2, 1.0):
+            lhs = s.cost(x, u, alpha) - default.cost(x, u, alpha)
+            assert lhs == pytest.approx((1 - alpha) * (c - 1) * imp, rel=1e-12, abs=1e-15)
+            # the control part alone is c times the default's
+            assert s.cost(x, u, alpha) + alpha * mi * (alpha > 0) == pytest.approx(
+                c * (default.cost(x, u, alpha) + alpha * mi * (alpha > 0)), rel=1e-12, abs=1e-18)
+    # hand computation of the m/s total: trapezoid of |u| in km/s^2 over seconds, times 1000
+    s = W.ScenarioSolver(case1, t, k, information=info, control_unit="m/s")
+    a_kms2 = np.linalg.norm(u, axis=1) * em.acceleration_unit_km_s2
+    dt_s = np.diff(t) * em.time_unit_s
+    hand_mps = 1e3 * float(np.sum(dt_s * (a_kms2[:-1] + a_kms2[1:]) / 2))
+    assert s.cost(x, u, 2e-2) == pytest.approx(0.98 * hand_mps - 2e-2 * mi, rel=1e-10)
+    # the default cost is what SCvx itself reports (same formula, same bits)
+    assert default.cost(x, u, 5e-3) == (1.0 - 5e-3) * imp - 5e-3 * mi
+
+
+def test_normalised_solve_is_the_default_solve_at_the_equivalent_weight(case1):
+    """(1-a) c I_u - a I has the minimisers of (1-a') I_u - a' I with a'/(1-a') = a/((1-a) c): the solver with
+    normalisation c at a must land where the default solver lands at a' (same start, same local optimum); the
+    default options give the unscaled solve bit for bit."""
+    from cislunar.guidance.scvx import solve_scvx
+
+    t, k, _ = case1.node_times(10)
+    xb, ub = case1.ballistic_guess(t)
+    info = case1.information_model()
+    alpha = 2e-2
+    s = W.ScenarioSolver(case1, t, k, information=info, control_unit="m/s", control_average="day")
+    c = s.control_scale
+    a_eq = alpha / (alpha + (1 - alpha) * c)
+    default = W.ScenarioSolver(case1, t, k, information=info)
+    r_c, r_1 = s(alpha, xb, ub), default(a_eq, xb, ub)
+    assert r_c.alpha == alpha and r_1.alpha == a_eq
+    # the same optimum: equal J_c to the solver's tolerance (the front is flat there: impulse and MI agree only to
+    # 1e-3 and 1e-4); a wrong scale (c instead of 1/c on the information) lands orders of magnitude away
+    assert s.cost(r_1.x, r_1.u, alpha) == pytest.approx(r_c.cost, rel=1e-7)
+    assert r_c.impulse == pytest.approx(r_1.impulse, rel=1e-3)
+    assert r_c.information == pytest.approx(r_1.information, rel=1e-4)
+    # the reported cost is J_c in its own units, the information in nats
+    assert r_c.cost == s.cost(r_c.x, r_c.u, alpha)
+    assert r_c.information == info(r_c.x[k], 0)
+    # the default options are the unscaled solve, bit for bit
+    direct = solve_scvx(case1.system, t, xb, ub, default.u_max, x_final=case1.observer_xf, info=info, info_node=k,
+                        alpha=a_eq)
+    assert r_1.cost == direct.cost and np.array_equal(r_1.u, direct.u) and np.array_equal(r_1.x, direct.x)
