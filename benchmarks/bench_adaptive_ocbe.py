@@ -11,6 +11,9 @@
 * the reset's metric :math:`M_k(\\alpha)` as :func:`reset_factor` evaluates it in its root search: through the
   checked public SRI updates (before) against their unchecked kernels after one checked evaluation (now); same
   values;
+* the state-covariance reset (``reset="inflate"``, the measurement-set study of
+  :func:`cislunar.papers.greaves_scheeres_2021.adaptive_studies.variant_study`): one single-trial adaptive filter
+  per run against the batched one (restarts from the detection epoch grouped by epoch); same detections and factors;
 * the delay study's first pass (:func:`first_pass_detections`): the batched OCBE with the smoother (before) against
   the filter only (now); same first-detection epochs.
 
@@ -92,6 +95,28 @@ def main(seed: int = 0) -> dict:
                               "ratio": (t1 - t0) / (t2 - t1), "identical": a == b}
     print(f"reset metric M(alpha): checked updates {1e3 * (t1 - t0) / alphas.size:.2f} ms, kernels "
           f"{1e3 * (t2 - t1) / alphas.size:.2f} ms per evaluation, ratio {(t1 - t0) / (t2 - t1):.1f}x; identical {a == b}")
+
+    ys, x0s = np.array([d.y for _, d in runs]), np.array([d.x0 for _, d in runs])
+    def one(d):
+        try:
+            return ad.adaptive_ocbe(em, sc.t, d.y, setup.observer_states, sc.model, sc.meas_cov, d.x0, d.P0,
+                                    setup.control_weight, reset="inflate", smooth=False, max_resets=5).detections
+        except (ad.ResetError, ocbe.FilterDivergenceError):
+            return None  # flagged in the batch
+
+    t0 = time.perf_counter()
+    single = [one(d) for _, d in runs]
+    t1 = time.perf_counter()
+    batched = ad.adaptive_ocbe_batch(em, sc.t, ys, setup.observer_states, sc.model, sc.meas_cov, x0s, runs[0][1].P0,
+                                     setup.control_weight, reset="inflate", smooth=False, max_resets=5,
+                                     on_failure="flag")[3]
+    t2 = time.perf_counter()
+    same = all(a is None or [d.epoch for d in a] == [d.epoch for d in b] and
+               np.allclose([d.factor for d in a], [d.factor for d in b], rtol=1e-7) for a, b in zip(single, batched))
+    result["inflate_reset"] = {"runs": len(runs), "single_s": t1 - t0, "batched_s": t2 - t1,
+                               "ratio": (t1 - t0) / (t2 - t1), "same_detections": same}
+    print(f"inflation reset, {len(runs)} runs: single {1e3 * (t1 - t0) / len(runs):.0f} ms/run, batched "
+          f"{1e3 * (t2 - t1) / len(runs):.0f} ms/run, ratio {(t1 - t0) / (t2 - t1):.1f}x; same detections {same}")
 
     draws = [det.draw_trial(rng, setup, magnitude_m_s=0.05) for _ in range(DELAY_RUNS)]
     args = (em, sc.t, np.array([d.y for d in draws]), setup.observer_states, sc.model, sc.meas_cov,

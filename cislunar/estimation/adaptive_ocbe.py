@@ -72,6 +72,20 @@ then diverges through a chain of further resets.  ``reset="likelihood"`` instead
 maximises the Gaussian likelihood of the innovation (covariance matching), which inflates only as far as the
 explainable part of the innovation asks.  Notebook 09b measures both rules.
 
+The state-covariance reset.  ``reset="inflate"`` reads "solves for a state covariance" literally: the predicted
+state covariance of epoch :math:`k`, :math:`P^-_k = \Phi_{xx}P_{k-1|k-1}\Phi_{xx}^\top + Q`, is multiplied by the
+factor :math:`\beta \ge 1` that solves
+
+.. math:: M_k(\beta) = \delta\mathbf y_k^\top\bigl(\beta H P^-_k H^\top + R\bigr)^{-1}\delta\mathbf y_k = m
+
+(monotone decreasing in :math:`\beta`, solved in :math:`\log\beta`), and the filter restarts at :math:`t_k` from
+the prior :math:`(\mathbf x^-_k, \beta P^-_k)`; the control weights are not changed, so epochs before :math:`k` are
+unchanged and only epochs from :math:`k` on are re-run.  Every state direction is inflated, position included, not
+only the velocity directions the control weight opens.  With ``smooth=True`` the smoother runs over each segment
+between such restarts separately (the OCBE's backward pass has no term for an inflated prior), so smoothed estimates
+before a restart do not see the data after it.  Like the mean rule, it sets the metric to its mean and so meets the
+same pure-noise components when they alone exceed the mean.
+
 Conventions: a detection needs three epochs *with measurements* in a row at or after epoch 1 (epoch 0 has no
 interval before it to reset); an epoch without any measurement has no metric (NaN) and breaks a run; a run still
 open at the end of the track is not a detection.  Times TU, states LU and LU/TU (rotating frame), control weights
@@ -95,7 +109,7 @@ from cislunar.utils import validation
 __all__ = ["DETECTION_PROBABILITY", "CONSECUTIVE_EPOCHS", "metric_law", "metric_limit", "MetricTerms",
            "RESET_RULES", "metric_terms", "forward_metric", "smoothed_metric", "first_detection", "Detection",
            "reset_factor", "AdaptiveOCBEResult", "adaptive_ocbe", "adaptive_ocbe_batch", "first_pass_detections",
-           "ResetError"]
+           "ResetError", "INFLATE", "ALL_RESET_RULES"]
 
 #: Probability of the metric's detection limit (the paper's 99 %).
 DETECTION_PROBABILITY = 0.99
@@ -103,6 +117,10 @@ DETECTION_PROBABILITY = 0.99
 CONSECUTIVE_EPOCHS = 3
 #: Reset rules of :func:`reset_factor`: the paper's ("mean") and maximum likelihood ("likelihood").
 RESET_RULES = ("mean", "likelihood")
+#: The reset that inflates the predicted state covariance until the metric equals its mean (module docstring).
+INFLATE = "inflate"
+#: Every reset of :func:`adaptive_ocbe`: the control-weight rules of :data:`RESET_RULES` and :data:`INFLATE`.
+ALL_RESET_RULES = RESET_RULES + (INFLATE,)
 
 
 class ResetError(RuntimeError):
@@ -372,7 +390,8 @@ class Detection:
     time : float
         ``t[epoch]``, TU.
     factor : float
-        Multiplier :math:`\\alpha` applied to the control weight of interval ``epoch - 1``.
+        Multiplier :math:`\\alpha` applied to the control weight of interval ``epoch - 1`` (``reset="inflate"``: the
+        multiplier :math:`\\beta` of the predicted state covariance at ``epoch``).
     metric_before, metric_after : float
         Metric at ``epoch`` before the reset and in the re-run (equal to the mean ``dof`` under the mean rule).
     """
@@ -389,6 +408,9 @@ def reset_factor(system: CR3BP, t, k: int, x_filt_prev, P_filt_prev, y_k, observ
                  control_weight: float, *, rule: str = "mean", target: float | None = None, n_sub: int = 9,
                  tol: float = DEFAULT_TOL, max_factor: float = 1e40):
     """Control-weight multiplier :math:`\\alpha` of the reset at epoch ``k``.
+
+    ``rule="inflate"``: instead the multiplier :math:`\\beta` of the predicted state covariance
+    :math:`P^-_k = \\Phi P\\Phi^\\top + Q` that sets the metric to ``target`` (module docstring).
 
     ``rule="mean"`` (the paper's): the metric at ``k`` becomes ``target`` (default: its mean, the dof).
     ``rule="likelihood"``: :math:`\\alpha` maximises the likelihood of the innovation,
@@ -453,7 +475,7 @@ def reset_factor(system: CR3BP, t, k: int, x_filt_prev, P_filt_prev, y_k, observ
     S = srif.sri_from_covariance(np.zeros(6), P, name="P_filt_prev")[0]
     eye = np.eye(6)
     target = float(H.shape[0]) if target is None else validation.positive(target, "target")
-    validation.choice(rule, "rule", RESET_RULES)
+    validation.choice(rule, "rule", ALL_RESET_RULES)
 
     zero = np.zeros(6)
     # alpha = 1 through the public updates (they check Phi, Q and Rk by name), every other alpha through their
@@ -466,6 +488,8 @@ def reset_factor(system: CR3BP, t, k: int, x_filt_prev, P_filt_prev, y_k, observ
         return float(srif._measurement_update(S_bar, zero, H, dy, Rk)[2]) ** 2
 
     hi = np.log(validation.positive(max_factor, "max_factor"))
+    if rule == INFLATE:
+        return _inflation_factor(k, H @ _predicted_covariance(Phi, P, Q) @ H.T, Rk, dy, target, hi, max_factor), m1
     if rule == "likelihood":
         # The innovation covariance C(alpha) is m x m and R keeps it SPD for every alpha, so its Cholesky factor gives
         # log det C and the whitened innovation directly.  (The determinant lemma on the SRI factors is equivalent
@@ -493,6 +517,65 @@ def reset_factor(system: CR3BP, t, k: int, x_filt_prev, P_filt_prev, y_k, observ
         raise ResetError(k, m1, target, f"metric still {metric(hi):.3g} with the control weight x {max_factor:.0e}")
     la = optimize.brentq(lambda a: metric(a) - target, 0.0, hi, xtol=1e-12, rtol=1e-12)
     return float(np.exp(la)), m1
+
+
+def _predicted_covariance(Phi, P, Q) -> np.ndarray:
+    """The OCBE's predicted state covariance :math:`\\Phi P\\Phi^\\top + Q` (symmetrised)."""
+    Pp = Phi @ P @ Phi.T + Q
+    return 0.5 * (Pp + Pp.T)
+
+
+def _inflation_factor(k, HPH, Rk, dy, target, hi, max_factor) -> float:
+    """:math:`\\beta \\ge 1` with :math:`\\delta y^\\top(\\beta HP^-H^\\top + R)^{-1}\\delta y` = ``target`` (brentq in
+    :math:`\\log\\beta`; 1 when the metric is already at most ``target``)."""
+    def metric(log_beta):
+        L = np.linalg.cholesky(np.exp(log_beta) * HPH + Rk)
+        w = linalg.solve_triangular(L, dy, lower=True)
+        return float(w @ w)
+
+    m1 = metric(0.0)
+    if m1 <= target:
+        return 1.0
+    if metric(hi) > target:
+        raise ResetError(k, m1, target, f"metric still {metric(hi):.3g} with the state covariance x {max_factor:.0e}")
+    return float(np.exp(optimize.brentq(lambda a: metric(a) - target, 0.0, hi, xtol=1e-12, rtol=1e-12)))
+
+
+def _inflated_prior(system, t, k, x_prev, P_prev, q, beta, n_sub, tol):
+    """Prior of the restart at ``t[k]`` after an inflation reset: the predicted state and :math:`\\beta P^-_k`
+    (the same prediction :func:`reset_factor` solved on)."""
+    tr = ocbe.ocbe_transition(system, x_prev, np.linspace(t[k - 1], t[k], n_sub), q, tol=tol)
+    P = _predicted_covariance(tr.phi[-1, :6, :6], np.asarray(P_prev, float), ocbe.ocbe_process_noise(tr.phi[-1]))
+    return tr.x[-1].copy(), beta * P
+
+
+def _reset(system, t, k, x_prev, P_prev, *args, **kw):
+    """:func:`reset_factor` inside the adaptive filters: a filtered covariance that has become numerically singular
+    (after a large inflation) is a failed reset (:class:`ResetError`), not a bad argument."""
+    try:
+        validation.spd(P_prev, "P_filt_prev", n=6)
+    except ValueError as exc:
+        raise ResetError(k, np.nan, np.nan, str(exc)) from None
+    return reset_factor(system, t, k, x_prev, P_prev, *args, **kw)
+
+
+#: Fields of an OCBE result per epoch (N) and per interval (N-1); the rest (t, t_sub, z) are rebuilt when stitching.
+_EPOCH_FIELDS = ("x_pred", "P_pred", "x_filt", "P_filt", "x_smooth", "P_smooth", "residual_norms")
+_INTERVAL_FIELDS = ("costate_step", "costate_smooth", "control_step", "control_smooth")
+
+
+def _stitch(res, k: int, tail):
+    """Result ``res`` up to epoch ``k`` (exclusive) followed by ``tail``, a run over ``t[k:]`` (single-trial
+    :class:`ocbe.OCBEResult`); Eq. 33's integrals recomputed over the whole track."""
+    new = {}
+    for f in fields(res):
+        v = getattr(res, f.name)
+        if f.name in _EPOCH_FIELDS + _INTERVAL_FIELDS and v is not None:
+            new[f.name] = np.concatenate([v[:k], getattr(tail, f.name)], axis=0)
+    new["z_step"] = float(ocbe._control_integral(res.t_sub, new["control_step"]))
+    if res.control_smooth is not None:
+        new["z_smooth"] = float(ocbe._control_integral(res.t_sub, new["control_smooth"]))
+    return replace(res, **new)
 
 
 @dataclass(frozen=True)
@@ -552,8 +635,10 @@ def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0,
         Probability of the metric limit (0.99 in the paper).
     consecutive : int
         Exceedances in a row that declare a maneuver (3 in the paper).
-    reset : {"mean", "likelihood"}
-        Reset rule (:func:`reset_factor`): the paper's (metric set to its mean) or maximum likelihood.
+    reset : {"mean", "likelihood", "inflate"}
+        Reset rule (:func:`reset_factor`): the paper's (metric set to its mean by the control weight), maximum
+        likelihood, or the state-covariance inflation (metric set to its mean by inflating the predicted state
+        covariance and restarting the filter there; module docstring).
     max_resets : int
         Safety bound on the number of resets.
     """
@@ -564,9 +649,13 @@ def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0,
     q = ocbe.control_weights(control_weight, N - 1).copy()
     consecutive = validation.integer(consecutive, "consecutive", minimum=1)
     max_resets = validation.integer(max_resets, "max_resets", minimum=0)
-    validation.choice(reset, "reset", RESET_RULES)
+    validation.choice(reset, "reset", ALL_RESET_RULES)
     validation.in_range(probability, "probability", 0.0, 1.0, closed=False)
     yy, obs3, R, avail = _measurement_inputs(N, y, observer_states, model, meas_cov, available)
+
+    def restart(k, x_k, P_k):
+        return ocbe.ocbe_filter_smoother(system, t[k:], yy[k:], obs3[k:], model, R[k:], x_k, P_k, q[k:],
+                                         available=avail[k:], n_sub=n_sub, smooth=smooth, tol=tol)
 
     def run():
         return ocbe.ocbe_filter_smoother(system, t, y, observer_states, model, meas_cov, x0, P0, q,
@@ -585,11 +674,15 @@ def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0,
         if len(detections) >= max_resets:
             raise ResetError(k, metric[k], dof[k], f"more than max_resets = {max_resets} resets")
         vis = np.flatnonzero(avail[k])
-        factor, m1 = reset_factor(system, t, k, res.x_filt[k - 1], res.P_filt[k - 1], y3[k, vis], obs3[k, vis],
+        factor, m1 = _reset(system, t, k, res.x_filt[k - 1], res.P_filt[k - 1], y3[k, vis], obs3[k, vis],
                                   model, R[k], q[k - 1], rule=reset, n_sub=n_sub, tol=tol)
         before = metric[k]
-        q[k - 1] *= factor
-        res = run()
+        if reset == INFLATE:
+            x_k, P_k = _inflated_prior(system, t, k, res.x_filt[k - 1], res.P_filt[k - 1], q[k - 1], factor, n_sub, tol)
+            res = _stitch(res, k, restart(k, x_k, P_k))
+        else:
+            q[k - 1] *= factor
+            res = run()
         metric = forward_metric(res, model, avail)[0]
         detections.append(Detection(k, k + consecutive - 1, float(t[k]), factor, float(before), float(metric[k])))
         start = k + 1
@@ -600,11 +693,11 @@ def adaptive_ocbe(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0,
 def _reset_rules(reset, B: int) -> list:
     """``reset`` (one rule, or one per trial) as a list of B rules, refused by name when malformed."""
     if not isinstance(reset, (list, tuple, np.ndarray)):
-        return [validation.choice(reset, "reset", RESET_RULES)] * B
+        return [validation.choice(reset, "reset", ALL_RESET_RULES)] * B
     rules = list(np.asarray(reset, dtype=object).reshape(-1))
     if len(rules) != B:
         raise ValueError(f"reset must name one rule or {B} rules (one per trial); got {len(rules)}")
-    return [validation.choice(r, f"reset[{i}]", RESET_RULES) for i, r in enumerate(rules)]
+    return [validation.choice(r, f"reset[{i}]", ALL_RESET_RULES) for i, r in enumerate(rules)]
 
 
 def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *,
@@ -624,7 +717,9 @@ def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x
     P0 : array_like, shape (6, 6) or (B, 6, 6)
     control_weight : scalar or array_like, shape (N-1,) or (B, N-1)
     reset : str or sequence of str
-        Reset rule (:func:`reset_factor`), for all trials or one per trial (B entries).
+        Reset rule (:func:`reset_factor`, one of :data:`ALL_RESET_RULES`), for all trials or one per trial (B
+        entries).  An ``"inflate"`` trial re-runs only from its detection epoch, batched with the other trials
+        reset at the same epoch.
     smooth : bool
         Run the smoother in every pass (``False``: the forward filter only, as ``adaptive_ocbe(..., smooth=False)``;
         the detections use the forward metric only, so they do not depend on it).
@@ -682,34 +777,57 @@ def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x
     while True:
         ks = [None if fail_epoch[b] >= 0 else
               first_detection(metric[b], limit, start=int(start[b]), consecutive=consecutive) for b in range(B)]
-        before = {}
+        before, restarts = {}, {}
         for b in (b for b in range(B) if ks[b] is not None):
             k = ks[b]
             try:
                 if len(dets[b]) >= max_resets:
                     raise ResetError(k, metric[b, k], dof[k], f"trial {b}: more than max_resets = {max_resets} resets")
-                factor, _ = reset_factor(system, t, k, out["x_filt"][b, k - 1], out["P_filt"][b, k - 1], yy[b, k],
+                factor, _ = _reset(system, t, k, out["x_filt"][b, k - 1], out["P_filt"][b, k - 1], yy[b, k],
                                          obs[k], model, meas_cov, q[b, k - 1], rule=rules[b], n_sub=n_sub, tol=tol)
             except ResetError as exc:
                 if not flag:
                     raise
                 drop(b, k, exc)
                 continue
-            q[b, k - 1] *= factor
+            if rules[b] == INFLATE:
+                restarts[b] = _inflated_prior(system, t, k, out["x_filt"][b, k - 1], out["P_filt"][b, k - 1],
+                                              q[b, k - 1], factor, n_sub, tol)
+            else:
+                q[b, k - 1] *= factor
             before[b] = (k, factor, float(metric[b, k]))
         if not before:
             break
-        idx = np.array(sorted(before))
-        sub = ocbe_batch(system, t, yy[idx], obs, model, meas_cov, x0a[idx], P0a[idx] if P0a.ndim == 3 else P0a,
-                         q[idx], n_sub=n_sub, tol=tol, smooth=smooth, on_failure=on_failure)
-        for name, v in out.items():
-            if v is not None:
-                v[idx] = getattr(sub, name)
-        metric[idx] = forward_metric(sub, model)[0]
-        if sub.failure_epoch is not None:
-            for i, b in enumerate(idx):
-                if sub.failure_epoch[i] >= 0:
-                    fail_epoch[b], fail_msg[b] = int(sub.failure_epoch[i]), str(sub.failure[i])
+        groups = [(0, np.array(sorted(b for b in before if rules[b] != INFLATE)))]
+        for k in sorted({before[b][0] for b in restarts}):
+            groups.append((k, np.array(sorted(b for b in restarts if before[b][0] == k))))
+        for k0, idx in groups:
+            if idx.size == 0:
+                continue
+            if k0 == 0:
+                sub = ocbe_batch(system, t, yy[idx], obs, model, meas_cov, x0a[idx],
+                                 P0a[idx] if P0a.ndim == 3 else P0a, q[idx], n_sub=n_sub, tol=tol, smooth=smooth,
+                                 on_failure=on_failure)
+            else:
+                sub = ocbe_batch(system, t[k0:], yy[idx, k0:], obs[k0:], model, meas_cov,
+                                 np.array([restarts[b][0] for b in idx]), np.array([restarts[b][1] for b in idx]),
+                                 q[idx, k0:], n_sub=n_sub, tol=tol, smooth=smooth, on_failure=on_failure)
+            for name, v in out.items():
+                if v is None:
+                    continue
+                if name in ("z_step", "z_smooth"):
+                    continue
+                v[idx, k0:] = getattr(sub, name)
+            for name, ctl in (("z_step", "control_step"), ("z_smooth", "control_smooth")):
+                if out.get(name) is not None and out.get(ctl) is not None:
+                    out[name][idx] = (getattr(sub, name) if k0 == 0 else
+                                      ocbe._control_integral(res.t_sub, out[ctl][idx]))
+            # the squared residual norms, as forward_metric gives them, NaN for a trial that failed in this re-run
+            metric[idx, k0:] = np.asarray(sub.residual_norms, float) ** 2
+            if sub.failure_epoch is not None:
+                for i, b in enumerate(idx):
+                    if sub.failure_epoch[i] >= 0:  # the whole trial NaN, as a re-run from epoch 0 leaves it
+                        drop(b, k0 + int(sub.failure_epoch[i]), sub.failure[i])
         for b, (k, factor, m0) in before.items():
             if fail_epoch[b] < 0:
                 dets[b].append(Detection(k, k + consecutive - 1, float(t[k]), factor, m0, float(metric[b, k])))

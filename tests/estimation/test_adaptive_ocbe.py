@@ -497,3 +497,91 @@ def test_batched_adaptive_flagged_filter_only_equals_single_trial(setup, max_res
             ad.adaptive_ocbe_batch(em, sc.t, np.array([c[0] for c in cases]), setup.observer_states, sc.model,
                                    sc.meas_cov, np.array([c[1] for c in cases]), P02, setup.control_weight,
                                    reset=["mean"] * 4)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The state-covariance (inflation) reset
+# ---------------------------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def informative_rates(setup):
+    """The detection setup with rates differenced over 1 TU (informative rates) and a 3 m/s burn drawn with it."""
+    import dataclasses
+
+    sc = setup.scenario
+    R = tracking.angles_rates_covariance(em, tracking.DEFAULT_SIGMA_ANGLE_RAD, rate_dt_s=em.time_unit_s)
+    s1 = dataclasses.replace(setup, scenario=dataclasses.replace(sc, meas_cov=R))
+    return s1, det.draw_trial(np.random.default_rng(1), s1, magnitude_m_s=3.0)
+
+
+def test_inflation_reset_solves_for_the_state_covariance_and_restores_consistency(informative_rates):
+    """A 3 m/s burn seen with informative rates: the filter without a reset is inconsistent after the burn; the
+    inflation reset multiplies the predicted covariance by the beta that solves
+    dy^T (beta H P^- H^T + R)^-1 dy = m (checked against that formula, independently of the SRI code), leaves the
+    control weights and the past untouched, and the filter is then consistent (at most DIVERGED_FRACTION of the
+    epochs from the reset on above the NEES 99.9 % quantile, final NEES inside its chi-square bounds).  Removing
+    the inflation (beta = 1) fails the consistency checks; mis-scaling it (beta x 10 or / 10) fails the metric one."""
+    s1, inp = informative_rates
+    sc = s1.scenario
+    a = _adaptive(s1, inp, reset="inflate", smooth=False)
+    plain = ocbe.ocbe_filter_smoother(em, sc.t, inp.y, s1.observer_states, sc.model, sc.meas_cov, inp.x0, inp.P0,
+                                      s1.control_weight, smooth=False)
+    lo, hi = stats.chi2.ppf([0.0005, consistency.NEES_PROBABILITY], 6)
+    d = a.detections[0]
+    k = d.epoch
+    n_plain = consistency.nees(plain.x_filt, plain.P_filt, inp.truth)
+    assert np.mean(n_plain[k:] > hi) > 0.5  # no reset: inconsistent (so the checks below can fail)
+    # beta from the innovation covariance of the first pass (an independent formula)
+    tr = ocbe.ocbe_transition(em, plain.x_filt[k - 1], np.linspace(sc.t[k - 1], sc.t[k], 9), s1.control_weight[k - 1])
+    Phi, Q = tr.phi[-1, :6, :6], ocbe.ocbe_process_noise(tr.phi[-1])
+    P_pred = Phi @ plain.P_filt[k - 1] @ Phi.T + Q
+    val, _, H = sc.model.evaluate(s1.observer_states[k], tr.x[-1])
+    dy = sc.model.residual(inp.y[k], val)
+    metric_at = lambda beta: float(dy @ np.linalg.solve(beta * H @ P_pred @ H.T + sc.meas_cov, dy))  # noqa: E731
+    assert d.factor > 10 and metric_at(1.0) == pytest.approx(d.metric_before, rel=1e-6)
+    assert metric_at(d.factor) == pytest.approx(4.0, rel=1e-6)
+    assert d.metric_after == pytest.approx(4.0, rel=1e-6) and a.metric[k] == pytest.approx(4.0, rel=1e-6)
+    assert np.allclose(a.result.P_pred[k], d.factor * P_pred, rtol=1e-6)
+    assert np.array_equal(a.control_weight, s1.control_weight)  # the control weights are not touched
+    assert np.array_equal(a.result.x_filt[:k], plain.x_filt[:k])  # nor the past
+    n_f = consistency.nees(a.result.x_filt, a.result.P_filt, inp.truth)
+    assert np.mean(n_f[k:] > hi) <= tracking.DIVERGED_FRACTION
+    assert lo < n_f[-1] < hi
+
+
+def test_inflation_reset_batched_equals_single_trial_and_smoother_segments(setup, informative_rates):
+    """The batched filter with reset="inflate" (restarts grouped by epoch) equals the single-trial one trial by
+    trial, chains of inflations included; with smooth=True the smoothed estimates after the last restart are those of
+    an OCBE run started there from the inflated prior."""
+    s1, inp = informative_rates
+    sc = setup.scenario
+    burns = [det.draw_trial(np.random.default_rng(s), setup, magnitude_m_s=m) for s, m in ((1, 3.0), (9, 1.0))]
+    quiet = det.draw_trial(np.random.default_rng(8), setup, None)
+    failing = det.draw_trial(np.random.default_rng(7), setup, magnitude_m_s=3.0)  # its covariance turns singular
+    cases = burns + [quiet, failing]
+    res, q, metric, dets = ad.adaptive_ocbe_batch(em, sc.t, np.array([c.y for c in cases]), setup.observer_states,
+                                                  sc.model, sc.meas_cov, np.array([c.x0 for c in cases]),
+                                                  cases[0].P0, setup.control_weight, reset="inflate", smooth=False,
+                                                  on_failure="flag")
+    assert len(dets[0]) > 1 and dets[2] == ()  # a chain of inflations (1-s rates) and no false reset
+    assert list(res.failed) == [False, False, False, True]
+    with pytest.raises(ad.ResetError, match="singular") as err:
+        _adaptive(setup, failing, reset="inflate", smooth=False)
+    assert res.failure_epoch[3] == err.value.epoch and np.all(np.isnan(metric[3]))
+    pickle.loads(pickle.dumps(err.value))
+    for b, c in enumerate(cases[:3]):
+        one = _adaptive(setup, c, reset="inflate", smooth=False)
+        assert [d.epoch for d in dets[b]] == [d.epoch for d in one.detections]
+        for d1, d2 in zip(dets[b], one.detections):
+            assert d1.factor == pytest.approx(d2.factor, rel=1e-7)
+        assert np.array_equal(q[b], one.control_weight)
+        assert np.allclose(metric[b], one.metric, rtol=1e-6, atol=1e-9)
+        assert np.max(np.abs(res.x_filt[b] - one.result.x_filt)) < 1e-9 * np.max(np.abs(one.result.x_filt))
+    a = _adaptive(s1, inp, reset="inflate", smooth=True)
+    k = a.detections[-1].epoch
+    tail = ocbe.ocbe_filter_smoother(em, s1.scenario.t[k:], inp.y[k:], s1.observer_states[k:], s1.scenario.model,
+                                     s1.scenario.meas_cov, a.result.x_pred[k], a.result.P_pred[k],
+                                     s1.control_weight[k:], smooth=True)
+    assert np.allclose(a.result.x_smooth[k:], tail.x_smooth, rtol=0, atol=1e-12)
+    assert a.result.z_smooth == pytest.approx(float(ocbe._control_integral(a.result.t_sub, a.result.control_smooth)))
+    with pytest.raises(ValueError, match="reset"):
+        _adaptive(setup, quiet, reset="inflated")

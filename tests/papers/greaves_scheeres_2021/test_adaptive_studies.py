@@ -93,7 +93,7 @@ def test_large_burn_run_and_closing_rows_are_judged_by_every_claim(setup, nrho):
                                 (3.0, "mean", True, 0.0, False, 1, True), (3.0, "likelihood", True, 0.0, False, 1, True)),
                                (0.05, 3.0), ("mean", "likelihood"))
     rows = ads.closing_rows(null, big, delays, rules, 1e-18)
-    assert set(rows) == set(CLAIMS)
+    assert set(rows) == set(CLAIMS) - set(ads.VARIANT_ROW_KEYS)  # variant_rows measures the others
     status = {key: CLAIMS[key].judge(**row).status for key, row in rows.items()}
     assert status["3 m/s prompt"] == "reproduced" and status["large prompt"] == "reproduced"
     assert status["large consistent"] == "reproduced" and status["no false resets"] == "derived"
@@ -193,3 +193,88 @@ def test_batched_reset_rule_rows_equal_the_single_trial_rows(setup):
         assert [r[:2] for r in batched] == [(m, rule) for m, _ in runs for rule in ad.RESET_RULES]
         assert sum(r[5] == max_resets + 1 for r in batched) == (6 if max_resets == 0 else 0)
         assert any(not r[2] for r in batched)  # the 50 mm/s run is not detected
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Measurement sets, the state-covariance reset and the e^-2 prediction run by run
+# ---------------------------------------------------------------------------------------------------------------
+def test_measurement_sets_share_the_truth_and_the_noise_draws(setup):
+    """Angles only drops the rates; 1-TU rates keep the rates' standard-normal draws, rescaled to sqrt(2) sigma per
+    TU (a factor TU_s smaller than the 1-s rates' noise); the rate-noise floor is the squared whitened 1-s rate
+    noise (a chi2_2 draw: mean 2 over many epochs)."""
+    inp = det.draw_trial(np.random.default_rng(2), setup, magnitude_m_s=0.3)
+    sc = setup.scenario
+    h = sc.model(setup.observer_states, inp.truth)
+    ang = ads.variant_data(setup, inp, "angles only")
+    np.testing.assert_array_equal(ang, inp.y[:, :2])
+    assert ads.variant_setup(setup, "angles only").scenario.model.dim == 2
+    tu = ads.variant_setup(setup, "rates 1 TU")
+    R1, R = np.diag(tu.scenario.meas_cov), np.diag(sc.meas_cov)
+    np.testing.assert_allclose(R1[2:] * em.time_unit_s**2, R[2:], rtol=1e-12)
+    np.testing.assert_allclose(R1[2:], 2 * R[0], rtol=1e-12)
+    y1 = ads.variant_data(setup, inp, "rates 1 TU")
+    np.testing.assert_array_equal(y1[:, :2], inp.y[:, :2])
+    np.testing.assert_allclose((y1[:, 2:] - h[:, 2:]) / np.sqrt(R1[2:]), (inp.y[:, 2:] - h[:, 2:]) / np.sqrt(R[2:]),
+                               rtol=1e-6)
+    floors = np.array([ads.rate_noise_floor(setup, inp, k) for k in range(sc.t.size)])
+    z = (inp.y[:, 2:] - h[:, 2:]) / np.sqrt(R[2:])
+    np.testing.assert_allclose(floors, np.sum(z**2, axis=1), rtol=1e-12)
+    assert abs(floors.mean() - 2.0) < 4 * np.sqrt(4.0 / floors.size)
+    assert ads.variant_setup(setup, "rates 1 s") is setup
+    with pytest.raises(ValueError, match="measurement_set"):
+        ads.variant_setup(setup, "rates 1 min")
+    with pytest.raises(ValueError, match="epoch"):
+        ads.rate_noise_floor(setup, inp, sc.t.size)
+
+
+def _vr(ms, rule, first, resets, floor=np.nan, mag=3.0, inconsistent=False, final_ok=True):
+    return ads.VariantRun(ms, mag, rule, first, resets, inconsistent, final_ok, False, floor)
+
+
+def test_variant_summaries_and_the_e2_test_count_runs_by_hand():
+    """Hand-made runs: the chain rate, delays and the run-by-run agreement of 'rate noise above 4' with 'chain'."""
+    runs = (_vr("rates 1 s", "mean", 40, 1, 1.0), _vr("rates 1 s", "mean", 40, 3, 6.0),
+            _vr("rates 1 s", "mean", 41, 2, 3.0, final_ok=False), _vr("rates 1 s", "mean", -1, 0),
+            _vr("angles only", "mean", 42, 1, inconsistent=True))
+    v = ads.VariantStudy(runs, (3.0,), 40, 2.0)
+    s = v.summary("rates 1 s", "mean")
+    assert (s["n"], s["n_detected"]) == (4, 3)
+    assert s["resets_per_detection"] == pytest.approx(2.0) and s["chain"] == pytest.approx(2 / 3)
+    assert s["median_delay_h"] == 0.0 and s["prompt"] == pytest.approx(0.75)
+    assert s["reconverged"] == pytest.approx(2 / 3)
+    assert v.summary("angles only", "mean")["median_delay_h"] == 4.0
+    e2 = v.e2_test()
+    assert (e2["n"], e2["n_over"], e2["n_chain"]) == (3, 1, 2)
+    assert e2["agreement"] == pytest.approx(2 / 3)  # the floor-3 chain is the one disagreement
+    assert e2["chain_given_over"] == 1.0 and e2["chain_given_under"] == pytest.approx(0.5)
+    with pytest.raises(ValueError, match="no runs"):
+        v.summary("rates 1 TU", "mean")
+
+
+def test_variant_study_is_the_same_on_any_executor_and_its_rows_are_judged(setup):
+    from concurrent.futures import ThreadPoolExecutor  # noqa: PLC0415
+
+    serial = ads.variant_study(setup, (3.0,), 1, np.random.default_rng(5))
+    with ThreadPoolExecutor(2) as pool:
+        pooled = ads.variant_study(setup, (3.0,), 1, np.random.default_rng(5), executor=pool)
+    same = (lambda x, y: x == y or (isinstance(x, float) and np.isnan(x) and np.isnan(y)))  # noqa: E731
+    assert len(serial.runs) == len(pooled.runs) == len(ads.MEASUREMENT_SETS) * len(ads.VARIANT_RULES)
+    for a, b in zip(serial.runs, pooled.runs):
+        assert all(same(x, y) for x, y in zip(dataclasses.astuple(a), dataclasses.astuple(b)))
+    assert [(r.measurement_set, r.rule) for r in serial.runs] == [
+        (ms, rule) for ms in ads.MEASUREMENT_SETS for rule in ads.VARIANT_RULES]
+    assert all(r.detected for r in serial.runs)  # a 3 m/s burn is seen by every measurement set
+    assert len({r.first_epoch for r in serial.runs if r.measurement_set != "rates 1 TU"}) == 1
+    inp = det.draw_trial(np.random.default_rng(11), setup, magnitude_m_s=0.05)
+    fig8 = ads.fig8_variants(setup, inp)
+    assert [(v.measurement_set, v.rule) for v in fig8] == [
+        (ms, rule) for ms in ads.MEASUREMENT_SETS for rule in ad.ALL_RESET_RULES]
+    assert len(ads.fig8_report(fig8).splitlines()) == len(fig8)
+    rows = ads.variant_rows(serial, fig8)
+    assert tuple(rows) == ads.VARIANT_ROW_KEYS
+    for key, row in rows.items():
+        assert CLAIMS[key].judge(**row).status
+    with pytest.raises(TypeError, match="fig8"):
+        ads.variant_rows(serial, [object()])
+    with pytest.raises(TypeError, match="executor"):
+        ads.variant_study(setup, (3.0,), 1, np.random.default_rng(5), executor="pool")
