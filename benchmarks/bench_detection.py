@@ -17,6 +17,11 @@ OCBE filter and smoother, z from the smoothed control.
   :func:`~cislunar.papers.greaves_scheeres_2021.detection.run_detection_monte_carlos` sweep, whose lockstep groups
   mix runs of the same track with different tunings (results bit-identical, asserted).
 
+* ``arc check``: the Monte Carlo with the arc impact check of the OCBE transitions unscreened (the 17-point Hermite
+  test of every sub-grid interval of every trial, as before 2026-11-26c; ``reference_detection.unscreened_arc_check``)
+  against the screened check of :func:`cislunar.cr3bp.propagation._check_arcs_outside_primaries` (today's), run
+  alternately in one process on the same trials; results bit-identical (asserted).
+
 Then the split of a trial's cost between drawing and filtering on both paths.  Times are CPU seconds of this
 process (``time.process_time``, robust on a shared machine; wall seconds are printed too).  Ratios come from one
 run; no timed assertion.  Run with ``OMP_NUM_THREADS=1 python -m benchmarks detection``.
@@ -36,6 +41,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "papers" 
 from reference_detection import (  # the test oracle, not part of the package
     reference_draw_trial,
     reference_monte_carlo,
+    unscreened_arc_check,
 )
 
 
@@ -43,6 +49,29 @@ def _timed(fn):
     c0, w0 = time.process_time(), time.perf_counter()
     out = fn()
     return time.process_time() - c0, time.perf_counter() - w0, out
+
+
+def arc_check(setup, pol, n_trials: int, seed: int, batch: int = 8, repeats: int = 2) -> dict:
+    """The Monte Carlo with the unscreened arc impact check (before) against the screened one (today's), CPU
+    seconds per trial, alternating ``repeats`` times (the smaller of each side is kept); z bit-identical."""
+    def run():
+        return det.run_detection_monte_carlo(setup, pol, n_trials, seed, batch_size=batch, progress=False)
+
+    c_old, c_new = [], []
+    for _ in range(repeats):
+        with unscreened_arc_check():
+            c, _, old = _timed(run)
+        c_old.append(c)
+        c, _, new = _timed(run)
+        c_new.append(c)
+        for name in ("z", "z_step", "nees_mean_fwd", "nees_mean_smooth", "nees_over_fwd", "nees_over_smooth"):
+            assert np.array_equal(getattr(old, name), getattr(new, name)), name
+    old_ms, new_ms = min(c_old) / n_trials * 1e3, min(c_new) / n_trials * 1e3
+    print(f"arc impact check, {n_trials} trials (lockstep {min(det.LOCKSTEP_TRIALS, n_trials)}): unscreened "
+          f"{old_ms:.2f} ms/trial, screened {new_ms:.2f} ms/trial (CPU, best of {repeats}), speed-up "
+          f"{old_ms / new_ms:.3f}x; every detection statistic bit-identical")
+    return {"arc_unscreened_ms_per_trial": old_ms, "arc_screened_ms_per_trial": new_ms,
+            "arc_speedup": old_ms / new_ms}
 
 
 def main(n_trials: int = 256, batch: int = 8, n_cells: int = 12, n_cell_trials: int = 24, seed: int = 0) -> dict:
@@ -54,6 +83,7 @@ def main(n_trials: int = 256, batch: int = 8, n_cells: int = 12, n_cell_trials: 
     reference_monte_carlo(setup, pol, 2 * batch, seed + 1, batch)
 
     result = {"n_trials": n_trials, "batch_size": batch, "lockstep_trials": det.LOCKSTEP_TRIALS}
+    result.update(arc_check(setup, pol, max(n_trials, 4 * det.LOCKSTEP_TRIALS), seed + 4, batch))
     c_old, w_old, old = _timed(lambda: reference_monte_carlo(setup, pol, n_trials, seed, batch))
     c_new, w_new, new = _timed(lambda: det.run_detection_monte_carlo(setup, pol, n_trials, seed, batch_size=batch,
                                                                      progress=False))

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from cislunar.cr3bp import orbits
+from cislunar.cr3bp import propagation as pr
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.cr3bp.propagation import (
     find_events,
@@ -134,3 +135,105 @@ def test_collision_raises_instead_of_returning_junk():
 def test_bad_event_kind():
     with pytest.raises(ValueError, match="events"):
         find_events(em, NRHO_GUESS, 1.0, ("perigee",))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The arc impact check of the OCBE transitions (_check_arcs_outside_primaries) and its screen
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def _hermite(r0, r1, v0, v1, h, s):
+    """Cubic Hermite interpolant of an interval at the fractions ``s`` (k,), written out independently."""
+    s = np.asarray(s)[:, None]
+    return ((1 + 2 * s) * (1 - s) ** 2 * r0 + s * (1 - s) ** 2 * h * v0 + s**2 * (3 - 2 * s) * r1
+            + s**2 * (s - 1) * h * v1)
+
+
+def test_hermite_spread_bounds_the_interpolant_on_loops_and_random_arcs():
+    rng = np.random.default_rng(11)
+    s = np.linspace(0.0, 1.0, 2001)
+    v = rng.standard_normal(3)
+    cases = [(np.zeros(3), np.zeros(3), v, -v, 0.7),  # a closed loop: the bound is tight within 8/27 vs 1/4
+             (np.zeros(3), np.zeros(3), v, v, 0.7),  # a figure of eight
+             (np.zeros(3), 1e-3 * v, 3 * v, -2 * v, -0.4)]  # backward interval
+    cases += [tuple(rng.standard_normal((4, 3)) * rng.choice([1e-3, 1.0, 10.0], 4)[:, None]) + (rng.uniform(-2, 2),)
+              for _ in range(300)]
+    worst = 0.0
+    for r0, r1, v0, v1, h in cases:
+        p = _hermite(r0, r1, v0, v1, h, s)
+        bound = pr._hermite_spread(r0, r1, v0, v1, h)
+        stray = max(np.max(np.linalg.norm(p - r0, axis=-1)), np.max(np.linalg.norm(p - r1, axis=-1)))
+        worst = max(worst, stray / bound)
+        assert stray <= bound * (1 + 1e-12), (r0, r1, v0, v1, h)
+    assert worst > 0.8  # and not loose everywhere: the loop comes within 27/32 of it
+
+
+def _dipping_arcs(depth_km, speed_km_s, half_hours, n_sub):
+    """Arcs through a perilune ``depth_km`` below the lunar surface (above it if negative), sampled at ``n_sub`` (even)
+    points outside the Moon, the perilune midway between two."""
+    r = em.km_to_lu(em.secondary_radius_km - depth_km)
+    v = speed_km_s / em.velocity_unit_km_s
+    peri = np.array([1 - em.mu + r, 0, 0, 0, v * np.cos(0.3), v * np.sin(0.3)])
+    h = float(em.days_to_tu(half_hours / 24.0))
+    x0 = propagate(em, peri, np.array([0.0, -h]), impact=False).x[-1]
+    t = np.linspace(0.0, 2 * h, n_sub)
+    x = propagate(em, x0, t, impact=False).x
+    assert np.all(np.linalg.norm(x[:, :3] - em.secondary_position, axis=-1) > em.secondary_radius)
+    return t, x
+
+
+@pytest.mark.parametrize("depth_km, speed_km_s, half_hours, n_sub", [
+    (300.0, 2.5, 0.5, 2), (50.0, 2.5, 0.25, 2), (20.0, 3.0, 1.0, 4), (1000.0, 3.4, 2.0, 8)])
+def test_screened_arc_check_raises_on_arcs_that_dip_below_the_surface_between_samples(depth_km, speed_km_s,
+                                                                                       half_hours, n_sub):
+    t, x = _dipping_arcs(depth_km, speed_km_s, half_hours, n_sub)
+    nrho = orbits.nrho_9_2(em)
+    calm = propagate(em, nrho.x0, nrho.period * np.linspace(0.4, 0.4 + 2 * (t[-1] - t[0]) / nrho.period, n_sub)).x
+    batch = np.stack([calm, x, calm], axis=1)  # (n_sub, 3, 6): the middle arc dips
+    for screen in (True, False):
+        with pytest.raises(pr.ImpactError, match="between grid points") as one:
+            pr._check_arcs_outside_primaries(em, t, x, screen=screen)
+        assert one.value.body == "Moon" and one.value.member is None
+        with pytest.raises(pr.ImpactError, match="between grid points") as many:
+            pr._check_arcs_outside_primaries(em, t, batch, first=10, screen=screen)
+        assert many.value.member == 11
+        pr._check_arcs_outside_primaries(em, t, calm, screen=screen)  # an arc far from both primaries passes
+
+
+def test_screen_keeps_every_interval_the_unscreened_test_flags_along_a_near_grazing_family(monkeypatch):
+    # perilunes from 2000 km above to 400 km below the surface, on sub-grids of several spacings: the screen must
+    # keep every interval the 17-point test would re-propagate (it may keep more), and both must re-propagate the
+    # same intervals and decide alike
+    calls = []
+    chunk = pr._propagate_chunk
+    monkeypatch.setattr(pr, "_propagate_chunk", lambda system, x0, grid, *a: calls.append(tuple(grid)) or
+                        chunk(system, x0, grid, *a))
+    rng = np.random.default_rng(2)
+    s = np.linspace(0.0, 1.0, 17)
+    for depth in np.linspace(-2000.0, 400.0, 12):
+        for n_sub, half in ((2, 0.25), (4, 0.5), (8, 2.0)):
+            t, x = _dipping_arcs(depth, rng.uniform(2.2, 3.5), half, n_sub)
+            h = np.diff(t)
+            r0, r1, v0, v1 = x[:-1, :3], x[1:, :3], x[:-1, 3:], x[1:, 3:]
+            p = np.stack([_hermite(r0[k], r1[k], v0[k], v1[k], h[k], s) for k in range(n_sub - 1)])
+            d = np.min(np.linalg.norm(p - em.secondary_position, axis=-1), axis=1)
+            reach = 0.5 * h * np.maximum(np.linalg.norm(v0, axis=-1), np.linalg.norm(v1, axis=-1))
+            flagged = d <= em.secondary_radius + reach
+            clear = (np.maximum(np.linalg.norm(r0 - em.secondary_position, axis=-1),
+                                np.linalg.norm(r1 - em.secondary_position, axis=-1))
+                     - pr._hermite_spread(r0, r1, v0, v1, h))
+            assert np.all(clear[flagged] <= em.secondary_radius + reach[flagged])
+            outcomes, repropagated = [], []
+            for screen in (True, False):
+                calls.clear()
+                try:
+                    pr._check_arcs_outside_primaries(em, t, x, screen=screen)
+                    outcomes.append("clear")
+                except pr.ImpactError as exc:
+                    outcomes.append(str(exc))
+                repropagated.append(list(calls))
+            assert outcomes[0] == outcomes[1], (depth, n_sub, outcomes)
+            expected = [tuple(t[k:k + 2]) for k in np.flatnonzero(flagged)]  # up to the one that raises
+            n_done = len(expected) if outcomes[0] == "clear" else max(1, len(repropagated[0]))
+            assert repropagated[0] == repropagated[1] == expected[:n_done], (depth, n_sub)
+            assert (outcomes[0] == "clear") == (depth < 0), (depth, n_sub, outcomes)

@@ -5,10 +5,19 @@ One trial at a time: the magnitude through ``scipy.stats.truncnorm.rvs``, the tr
 :func:`cislunar.papers.greaves_scheeres_2021.tracking.simulate_truth` (three propagations per burn trial), the
 measurements and hand-off by the tracking module, then one batched OCBE call per lockstep group and the NEES
 bookkeeping trial by trial.
+
+:func:`unscreened_arc_check` puts back the arc impact check of the OCBE transitions as it was before 2026-11-26c
+(the 17-point Hermite test on every sub-grid interval of every trial, without the screen of
+:func:`cislunar.cr3bp.propagation._check_arcs_outside_primaries`).
 """
+
+import contextlib
+import functools
 
 import numpy as np
 
+from cislunar.cr3bp import propagation
+from cislunar.estimation import batched_ocbe
 from cislunar.estimation.batched_ocbe import ocbe_batch
 from cislunar.estimation.consistency import _nees
 from cislunar.papers.greaves_scheeres_2021 import detection as det
@@ -70,3 +79,16 @@ def reference_monte_carlo(setup, policy, n_trials, seed, batch_size=8):
         out += [r for batch in reference_detection_batches(rngs[a:a + det.LOCKSTEP_TRIALS // batch_size], setup,
                                                            policy, batch_size) for r in batch]
     return out[:n_trials]
+
+
+@contextlib.contextmanager
+def unscreened_arc_check():
+    """Within the block, the batched OCBE checks its arcs with the unscreened test (``screen=False``): the path
+    before the screen, for the tests and ``benchmarks/bench_detection.py`` (not thread-safe: it patches a module)."""
+    screened = batched_ocbe._check_arcs_outside_primaries
+    batched_ocbe._check_arcs_outside_primaries = functools.partial(propagation._check_arcs_outside_primaries,
+                                                                   screen=False)
+    try:
+        yield
+    finally:
+        batched_ocbe._check_arcs_outside_primaries = screened

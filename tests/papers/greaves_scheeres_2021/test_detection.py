@@ -9,8 +9,10 @@ from scipy import stats
 
 from cislunar.cr3bp import orbits
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
-from cislunar.estimation import batched_ocbe, consistency
+from cislunar.cr3bp.propagation import propagate
+from cislunar.estimation import batched_ocbe, consistency, ocbe
 from cislunar.papers.greaves_scheeres_2021 import detection as det
+from tests.papers.greaves_scheeres_2021 import reference_detection
 
 # ---------------------------------------------------------------------------------------------------------------
 # Station-keeping policy (Eqs. 3-5)
@@ -232,6 +234,59 @@ def test_lockstep_groups_equal_separate_batches_and_any_executor(short_setup):
         procs = det.run_detection_monte_carlo(s, det.QUIET_POLICY, n, 21, batch_size=B, executor=ex, progress=False)
     for name in ("z", "z_step", "magnitude", "azimuth", "elevation"):
         assert np.array_equal(getattr(mc, name), getattr(procs, name), equal_nan=True), name
+
+
+def _moon_dipping_prior(s):
+    """A prior mean at ``t[0]`` whose fast (3.5 km/s) ballistic arc passes 300 km below the lunar surface a tenth of
+    the way to the next sub-grid point (every sub-grid state outside both primaries).  Off-centre, so that the
+    farther end of that sub-interval lies beyond ``R + h v_max / 2`` of the Moon: only the screen's stray bound
+    keeps the interval for the 17-point test."""
+    r = em.km_to_lu(em.secondary_radius_km - 300.0)
+    v = 3.5 / em.velocity_unit_km_s
+    peri = np.array([1 - em.mu + r, 0, 0, 0, v * np.cos(0.3), v * np.sin(0.3)])
+    tenth = 0.1 * (s.scenario.t[1] - s.scenario.t[0]) / (s.n_sub - 1)
+    x0 = propagate(em, peri, [0.0, -tenth], impact=False).x[-1]
+    sub = propagate(em, x0, np.linspace(0.0, s.scenario.t[1] - s.scenario.t[0], s.n_sub), impact=False).x
+    assert np.all(em.distances(sub)[1] > em.secondary_radius) and np.all(em.distances(sub)[0] > em.primary_radius)
+    return x0
+
+
+def test_screened_arc_check_leaves_the_filter_bit_identical_and_still_stops_a_trial_that_dips_into_the_moon(
+        short_setup):
+    """The screen of the arc impact check (propagation._check_arcs_outside_primaries) against the unscreened check
+    (the path before it): the same filter output bit for bit on ordinary trials, and the same failure, named as an
+    impact between grid points, for a trial whose reference dips below the Moon's surface between sub-grid points."""
+    s = short_setup
+    sc = s.scenario
+    inputs = [det.draw_trial(k, s, det.QUIET_POLICY if j % 2 else None)
+              for j, k in enumerate(np.random.default_rng(31).spawn(4))]
+    x_dip = _moon_dipping_prior(s)
+    y_dip = inputs[0].y.copy()
+    y_dip[0] = sc.model(s.observer_states[0], x_dip)
+    y = np.array([i.y for i in inputs] + [y_dip])
+    x0 = np.array([i.x0 for i in inputs] + [x_dip])
+    P0 = np.array([i.P0 for i in inputs] + [inputs[0].P0])
+    args = (em, sc.t, y, s.observer_states, sc.model, sc.meas_cov, x0, P0, s.control_weight)
+
+    def run():
+        flagged = batched_ocbe.ocbe_batch(*args, n_sub=s.n_sub, tol=s.tol, on_failure="flag")
+        with pytest.raises(ocbe.FilterDivergenceError) as stop:
+            batched_ocbe.ocbe_batch(*args, n_sub=s.n_sub, tol=s.tol)
+        return flagged, str(stop.value), det.run_detection_monte_carlo(s, det.QUIET_POLICY, 6, 3, batch_size=2,
+                                                                        progress=False)
+
+    new, stop_new, mc_new = run()
+    with reference_detection.unscreened_arc_check():
+        old, stop_old, mc_old = run()
+    assert list(new.failure_epoch) == [-1, -1, -1, -1, 1]
+    assert "ImpactError" in new.failure[4] and "Moon" in new.failure[4] and "between grid points" in new.failure[4]
+    assert stop_new == stop_old and "between grid points" in stop_new
+    assert list(new.failure) == list(old.failure)
+    for name in ("x_pred", "x_filt", "P_filt", "x_smooth", "P_smooth", "control_smooth", "z_step", "z_smooth"):
+        assert np.array_equal(getattr(new, name), getattr(old, name), equal_nan=True), name
+    assert np.all(np.isfinite(new.z_smooth[:4]))
+    for name in ("z", "z_step", "nees_mean_fwd", "nees_mean_smooth"):
+        assert np.array_equal(getattr(mc_new, name), getattr(mc_old, name)), name
 
 
 # ---------------------------------------------------------------------------------------------------------------
