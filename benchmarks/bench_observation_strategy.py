@@ -13,7 +13,13 @@ Both see the same seeds; the benchmark checks that every run is flagged alike an
 difference of the mean NEES.  Cells: the 9:2 NRHO at 2 h with angles and rates (20 runs, as a full-mode cell), at
 12 h angles only (20 runs), at 10 min (4 runs, as the 1-min cells: many short intervals), and a regime-map group
 (angles only, 12 h, the hand-offs 10 km and 10,000 km, 10 runs each: half the runs diverge).  Ratios come from one
-run (the machine may be shared); no timed assertion.  Run with ``OMP_NUM_THREADS=1 python -m benchmarks
+run (the machine may be shared); no timed assertion.
+
+:func:`sri_sets` (also run by :func:`main`): notebook 09's SRI / covariance-form ladder (Section 5d) filters M = 50
+measurement sets of the linearised 9:2 NRHO in SRI form; ``per set`` runs
+:func:`cislunar.estimation.srif.filter_smoother` once per set (the path first written), ``columns`` runs
+:func:`cislunar.estimation.srif.filter_many` once with the sets as information-vector columns (the path the notebook
+takes); the largest difference of the estimates is printed.  Run with ``OMP_NUM_THREADS=1 python -m benchmarks
 observation_strategy``.
 """
 
@@ -70,7 +76,29 @@ def main(seed: int = 0) -> dict:
     print(f"{'all cells':>42}: {n_all:3d} runs | single {t_single:.1f} s, batched {t_batched:.1f} s, ratio "
           f"{t_single / t_batched:.1f}x")
     result["ratio"] = t_single / t_batched
+    result["sri_sets"] = sri_sets(seed)
     return result
+
+
+def sri_sets(seed: int = 0, n_sets: int = 50) -> dict:
+    """Per-set SRI filters against one multi-column SRI filter on notebook 09's linear problem (ratio)."""
+    from cislunar.estimation import srif
+    from cislunar.papers.greaves_scheeres_2021 import custody
+
+    pb = custody.linear_problem(em, orbits.nrho_9_2(em))
+    truth, ys, x0 = pb.simulate(np.random.default_rng(seed), n_sets)
+    Hs = [H if m else np.zeros((0, 6)) for H, m in zip(pb.Hs, pb.measured)]
+    covs, eyes = [pb.meas_cov] * pb.t.size, [np.eye(6)] * (pb.t.size - 1)
+    t0 = time.perf_counter()
+    old = np.array([srif.filter_smoother(x0[j], pb.P0, pb.Phis, Hs, list(ys[j]), covs, eyes, list(pb.Qs),
+                                         smooth=False).x_filt for j in range(n_sets)])
+    t1 = time.perf_counter()
+    new = srif.filter_many(x0, pb.P0, pb.Phis, Hs, ys, covs, eyes, list(pb.Qs))[0]
+    t2 = time.perf_counter()
+    diff = float(np.max(np.abs(new - old)) / np.max(np.abs(old)))
+    print(f"{'SRI ladder, ' + str(n_sets) + ' sets x ' + str(pb.t.size) + ' epochs':>42}: per set {t1 - t0:.2f} s, "
+          f"columns {t2 - t1:.3f} s, ratio {(t1 - t0) / (t2 - t1):.0f}x | max relative difference {diff:.1e}")
+    return {"per_set_s": t1 - t0, "columns_s": t2 - t1, "ratio": (t1 - t0) / (t2 - t1), "max_rel_diff": diff}
 
 
 if __name__ == "__main__":

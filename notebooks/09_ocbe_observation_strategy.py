@@ -52,6 +52,10 @@ N_MAP = None  # runs per regime-map cell (None: 2 quick, 10 full)
 CADENCE_AXES = None  # filter-side axes (Section 5c): cadences, hours (None: [12] quick; [1, 2, 6, 12] full)
 N_AXES = None  # runs per filter-axis cell (None: 2 quick, 10 full)
 N_DRAWS_EXAMPLE = 10  # fresh draws per Fig. 4 analogue (the clearest divergence is shown)
+CUSTODY_PERIODS = None  # custody tracks (Section 5d): NRHO periods, a burn at every apoapsis (None: 5 quick, 10 full)
+N_CUSTODY = None  # custody runs per station-keeping policy (None: 2 quick, 32 full)
+N_DRAWS_CONDITIONING = None  # Monte Carlo draws per case of the SRI / covariance comparison (None: 20 quick, 50 full)
+CADENCES_COST = None  # run time against cadence, hours (None: [2, 6, 12] quick; 1 min, 10 min, 30 min, 1-12 h full)
 WORKERS = None  # local processes for the Monte Carlo, 1 runs serially (None: 1 quick, 2 full)
 SCHEDULER = ""  # address of a Dask scheduler to run on, e.g. "tcp://10.0.0.5:8786" ("": none; WORKERS applies)
 
@@ -68,6 +72,11 @@ cadence_map = CADENCE_MAP if CADENCE_MAP is not None else ([12.0] if QUICK else 
 n_runs_map = N_MAP if N_MAP is not None else (2 if QUICK else 10)
 cadence_axes = CADENCE_AXES if CADENCE_AXES is not None else ([12.0] if QUICK else [1.0, 2.0, 6.0, 12.0])
 n_runs_axes = N_AXES if N_AXES is not None else (2 if QUICK else 10)
+custody_periods = CUSTODY_PERIODS if CUSTODY_PERIODS is not None else (5 if QUICK else 10)
+n_custody = N_CUSTODY if N_CUSTODY is not None else (2 if QUICK else 32)
+n_draws_conditioning = N_DRAWS_CONDITIONING if N_DRAWS_CONDITIONING is not None else (20 if QUICK else 50)
+cadences_cost = CADENCES_COST if CADENCES_COST is not None else (
+    [2.0, 6.0, 12.0] if QUICK else [1 / 60, 10 / 60, 0.5, 1.0, 2.0, 4.0, 6.0, 12.0])
 workers = WORKERS if WORKERS is not None else (1 if QUICK else 2)
 sigma_angle = SIGMA_ANGLE_URAD / 1e6  # rad (division, so that 10.0 gives exactly 10e-6)
 
@@ -78,9 +87,12 @@ import numpy as np
 
 from cislunar.cr3bp import orbits
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.papers.greaves_scheeres_2021 import custody as cu
+from cislunar.papers.greaves_scheeres_2021 import detection as det
 from cislunar.papers.greaves_scheeres_2021 import observation_strategy as obs
 from cislunar.papers.greaves_scheeres_2021 import tracking
 from cislunar.papers.greaves_scheeres_2021.claims.observation_strategy import CLAIMS
+from cislunar.papers.greaves_scheeres_2021.claims.operations import CLAIMS as OPS
 from cislunar.publish import plotting
 from cislunar.publish.report import ComparisonTable
 from cislunar.utils.executors import open_executor
@@ -491,6 +503,152 @@ print(cand.report())
 # "consistent (tuned)", not an independent reproduction.
 
 # %% [markdown]
+# ## 5d · Operational claims: custody over many periods, the SRI form, re-linearisation, cadence and run time
+#
+# The paper ends its tuning section with an operational promise: with one L2 observer, angles and rates every
+# 2 hours and the control weight raised for 8 hours around apoapsis, "an observer can use this strategy to
+# maintain custody of the craft for an indefinite time as it performs station keeping maneuvers on a NRHO". It
+# also says that the square-root-information form is there "to reduce numerical instability", that
+# re-linearisation is "extremely important" because without it the filter can fail "within a single orbit", and
+# that 2 hours "balances filter accuracy and algorithm run-time, and appears to be a sweet spot". None of these
+# was tested above. The definitions used below were written down, with every tolerance, before the first run
+# (`cislunar.papers.greaves_scheeres_2021.custody`, module docstring; the claims in
+# `cislunar.papers.greaves_scheeres_2021.claims.operations`).
+#
+# **Custody, defined before looking.** A tracking camera is pointed along the line of sight of the filter's
+# *prediction* for the next image. Custody is kept at an epoch when the angle between that line of sight and the
+# true one is within the camera's half field of view, which we take as 0.5° (a 1° narrow-field camera: our choice,
+# the paper names no sensor); custody through a period means at every epoch so far (a lost target is not
+# re-acquired), and a numerical failure loses it. Consistency is judged period by period with the chapter's run
+# rule (a run is inconsistent in a period when more than 5 % of that period's epochs have a NEES above the 99.9 %
+# quantile).
+#
+# **The scenario.** The paper's final strategy on the 9:2 NRHO: the Earth-radar hand-off at periapsis, one L2
+# observer, angles and rates every 2 h, and a station-keeping burn at *every* apoapsis, drawn from the paper's
+# policies (Eqs. 3-5, Table 2: random pointing, truncated-Gaussian magnitude): the quiet one (50 ± 15 mm/s, the
+# paper's "often on the order of 10's of mm/s") and the active one (1 ± 0.3 m/s). The filter does not know the
+# burns; its control weight is raised over 8 h around every apoapsis to the white-noise acceleration whose
+# velocity variance over the window matches the policy's burn (`detection.window_control_weight`, notebook 10),
+# and is notebook 10's $10^{-18}$ km²/s³ elsewhere. The runs are batched OCBE lock-steps, one executor task per
+# 16 runs.
+
+# %%
+t_custody = time.perf_counter()
+custody = {p.name: cu.custody_study(em, nrho, periods=custody_periods, policy=p, n_runs=n_custody, seed=SEED,
+                                    sigma_angle_rad=sigma_angle, executor=executor)
+           for p in (det.QUIET_POLICY, det.ACTIVE_POLICY)}
+print(f"custody: {2 * n_custody} runs of {custody_periods} periods in {time.perf_counter() - t_custody:.0f} s")
+custody_weak = None if QUICK else cu.custody_study(
+    em, nrho, periods=custody_periods, policy=det.QUIET_POLICY, n_runs=n_custody, seed=SEED,
+    q_window_km2_s3=0.1 * det.window_control_weight(det.QUIET_POLICY), sigma_angle_rad=sigma_angle, executor=executor)
+for c in custody.values():
+    print(c.report())
+if custody_weak is not None:  # full mode only
+    print("the same quiet-policy runs with the window weight ten times weaker (notebook 10's threshold reading):")
+    print(custody_weak.report())
+_ = plotting.save_figure(cu.figure_custody(custody.values()), "09_custody_multi_period", output_dir=out)
+
+# %% [markdown]
+# **Reading the custody runs** (the sentences describe the full run, 32 runs of 10 periods per policy; the printed
+# lines are this run's). Every run keeps custody through every period with either policy, and by a wide margin:
+# the worst pointing error of the prediction (right panel) is set by the hand-off in the first period (0.011°: a
+# 10-km error seen from about 70,000 km) and then stays at 0.001-0.002° with the quiet burns and 0.005-0.007° with
+# the active ones, a hundred times inside the 0.5° bound; a camera would have to be about a hundred times narrower
+# before custody were at risk. The runs also stay consistent (left panel, dashed): at most one run in 32 (3 %) is
+# inconsistent in the first period and none afterwards, with either policy; the raised window lets the filter
+# absorb each burn, and with the quiet policy the filter's 3-sigma position returns to 1.5-2 km by the end of
+# every period. With the active policy the same holds for seven periods; then the 3-sigma position at the end of
+# a period grows (median 7, 11 and 34 km in periods 8-10) and the worst error reaches about 130 km. The burns are
+# randomly pointed, as in the paper's Eqs. 3-5, not station keeping: after several 1-m/s kicks the true track has
+# left the NRHO, and the filter follows it with less favourable geometry. On this evidence the paper's
+# "indefinitely" holds for as long as we ran it, for either policy, while the active-policy runs show that
+# "indefinitely" also needs the burns to keep the craft on its orbit.
+#
+# The tuning matters more than the bound: the window weight is matched to the burns (the white-noise acceleration
+# whose velocity variance over 8 h equals the burn's), a choice we settled after a first probe with a weaker
+# weight, so the consistency rows are marked tuned. With a window ten times weaker
+# (notebook 10's threshold reading, the last printed block in full mode, the same draws) the runs still keep custody, but
+# 34-69 % of them are inconsistent in each period: custody is the easier of the two promises.
+#
+# **The SRI form under ill-conditioning.** The OCBE's numerical form is tested on a problem where the exact answer
+# is known: the 9:2 NRHO linearised about its reference (transition matrices and measurement Jacobians of the
+# reference, angles and rates from L2, one period from apoapsis), a linear Gauss-Markov problem, so every filter
+# below solves exactly the same equations and differs only in arithmetic. Three forms of the same Kalman filter run
+# on the same draws: the SRI form (`cislunar.estimation.srif.filter_smoother`, the kernels of the OCBE), the
+# *Joseph* covariance form $P^+ = (I-KH)P^-(I-KH)^\top + KRK^\top$ (as in filterpy's `KalmanFilter`, against
+# which the tests check it), and the *conventional* form $P^+ = (I-KH)P^-$, neither symmetrised. A ladder of cases
+# makes the information matrix ill-conditioned the classic way: a wider prior, a long gap without measurements
+# (three days, so the dynamics stretch the prior), then dense precise updates, with tiny process noise. Each form
+# has *lost symmetry* when $\max|P-P^\top| > 10^{-8}\max|P|$, *lost positive definiteness* when a Cholesky
+# factorisation of $P$ fails, and *lost consistency* when the mean NEES over the draws leaves its 99.9 % band at
+# more than 5 % of the epochs (the SRI form's NEES is computed from its square root, $\|R\,e\|^2$).
+
+# %%
+LADDER = {"well conditioned (the chapter's case)": dict(),
+          "prior x1e3, 0.1 urad, 3-day gap": dict(prior_scale=1e3, sigma_angle_rad=1e-7, gap_hours=72.0,
+                                                  q_km2_s3=1e-24),
+          "prior x1e4, 10 nrad, 3-day gap": dict(prior_scale=1e4, sigma_angle_rad=1e-8, gap_hours=72.0,
+                                                 q_km2_s3=1e-26),
+          "prior x1e5, 10 nrad, 3-day gap": dict(prior_scale=1e5, sigma_angle_rad=1e-8, gap_hours=72.0,
+                                                 q_km2_s3=1e-26)}
+ladder = list(LADDER) if not QUICK else [list(LADDER)[0], list(LADDER)[2]]
+rng_cond = np.random.default_rng([SEED, 95])
+conditioning = {name: cu.conditioning_case(cu.linear_problem(em, nrho, **LADDER[name]), n_draws_conditioning,
+                                           rng_cond, label=name) for name in ladder}
+for case in conditioning.values():
+    print(case.report())
+worst = conditioning[ladder[-1]]
+_ = plotting.save_figure(cu.figure_conditioning(worst), "09_sri_vs_covariance_form", output_dir=out)
+
+# %% [markdown]
+# **Reading the ladder** (the printed lines; the figure shows the last case). On the chapter's own case the three
+# forms agree to about $10^{-11}$ of the covariance scale, and all are consistent: there is nothing for the SRI
+# form to fix at 10 µrad and the paper's hand-off, even though the information matrix already has a condition
+# number near $10^9$. As the ladder climbs, the conventional form loses symmetry and positive definiteness first
+# (at an information condition number near $10^{12}$) and then consistency (near $10^{16}$, where its NEES leaves
+# the band by many orders of magnitude); the Joseph form holds longer, then loses symmetry (near $10^{16}$) and
+# positive definiteness (near $10^{18}$) while its estimates stay consistent; the SRI form keeps all three on every
+# rung. The covariance it reports is formed only for display, from its square root, and is
+# symmetric by construction (its smallest eigenvalue may round to $-10^{-16}$ of the largest, as the figure's
+# red cross shows, but a Cholesky factor exists throughout). So the SRI form is more stable, as the paper says, but only where the information is
+# conditioned far worse than in the paper's own scenario.
+#
+# **Re-linearisation.** The fixed-reference filter of Section 5c keeps the hand-off trajectory as its reference
+# for the whole track (a linearised Kalman filter), where the paper's filter re-linearises about every update. The
+# closing table reads the Section 5c numbers with rates: the paper's claim holds if the fixed reference fails in
+# more than 10 % of the runs at some cadence while the re-linearised filter fails in at most 10 % at every one.
+#
+# **Run time against cadence.** The chapter's filter (single trial, forward pass, angles and rates, one period
+# from apoapsis) is timed at each cadence (CPU time, best of up to three runs after a warm-up, one in quick
+# mode); accuracy is its final 3-sigma position (the Table 4 quantity). The *knee* was defined before looking:
+# going from a cadence
+# to the next denser one is worth it when the accuracy improves at least as fast, in logarithm, as the run time
+# grows (elasticity $-\Delta\log A/\Delta\log C \ge 1$); the knee is the densest cadence reached from 12 h
+# through such steps, and 2 h is a "sweet spot" when the knee is 1, 2 or 4 h. The seconds depend on the machine
+# and its load; the ratios between cadences carry the result.
+
+# %%
+t_cost = time.perf_counter()
+cost = cu.cadence_cost_study(em, nrho, cadences_cost, CONTROL_WEIGHT_KM2_S3, seed=SEED, sigma_angle_rad=sigma_angle,
+                             repeats=1 if QUICK else 3)
+print(f"cadence costs measured in {time.perf_counter() - t_cost:.0f} s")
+print(cost.report())
+_ = plotting.save_figure(cu.figure_cadence_cost(cost), "09_cadence_run_time", output_dir=out)
+
+# %% [markdown]
+# **Reading the cost curve** (the full run: 1 minute to 12 hours; the printed lines are this run's, and the
+# seconds are this process's CPU time, less disturbed by other work on the machine than the wall clock, while the
+# ratios carry the result). Between 12 h and 4 h the run time grows slowly (about 1.8 times for three times the
+# updates: integrating the transition through the period costs about as much as the updates); from 2 h down to one
+# minute it grows almost in proportion to the number of updates (about 100 times for 121 times the updates), while
+# the final 3-sigma position falls only about like the inverse square root of that number (0.95 km at 2 h, 0.10 km
+# at 1 min). Every step of the grid has an elasticity between about 0.45 and 0.9, below the 1 the definition asks
+# for, so the knee is at 12 h: the curve is a smooth power law without a bend at 2 h. A 2-h cadence is a
+# reasonable point on it (about three times the run time of the 12-h cadence for less than half its
+# uncertainty), but the data do not single it out as a sweet spot; the closing table says so. Two timings of the
+# full grid on a loaded machine gave the same knee and elasticities within about 0.15 of each other.
+
+# %% [markdown]
 # ## 6 · Paper versus reproduction
 #
 # Every row is a claim declared before the runs, with its criterion, in
@@ -508,7 +666,14 @@ print(cand.report())
 # * the filter-axes row asks for the same contrast at every cadence tried, for at least one of the filters of
 #   Section 5c (the unwrapped-azimuth filter counts: the paper's filter may have had that bug);
 # * "quantitatively better" is read as a smaller median final 3-sigma position than the 9:2 NRHO's at half of the
-#   cadences or more. The outer-band rows are marked tuned, since that orbit was chosen for fitting the remarks.
+#   cadences or more. The outer-band rows are marked tuned, since that orbit was chosen for fitting the remarks;
+# * the operational rows of Section 5d use the definitions written there before the runs: custody "indefinitely"
+#   holds when every run keeps the prediction within the camera's 0.5° half field of view through every period,
+#   and the filter stays consistent when at most 10 % of the runs are inconsistent in any period (one row each per
+#   station-keeping policy); the SRI row asks that the SRI form stay consistent on every rung where a covariance
+#   form fails, and that the forms agree on the chapter's case; the re-linearisation row asks that the
+#   fixed-reference filter fail in more than 10 % of the runs with rates at some cadence while the re-linearised
+#   one does not; the sweet-spot row asks that the knee of the accuracy-against-run-time curve be 1, 2 or 4 h.
 #
 # The Table 4 rows have no paper value (the table is missing from the text) and only record our medians.
 
@@ -545,7 +710,10 @@ tf, ts = typical.forward, typical.smoothed
 table.add(CLAIMS["typical_run"].judge(
     not (tf.diverged or ts.diverged), shown=f"mean NEES forward {tf.nees_mean:.1f}, smoothed {ts.nees_mean:.1f}; "
     f"epochs over 99.9 %: {100 * tf.inconsistent_fraction:.1f} % / {100 * ts.inconsistent_fraction:.1f} %",
-    note="one run (Section 3)"))
+    note="one run (Section 3)" + (
+        f"; {100 * np.mean([r.diverged for r in with_rates.runs['9:2 NRHO', TYPICAL_CADENCE_H]]):.0f} % of the "
+        f"{len(with_rates.runs['9:2 NRHO', TYPICAL_CADENCE_H])} Monte Carlo runs of this cell (Section 5) are "
+        "inconsistent" if ("9:2 NRHO", TYPICAL_CADENCE_H) in with_rates.runs else "")))
 r92, rst, rso = (with_rates.by_cadence(n) for n in ORBITS)
 for cad in sorted(r92):
     table.add(obs.filled(CLAIMS["table4"], cadence=obs.cadence_label(cad)).judge(
@@ -570,8 +738,9 @@ for key, o in zip(("9_2", "inner", "outer"), ORBITS):
         bool(min(at_paper) > 0.5), shown=(f"from {ons:g} km" if ons is not None else
                                           f"none up to {10 * max(handoff_map):g} km")
         + f"; at 10 km {obs.pct_span(at_paper)} of runs diverge",
-        reason="consistent at the stated hand-off" if max(at_paper) <= 0.5 else
-        "at 10 km most runs diverge only in some (noise, cadence) cells",
+        reason=("at the stated hand-off at most half of the runs diverge in every (noise, cadence) cell"
+                + (" (none in most)" if np.median(at_paper) == 0 else "") if max(at_paper) <= 0.5 else
+                "at 10 km most runs diverge only in some (noise, cadence) cells"),
         note=f"smallest hand-off over noise {'/'.join(f'{sg * 1e6:g}' for sg in sigma_map)} urad and cadence "
         f"{'/'.join(f'{c:g}' for c in cadence_map)} h"))
 full_axes = axes_study.axes_with_full_contrast
@@ -596,6 +765,44 @@ for key, name in (("inner", "stable NRHO (inner band)"), ("outer", "stable NRHO 
 table.add(CLAIMS["inner_better"].judge(b_in, shown=f"smaller final sigma at {100 * b_in:.0f}% of cadences",
                                        note="final epoch at apoapsis after one period; the paper's Table 4 values "
                                        "are not available to compare"))
+quiet_c = custody[det.QUIET_POLICY.name]
+for pname, c in custody.items():
+    fields = dict(periods=c.periods, runs=c.n_runs, policy=pname)
+    table.add(obs.filled(OPS["custody_indefinite"], **fields).judge(
+        c.kept_throughout, shown=f"custody kept in {100 * c.custody_fraction[-1]:.0f} % of runs through period "
+        f"{c.periods}; worst pointing error {np.rad2deg(np.max(c.max_pointing_rad)):.4f} deg",
+        note=f"bound 0.5 deg (1-deg camera, our choice); burns {1e3 * c.burn_m_s.min():.0f}-{1e3 * c.burn_m_s.max():.0f}"
+        f" mm/s, one per apoapsis; window weight matched to the policy; 2-h cadence, periapsis hand-off"))
+    table.add(obs.filled(OPS["custody_consistent"], **fields).judge(
+        c.worst_inconsistent_fraction, shown=f"{100 * c.worst_inconsistent_fraction:.0f} % of runs inconsistent in "
+        f"the worst period; median mean NEES {np.nanmedian(c.nees_mean):.1f}", note=f"{c.n_runs} runs per period"))
+lost_cov = {n: any(k.lost(f)[p] for f in ("Joseph", "conventional") for p in k.lost(f))
+            for n, k in conditioning.items()}
+sri_ok = all(not any(k.lost("SRI").values()) for n, k in conditioning.items() if lost_cov[n])
+well = conditioning[ladder[0]]
+table.add(OPS["sri_stable"].judge(
+    bool(sri_ok and well.max_diff < 1e-8 and any(lost_cov.values())),
+    shown="; ".join(f"{n}: covariance form lost "
+                    + (", ".join(sorted({p for f in ('Joseph', 'conventional') for p, v in k.lost(f).items() if v}))
+                       or "nothing") + ", SRI " + (", ".join(p for p, v in k.lost("SRI").items() if v) or "nothing")
+                    for n, k in conditioning.items()),
+    reason=("no rung of the ladder made a covariance form fail" if not any(lost_cov.values()) else ""),
+    note=f"linearised 9:2 NRHO, {n_draws_conditioning} draws per case; forms agree to {well.max_diff:.0e} on the "
+    "chapter's case; the paper's own case is well conditioned enough for either form"))
+ax_rates = {a: max(axes_study.cells[a, "9:2 NRHO", c, "angles+rates"] for c in axes_study.cadences)
+            for a in ("baseline", "fixed reference")}
+table.add(obs.filled(OPS["relinearization_needed"], cadences=", ".join(obs.cadence_label(c)
+                                                                          for c in axes_study.cadences)).judge(
+    bool(ax_rates["fixed reference"] > 0.10 and ax_rates["baseline"] <= 0.10),
+    shown=f"diverged runs, worst cadence: fixed reference {100 * ax_rates['fixed reference']:.0f} %, re-linearised "
+    f"{100 * ax_rates['baseline']:.0f} %", note=f"Section 5c, {n_runs_axes} runs per cell, the same draws"))
+table.add(obs.filled(OPS["cadence_sweet_spot"], cadences=f"{obs.cadence_label(min(cost.cadences_h))}-"
+                     f"{obs.cadence_label(max(cost.cadences_h))}").judge(
+    cost.knee_h in (1.0, 2.0, 4.0), shown=f"knee at {obs.cadence_label(cost.knee_h)}; elasticity "
+    f"{np.nanmin(cost.elasticity):.2f}-{np.nanmax(cost.elasticity):.2f}; 2 h costs {1 / cost.cost_ratio()[0]:.2f}x "
+    f"the {obs.cadence_label(cost.cadences_h[0])} run for {cost.sigma3_km[list(cost.cadences_h).index(2.0)] / cost.sigma3_km[0]:.2f}x its "
+    "3-sigma" if 2.0 in cost.cadences_h else f"knee at {obs.cadence_label(cost.knee_h)}",
+    note="CPU time of the single-trial filter per period, best of up to 3 runs"))
 executors.close()  # shuts the worker processes down
 table.display()
 

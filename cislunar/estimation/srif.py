@@ -31,6 +31,7 @@ __all__ = [
     "smoother_step",
     "SRIResult",
     "filter_smoother",
+    "filter_many",
     "factor_process_noise",
 ]
 
@@ -359,3 +360,93 @@ def filter_smoother(x0, P0, Phis, Hs, ys, meas_covs, Gammas=None, Qs=None, *, sm
             xs_list[k], Ps_list[k] = covariance_from_sri(Rs, zs)
         xs, Ps = np.array(xs_list), np.array(Ps_list)
     return SRIResult(np.array(xf), np.array(Pf), np.array(xp), np.array(Pp), xs, Ps, np.array(Rf), np.array(res))
+
+
+def filter_many(x0s, P0, Phis, Hs, ys, meas_covs, Gammas=None, Qs=None):
+    """The SRI filter of :func:`filter_smoother` (forward pass) for M measurement sets of the same model at once.
+
+    The square-root information matrix does not depend on the measurements, so one triangularisation per update
+    carries every set as an extra right-hand-side column of the information vector (Bierman 1977, ch. V): each
+    set's estimate equals :func:`filter_smoother`'s for that set to round-off, at the cost of about one filter.
+
+    Parameters
+    ----------
+    x0s : array_like, shape (M, n)
+        Prior means, one per set (the prior covariance ``P0`` (n, n) is shared).
+    Phis, Hs, meas_covs, Gammas, Qs
+        As in :func:`filter_smoother` (shared by all sets); an epoch without a measurement has ``H`` of shape
+        (0, n).
+    ys : array_like, shape (M, N, m) or sequence of length N of arrays (M, m_k)
+        The measurements of each set at each epoch (``(M, 0)`` or anything empty where ``H`` is empty).
+
+    Returns
+    -------
+    x_filt : ndarray, shape (M, N, n)
+    P_filt : ndarray, shape (N, n, n)
+        :math:`R^{-1}R^{-\\top}` (shared).
+    R_filt : ndarray, shape (N, n, n)
+        Square-root information matrices after each update (shared).
+    """
+    x0s = validation.as_array(x0s, "x0s", ndim=(2,), min_size=1)
+    M, n = x0s.shape
+    if np.shape(P0) != (n, n):
+        raise ValueError(f"P0 must be {n}x{n} to match x0s (shape {x0s.shape}); got shape {np.shape(P0)}")
+    empty = isinstance(Phis, (list, tuple)) and len(Phis) == 0
+    Phis = np.zeros((0, n, n)) if empty else validation.as_array(Phis, "Phis", ndim=(3,))
+    if Phis.shape[1:] != (n, n):
+        raise ValueError(f"Phis must have shape (N-1, {n}, {n}); got {Phis.shape}")
+    N = Phis.shape[0] + 1
+    for name, seq in (("Hs", Hs), ("meas_covs", meas_covs), ("Gammas", Gammas), ("Qs", Qs)):
+        if seq is None and name in ("Gammas", "Qs"):
+            continue
+        if isinstance(seq, (str, bytes)) or not hasattr(seq, "__len__"):
+            raise validation.ArgumentTypeError(f"{name} must be a sequence (one entry per epoch); got "
+                                               f"{type(seq).__name__}")
+    for name, seq in (("Hs", Hs), ("meas_covs", meas_covs)):
+        if len(seq) != N:
+            raise ValueError(f"{name} must have {N} entries (one per epoch); got {len(seq)}")
+    if isinstance(ys, (str, bytes)) or not hasattr(ys, "__len__"):
+        raise validation.ArgumentTypeError(f"ys must be an array (M, N, m) or a sequence of N arrays; got "
+                                           f"{type(ys).__name__}")
+    if isinstance(ys, np.ndarray) and ys.ndim == 3:
+        if ys.shape[:2] != (M, N):
+            raise ValueError(f"ys must have shape ({M}, {N}, m) to match x0s and Phis; got {ys.shape}")
+
+        def y_of(k):
+            return ys[:, k]
+    else:
+        if len(ys) != N:
+            raise ValueError(f"ys must have {N} entries (one per epoch); got {len(ys)}")
+
+        def y_of(k):
+            return np.asarray(ys[k], dtype=float)
+    noise = Gammas is not None
+    if noise and (Qs is None or len(Gammas) != N - 1 or len(Qs) != N - 1):
+        raise ValueError(f"Gammas and Qs must both have {N - 1} entries")
+    R = _chol_upper_inverse(P0, "P0")
+    Z = R @ x0s.T  # (n, M): one information vector per set
+    xf, Rf = np.empty((M, N, n)), np.empty((N, n, n))
+    for k in range(N):
+        H = validation.as_array(Hs[k], f"Hs[{k}]").reshape(-1, n) if np.size(Hs[k]) else np.zeros((0, n))
+        if H.shape[0]:
+            Y = validation.as_array(y_of(k), f"ys at epoch {k}", shape=(M, H.shape[0]))
+            W = _chol_upper_inverse(meas_covs[k], f"meas_covs[{k}]")
+            if W.shape[0] != H.shape[0]:
+                raise ValueError(f"meas_covs[{k}] must be {H.shape[0]}x{H.shape[0]}")
+            U = _triangularize(np.block([[R, Z], [W @ H, W @ Y.T]]))
+            R, Z = U[:n, :n], U[:n, n:]
+        xf[:, k] = np.linalg.solve(R, Z).T
+        Rf[k] = R
+        if k < N - 1:
+            Phi = Phis[k]
+            Rt = np.linalg.solve(Phi.T, R.T).T  # R Phi^{-1}
+            if noise:
+                G = validation.as_array(Gammas[k], f"Gammas[{k}]", ndim=(2,))
+                Rw = _chol_upper_inverse(Qs[k], f"Qs[{k}]")
+                r = Rw.shape[0]
+                U = _triangularize(np.block([[Rw, np.zeros((r, n)), np.zeros((r, M))], [-Rt @ G, Rt, Z]]))
+                R, Z = U[r:r + n, r:r + n], U[r:r + n, r + n:]
+            else:
+                U = _triangularize(np.hstack([Rt, Z]))
+                R, Z = U[:n, :n], U[:n, n:]
+    return xf, _cov_of_sri(Rf), Rf

@@ -150,3 +150,30 @@ def test_stacked_kernels_equal_one_matrix_at_a_time_and_keep_the_information():
     assert np.allclose(Rb[2], one, rtol=1e-13, atol=1e-13)
     with pytest.raises(np.linalg.LinAlgError):
         srif._sri_of_cov(-P)
+
+
+@pytest.mark.parametrize("noise", [True, False])
+def test_filter_many_equals_filter_smoother_set_by_set(noise):
+    """Several measurement sets as extra information-vector columns: each set's estimate is filter_smoother's."""
+    rng = np.random.default_rng(11)
+    x0, P0, Phis, Gammas, Qs, Hs, Rs, _ = _random_system(rng, n=4, m=2, N=10)
+    Hs[3] = np.zeros((0, 4))  # an epoch without a measurement
+    M = 5
+    x0s = x0 + rng.standard_normal((M, 4))
+    ys = rng.standard_normal((M, 10, 2))
+    kw = dict(Gammas=Gammas, Qs=Qs) if noise else {}
+    xf, Pf, Rf = srif.filter_many(x0s, P0, Phis, Hs, ys, Rs, **kw)
+    for j in range(M):
+        ref = srif.filter_smoother(x0s[j], P0, Phis, Hs, list(ys[j]), Rs, smooth=False, **kw)
+        assert np.allclose(xf[j], ref.x_filt, rtol=1e-10, atol=1e-10)
+        assert np.allclose(Pf, ref.P_filt, rtol=1e-10, atol=1e-12)
+        assert np.allclose(Rf, ref.R_filt, rtol=1e-10, atol=1e-10)
+
+
+def test_filter_many_refuses_mismatched_measurements():
+    rng = np.random.default_rng(12)
+    x0, P0, Phis, Gammas, Qs, Hs, Rs, _ = _random_system(rng, n=4, m=2, N=6)
+    with pytest.raises(ValueError, match="ys"):
+        srif.filter_many(np.zeros((3, 4)), P0, Phis, Hs, np.zeros((2, 6, 2)), Rs, Gammas, Qs)
+    with pytest.raises(ValueError, match="P0"):
+        srif.filter_many(np.zeros((3, 4)), np.eye(3), Phis, Hs, np.zeros((3, 6, 2)), Rs, Gammas, Qs)
