@@ -40,7 +40,9 @@ What makes it converge (documented departures from the printed method)
 * A predicted decrease at the noise level of the subproblem solution counts as :math:`\rho = 1`; Clarabel runs
   with tight tolerances; the iteration stops only on an accepted step with defects below ``defect_tol``, a
   cost change below ``tol`` and an inactive trust region.  A trust region that shrinks below ``eta_min`` raises
-  :class:`SCvxError` (never a success).
+  :class:`SCvxError` (never a success).  ``solve_scvx(..., practical_stop=PracticalStop(...))`` adds a practical
+  rule (off by default): stop after a few consecutive accepted steps with closed defects and a small cost change,
+  the trust region active or not (the paper prints no stopping test).
 
 The information model protocol
 ------------------------------
@@ -78,7 +80,7 @@ from cislunar.guidance.discretization import _check_outside, _foh_discretize
 from cislunar.utils import validation
 from cislunar.utils.progress import progress as _progress
 
-__all__ = ["SCvxSettings", "SCvxResult", "SCvxError", "SCvxWorkspace", "solve_scvx", "concave_part", "finite_difference_hessian",
+__all__ = ["SCvxSettings", "PracticalStop", "SCvxResult", "SCvxError", "SCvxWorkspace", "solve_scvx", "concave_part", "finite_difference_hessian",
            "SweepResult", "homotopy_sweep", "impulse"]
 
 METHODS = ("augmented_lagrangian", "penalty")
@@ -233,6 +235,38 @@ class SCvxSettings:
         validation.in_range(self.active_tol, "active_tol", 0.0, 1.0, closed=False)
 
 
+@dataclass(frozen=True)
+class PracticalStop:
+    """A practical stopping rule for :func:`solve_scvx` (keyword ``practical_stop``; default none: only the strict
+    test of :class:`SCvxSettings` stops a run).
+
+    The run also stops, as a success with ``SCvxResult.stopped_by == "practical"``, after ``window`` consecutive
+    accepted steps that each end with the largest defect norm and constraint violation at most ``defect_tol`` and
+    change both the merit function (objective plus defect penalty) and the objective by at most
+    ``cost_tol (1 + |J|)``; rejected steps in between neither count nor reset the count.  Unlike the strict test it
+    does not ask for an inactive trust region, which a linear information model (the paper's Eq. 44) pins to its
+    boundary; it never stops with open defects.  The paper prints no stopping test.
+
+    Attributes
+    ----------
+    window : int
+        Consecutive qualifying accepted steps (>= 1).
+    defect_tol : float
+        Largest defect norm and violation allowed (LU, LU/TU; > 0).
+    cost_tol : float
+        Largest relative cost change per step allowed (> 0).
+    """
+
+    window: int = 5
+    defect_tol: float = 1e-8
+    cost_tol: float = 1e-8
+
+    def __post_init__(self):
+        validation.integer(self.window, "window", minimum=1)
+        validation.positive(self.defect_tol, "defect_tol")
+        validation.positive(self.cost_tol, "cost_tol")
+
+
 @dataclass
 class SCvxResult:
     """Converged SCvx solution.
@@ -260,6 +294,8 @@ class SCvxResult:
         Per iteration: ``iteration, cost, new_cost, predicted, actual, rho, eta, accepted, tr_active, step,
         max_defect, max_violation, model_error_defect, model_error_info, penalty_weight, multiplier_update,
         information, impulse, status`` and the times ``t_discretize, t_info, t_hessian, t_solve`` (seconds).
+    stopped_by : {"strict", "practical"}
+        Which stopping test ended the run (``"practical"``: :class:`PracticalStop`).
     """
 
     t: np.ndarray
@@ -271,6 +307,7 @@ class SCvxResult:
     information: float
     max_defect: float
     history: list = field(default_factory=list)
+    stopped_by: str = "strict"
 
     @property
     def iterations(self) -> int:
@@ -467,7 +504,8 @@ def _check_constraint(obj, i, n):
 
 def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None, info=None, info_node=None,
                constraints=(), alpha: float = 0.0, settings: SCvxSettings | None = None, solver: str = "CLARABEL",
-               progress: bool = False, workspace: SCvxWorkspace | None = None) -> SCvxResult:
+               progress: bool = False, workspace: SCvxWorkspace | None = None,
+               practical_stop: PracticalStop | None = None) -> SCvxResult:
     """Solve the observer trajectory problem by SCvx (see the module docstring for the algorithm).
 
     Parameters
@@ -499,6 +537,8 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
     workspace : SCvxWorkspace, optional
         Keeps the canonicalised convex subproblem for the next run with the same structure (a sweep passes one
         workspace to all its runs); default: a subproblem built for this run only.
+    practical_stop : PracticalStop, optional
+        A practical stopping rule besides the strict test (default none: results bit-for-bit those without it).
 
     Returns
     -------
@@ -542,6 +582,8 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
     validation.boolean(progress, "progress")
     if workspace is not None:
         validation.instance(workspace, "workspace", SCvxWorkspace)
+    if practical_stop is not None:
+        validation.instance(practical_stop, "practical_stop", PracticalStop)
     if not isinstance(solver, str) or solver.upper() not in cp.installed_solvers():
         raise ValueError(f"solver must be the name of an installed cvxpy solver {cp.installed_solvers()}; got "
                          f"{solver!r}")
@@ -629,6 +671,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
     eta = st.eta0
     threshold = st.multiplier_threshold0
     last_progress, best_defect = 0, feasibility(ev)[0]
+    quiet = 0  # consecutive accepted steps meeting the practical stopping rule (practical_stop)
     history: list = []
     bar = _progress(range(st.max_iter), desc=f"SCvx alpha={alpha:g}", enabled=progress)
     try:
@@ -711,6 +754,15 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
                 if small and feasible and not tr_active:
                     return SCvxResult(t, x_ref, u_ref, alpha, obj_ref, _impulse(dt, u_ref),
                                       ev["info"] if info is not None else float("nan"), max_def_new, history)
+                if practical_stop is not None:
+                    ps = practical_stop
+                    calm = max(abs(actual), obj_change) <= ps.cost_tol * scale
+                    closed = max_def_new <= ps.defect_tol and viol_new <= ps.defect_tol
+                    quiet = quiet + 1 if calm and closed else 0
+                    if quiet >= ps.window:
+                        return SCvxResult(t, x_ref, u_ref, alpha, obj_ref, _impulse(dt, u_ref),
+                                          ev["info"] if info is not None else float("nan"), max_def_new, history,
+                                          stopped_by="practical")
                 # the iteration goes on: gradient (and Hessian) at the new reference (not computed on the converged
                 # step, where nothing would use them); the value is info(x, 0)'s
                 t0 = time.perf_counter()

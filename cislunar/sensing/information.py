@@ -49,6 +49,17 @@ equivalent trace form :math:`\partial\mathcal I/\partial\xi = \mathrm{tr}(\tilde
 \tilde P\tilde H^T)` with :math:`\partial\tilde H` assembled block by block as in Eq. 50 (product rule along the
 chain of transition matrices).
 
+Range-dependent measurement noise (keyword-only, off by default)
+-----------------------------------------------------------------
+The linear-Gaussian MI of range-rate measurements grows without bound as the observer nears a target: the
+range-rate row of :math:`H` with respect to the relative position is :math:`(\Delta\dot{\mathbf r} -
+\dot\rho\hat\rho)^T/\rho`.  :func:`range_noise_scale` gives the row scale of a noise whose standard deviation
+grows as the range shrinks, :math:`\sigma(\rho) = \sigma\sqrt{1 + (\rho_c/\rho)^2}` (unchanged far from the
+target, :math:`\propto 1/\rho` inside :math:`\rho_c`), for every row of a target; since scaling the noise of a
+target's rows by :math:`g` is the same as scaling those rows of :math:`H` by :math:`1/g` (the noise blocks are per
+target), :class:`InformationKernel` and :func:`window_information` take it as ``row_scale`` (and its derivative
+``d_row_scale`` for the gradient).  With the defaults (``None``) every value is bit-for-bit unchanged.
+
 All logarithms are natural: information in nats.
 """
 
@@ -81,6 +92,7 @@ __all__ = [
     "mutual_information_gradient",
     "InformationKernel",
     "window_information",
+    "range_noise_scale",
     "gaussian_kl",
     "monte_carlo_mutual_information",
     "TimingResult",
@@ -704,16 +716,30 @@ class InformationKernel:
             raise ValueError("H must be finite (no NaN or inf)")
         return F, H
 
-    def value(self, F, H) -> float:
+    def _row_scale(self, row_scale, name="row_scale"):
+        N, M, _ = self.shape
+        s = validation.as_array(row_scale, name, shape=(N, M))
+        if np.any(s <= 0):
+            raise ValueError(f"{name} must be positive (a factor on measurement rows); got min {s.min()}")
+        return s
+
+    def value(self, F, H, *, row_scale=None) -> float:
         """:func:`mutual_information` of the window with transitions ``F`` (N-1, n, n) and Jacobians ``H`` (N, M, n),
-        nats."""
+        nats.  ``row_scale`` (N, M), optional: positive factors on the rows of ``H`` (a noise standard deviation
+        divided by them, e.g. :func:`range_noise_scale`; default none: bit-for-bit the unscaled value)."""
         F, H = self._check(F, H)
+        if row_scale is not None:
+            H = self._row_scale(row_scale)[..., None] * H
         return float(np.sum(_sqrt_sweep(self.P0, F, self.LQ, np.linalg.solve(self.LR, H))))
 
-    def value_gradient(self, F, H, dF, dH):
+    def value_gradient(self, F, H, dF, dH, *, row_scale=None, d_row_scale=None):
         """:func:`mutual_information_gradient` (reverse mode): ``(info, grad (p,))`` for derivatives ``dF``
-        (N-1, n, n, p) and ``dH`` (N, M, n, p)."""
+        (N-1, n, n, p) and ``dH`` (N, M, n, p).  ``row_scale`` (N, M) and its derivative ``d_row_scale``
+        (N, M, p), optional together: the rows of ``H`` are scaled (as in :meth:`value`) and the product rule
+        enters the gradient."""
         F, H = self._check(F, H)
+        if (row_scale is None) != (d_row_scale is None):
+            raise ValueError("row_scale and d_row_scale must be given together (or neither)")
         dF = self._float(dF, "dF")
         dH = self._float(dH, "dH")
         if dF.ndim != 4 or dF.shape[:3] != F.shape or dF.shape[-1] < 1:
@@ -727,10 +753,54 @@ class InformationKernel:
             raise ValueError("dF must be finite (no NaN or inf)")
         if not np.isfinite(dH).all():
             raise ValueError("dH must be finite (no NaN or inf)")
+        if row_scale is not None:
+            sc = self._row_scale(row_scale)
+            ds = validation.as_array(d_row_scale, "d_row_scale", shape=sc.shape + (dH.shape[-1],))
+            dH = sc[..., None, None] * dH + H[..., None] * ds[:, :, None, :]
+            H = sc[..., None] * H
         return _gradient_sqrt_reverse(self.P0, F, self.Q, H, self.LR, dF, dH, self.LQ)
 
 
-def window_information(lin: AugmentedLinearization, *, method: str = "structured", gradient: bool = False):
+def range_noise_scale(lin: AugmentedLinearization, range_scale: float, *, derivatives: bool = False):
+    r"""Row scale of a range-dependent noise, :math:`1/g(\rho) = \rho/\sqrt{\rho^2 + \rho_c^2}`, for every
+    measurement row of each target (the noise standard deviation times :math:`g = \sqrt{1 + (\rho_c/\rho)^2}`).
+
+    Parameters
+    ----------
+    lin : AugmentedLinearization
+        The window (observer and target states at the measurement times; ``observer_stm`` for the derivative).
+    range_scale : float
+        :math:`\rho_c` (> 0), LU: the noise is :math:`\sqrt2` times larger at this range and grows like
+        :math:`\rho_c/\rho` inside it.
+    derivatives : bool
+        Also return the derivative with respect to the observer state at ``t[0]`` (through ``lin.observer_stm``).
+
+    Returns
+    -------
+    ndarray (N, M), or (ndarray (N, M), ndarray (N, M, 6))
+        Factors in (0, 1) for :meth:`InformationKernel.value` (``row_scale``), and ``d_row_scale`` in 1/LU and
+        TU/LU.
+    """
+    validation.instance(lin, "lin", AugmentedLinearization)
+    rc = validation.positive(range_scale, "range_scale")
+    derivatives = validation.boolean(derivatives, "derivatives")
+    n_t = lin.targets.shape[0]
+    m = lin.H.shape[1] // n_t
+    rel = lin.observer[None, :, :3] - lin.targets[:, :, :3]  # (N_T, N, 3): observer minus target
+    rho = np.linalg.norm(rel, axis=-1)
+    s = rho / np.sqrt(rho**2 + rc**2)  # (N_T, N)
+    scale = np.repeat(s.T, m, axis=1)  # (N, M): target j's rows j m .. j m + m - 1
+    if not derivatives:
+        return scale
+    # d s / d rho = rc^2 / (rho^2 + rc^2)^1.5; d rho / d x0 = rho_hat^T Phi_S(t_k, t0)[:3, :]
+    dsdr = rc**2 / (rho**2 + rc**2) ** 1.5
+    drho = np.einsum("jka,kab->jkb", rel / rho[..., None], lin.observer_stm[:, :3, :])  # (N_T, N, 6)
+    dscale = np.repeat(np.moveaxis(dsdr[..., None] * drho, 0, 1), m, axis=1)  # (N, M, 6)
+    return scale, dscale
+
+
+def window_information(lin: AugmentedLinearization, *, method: str = "structured", gradient: bool = False,
+                       range_scale: float | None = None):
     """Mutual information (and optionally its gradient w.r.t. the observer state at the window start) of a window.
 
     Parameters
@@ -739,6 +809,9 @@ def window_information(lin: AugmentedLinearization, *, method: str = "structured
         From :func:`cislunar.sensing.covariance.linearize_augmented` (``derivatives=True`` for the gradient).
     method : {"structured", "dense"}
     gradient : bool
+    range_scale : float, optional
+        :math:`\rho_c` of a range-dependent noise (:func:`range_noise_scale`), LU; default none (the noise of
+        ``lin.R``, bit-for-bit the plain value).  Structured method only.
 
     Returns
     -------
@@ -747,6 +820,17 @@ def window_information(lin: AugmentedLinearization, *, method: str = "structured
     """
     validation.instance(lin, "lin", AugmentedLinearization)
     validation.choice(method, "method", ("structured", "dense"))
+    if range_scale is not None:
+        if method != "structured":
+            raise ValueError("range_scale needs method='structured'")
+        gradient = validation.boolean(gradient, "gradient")
+        if gradient and lin.dF is None:
+            raise ValueError("lin has no derivatives: build it with linearize_augmented(..., derivatives=True)")
+        kernel = InformationKernel(lin.P0, lin.Q, lin.R, lin.t.size)
+        if gradient:
+            sc, ds = range_noise_scale(lin, range_scale, derivatives=True)
+            return kernel.value_gradient(lin.F, lin.H, lin.dF, lin.dH, row_scale=sc, d_row_scale=ds)
+        return kernel.value(lin.F, lin.H, row_scale=range_noise_scale(lin, range_scale))
     if validation.boolean(gradient, "gradient"):
         if lin.dF is None:
             raise ValueError("lin has no derivatives: build it with linearize_augmented(..., derivatives=True)")

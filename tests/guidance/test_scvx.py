@@ -449,3 +449,90 @@ def test_no_gradient_or_hessian_on_the_converged_step():
     assert len(grads) == accepted  # the initial reference and every accepted step but the last
     assert len(hessians) >= accepted  # hessian_refresh = 0: at every reference (and after poor-model rejections)
     assert not any(np.array_equal(x, res.x[5]) for x in grads + hessians)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# the practical stopping rule (solve_scvx(..., practical_stop=PracticalStop(...)))
+# ---------------------------------------------------------------------------------------------------------------
+def _practical_meets(res, ps, alpha):
+    """Per accepted step: does it meet the practical rule (defects and violation <= defect_tol, merit and
+    objective change <= cost_tol (1 + |J|))?  Recomputed from the history, independently of the solver."""
+    out, obj_ref = [], None
+    for rec in res.history:
+        if not rec["accepted"]:
+            continue
+        obj_new = (1.0 - alpha) * rec["impulse"] - alpha * rec["information"]
+        scale = 1.0 + abs(rec["cost"])
+        change = max(abs(rec["actual"]), abs(obj_new - obj_ref) if obj_ref is not None else np.inf)
+        out.append(change <= ps.cost_tol * scale and rec["max_defect"] <= ps.defect_tol
+                   and rec["max_violation"] <= ps.defect_tol)
+        obj_ref = obj_new
+    return out
+
+
+def test_practical_rule_stops_the_linear_model_where_the_strict_test_cannot(case1):
+    """The paper's linear MI model (Eq. 44) with the augmented Lagrangian on test case 1: every step ends on the
+    trust-region boundary, so the strict test (inactive trust region) cannot stop it; the practical rule stops it on
+    the first run of `window` qualifying accepted steps, with closed defects, at the optimum of the default
+    (concave-quadratic) model.  On this coarse grid the run ends in a four-step cycle whose accepted steps leave
+    defects of 1.1e-8 (second order in eta ~ 1e-4), so the defect tolerance here is 1e-7 (notebook 03 uses 1e-8 on
+    its finer grid)."""
+    alpha = ALPHAS[-1]
+    ps = scvx.PracticalStop(window=5, defect_tol=1e-7, cost_tol=1e-8)
+    res = _solve(case1, alpha, case1["x0"], case1["u0"], settings=scvx.SCvxSettings(information_model="linear"),
+                 practical_stop=ps)
+    assert res.stopped_by == "practical"
+    assert res.history[-1]["accepted"] and res.history[-1]["tr_active"]  # the strict test could not have stopped here
+    assert res.max_defect <= ps.defect_tol
+    model = D.foh_discretize(em, case1["t"], res.x, res.u)  # defects recomputed independently
+    assert np.max(np.linalg.norm(model.defects, axis=1)) <= ps.defect_tol
+    meets = _practical_meets(res, ps, alpha)
+    run = 0
+    for i, m in enumerate(meets):  # the stop is on the first accepted step that completes a run of `window`
+        run = run + 1 if m else 0
+        assert (run >= ps.window) == (i == len(meets) - 1), (i, meets)
+    ref = _solve(case1, alpha, case1["x0"], case1["u0"])  # default: augmented Lagrangian, quadratic model, strict
+    assert ref.stopped_by == "strict"
+    assert abs(res.cost - ref.cost) <= 1e-6
+
+
+def test_practical_rule_never_stops_with_open_defects():
+    """A terminal state out of reach (thrust bound 1e-6 a_max): the defects cannot close, so even a rule that
+    accepts any cost change and a single step must not stop; the run ends in SCvxError."""
+    sc = wolf_jones.test_case_1()
+    t = np.linspace(0.0, 2 * sc.period, 12)
+    st = scvx.SCvxSettings(max_iter=8, stall_iter=0)
+    with pytest.raises(scvx.SCvxError) as err:
+        scvx.solve_scvx(em, t, propagate(em, sc.observer_x0, t).x, np.zeros((t.size, 3)),
+                        np.full(t.size, 1e-6 * A_MAX), x_final=sc.observer_xf, settings=st,
+                        practical_stop=scvx.PracticalStop(window=1, cost_tol=1e3, defect_tol=1e-8))
+    hist = err.value.history
+    assert len(hist) == 8 and sum(h["accepted"] for h in hist) >= 1
+    assert min(h["max_defect"] for h in hist if h["accepted"]) > 1e-8  # the defects really stayed open
+
+
+def test_practical_rule_off_or_unmet_leaves_the_run_unchanged(transfer_run):
+    """Default settings stop on the strict test; a practical rule that can never be met changes no iterate."""
+    base = transfer_run["res"]
+    assert base.stopped_by == "strict"
+    sc = wolf_jones.test_case_1()
+    t = np.linspace(0.0, 2 * sc.period, 16)
+    res = scvx.solve_scvx(em, t, propagate(em, sc.observer_x0, t).x, np.zeros((t.size, 3)), np.full(t.size, A_MAX),
+                          x_final=sc.observer_xf, settings=scvx.SCvxSettings(),
+                          practical_stop=scvx.PracticalStop(window=3, defect_tol=1e-300, cost_tol=1e-300))
+    assert res.stopped_by == "strict"
+    assert np.array_equal(res.x, base.x) and np.array_equal(res.u, base.u) and res.cost == base.cost
+    assert [h["cost"] for h in res.history] == [h["cost"] for h in base.history]
+
+
+@pytest.mark.parametrize("field, value, exc", [("window", 0, ValueError), ("window", 1.5, ValueError),
+                                               ("defect_tol", 0.0, ValueError), ("cost_tol", -1e-8, ValueError),
+                                               ("cost_tol", "1e-8", TypeError)])
+def test_practical_stop_validates_every_field(field, value, exc):
+    with pytest.raises(exc, match=field):
+        scvx.PracticalStop(**{field: value})
+    dro, xf, t = _transfer()
+    with pytest.raises(TypeError, match="practical_stop"):
+        scvx.solve_scvx(em, t, propagate(em, dro.x0, t).x, np.zeros((t.size, 3)), np.full(t.size, A_MAX),
+                        x_final=xf, practical_stop=dict(window=5))
+

@@ -416,3 +416,81 @@ def test_information_kernel_refuses_bad_input_by_name():
     with pytest.raises(ValueError, match="dH"):
         K.value_gradient(F, H, dF, dH[:2])
     assert K.value(F, H) == I.mutual_information(P0, F, Q, H, R)  # the checked arrays were not changed
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# range-dependent noise (keyword-only row_scale / range_scale)
+# ---------------------------------------------------------------------------------------------------------------
+def _window_ranges(lin):
+    return np.linalg.norm(lin.observer[None, :, :3] - lin.targets[:, :, :3], axis=-1)  # (N_T, N), LU
+
+
+def test_range_noise_equals_the_mi_with_range_scaled_noise_covariances(window):
+    """Scaling the rows of H by s = rho / sqrt(rho^2 + rho_c^2) is the MI of Eq. 18 with every target's noise block
+    scaled by 1/s^2 (independent: the dense stacked formula with the scaled R)."""
+    lin, _ = window
+    rc = float(np.median(_window_ranges(lin)))
+    s = I.range_noise_scale(lin, rc)
+    assert s.shape == lin.H.shape[:2] and np.all((s > 0) & (s < 1))
+    R_scaled = lin.R / (s[:, :, None] * s[:, None, :])  # block-diagonal per target: same s on a target's rows
+    dense = I.mutual_information_dense(lin.P0, lin.F, lin.Q, lin.H, R_scaled)
+    assert I.window_information(lin, range_scale=rc) == pytest.approx(dense, rel=1e-10)
+    assert I.window_information(lin, range_scale=rc) < I.window_information(lin)  # more noise, less information
+    # defaults: bit for bit the plain values
+    kernel = I.InformationKernel(lin.P0, lin.Q, lin.R, lin.t.size)
+    assert kernel.value(lin.F, lin.H, row_scale=None) == I.window_information(lin)
+    g0 = I.window_information(lin, gradient=True)
+    g1 = I.window_information(lin, gradient=True, range_scale=None)
+    assert g0[0] == g1[0] and np.array_equal(g0[1], g1[1])
+
+
+def test_range_noise_gradient_matches_finite_differences(window):
+    """d I / d x_S(t_0) with the range-dependent noise (product rule through the row scale) against fourth-order
+    central differences of the value (re-propagated, Q held fixed); the scale's own derivative matters."""
+    lin, R = window
+    rc = float(np.median(_window_ranges(lin)))
+    val, grad = I.window_information(lin, gradient=True, range_scale=rc)
+    assert val == pytest.approx(I.window_information(lin, range_scale=rc), rel=1e-12)
+
+    def f(x):
+        return I.window_information(C.linearize_augmented(EARTH_MOON, x, TARGETS, lin.t, M.RANGE_RANGE_RATE, R,
+                                                          lin.P0, Q=lin.Q), range_scale=rc)
+
+    h = 1e-6
+    fd = np.zeros(6)
+    for j in range(6):
+        e = np.zeros(6)
+        e[j] = h
+        fd[j] = (8 * (f(OBSERVER + e) - f(OBSERVER - e)) - (f(OBSERVER + 2 * e) - f(OBSERVER - 2 * e))) / (12 * h)
+    scale = np.max(np.abs(fd))
+    np.testing.assert_allclose(grad, fd, rtol=1e-5, atol=1e-5 * scale)
+    # the scale held fixed (no product-rule term) gives a visibly different gradient: the test would catch its loss
+    kernel = I.InformationKernel(lin.P0, lin.Q, lin.R, lin.t.size)
+    s, ds = I.range_noise_scale(lin, rc, derivatives=True)
+    _, frozen = kernel.value_gradient(lin.F, lin.H, lin.dF, lin.dH, row_scale=s, d_row_scale=np.zeros_like(ds))
+    assert np.max(np.abs(frozen - fd)) > 1e-3 * scale
+    # d_row_scale itself against central differences of the scale
+    for j in range(6):
+        e = np.zeros(6)
+        e[j] = h
+        sp = I.range_noise_scale(C.linearize_augmented(EARTH_MOON, OBSERVER + e, TARGETS, lin.t, M.RANGE_RANGE_RATE,
+                                                       R, lin.P0, Q=lin.Q), rc)
+        sm = I.range_noise_scale(C.linearize_augmented(EARTH_MOON, OBSERVER - e, TARGETS, lin.t, M.RANGE_RANGE_RATE,
+                                                       R, lin.P0, Q=lin.Q), rc)
+        np.testing.assert_allclose(ds[..., j], (sp - sm) / (2 * h), rtol=1e-6, atol=1e-9 * np.abs(ds).max())
+
+
+def test_range_noise_refuses_bad_input_by_name(window):
+    lin, _ = window
+    kernel = I.InformationKernel(lin.P0, lin.Q, lin.R, lin.t.size)
+    s, ds = I.range_noise_scale(lin, 0.01, derivatives=True)
+    with pytest.raises(ValueError, match="row_scale"):
+        kernel.value(lin.F, lin.H, row_scale=-s)
+    with pytest.raises(ValueError, match="row_scale"):
+        kernel.value(lin.F, lin.H, row_scale=s[:, :1])
+    with pytest.raises(ValueError, match="d_row_scale"):
+        kernel.value_gradient(lin.F, lin.H, lin.dF, lin.dH, row_scale=s)
+    with pytest.raises(ValueError, match="range_scale"):
+        I.range_noise_scale(lin, 0.0)
+    with pytest.raises(ValueError, match="range_scale"):
+        I.window_information(lin, range_scale=0.01, method="dense")

@@ -10,6 +10,10 @@ What is here
   the largest-defect ratios that a superlinear rate would drive to zero).
 * :func:`single_shooting`: the converged first-order-hold control re-flown from the initial state alone.
 * :func:`blended_guess`, :func:`guess_study`: the same problem from random initial guesses.
+* :func:`printed_method_study`: the printed SCvx, fairly (issue 22 item 4): test case 1 with the information reward
+  solved by every combination of the paper's ingredients (L1 exact penalty, linear MI model of Eq. 44) and ours
+  (augmented Lagrangian, concave-quadratic MI model), under the strict stopping test and under the practical rule
+  :class:`cislunar.guidance.scvx.PracticalStop`.
 * ``figure_*``: the chapter's figures.
 
 Units: non-dimensional (LU, TU, LU/TU, LU/TU^2) unless a name says ``_km``, ``_mm_s`` or ``_d``; Earth-Moon
@@ -18,6 +22,7 @@ rotating frame.
 
 from __future__ import annotations
 
+import functools
 import itertools
 from dataclasses import dataclass
 
@@ -35,13 +40,18 @@ from cislunar.utils.montecarlo import map_tasks
 __all__ = [
     "GuessStudy",
     "IterationSummary",
+    "PRACTICAL_STOP",
+    "PrintedMethodStudy",
+    "VariantRun",
     "ShootingCheck",
     "TransferProblem",
     "blended_guess",
     "figure_converged_control",
     "figure_iterations",
+    "figure_printed_method",
     "guess_study",
     "iteration_summary",
+    "printed_method_study",
     "single_shooting",
     "solve",
     "transfer_problem",
@@ -238,6 +248,145 @@ def guess_study(problem: TransferProblem, n_guesses: int, rng: np.random.Generat
 
 
 # ---------------------------------------------------------------------------------------------------------------
+# The printed method, fairly (issue 22 item 4)
+# ---------------------------------------------------------------------------------------------------------------
+PRACTICAL_STOP = scvx.PracticalStop(window=5, defect_tol=1e-8, cost_tol=1e-8)
+"""The practical stopping rule of :func:`printed_method_study`, fixed before any run: five consecutive accepted steps
+with the largest defect at most 1e-8 (LU: 3.8 m; LU/TU: 1 cm/s) and a relative cost change at most 1e-8."""
+
+VARIANTS = {  # label: (method, information model, practical rule?)
+    "AL + quadratic, strict": ("augmented_lagrangian", "quadratic", False),
+    "AL + linear, strict": ("augmented_lagrangian", "linear", False),
+    "AL + linear, practical": ("augmented_lagrangian", "linear", True),
+    "L1 + linear, practical": ("penalty", "linear", True),
+    "L1 + quadratic, practical": ("penalty", "quadratic", True),
+}
+"""The runs of :func:`printed_method_study`: the package's default first (the reference optimum), the printed method
+(L1 exact penalty, linear model of Eq. 44) last but one."""
+
+
+@dataclass(frozen=True)
+class VariantRun:
+    r"""One SCvx run of :func:`printed_method_study`.
+
+    ``converged``: the run stopped as a success (``stopped_by``: "strict" or "practical"), else ``outcome`` is the
+    :class:`~cislunar.guidance.scvx.SCvxError` reason; ``cost``: objective :math:`(1-\alpha_h)\,\mathrm{impulse}
+    - \alpha_h\mathcal I` (penalty excluded, non-dimensional) at the last accepted reference; ``max_defect``: its
+    largest defect (LU or LU/TU); ``eta``: the last trust-region radius; ``tr_active``: fraction of the steps that
+    ended on the trust-region boundary.
+    """
+
+    label: str
+    method: str
+    information_model: str
+    practical: bool
+    converged: bool
+    stopped_by: str
+    outcome: str
+    iterations: int
+    cost: float
+    max_defect: float
+    eta: float
+    tr_active: float
+    history: list
+
+
+@dataclass(frozen=True)
+class PrintedMethodStudy:
+    """Test case 1 at one weight solved by every combination of the paper's SCvx ingredients and ours.
+
+    ``runs``: label -> :class:`VariantRun` (labels of :data:`VARIANTS`); ``reference``: the cost of the package's
+    default run (augmented Lagrangian, quadratic MI model, strict stop), non-dimensional.
+    """
+
+    alpha: float
+    n_nodes: int
+    max_iter: int
+    runs: dict
+
+    @property
+    def reference(self) -> float:
+        return self.runs["AL + quadratic, strict"].cost
+
+    def gap(self, label: str) -> float:
+        """Cost of run ``label`` minus the reference (non-dimensional; positive: worse)."""
+        return self.runs[validation.choice(label, "label", tuple(self.runs))].cost - self.reference
+
+    def summary(self) -> str:
+        lines = [f"test case 1, alpha_h = {self.alpha:g}, {self.n_nodes} nodes, at most {self.max_iter} iterations; "
+                 f"practical rule: {PRACTICAL_STOP.window} accepted steps with defects <= "
+                 f"{PRACTICAL_STOP.defect_tol:g} and relative cost change <= {PRACTICAL_STOP.cost_tol:g}",
+                 f"{'run':<27} {'stops':>10} {'iter':>5} {'cost':>14} {'- reference':>12} {'defect':>8} {'eta':>8} "
+                 f"{'on TR':>6}"]
+        if not self.runs["AL + quadratic, strict"].converged:
+            lines.insert(1, "(the reference run did not converge within the limit: distances are to its last iterate)")
+        for r in self.runs.values():
+            lines.append(f"{r.label:<27} {(r.stopped_by or 'no'):>10} {r.iterations:5d} {r.cost:14.10f} "
+                         f"{r.cost - self.reference:12.2e} {r.max_defect:8.1e} {r.eta:8.1e} {r.tr_active:6.0%}"
+                         + ("" if r.converged else f"  ({r.outcome})"))
+        return "\n".join(lines)
+
+
+def _variant_task(problem: tuple, label: str) -> VariantRun:
+    """One run of :func:`printed_method_study` (module level: picklable for an executor)."""
+    system, t, x_ball, u_ball, u_max, x_final, info, k_ws, alpha, max_iter = problem
+    method, model, practical = VARIANTS[label]
+    st = scvx.SCvxSettings(method=method, information_model=model, max_iter=max_iter)
+    try:
+        r = scvx.solve_scvx(system, t, x_ball, u_ball, u_max, x_final=x_final, info=info, info_node=k_ws, alpha=alpha,
+                            settings=st, practical_stop=PRACTICAL_STOP if practical else None)
+        hist, ok, by, outcome = r.history, True, r.stopped_by, f"{r.stopped_by} stop after {r.iterations} iterations"
+    except scvx.SCvxError as exc:
+        hist, ok, by, outcome = exc.history, False, "", exc.reason
+    acc = [h for h in hist if h["accepted"]]
+    last = acc[-1] if acc else None
+    cost = (1.0 - alpha) * last["impulse"] - alpha * last["information"] if last else float("nan")
+    return VariantRun(label, method, model, practical, ok, by, outcome, len(hist), float(cost),
+                      float(last["max_defect"]) if last else float("nan"), float(hist[-1]["eta"]) if hist else float("nan"),
+                      float(np.mean([h["tr_active"] for h in hist])) if hist else float("nan"), hist)
+
+
+def printed_method_study(n_nodes: int, *, alpha: float = 5e-3, max_iter: int = 300, sigma: float = 1.0,
+                         labels=None, executor=None) -> PrintedMethodStudy:
+    """Test case 1 (information reward at weight ``alpha``) from the ballistic DRO by each variant of :data:`VARIANTS`.
+
+    Parameters
+    ----------
+    n_nodes : int
+        Sundman nodes (window ends moved onto nodes).
+    alpha : float
+        Homotopy weight in (0, 1].
+    max_iter : int
+        Iteration limit of every run.
+    sigma : float
+        Sundman exponent.
+    labels : sequence of str, optional
+        Subset of :data:`VARIANTS` (default all); the reference run is always included.
+    executor : optional
+        Runs the variants side by side (:func:`cislunar.utils.montecarlo.map_tasks`); results do not depend on it.
+    """
+    n = validation.integer(n_nodes, "n_nodes", minimum=4)
+    alpha = validation.in_range(alpha, "alpha", 0.0, 1.0)
+    if alpha == 0.0:
+        raise ValueError("alpha must be > 0 (the information reward is what the linear model approximates)")
+    max_iter = validation.integer(max_iter, "max_iter", minimum=1)
+    sigma = validation.positive(sigma, "sigma", allow_zero=True)
+    chosen = list(VARIANTS) if labels is None else list(labels)
+    for lab in chosen:
+        validation.choice(lab, "labels", tuple(VARIANTS))
+    chosen = ["AL + quadratic, strict"] + [lab for lab in chosen if lab != "AL + quadratic, strict"]
+    _checks.executor(executor)
+    sc = scenarios.test_case_1()
+    t, k_ws, _ = sc.node_times(n, sigma)
+    x_ball, u_ball = sc.ballistic_guess(t)
+    problem = (sc.system, t, x_ball, u_ball, sc.control_bounds(t), np.asarray(sc.observer_xf), sc.information_model(),
+               int(k_ws), float(alpha), max_iter)
+    runs = map_tasks(functools.partial(_variant_task, problem), chosen, executor=executor, progress=False,
+                     desc="SCvx variants")
+    return PrintedMethodStudy(float(alpha), n, max_iter, {r.label: r for r in runs})
+
+
+# ---------------------------------------------------------------------------------------------------------------
 # Figures
 # ---------------------------------------------------------------------------------------------------------------
 
@@ -305,4 +454,36 @@ def figure_converged_control(problem: TransferProblem, u, shooting: ShootingChec
     ax2.set(xlabel=r"$\Delta x$ [km]", ylabel=r"$\Delta y$ [km]",
             title="converged minus initial DRO, at the nodes (rotating frame)")
     ax2.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=2, frameon=False)
+    return fig
+
+
+def figure_printed_method(study: PrintedMethodStudy):
+    """Each variant of :func:`printed_method_study`: distance of the cost to the reference optimum after each
+    accepted step (non-dimensional), and the largest defect after each step (LU or LU/TU)."""
+    validation.instance(study, "study", PrintedMethodStudy)
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.6), layout="constrained")
+    styles = {"AL + quadratic, strict": ("C0", "-"), "AL + linear, strict": ("C2", "--"),
+              "AL + linear, practical": ("C2", "-"), "L1 + linear, practical": ("C3", "-"),
+              "L1 + quadratic, practical": ("C1", "-")}
+    a, ref = study.alpha, study.reference
+    for lab, r in study.runs.items():
+        color, ls = styles.get(lab, ("0.5", "-"))
+        acc = [h for h in r.history if h["accepted"]]
+        it = np.array([h["iteration"] + 1 for h in acc])
+        cost = np.array([(1 - a) * h["impulse"] - a * h["information"] for h in acc])
+        end = "stops" if r.converged else "no stop"
+        ax1.semilogy(it, np.maximum(np.abs(cost - ref), 1e-12), ls, color=color, lw=1.2,
+                     label=f"{lab} ({end}, {r.iterations} it)")
+        ax2.semilogy([h["iteration"] + 1 for h in r.history], [max(h["max_defect"], 1e-16) for h in r.history], ls,
+                     color=color, lw=1.0)
+    ax1.axhline(1e-6, color="0.4", ls=":", lw=0.8)
+    ax1.set(xlabel="iteration [-]", ylabel="|cost - reference optimum| [non-dim.]\n(accepted steps)",
+            title=rf"test case 1, $\alpha_h$ = {a:g}: distance to the optimum")
+    ax2.axhline(PRACTICAL_STOP.defect_tol, color="0.4", ls="--", lw=0.8, label="practical rule: defects")
+    ax2.set(xlabel="iteration [-]", ylabel="largest defect after the step [LU or LU/TU]", title="defects")
+    for ax in (ax1, ax2):
+        ax.xaxis.set_major_locator(plt.MaxNLocator(integer=True))
+    ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.17), ncol=2, frameon=False)
+    ax2.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.17), frameon=False)
+    fig.suptitle("The printed SCvx (L1 exact penalty, linear MI model) against the package's ingredients")
     return fig

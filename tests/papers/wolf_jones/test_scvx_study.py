@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from cislunar.guidance import scvx
+from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.papers.wolf_jones import scvx_study as S
 
 
@@ -74,3 +75,32 @@ def test_a_tighter_thrust_bound_reaches_the_problem(problem):
     tight = S.transfer_problem(16, 1.0, a_max_km_s2=1e-8)
     assert tight.scenario.a_max == pytest.approx(0.01 * problem.scenario.a_max)
     assert np.allclose(tight.u_max, 0.01 * problem.u_max) and np.array_equal(tight.t, problem.t)
+
+
+def test_printed_method_study_costs_are_the_objective_of_independent_runs():
+    """The reference row is the package's default run (re-solved here independently: the same cost to round-off);
+    each row's cost is (1 - alpha) impulse - alpha MI of its last accepted step, and gaps are cost differences."""
+    study = S.printed_method_study(10, alpha=5e-3, max_iter=60, labels=["L1 + linear, practical"])
+    assert list(study.runs) == ["AL + quadratic, strict", "L1 + linear, practical"]
+    ref = study.runs["AL + quadratic, strict"]
+    assert ref.converged and ref.stopped_by == "strict"
+    sc = wj.test_case_1()
+    t, k_ws, _ = sc.node_times(10, 1.0)
+    x0, u0 = sc.ballistic_guess(t)
+    info = sc.information_model()
+    res = scvx.solve_scvx(sc.system, t, x0, u0, sc.control_bounds(t), x_final=sc.observer_xf, info=info,
+                          info_node=k_ws, alpha=5e-3)
+    assert ref.cost == pytest.approx(res.cost, rel=1e-12, abs=1e-14)
+    assert res.cost == pytest.approx((1 - 5e-3) * res.impulse - 5e-3 * info(res.x[k_ws], 0), rel=1e-12)
+    pen = study.runs["L1 + linear, practical"]
+    assert pen.method == "penalty" and pen.information_model == "linear" and pen.practical
+    last = [h for h in pen.history if h["accepted"]][-1]
+    assert pen.cost == pytest.approx((1 - 5e-3) * last["impulse"] - 5e-3 * last["information"], rel=1e-14)
+    assert study.gap(pen.label) == pytest.approx(pen.cost - ref.cost, rel=1e-14)
+    if not pen.converged:  # a run that does not stop says why, and never claims a practical stop
+        assert pen.stopped_by == "" and pen.outcome
+    assert "L1 + linear, practical" in study.summary()
+    with pytest.raises(ValueError, match="labels"):
+        S.printed_method_study(10, labels=["L2 + cubic"])
+    with pytest.raises(ValueError, match="alpha"):
+        S.printed_method_study(10, alpha=0.0)

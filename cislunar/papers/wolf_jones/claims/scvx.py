@@ -4,14 +4,26 @@
 Declarations only.  Tolerances fixed before the run: converged node defects at most 1e-9 LU; the converged control,
 re-flown by single shooting, within 1 km of x_f; a superlinear rate needs at least that every step shrink the
 largest defect by half (a ratio of successive largest defects at most 0.5); zero thrust in the window exactly (an
-imposed input, so a derived row, not evidence for the paper).  Convergence is shown at alpha_h = 0 only (the
-information reward is notebooks 05-06's).  The two documented departures from the printed method (augmented
+imposed input, so a derived row, not evidence for the paper).  The rows of sections 2-4 are at alpha_h = 0 (no
+information reward); section 5's rows (below) are at alpha_h = 5e-3.  The two documented departures from the printed method (augmented
 Lagrangian; noise rule and cap of the trust region) are rows that differ by construction.
+
+The printed method, fairly (section 6 of notebook 03, issue 22 item 4): test case 1 with the information reward at
+alpha_h = 5e-3, from the ballistic DRO, by each combination of the paper's ingredients (L1 exact penalty, linear MI
+model of Eq. 44) and ours (augmented Lagrangian, concave-quadratic MI model).  The practical stopping rule
+(``scvx_study.PRACTICAL_STOP``: five consecutive accepted steps with the largest defect <= 1e-8 and a relative
+cost change <= 1e-8) was fixed before any run.  The cost tolerance of "reaches the optimum", |cost - reference| <=
+1e-6 (non-dimensional cost of about 0.54, so ~2e-6 relative), was fixed after a first exploratory run on 40 nodes
+(printed method 3.7e-5 away, augmented Lagrangian with the linear model 1.5e-9 away): every tolerance between 1e-8
+and 3e-5 gives the same verdicts.
 """
 
 from __future__ import annotations
 
 from cislunar.publish.claims import AtMost, Claim, Equals, Holds
+
+#: |cost - reference optimum| (non-dimensional) within which a run "reaches the optimum" (module docstring).
+OPTIMUM_TOL = 1e-6
 
 CLAIMS = {
     "defects": Claim(
@@ -52,4 +64,32 @@ CLAIMS = {
         source="Eq. 36, Table 1",
         reason="documented choice: a noise rule sets rho = 1 when the predicted decrease is at the subproblem's noise "
                "level, and eta is capped at eta_max"),
+    "printed_stops": Claim(
+        "printed SCvx (L1 exact penalty, linear MI model of Eq. 44) stops, test case 1 at alpha_h = 5e-3, under the "
+        "practical rule", "converges (implied: Figs. 2 and 5 show converged plans)",
+        Holds("the run meets the practical stopping rule within its iteration limit"),
+        source="Eqs. 42-44; Figs. 2, 5",
+        reason="the L1 exact penalty creeps: with the defects down to ~1e-8 every step still sits on the trust-region "
+               "boundary, the second-order defects of a step of size eta cost gamma O(eta^2) against a predicted gain "
+               "O(eta), so rho stays at 0.1-0.2 and eta at 1e-4 to 4e-4, and the cost still falls by a few 1e-6 "
+               "(relative) per step when the limit is reached"),
+    "printed_gap": Claim(
+        "printed SCvx: last iterate's cost against the optimum (our solver)", "-",
+        AtMost(OPTIMUM_TOL), kind="beyond paper",
+        reason="the printed method is still creeping towards the optimum when the iteration limit is reached"),
+    "al_linear": Claim(
+        "augmented Lagrangian with the paper's linear MI model (Eq. 44), practical rule", "-",
+        Holds(f"stops under the practical rule at a cost within {OPTIMUM_TOL:g} of the optimum"), kind="beyond paper",
+        reason="the augmented Lagrangian with the linear model does not reach the optimum under the practical rule"),
+    "stopping_test": Claim(
+        "stopping test", "not printed (Eqs. 34-36 give the ratio test only)", kind="not in paper",
+        reason="ours: the strict test (accepted step, defects <= 5e-10, cost change <= 1e-8 (1 + |J|), inactive trust "
+               "region) by default; the practical rule (the same without the trust-region condition, held for five "
+               "accepted steps) as an option"),
+    "failing_ingredient": Claim(
+        "which printed ingredient fails", "-",
+        Holds("the L1 exact-penalty runs (linear and quadratic MI model) do not stop within the limit while the "
+              "augmented Lagrangian with the linear MI model stops under the practical rule"),
+        kind="beyond paper",
+        reason="the ingredient that fails is not the L1 exact penalty alone (see the runs of section 5 of notebook 03)"),
 }
