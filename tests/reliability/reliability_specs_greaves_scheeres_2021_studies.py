@@ -58,6 +58,16 @@ def burn_inputs():
 
 
 @functools.lru_cache(maxsize=None)
+def variants():
+    return ads.variant_study(setup(), np.array([3.0]), 1, np.random.default_rng(0))
+
+
+@functools.lru_cache(maxsize=None)
+def fig8():
+    return ads.fig8_variants(setup(), burn_inputs())
+
+
+@functools.lru_cache(maxsize=None)
 def big_run():
     return ads.adaptive_run(setup(), burn_inputs())
 
@@ -194,6 +204,23 @@ def specs(Spec, lazy):
     s.append(S("closing_rows.adaptive_studies", ads.closing_rows,
                dict(null=lazy(null), big=lazy(big_run), delays=lazy(delays), rules=lazy(rules), q_base_km2_s3=1e-18),
                dict(null="instance", big="instance", delays="instance", rules="instance", q_base_km2_s3="pos")))
+    s.append(S("variant_setup", ads.variant_setup, dict(setup=lazy(setup), measurement_set="angles only"),
+               dict(setup="instance", measurement_set="choice")))
+    s.append(S("variant_data", ads.variant_data,
+               dict(setup=lazy(setup), inputs=lazy(burn_inputs), measurement_set="rates 1 TU"),
+               dict(setup="instance", inputs="instance", measurement_set="choice")))
+    s.append(S("rate_noise_floor", ads.rate_noise_floor, dict(setup=lazy(setup), inputs=lazy(burn_inputs), epoch=2),
+               dict(setup="instance", inputs="instance", epoch="int0")))
+    s.append(S("variant_study", ads.variant_study,
+               dict(setup=lazy(setup), magnitudes_m_s=np.array([3.0]), n_per_magnitude=1, rng=rng, max_resets=5,
+                    executor=None),
+               dict(setup="instance", magnitudes_m_s="vec", n_per_magnitude="int1", rng="rng", max_resets="int1",
+                    executor="instance_opt")))
+    s.append(S("fig8_variants", ads.fig8_variants, dict(setup=lazy(setup), inputs=lazy(burn_inputs), max_resets=5),
+               dict(setup="instance", inputs="instance", max_resets="int1")))
+    s.append(S("fig8_report", ads.fig8_report, dict(variants=lazy(fig8)), dict(variants="iterable")))
+    s.append(S("variant_rows", ads.variant_rows, dict(variants=lazy(variants), fig8=lazy(fig8)),
+               dict(variants="instance", fig8="iterable")))
     # detection_studies (notebook 10) ------------------------------------------------------------------------------
     s.append(S("accuracy_standard_error", ds.accuracy_standard_error, dict(paper=0.97, n=200),
                dict(paper="range:0:1", n="int1")))

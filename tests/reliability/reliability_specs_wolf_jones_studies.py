@@ -260,6 +260,7 @@ def specs(Spec, lazy):
                dict(n_samples="int2", rng="rng", p="pos", h="real", r="pos")))
     s.append(S("constant_velocity_toy", mis.constant_velocity_toy, dict(dt=1.0, n_times=3, psd=0.01, r=0.25),
                dict(dt="pos", n_times="int2", psd="nonneg", r="pos")))
+    s.append(S("reference_period", mis.reference_period, dict(system=em), dict(system="system")))
     s.append(S("case_2_window", mis.case_2_window,
                dict(system=em, t=lz(lambda: window().t), range_sigma_km=0.1, range_rate_sigma_km_s=1e-5),
                dict(system="system", t="grid_opt", range_sigma_km="pos", range_rate_sigma_km_s="pos")))
