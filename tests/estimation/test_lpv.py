@@ -202,6 +202,18 @@ def test_norms_against_python_control():
         assert lpv.hinf_norm(A, B, C) == pytest.approx(control.norm(sys, p="inf", tol=1e-10), rel=1e-6)
 
 
+def test_batched_sigma_max_equals_one_frequency_at_a_time():
+    """The H-infinity kernel evaluates its frequency grid in one batched call: the largest singular value of
+    C (jwI - A)^-1 B at each frequency, as the one-frequency form computes it (and, at w = 0, the DC gain's)."""
+    rng = np.random.default_rng(7)
+    A = rng.standard_normal((4, 4)) - 3 * np.eye(4)
+    B, C = rng.standard_normal((4, 5)), rng.standard_normal((2, 4))
+    w = np.concatenate([[0.0], np.geomspace(1e-3, 1e3, 25)])
+    one = np.array([lpv._sigma_max(A, B, C, x) for x in w])
+    assert lpv._sigma_max_many(A, B, C, w) == pytest.approx(one, rel=1e-13)
+    assert one[0] == pytest.approx(np.linalg.norm(C @ np.linalg.solve(-A, B), 2), rel=1e-12)
+
+
 @pytest.mark.parametrize("zeta", [0.15, 0.3, 0.45, 0.6])
 @pytest.mark.parametrize("omega", [0.37, 3.7, 41.0])
 def test_hinf_norm_second_order_closed_form(zeta, omega):

@@ -270,9 +270,17 @@ class ObjectiveStudy:
     sparsity_tol: float
     same_tol: float
 
+    def _solved(self, objective: str) -> str:
+        objective = validation.choice(objective, "objective", OBJECTIVES)
+        if any((objective, n) not in self.designs for n in NORMS):
+            solved = sorted({k[0] for k in self.designs})
+            raise ValueError(f"objective {objective!r} was not solved in this study (objective_norm_study's "
+                             f"objectives); solved: {solved}")
+        return objective
+
     def same_theta1(self, objective: str) -> bool:
         r""":math:`|\kappa_{\sin}/\kappa_{\cos} - 1| <` ``same_tol`` for both norms under ``objective``."""
-        objective = validation.choice(objective, "objective", OBJECTIVES)
+        objective = self._solved(objective)
         return all(abs(self.designs[(objective, n)].kappa[0] / self.designs[(objective, n)].kappa[1] - 1)
                    < self.same_tol for n in NORMS)
 
@@ -284,34 +292,50 @@ class ObjectiveStudy:
 
     def all_used(self, objective: str) -> bool:
         """Both theorems use all six sensors under ``objective``."""
-        objective = validation.choice(objective, "objective", OBJECTIVES)
+        objective = self._solved(objective)
         return all(self.designs[(objective, n)].used.all() for n in NORMS)
 
     @property
     def six_equal_linf(self) -> bool:
         """With p = inf the six precisions agree within ``same_tol`` (relative), for both norms."""
+        self._solved("linf")
         return all(np.ptp(self.designs[("linf", n)].kappa) < self.same_tol * self.designs[("linf", n)].kappa.max()
                    for n in NORMS)
 
 
 def objective_norm_study(scenario: Scenario, designs: Designs, *, sparsity_tol: float = 1e-4,
-                         same_tol: float = 1e-3) -> ObjectiveStudy:
-    """Solve the six-sensor problems with p = 2 and p = inf (p = 1 is ``designs.all``)."""
+                         same_tol: float = 1e-3, objectives=("l2", "linf")) -> ObjectiveStudy:
+    """Solve the six-sensor problems with p = 2 and p = inf (p = 1 is ``designs.all``).
+
+    ``objectives`` (a subset of ``("l2", "linf")``, at least one) selects which are solved (each is two 64-vertex
+    solves; the tests ask for one).
+    """
     scenario = validation.instance(scenario, "scenario", Scenario)
     designs = validation.instance(designs, "designs", Designs)
     sparsity_tol = validation.in_range(sparsity_tol, "sparsity_tol", 0.0, 1.0)
     same_tol = validation.positive(same_tol, "same_tol")
+    objectives = validation.one_or_many(objectives, "objectives", str, "objective name")
+    objectives = [validation.choice(o, "objectives", ("l2", "linf")) for o in objectives]
     V = scenario.box.vertices()
     out = {("l1", n): designs.all[n] for n in designs.all}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # p = inf, Hinf may end optimal_inaccurate: reported
         for obj in ("l2", "linf"):
+            if obj not in objectives:
+                continue
             for n in NORMS:
+                lmi = lpv.PrecisionLMI.for_cr3bp(scenario.model, V, n, objective=obj, **_pole_kw(n, designs.pole_radius))
+                if (obj, n) == ("l2", "hinf"):
+                    # p = 2 H-infinity ends optimal_inaccurate at its default scaling (boxes from 600 to 4000 orbit
+                    # samples), as p = 1 does (paper_designs); start at the first scaling solve() retries, which then
+                    # tries the default one later: the same problem objects and solves, the same first 'optimal'
+                    # design.  Quick box (600): optimal at once, one failed 64-vertex solve fewer; full box (4000):
+                    # optimal only at (30, balanced), the fifth either way (no saving)
+                    lmi = lmi.rescaled(lpv.RETRY_SCALINGS[0][0], lmi.balanced_state_scale)
                 # p = inf, H-infinity: no scaling of the retry list reaches optimal (all end optimal_inaccurate, and
                 # solve() then returns the first, default-scaled solution): solved once, its status reported
-                out[(obj, n)] = lpv.PrecisionLMI.for_cr3bp(scenario.model, V, n, objective=obj,
-                                                           **_pole_kw(n, designs.pole_radius)).solve(
-                    designs.gamma, sparsity_tol=sparsity_tol, retry=not (obj == "linf" and n == "hinf"))
+                out[(obj, n)] = lmi.solve(designs.gamma, sparsity_tol=sparsity_tol,
+                                          retry=not (obj == "linf" and n == "hinf"))
     return ObjectiveStudy(out, sparsity_tol, same_tol)
 
 
