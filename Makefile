@@ -14,6 +14,9 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export PYTHONHASHSEED := 0
 export JUPYTER_PREFER_ENV_PATH := 1
+# Byte code in .venv/pycache, never beside the sources (measured gain and reasons above the test target)
+export PYTHONPYCACHEPREFIX := $(CURDIR)/$(VENV)/pycache
+export PYTHONDONTWRITEBYTECODE :=
 # hypothesis keeps its example database and caches in the venv, not in the repository
 export HYPOTHESIS_STORAGE_DIRECTORY ?= $(CURDIR)/.venv/hypothesis
 
@@ -53,6 +56,14 @@ lock: $(STAMP)
 	$(VENV)/bin/uv pip compile pyproject.toml --extra notebooks --extra book --extra cluster --extra test \
 	    --python-version 3.11 --python-platform linux --generate-hashes --no-header -q -o requirements.lock
 
+# (the two exports are at the top of this file and serve every target: `make reproduce` starts a kernel per notebook)
+# Byte code of every module (standard library, site-packages, cislunar, pytest's rewritten test modules) is kept in
+# .venv/pycache, the scratch folder, never beside the sources (where it would also fail the repository check below).
+# `make test` starts dozens of Python processes (two workers, a kernel per notebook and per runner test, spawned
+# pools); without written byte code (PYTHONDONTWRITEBYTECODE=1 here, and uv installs none) each one compiled numpy,
+# scipy, matplotlib, cvxpy and cislunar again.  Measured 2026-11-26 (2 cores, load 5-9) on a uv-installed venv:
+# importing that stack 4.3 s CPU per process against 1.8 s with this cache warm; the runner and notebook unit tests
+# (10 tests, ~11 processes) 42-44 s against 22 s CPU; collecting the suite 10.6 against 6.0 s per worker.
 test: $(STAMP)
 	@$(REPO_STATE) > $(VENV)/repo-state-before
 	@$(PYTEST) -n 2 --dist loadgroup tests; status=$$?; \

@@ -105,14 +105,24 @@ class QuickRuns:
 #    single tests last, so that many small units even out the workers' finish.
 # 3. The expected quick-mode seconds of each notebook come from the last run (pytest's cache) or, on a fresh clone,
 #    from the table below (quick mode on an idle core, issue 12 budget <= 30 s each).
+# 4. Longest first inside each rank too: every work unit's seconds (a group's summed over its tests) of the last
+#    `-n 2 --dist loadgroup` run are kept in pytest's cache, and the groups and the single tests are handed out in
+#    decreasing expected seconds (units never timed keep collection order: groups first, single tests last), so
+#    the last units of the run are the shortest ones and the two workers finish together.
 QUICK_SECONDS = {"01": 7, "02": 8, "03": 9, "04": 7, "05": 30, "06": 30, "07": 20, "08": 21, "09": 30, "09b": 30,
                  "10": 30, "11": 30, "12": 30}
 _CACHE_KEY = "cislunar/quick-notebook-seconds"
+_UNIT_KEY = "cislunar/work-unit-seconds"
 
 
 def pytest_configure(config):
     if hasattr(config.option, "loadscopereorder"):
         config.option.loadscopereorder = False  # keep the order of pytest_collection_modifyitems (rule 2)
+
+
+def _unit(nodeid: str, group: str | None) -> str:
+    """The xdist work unit of a test: its group (all its tests run in one worker), else the test itself."""
+    return f"group:{group}" if group is not None else nodeid
 
 
 def _expected_seconds(config, stem: str) -> float:
@@ -134,21 +144,32 @@ def pytest_collection_modifyitems(config, items):
                 return f"module-fixtures:{item.path.name}"
         return None
 
+    units = config.cache.get(_UNIT_KEY, {}) if getattr(config, "cache", None) is not None else {}
+
     def rank(item):
         marker = item.get_closest_marker("xdist_group")
         callspec = getattr(item, "callspec", None)
         source = callspec.params.get("source") if callspec is not None else None
         if item.get_closest_marker("notebook") and marker is None and isinstance(source, Path):
             return (0, -_expected_seconds(config, source.stem))  # one notebook per unit, longest first
-        if marker is None:
-            return (3, 0.0)  # single tests last: many small units even out the two workers' finish
-        return (2, 0.0) if marker.args and marker.args[0] == "book" else (1, 0.0)
+        if marker is None:  # single tests last, longest first (rule 4): the small ones even out the finish
+            return (3, -float(units.get(_unit(item.nodeid, None), 0.0)))
+        if marker.args and marker.args[0] == "book":
+            return (2, 0.0)
+        return (1, -float(units.get(_unit(item.nodeid, _group_name(item)), float("inf"))))
 
     for item in items:
         group = module_group(item)
         if group is not None:
             item.add_marker(pytest.mark.xdist_group(group))
     items[:] = [it for _, it in sorted(enumerate(items), key=lambda p: (rank(p[1]), p[0]))]
+
+
+def _group_name(item) -> str | None:
+    """The name xdist's loadgroup gives the unit of ``item`` (its ``xdist_group`` marks joined), or ``None``."""
+    names = sorted({str(m.args[0] if m.args else m.kwargs.get("name", "default"))
+                    for m in item.iter_markers("xdist_group")})
+    return "_".join(names) if names else None
 
 
 @pytest.hookimpl(trylast=True, specname="pytest_collection_modifyitems")
@@ -161,16 +182,32 @@ def pytest_collection_modifyitems_xdist_scopes(config, items):
     from _pytest.nodeid import NodeId
 
     for item in items:
-        names = sorted({str(m.args[0] if m.args else m.kwargs.get("name", "default"))
-                        for m in item.iter_markers("xdist_group")})
-        if names and "@" not in item.nodeid and hasattr(item, "_id"):
-            item._id = NodeId.parse(f"{item.nodeid}@{'_'.join(names)}")
+        group = _group_name(item)
+        if group is not None and "@" not in item.nodeid and hasattr(item, "_id"):
+            item._id = NodeId.parse(f"{item.nodeid}@{group}")
+
+
+_UNIT_SECONDS: dict = {}  # controller side: seconds of each work unit run in this session (rule 4)
+
+
+def pytest_runtest_logreport(report):
+    """Add a test phase's seconds to its work unit (on the xdist controller, whose node ids carry ``@group``)."""
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        return
+    nodeid, _, group = report.nodeid.rpartition("@") if "@" in report.nodeid else (report.nodeid, "", "")
+    key = _unit(nodeid, group or None)
+    _UNIT_SECONDS[key] = _UNIT_SECONDS.get(key, 0.0) + float(getattr(report, "duration", 0.0) or 0.0)
 
 
 def pytest_sessionfinish(session):
-    """Remember how long each quick notebook took (rule 3), from the shared run records of this session."""
+    """Remember how long each work unit (rule 4) and each quick notebook (rule 3, from the shared run records of
+    this session) took."""
     if os.environ.get("PYTEST_XDIST_WORKER") or getattr(session.config, "cache", None) is None:
         return
+    if getattr(session.config.option, "dist", "no") == "loadgroup" and _UNIT_SECONDS:  # rule 4, `make test` only
+        units = dict(session.config.cache.get(_UNIT_KEY, {}))
+        units.update({k: round(v, 2) for k, v in _UNIT_SECONDS.items()})
+        session.config.cache.set(_UNIT_KEY, units)
     factory = getattr(session.config, "_tmp_path_factory", None)
     if factory is None or factory._basetemp is None:
         return
