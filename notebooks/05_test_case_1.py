@@ -33,7 +33,7 @@
 
 # %% tags=["parameters"]
 QUICK = False
-SEED = 0  # no random draws in this chapter: every computation is deterministic
+SEED = 0  # seed of the random perturbation starts of the multi-start (Section 3); everything else is deterministic
 OUTPUT_DIR = ""
 N_NODES = None  # Sundman-spaced nodes over the two periods; the paper does not give its N (None: 18 quick, 40 full)
 N_NODES_ALT = None  # node count of the second grid of the mesh check, Section 5 (None: 20 quick, 28 full)
@@ -45,7 +45,15 @@ PENALTY_GAMMAS = None  # exact-penalty weights gamma swept, unstated in the pape
 BUDGETS_EXTRA_MPS = None  # impulse budgets above the baseline's, Section 8, m/s (None: [5] quick, [1, 5, 20] full)
 BUDGET_RTOL = 0.02  # a budget counts as met within this relative tolerance (fixed before solving)
 FORWARD_HESSIAN = None  # forward (True) or central (False) differences for the MI Hessian (None: True quick, False full)
-WORKERS = None  # local processes for the exact-penalty runs of Section 4, 1 runs serially (None: 1 quick, 2 full)
+MS_ALPHAS = None  # weights solved from several starts in Section 3, a subset of ALPHAS (None: [5e-3] quick, all full)
+MS_RANDOM = None  # random perturbation starts per weight in the multi-start (None: 1 quick, 1 full)
+MS_SEEDS_Z = None  # +z and -z seeded starts in the multi-start (None: False quick, True full)
+MESH_NODES = None  # node counts of the mesh study besides N_NODES, Section 5 (None: [14] quick, [20, 30, 60] full)
+MESH_ALPHAS = None  # weights of the mesh study, in ALPHAS (None: [5e-3] quick, [5e-3, 2e-2] full)
+MESH_RTOL = 0.05  # a weight's plan has converged in the mesh when impulse, MI and RMS change by at most this much
+#                   between the two finest grids (fixed before solving)
+WORKERS = None  # local processes for the multi-start, the mesh study and the exact-penalty runs, 1 runs serially
+#                 (None: 1 quick, 2 full)
 SCHEDULER = ""  # address of a Dask scheduler to run them on, e.g. "tcp://10.0.0.5:8786" ("": none; WORKERS applies)
 
 # %%
@@ -60,13 +68,20 @@ penalty_gammas = PENALTY_GAMMAS if PENALTY_GAMMAS is not None else ([1e1, 1e3, 1
 budgets_extra_mps = BUDGETS_EXTRA_MPS if BUDGETS_EXTRA_MPS is not None else ([5.0] if QUICK else [1.0, 5.0, 20.0])
 forward_hessian = FORWARD_HESSIAN if FORWARD_HESSIAN is not None else QUICK
 workers = WORKERS if WORKERS is not None else (1 if QUICK else 2)
+ms_alphas = MS_ALPHAS if MS_ALPHAS is not None else ([5e-3] if QUICK else list(alphas))
+ms_random = MS_RANDOM if MS_RANDOM is not None else 1
+ms_seeds_z = MS_SEEDS_Z if MS_SEEDS_Z is not None else not QUICK
+mesh_nodes = MESH_NODES if MESH_NODES is not None else ([14] if QUICK else [20, 30, 60])
+mesh_alphas = MESH_ALPHAS if MESH_ALPHAS is not None else ([5e-3] if QUICK else [5e-3, alphas[-1]])
 if 5e-3 not in alphas:
     raise ValueError(f"ALPHAS must contain 5e-3 (Figs. 1 and 3, Section 4, the mesh check); got {alphas}")
+
+import dataclasses
 
 import numpy as np
 
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
-from cislunar.papers.wolf_jones import figures
+from cislunar.papers.wolf_jones import figures, global_search
 from cislunar.papers.wolf_jones import scenarios as wolf_jones
 from cislunar.papers.wolf_jones import test_case_studies as studies
 from cislunar.papers.wolf_jones.claims.test_case_1 import CLAIMS
@@ -76,7 +91,7 @@ from cislunar.utils.executors import open_executor
 
 plotting.use_style()
 out = OUTPUT_DIR or None
-rng = np.random.default_rng(SEED)  # not used: every computation here is deterministic
+rng = np.random.default_rng(SEED)  # the multi-start's random perturbation starts (Section 3)
 table = ComparisonTable("05 Wolf & Jones test case 1 (Tables 2-3, Figs. 1-5)")
 MPS = em.velocity_unit_km_s * 1e3
 
@@ -160,7 +175,41 @@ case = studies.sweep_test_case_1(sc, n_nodes, alphas, sigma=SIGMA, forward_hessi
 
 # %%
 print(case.summary())  # nodes, the ballistic guess, every SCvx run of both sweeps, the best per weight
+sweep_best = list(case.best)  # kept to report what the multi-start below changes
+
+# %% [markdown]
+# **Several starts per weight.** Two sweeps are two starts per weight at most, both warm starts from neighbouring
+# optima. How good is their best? `global_search.multi_start` solves each weight again from several starts: the
+# ballistic guess, a $+z$ and a $-z$ seed (a small out-of-plane thrust before the window; the problem is planar, so
+# these test whether leaving the plane pays), random perturbations of the control (a Gaussian direction of 5 % of
+# $a_{max}$ per node, drawn from the notebook's generator before anything is solved), and, in a second round, the
+# best plan of each neighbouring weight. The sweep's plans count as starts too, so the multi-start can only match or
+# beat them. Two converged plans are the *same* local optimum when their costs agree within $10^{-6}(1+|J|)$ and
+# their node positions (or one's and the other's $z$-mirror) never lie more than 100 km apart; otherwise they are
+# *distinct* (tolerances fixed before the runs). The table gives, per weight, how many starts converged, how many
+# distinct optima they reached, and the spread of their costs.
+
+# %%
+with open_executor(workers, SCHEDULER) as executor:
+    ms = global_search.multi_start(case.solver, ms_alphas, rng=rng, n_random=ms_random, seeds_z=ms_seeds_z,
+                                   known=global_search.known_from_sweep(case.sweep, ms_alphas), executor=executor)
+print(ms.summary())
+ms_better = ms.improvements([sweep_best[alphas.index(a)] for a in ms_alphas])
+print("better than the sweep's best: " + ("; ".join(
+    f"alpha_h {a:g}: cost {c0:.6f} -> {c1:.6f} (from {lab})" for a, c0, c1, lab in ms_better) or "nowhere"))
+
+# %% [markdown]
+# **What the rest of the chapter uses.** Where a start beats the sweep, its plan replaces the sweep's best at that
+# weight (`global_search.adopt`): every later section, figure and closing row reads the best plan found per weight.
+# The impulse and information of the replaced plans are printed (old -> new), so the sweep's numbers stay on record.
+
+# %%
+case = dataclasses.replace(case, sweep=global_search.adopt(case.sweep, ms))
 best, impulse_mps, mi = case.best, case.impulse_mps, case.mi
+for a, _, _, lab in ms_better:
+    i_ = alphas.index(a)
+    print(f"alpha_h {a:g}: impulse {sweep_best[i_].impulse * MPS:.3f} -> {impulse_mps[i_]:.3f} m/s, MI "
+          f"{sweep_best[i_].information:.3f} -> {mi[i_]:.3f} nats (from {lab})")
 
 # %% [markdown]
 # ## 4 · One convergence history, and the exact penalty for comparison
@@ -210,6 +259,25 @@ mesh = studies.mesh_check(case, n_nodes_alt, 5e-3, sigma=SIGMA)
 print(mesh.summary())
 
 # %% [markdown]
+# **Mesh study.** One second grid says little about convergence. `global_search.mesh_study` solves the headline
+# weights on several Sundman grids (up to 60 nodes in the full run), each from the figures' plan interpolated onto
+# the grid and (full run only) from the ballistic guess, and keeps the better. A weight's plan counts as converged
+# in the mesh when impulse, MI and terminal RMS change by at most `MESH_RTOL` (5 %, fixed before solving) between
+# the two finest grids. The figures use the `N_NODES` grid (printed).
+
+# %%
+with open_executor(workers, SCHEDULER) as executor:
+    mstudy = global_search.mesh_study(case.solver, {a: best[alphas.index(a)] for a in mesh_alphas}, mesh_nodes,
+                                      sigma=SIGMA, rtol=MESH_RTOL, cold=not QUICK, executor=executor)
+print(mstudy.summary())
+
+# %% [markdown]
+# **Reading.** Impulse is the quantity that moves most with the grid: the plans are a few near-impulsive thrust
+# spikes, and where a spike can sit depends on the nodes; MI and RMS, which depend only on the window-start state,
+# move less. The changes are printed per pair of consecutive grids; the closing table records whether the finest
+# pair meets the tolerance.
+
+# %% [markdown]
 # ## 6 · Figures 1-3: trajectories and thrust
 #
 # Between nodes the control is linear in time, so a dense re-flight with linearly interpolated controls is the
@@ -239,6 +307,11 @@ print(f"largest |a_z| / largest |a| over the grid: {az_share:.1e} (planar proble
 # average is the total divided by a constant, which does not change the shape of the curve. Finally the plans of
 # $\alpha_h = 0$ and the largest $\alpha_h$ are judged again with the literal unit fix of Table 3's process noise.
 #
+# Fig. 5's curve is the **lower envelope over every distinct optimum the multi-start of Section 3 found**
+# (`global_search.lower_envelope`: the plans no other plan beats on both impulse and RMS, monotone by construction);
+# grey crosses are the other local optima, dots the best-cost plan per weight. A best-cost plan need not lie on
+# the envelope: the cost weighs MI against impulse, not the RMS, so a costlier optimum can end with a lower RMS.
+#
 # Observer and target panels look alike, and should: a relative-position measurement fixes
 # $x_{\mathcal T} - x_{\mathcal S}$ to 100 m, so the absolute errors of the two spacecraft move together and their
 # RMS values agree to a fraction of a kilometre; what the dynamics must supply is the common absolute part.
@@ -247,7 +320,11 @@ print(f"largest |a_z| / largest |a| over the grid: {az_share:.1e} (planar proble
 cr = studies.crlb_study(case)
 crlb, term_obs, term_tgt, lit = cr.crlb, cr.term_obs, cr.term_tgt, cr.literal
 _ = plotting.save_figure(figures.crlb_axes(em, alphas, crlb), "05_fig4_crlb", output_dir=out)
-_ = plotting.save_figure(figures.pareto(alphas, impulse_mps, term_obs, term_tgt), "05_fig5_pareto", output_dir=out)
+fp = global_search.front_points(ms, sc, case.k_ws, others=dict(zip(alphas, best)))  # every distinct optimum
+env = fp.envelope()
+_ = plotting.save_figure(figures.pareto(alphas, impulse_mps, term_obs, term_tgt, front=fp), "05_fig5_pareto",
+                         output_dir=out)
+print(fp.summary())
 for a, imp, mo, mt, m1, m2 in zip(alphas, impulse_mps, term_obs, term_tgt, mi, cr.mi_eval):
     print(f"alpha_h {a:7.4f}: {imp:8.3f} m/s  terminal RMS observer {mo:7.3f} km, target {mt:7.3f} km;  "
           f"MI {m1:.3f} (planning Q) / {m2:.3f} nats (Q along the trajectory)")
@@ -449,6 +526,27 @@ table.add(CLAIMS["pareto_values"].judge(term_tgt[-1], shown=f"{impulse_mps[-1]:.
 table.add(CLAIMS["local_optima"].judge(case.cost_gap, shown=f"largest cost difference {case.cost_gap:.0e}: " + (
     "distinct local optima found" if case.distinct_optima else "both sweeps reach the same optimum on this grid"),
     note="best cost per alpha_h kept; differences below 1e-8 relative are solver round-off"))
+table.add(CLAIMS["distinct_optima"].judge(max(ms.n_distinct), shown="optima found per alpha_h: " + ", ".join(
+    f"{a:g}: {n_}" for a, n_ in zip(ms.alphas, ms.n_distinct)), note=f"{len(ms.outcomes)} starts; cost range per "
+    "alpha_h: " + ", ".join(f"{a:g}: {hi - lo:.1e}" for a, (lo, hi) in zip(ms.alphas, ms.cost_range))
+    + "; same optimum: cost within 1e-6 (1 + |J|), plans within 100 km"))
+table.add(CLAIMS["multi_start"].judge(len(ms_better), shown=(
+    f"better than the sweeps at {len(ms_better)} of {len(ms.alphas)} weights"
+    + ("" if not ms_better else ": " + "; ".join(
+        f"{a:g}: {sweep_best[alphas.index(a)].impulse * MPS:.2f} -> {impulse_mps[alphas.index(a)]:.2f} m/s, cost "
+        f"{c0:.5f} -> {c1:.5f}" for a, c0, c1, _ in ms_better))),
+    note="the figures and rows above use the best plan per weight"))
+off_env = [a for i_, a in enumerate(fp.alpha) if fp.optimum[i_] == 0 and i_ not in set(env.index.tolist())]
+table.add(CLAIMS["envelope"].judge(len(env.index), shown=f"{len(env.index)} of {len(fp.alpha)} distinct optima "
+                                   f"on the envelope; {impulse_mps[0]:.2f} -> {env.x[-1]:.1f} m/s, observer RMS "
+                                   f"{env.y[0]:.1f} -> {env.y[-1]:.2f} km", note=(
+    "best-cost plans off the envelope (a costlier optimum ends with a lower RMS) at alpha_h " + (
+        ", ".join(f"{a:g}" for a in off_env) or "none"))))
+table.add(CLAIMS["mesh_study"].judge(all(mstudy.converged(a) for a in mstudy.alphas), shown="; ".join(
+    f"alpha_h {a:g}: " + ", ".join(f"{r.n_nodes} nodes {r.impulse_mps:.2f} m/s / {r.rms_km:.1f} km"
+                                   for r in mstudy.table(a) if r.converged) for a in mstudy.alphas),
+    note=f"figures use {mstudy.figure_nodes} nodes; largest change between the two finest grids: " + ", ".join(
+        f"{a:g}: {100 * mstudy.finest_change(a):.1f} %" for a in mstudy.alphas)))
 table.display()
 
 # %% [markdown]

@@ -14,7 +14,7 @@ from matplotlib.collections import LineCollection
 
 from cislunar.cr3bp.dynamics import check_system
 from cislunar.cr3bp.propagation import propagate
-from cislunar.papers.wolf_jones import _checks
+from cislunar.papers.wolf_jones import _checks, global_search
 from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.papers.wolf_jones import test_case_studies as studies
 from cislunar.publish import plotting
@@ -174,13 +174,34 @@ def crlb_axes(system, alphas, crlb):
     return fig
 
 
-def pareto(alphas, impulse_mps, term_obs, term_tgt):
-    """Fig. 5 analogue: total impulse against terminal position RMS, observer and target, labelled by alpha_h."""
+def _envelope_layer(ax, front, axis: str, loglog: bool = False) -> None:
+    """Every distinct local optimum of a multi-start (grey) and their lower envelope (the front, black line)."""
+    y = getattr(front, axis)
+    x = np.maximum(front.impulse_mps, 1e-3) if loglog else front.impulse_mps
+    other = front.optimum > 0
+    ax.plot(x[other], y[other], "x", color="0.55", ms=6, label="other local optima (multi-start)")
+    env = front.envelope(axis)
+    ax.plot(x[env.index], env.y, "-", color="k", lw=1.3, zorder=1, label="lower envelope over all starts")
+
+
+def pareto(alphas, impulse_mps, term_obs, term_tgt, front=None):
+    """Fig. 5 analogue: total impulse against terminal position RMS, observer and target, labelled by alpha_h.
+
+    With ``front`` (:class:`~cislunar.papers.wolf_jones.global_search.FrontPoints`) the curve is the lower envelope
+    of every distinct optimum the multi-start found, the per-weight best plans marked on it and the other optima
+    in grey; without it the per-weight plans are joined."""
     v = _same_length(None, alphas=alphas, impulse_mps=impulse_mps, term_obs=term_obs, term_tgt=term_tgt)
     alphas, impulse_mps, term_obs, term_tgt = v["alphas"], v["impulse_mps"], v["term_obs"], v["term_tgt"]
+    if front is not None:
+        validation.instance(front, "front", global_search.FrontPoints)
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
-    for ax, term, name in zip(axes, (term_obs, term_tgt), ("observer", "target")):
-        ax.plot(impulse_mps, term, "o-")
+    for ax, term, name, axis in zip(axes, (term_obs, term_tgt), ("observer", "target"), ("rms_obs", "rms_tgt")):
+        if front is None:
+            ax.plot(impulse_mps, term, "o-")
+        else:
+            _envelope_layer(ax, front, axis)
+            ax.plot(impulse_mps, term, "o", color="C0", label=r"best plan per $\alpha_h$")
+            ax.legend(fontsize=7, loc="upper right")
         for a, x_, y_ in zip(alphas, impulse_mps, term):
             ax.annotate(f"{a:g}", (x_, y_), textcoords="offset points", xytext=(4, 4), fontsize=7)
         ax.set(xlabel="total impulse [m/s]", ylabel="position RMS at the window end [km]", title=name, yscale="log")
@@ -411,12 +432,24 @@ def noise_readings(system, readings: studies.NoiseReadings):
     return fig
 
 
-def pareto_fronts(fr: studies.Front):
-    """Fig. 10 analogue: impulse against terminal RMS (observer, targets), and MI against RMS."""
+def pareto_fronts(fr: studies.Front, front=None):
+    """Fig. 10 analogue: impulse against terminal RMS (observer, targets), and MI against RMS.
+
+    With ``front`` (:class:`~cislunar.papers.wolf_jones.global_search.FrontPoints`) the observer and target fronts
+    are the lower envelopes of every distinct optimum the multi-start found (targets: their mean RMS), the
+    per-weight best plans marked and the other optima in grey."""
     validation.instance(fr, "fr", studies.Front)
+    if front is not None:
+        validation.instance(front, "front", global_search.FrontPoints)
     dvs, rms_obs, rms_tgt, mis = fr.dv, fr.rms_obs, fr.rms_tgt, fr.mi
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
-    axes[0].loglog(np.maximum(dvs, 1e-3), rms_obs, "o-")
+    if front is None:
+        axes[0].loglog(np.maximum(dvs, 1e-3), rms_obs, "o-")
+    else:
+        _envelope_layer(axes[0], front, "rms_obs", loglog=True)
+        _envelope_layer(axes[1], front, "rms_tgt", loglog=True)
+        axes[0].loglog(np.maximum(dvs, 1e-3), rms_obs, "o", color="C0", label=r"best plan per $\alpha_h$")
+        axes[0].legend(fontsize=7, loc="upper right")
     for n_, (a, x_, y_) in enumerate(zip(fr.alphas, dvs, rms_obs)):  # every point labelled, alternately up/down
         up = n_ % 2 == 0
         axes[0].annotate(rf"$\alpha_h$ = {a:g}" if n_ == 0 else f"{a:g}", (x_, y_), textcoords="offset points",
@@ -424,7 +457,8 @@ def pareto_fronts(fr: studies.Front):
                          va="bottom" if up else "top", fontsize=7)
     axes[0].set(xlabel=r"total impulse $\Delta V$ [m/s]", ylabel="terminal position RMS [km]", title="observer")
     for i, (mk, ls) in enumerate((("o", "-"), ("s", "--"), ("^", ":"))):
-        axes[1].loglog(np.maximum(dvs, 1e-3), rms_tgt[:, i], marker=mk, ls=ls, ms=8 - 2 * i, label=f"target {i + 1}")
+        axes[1].loglog(np.maximum(dvs, 1e-3), rms_tgt[:, i], marker=mk, ls=ls if front is None else "none",
+                       ms=8 - 2 * i, label=f"target {i + 1}")
     axes[1].set(xlabel=r"total impulse $\Delta V$ [m/s]", ylabel="terminal position RMS [km]",
                 title="targets (nearly coincide: see text)")
     axes[1].legend(fontsize=8, loc="upper right")
@@ -436,11 +470,13 @@ def pareto_fronts(fr: studies.Front):
     for ax in axes:  # room above and below the end points (log axes)
         lo, hi = ax.get_ylim()
         ax.set_ylim(lo / 1.3, hi * 1.3)
+    lo_x, hi_x = (dvs.min(), dvs.max()) if front is None else (min(dvs.min(), front.impulse_mps.min()),
+                                                               max(dvs.max(), front.impulse_mps.max()))
     for ax in axes[:2]:  # plain impulse ticks (a log axis spanning one decade would print a single label)
-        ticks = [v for v in (1, 2, 5, 10, 20, 50, 100, 200) if 0.7 * dvs.min() <= v <= 1.4 * dvs.max()]
+        ticks = [v for v in (1, 2, 5, 10, 20, 50, 100, 200) if 0.7 * lo_x <= v <= 1.4 * hi_x]
         ax.set_xticks(ticks, [f"{v:g}" for v in ticks])
         ax.xaxis.set_minor_formatter(plt.NullFormatter())
-        ax.set_xlim(0.8 * dvs.min(), 1.6 * dvs.max())
+        ax.set_xlim(0.8 * lo_x, 1.6 * hi_x)
     fig.tight_layout()
     return fig
 

@@ -94,4 +94,17 @@ CLAIMS = {
         "Pareto values (impulse, terminal RMS)", "plotted only (Fig. 5), no numbers", kind="not in paper",
         reason="the paper's axes are not quantitatively readable; N and sigma of the nodes are not given either"),
     "local_optima": Claim("upward vs downward sweep (local optima)", "not discussed", kind="beyond paper"),
+    # issue 22, item 1 (global quality); tolerances fixed before the runs: two plans are one optimum when their
+    # costs agree within 1e-6 (1 + |J|) and their node positions (or z-mirrors) within 100 km; a plan is
+    # mesh-converged when impulse, MI and terminal RMS change by at most 5 % between the two finest grids
+    "distinct_optima": Claim("distinct local optima per alpha_h (multi-start: ballistic, +/-z seeds, random, "
+                             "neighbours, the sweeps)", "not discussed", kind="beyond paper"),
+    "multi_start": Claim("multi-start against the sweeps' best plan", "-", kind="beyond paper"),
+    "envelope": Claim("Fig. 5 front as the lower envelope over every optimum found", "one curve (Fig. 5)",
+                      kind="beyond paper"),
+    "mesh_study": Claim(
+        "plans converged in the node grid at the headline weights (mesh study up to 60 nodes)", "N not given",
+        Holds("impulse, MI and observer terminal RMS change by at most 5 % between the two finest grids at every "
+              "headline weight"), kind="beyond paper",
+        reason="the near-impulsive plans move with the grid by more than the 5 % tolerance"),
 }
