@@ -15,11 +15,13 @@ from cislunar.estimation import adaptive_ocbe as ad
 from cislunar.estimation.ocbe import OCBEResult
 from cislunar.papers.greaves_scheeres_2021 import adaptive_studies as ads
 from cislunar.papers.greaves_scheeres_2021 import detection as det
+from cislunar.papers.greaves_scheeres_2021 import detection_studies as dstudies
 from cislunar.papers.greaves_scheeres_2021 import panels as ocbe_panels
 from cislunar.utils import validation
 
 __all__ = ["metric_law", "adaptive_errors", "adaptive_control_metric", "delays", "reset_rules", "station_keeping_policy",
-           "control_integral_pdfs", "z_vs_maneuver", "pm_j_search", "health_lead", "health_metric", "tuning_map"]
+           "control_integral_pdfs", "z_vs_maneuver", "pm_j_search", "health_lead", "health_metric", "tuning_map",
+           "joint_search", "lead_grid"]
 
 _OUTCOME_COLORS = {"prompt": "C0", "late": "C3", "nearly periapsis": "C1", "not detected": "0.6"}
 
@@ -420,4 +422,71 @@ def tuning_map(tmap: dict, orbit_names, policy_names, variants, base_variant: st
     h, lab = ax[1, 0].get_legend_handles_labels()
     fig.legend(h, lab, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=4, fontsize=8)
     fig.tight_layout(h_pad=5.0)
+    return fig
+
+
+def joint_search(joint: dstudies.JointSearch):
+    """The joint search (issue 23): per screened setting, the larger threshold deviation of the two policies
+    against the worst consistency cell (left; one colour per window, filled: rerun at paper size), and the paper-size
+    thresholds over the paper's with their bootstrap standard errors (right).  Grey boxes: the screen's and the
+    confirmation's criteria."""
+    validation.instance(joint, "joint", dstudies.JointSearch)
+    fig, ax = plt.subplots(1, 2, figsize=(12, 4.2))
+    windows = sorted({k[0] for k in joint.screen})
+    for i, w in enumerate(windows):
+        keys = [k for k in joint.screen if k[0] == w]
+        dev = [100 * max(abs(joint.screen[k][p]["z_lim"] / joint.paper_zlim[p] - 1) for p in joint.policies)
+               for k in keys]
+        worst = [100 * max(joint.screen[k][p]["worst"] for p in joint.policies) for k in keys]
+        filled = [k in joint.confirm for k in keys]
+        ax[0].scatter(np.array(dev)[filled], np.array(worst)[filled], color=f"C{i}", s=18, label=f"{w:g} h window")
+        ax[0].scatter(np.array(dev)[~np.array(filled)], np.array(worst)[~np.array(filled)], facecolor="none",
+                      edgecolor=f"C{i}", s=18)
+    for tol, lim, ls in ((dstudies.JOINT_SCREEN_ZLIM_TOL, joint.screen_limit, ":"),
+                         (dstudies.JOINT_ZLIM_TOL, dstudies.CONSISTENT_FRACTION, "--")):
+        ax[0].plot([0, 100 * tol, 100 * tol], [100 * lim, 100 * lim, 0], color="0.4", ls=ls, lw=1)
+    ax[0].set(xlabel="larger |z_lim / paper - 1| of the two policies [%]", ylabel="worst cell: inconsistent runs [%]",
+              title=f"screen: {len(joint.screen)} settings ({joint.n_screen[0]} + {joint.n_screen[1]} runs)")
+    ax[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
+    keys = list(joint.confirm)
+    for j, p in enumerate(joint.policies):
+        r = [joint.confirm[k][p]["z_lim"] / joint.paper_zlim[p] for k in keys]
+        e = [2 * joint.confirm[k][p]["z_lim_se"] / joint.paper_zlim[p] for k in keys]
+        ax[1].errorbar(np.arange(len(keys)) + 0.15 * (j - 0.5), r, yerr=e, fmt="o" if j == 0 else "s", ms=4,
+                       label=f"{p} (+- 2 se)")
+    ax[1].axhspan(1 - dstudies.JOINT_ZLIM_TOL, 1 + dstudies.JOINT_ZLIM_TOL, color="0.9", zorder=0)
+    ax[1].set(xticks=np.arange(len(keys)), ylabel="z_lim / paper's [-]",
+              xlabel="setting [window h, f, noise, base weight km^2/s^3, burn time h]", title=f"paper size ({joint.n_paper[0]} + "
+              f"{joint.n_paper[1]} runs); * = both criteria met")
+    ax[1].set_xticklabels([("* " if k in joint.passed else "") + f"{k[0]:g} h, f {k[1]:g}\n{k[3]:g} urad, "
+                           f"{k[2]:.0e}, {k[4]:+g} h" for k in keys], rotation=90, fontsize=7)
+    ax[1].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def lead_grid(grid: dstudies.LeadGrid):
+    """The Fig. 22 race over the window weight factor f (x) and the angle noise (one line each): share of the
+    judged-size runs whose residual test stays silent (left), whose control test is strictly first (middle), and
+    the median z over the burn (right)."""
+    validation.instance(grid, "grid", dstudies.LeadGrid)
+    fs = sorted({k[0] for k in grid.cells})
+    noises = sorted({k[1] for k in grid.cells})
+    fig, ax = plt.subplots(1, 3, figsize=(14, 3.8))
+    for i, s in enumerate(noises):
+        pts = [(f, grid.summary((f, s))) for f in fs if (f, s) in grid.cells]
+        x = [f for f, _ in pts]
+        for a, key, scale in ((ax[0], "residual_silent", 100), (ax[1], "control_first", 100), (ax[2], "z_ratio", 1)):
+            a.plot(x, [scale * d[key] for _, d in pts], "o-", color=f"C{i}", label=f"{s:g} micro-rad")
+    for a in ax[:2]:
+        a.axhline(50, color="0.5", ls=":", lw=1)
+    ax[2].axhline(0.5, color="0.5", ls=":", lw=1)
+    ax[0].set(ylabel="residual test silent for 24 h [% of runs]")
+    ax[1].set(ylabel="control test strictly first [% of runs]")
+    ax[2].set(ylabel="median z / burn [-]")
+    for a in ax:
+        a.set(xscale="log", xlabel="window weight factor f [-]")
+    ax[2].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
+    fig.suptitle(f"{grid.magnitude_m_s:g} m/s burns at the quiet tuning", fontsize=10)
+    fig.tight_layout()
     return fig

@@ -264,7 +264,10 @@ def small_studies():
                                         ("f = 0.1, 100 urad", 0.1, 100.0))):
         s_l = det.make_setup(em, orbit_set["9:2 NRHO"], f_ * det.window_control_weight(det.QUIET_POLICY, window),
                              q_base, sigma_angle_rad=sig * 1e-6)
-        lead[tag] = det.health_lead_study(s_l, (0.5,), 10, 1, [0, 60, i], horizon_hours=6.0)
+        lead[tag] = det.health_lead_study(s_l, (0.5,), 10, 1, [0, 60, i], horizon_hours=2.0)
+    joint = ds.run_joint_search(em, orbit_set["9:2 NRHO"], policies, (8.0,), (0.3,), (q_base,), (10.0,), (0.0,), (4, 4),
+                                (4, 4), 2, [0, 95], paper_zlim=PAPER_ZLIM, batch_size=4)
+    lead_grid = ds.LeadGrid({(0.3, 20.0): lead["f = 0.1, 10 urad"]}, 0.5)  # a real race, labelled as a grid cell
     sig_level = {tag: burn_z.sigma_level(f_, g["9:2 NRHO", "quiet"].h1.z)
                  for tag, f_, g in (("f = 0.1", 0.1, train.tuned), ("f_c", tmap.f_c, train.predicted))}
     health = det.draw_trial(np.random.default_rng([0, 8]), s_q, magnitude_m_s=0.5)
@@ -275,8 +278,9 @@ def small_studies():
         q_window_quiet=(s_q.q_window_km2_s3, s_c["9:2 NRHO", "quiet"].q_window_km2_s3), spike=spike, train=train,
         pm_j=pm_j, pm_mc=pm_mc, burn_z=burn_z, sig_level=sig_level, lead=lead,
         health_nees_mean=float(consistency.nees(rh.x_smooth, rh.P_smooth, health.truth).mean()),
-        health_residual_norms=rh.residual_norms, sigma_angle_rad=10e-6)
-    return dict(rows=rows, tmap=tmap, train=train, spike=spike, burn_z=burn_z, lead=lead, sig_level=sig_level)
+        health_residual_norms=rh.residual_norms, sigma_angle_rad=10e-6, joint=joint, lead_grid=lead_grid)
+    return dict(rows=rows, tmap=tmap, train=train, spike=spike, burn_z=burn_z, lead=lead, sig_level=sig_level,
+                joint=joint)
 
 
 def test_closing_rows_measure_every_declared_claim_from_real_studies(small_studies):
@@ -315,6 +319,9 @@ def test_closing_rows_carry_the_studies_numbers(small_studies):
     assert {k for k in rows if k.startswith("control first")} == {
         "control first, f = 0.1, 10 urad", "control first, f_c, 10 urad", "control first, f = 0.1, 100 urad"}
     assert all(isinstance(rows[k]["measured"], bool) for k in rows if k.startswith("control first"))
+    # the joint-search and race-grid rows carry the studies' verdicts
+    assert rows["joint 8h"]["measured"] is small_studies["joint"].any_8h
+    assert rows["race grid"]["measured"] is False or rows["race grid"]["measured"] is True
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -385,3 +392,160 @@ def test_figures_draw_a_single_orbit_or_setting_and_refuse_missing_cells():
     with pytest.raises(ValueError, match="tmap"):
         figures.tuning_map({}, ["9:2 NRHO"], ["quiet"], ["base"], "base", (0.1,), (0.1,), 0.1, 0.1, {"quiet": 0.02},
                            lambda *a: 0.0)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# the joint search (issue 23): criteria at their fixed edges, seeds and stages, burn time, executors
+# ---------------------------------------------------------------------------------------------------------------
+def _joint_cells(z_rel, worst, se=1e-4):
+    """Both policies at a relative threshold deviation ``z_rel`` (per policy or one for both) and worst cell."""
+    z_rel = z_rel if isinstance(z_rel, dict) else {p: z_rel for p in PAPER_ZLIM}
+    return {p: dict(z_lim=PAPER_ZLIM[p] * (1 + z_rel[p]), worst=worst, z_lim_se=se, h1=(worst, 0.0), err=0.1,
+                    n=(40, 80)) for p in PAPER_ZLIM}
+
+
+def test_joint_search_criteria_flip_at_their_fixed_edges():
+    k8, k4 = (8.0, 0.2, 1e-18, 10.0, 0.0), (4.0, 0.2, 1e-18, 10.0, 0.0)
+    lim = 0.10 + 2 * np.sqrt(0.1 * 0.9 / 80)  # the screen's: 10 % + 2 binomial standard errors of 80 burn runs
+    for z, w, screened in ((0.399, 0.999 * lim, True), (-0.399, 0.0, True), (0.401, 0.0, False),
+                           (0.0, 1.001 * lim, False), ({"active": 0.0, "quiet": -0.401}, 0.0, False)):
+        js = ds.JointSearch({k8: _joint_cells(z, w)}, {}, dict(PAPER_ZLIM), (40, 80), (500, 3000), 40)
+        assert js.screen_limit == pytest.approx(lim)
+        assert (js.screen_passed == [k8]) is screened, (z, w)
+    for z, w, ok in ((0.249, 0.10, True), (-0.249, 0.0, True), (0.251, 0.0, False), (0.0, 0.1001, False),
+                     ({"active": 0.0, "quiet": 0.26}, 0.0, False)):
+        js = ds.JointSearch({k8: _joint_cells(0.0, 0.0), k4: _joint_cells(0.0, 0.0)},
+                            {k8: _joint_cells(z, w), k4: _joint_cells(0.0, 0.0)}, dict(PAPER_ZLIM), (40, 80),
+                            (500, 3000), 40)
+        assert js.any_8h is ok and (k8 in js.passed) is ok and k4 in js.passed, (z, w)
+        assert js.windows_passed() == ([4.0, 8.0] if ok else [4.0])
+    # only the 4-h setting holds: the 8-h row says no, and the report names the windows
+    js = ds.JointSearch({k8: _joint_cells(0.3, 0.2), k4: _joint_cells(0.1, 0.0)}, {k4: _joint_cells(0.1, 0.0)},
+                        dict(PAPER_ZLIM), (40, 80), (500, 3000), 40)
+    assert not js.any_8h and js.passed == [k4] and js.best_8h()[0] == k8
+    assert "any with the paper's 8-h window: no" in js.report() and "windows [4.0]" in js.report()
+
+
+def test_joint_search_screens_then_reruns_the_passing_settings_with_their_own_seeds(nrho_92, monkeypatch):
+    from concurrent.futures import ThreadPoolExecutor
+
+    pol = {"quiet": det.QUIET_POLICY}
+    monkeypatch.setattr(ds, "CONSISTENT_FRACTION", 1.0)  # every setting passes: the confirmation stage runs
+    monkeypatch.setattr(ds, "JOINT_SCREEN_ZLIM_TOL", 1e9)
+    kw = dict(windows_hours=(4.0, 8.0), factors=(0.3,), q_bases_km2_s3=(1e-18,), noise_urad=(10.0,),
+              burn_offsets_hours=(0.0, 3.0), n_screen=(4, 4), n_paper=(4, 6), n_boot=3, seed=[0, 95],
+              paper_zlim=PAPER_ZLIM, batch_size=4)
+    js = ds.run_joint_search(em, nrho_92, pol, **kw)
+    # a 3-h offset lies outside the 4-h window's half width: skipped there, kept in the 8-h window
+    keys = [(4.0, 0.3, 1e-18, 10.0, 0.0), (8.0, 0.3, 1e-18, 10.0, 0.0), (8.0, 0.3, 1e-18, 10.0, 3.0)]
+    assert list(js.screen) == keys and list(js.confirm) == keys
+    assert js.screen[keys[0]]["quiet"]["n"] == (4, 4) and js.confirm[keys[0]]["quiet"]["n"] == (4, 6)
+    # stage 1 of setting i is run_policy_study with the seed [*seed, 1, i, j] on the setting's set-up
+    setups = ds._joint_setups(em, nrho_92, pol, keys[2])
+    ref = det.run_policy_study(setups["quiet"], det.QUIET_POLICY, 4, 6, 0, [0, 95, 1, 2, 0], batch_size=4,
+                               progress=False)
+    assert js.confirm[keys[2]]["quiet"]["z_lim"] == ref.threshold.z_lim
+    boot = det.threshold_bootstrap(ref.h0.z, ref.h1.z, 3, np.random.default_rng([0, 95, 2, 2, 0]))
+    assert js.confirm[keys[2]]["quiet"]["z_lim_se"] == pytest.approx(boot[:, 0].std(ddof=1), rel=1e-12)
+    # the burn moves 3 h after the apoapsis; the window stays where it is
+    base = ds._joint_setups(em, nrho_92, pol, keys[1])["quiet"]
+    assert (setups["quiet"].t_maneuver - base.t_maneuver) * em.time_unit_s == pytest.approx(3 * 3600.0)
+    np.testing.assert_array_equal(setups["quiet"].control_weight, base.control_weight)
+    assert js.screen[keys[2]]["quiet"]["z_lim"] != js.screen[keys[1]]["quiet"]["z_lim"]
+    # a reused screen and a confirmation restricted to some windows give the full run's numbers for those windows
+    part = ds.run_joint_search(em, nrho_92, pol, **kw, screened=js, confirm_windows=(8.0,))
+    assert part.screen is js.screen and list(part.confirm) == keys[1:]
+    assert all(part.confirm[k] == js.confirm[k] for k in keys[1:])
+    with pytest.raises(ValueError, match="screened"):
+        ds.run_joint_search(em, nrho_92, pol, **{**kw, "factors": (0.2,)}, screened=js)
+    # the same numbers whatever executor runs the Monte Carlo
+    with ThreadPoolExecutor(2) as ex:
+        js2 = ds.run_joint_search(em, nrho_92, pol, **kw, executor=ex)
+    assert js2 == js or (js2.screen == js.screen and js2.confirm == js.confirm)
+
+
+def test_joint_search_and_lead_grid_refuse_bad_arguments(nrho_92):
+    pol = {"quiet": det.QUIET_POLICY}
+    kw = dict(windows_hours=(2.0,), factors=(0.3,), q_bases_km2_s3=(1e-18,), noise_urad=(10.0,),
+              burn_offsets_hours=(0.0,), n_screen=(4, 4), n_paper=(4, 6), n_boot=3, seed=[0], paper_zlim=PAPER_ZLIM)
+    for change, name in ((dict(burn_offsets_hours=(2.0,)), "burn_offsets_hours"), (dict(n_screen=(4,)), "n_screen"),
+                         (dict(paper_zlim={"active": 0.4}), "paper_zlim"), (dict(factors=(-0.1,)), "factors"),
+                         (dict(executor=3), "executor")):
+        with pytest.raises(ValueError, match=name):
+            ds.run_joint_search(em, nrho_92, pol, **{**kw, **change})
+    with pytest.raises(ValueError, match="judged_m_s"):
+        ds.run_lead_grid(em, nrho_92, (0.1,), (20.0,), (0.1,), 10, 1, [0], q_base_km2_s3=1e-18, window_hours=8.0)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# the Fig. 22 race over f and noise
+# ---------------------------------------------------------------------------------------------------------------
+def _lead(c, r, z_ratio):
+    """A race at 0.5 m/s: per run the epoch at which the control (``c``) and the residual (``r``) test fire, -1 never."""
+    return det.HealthLeadStudy(np.array([0.5]), np.arange(1.0, 13.0) * 2, np.array([c]), np.array([r]), 0.0, 0.0,
+                               np.full((1, len(c)), 0.5 * z_ratio), np.ones(3), 0.00135)
+
+
+def test_lead_grid_combination_needs_every_part():
+    c6, r_silent6 = [0] * 6 + [-1] * 4, [1] * 4 + [-1] * 6
+    cases = {  # each part just over / just at its edge of one half
+        (0.1, 20.0): (_lead(c6, r_silent6, 0.5), True),
+        (0.3, 20.0): (_lead(c6, [1] * 5 + [-1] * 5, 0.9), False),  # residuals silent in only half of the runs
+        (1.0, 20.0): (_lead([0] * 5 + [-1] * 5, r_silent6, 0.9), False),  # the control test fires in only half
+        (0.1, 30.0): (_lead([0] * 5 + [3] * 2 + [-1] * 3, [-1] * 5 + [1] * 2 + [-1] * 3, 0.9), False),  # first in half
+        (0.1, 50.0): (_lead(c6, r_silent6, 0.49), False)}  # z recovers less than half the burn
+    grid = ds.LeadGrid({k: h for k, (h, _) in cases.items()}, 0.5)
+    for k, (h, holds) in cases.items():
+        s = grid.summary(k)
+        assert s["holds"] is holds, (k, s)
+        assert s["control_first"] == pytest.approx(h.outcome_fractions()["control first"][0])
+    assert grid.summary((0.1, 30.0))["control_fires"] == 0.7 and grid.summary((0.1, 30.0))["residual_silent"] == 0.8
+    assert grid.holding == [(0.1, 20.0)] and "f = 0.1, 20 urad" in grid.report().splitlines()[-1]
+
+
+def test_lead_grid_cells_are_health_lead_studies_with_their_seeds(nrho_92):
+    grid = ds.run_lead_grid(em, nrho_92, (0.3,), (20.0, 50.0), (0.5,), 10, 1, [0, 61], q_base_km2_s3=1e-18,
+                            window_hours=8.0, horizon_hours=2.0)
+    assert list(grid.cells) == [(0.3, 20.0), (0.3, 50.0)]
+    s = det.make_setup(em, nrho_92, 0.3 * det.window_control_weight(det.QUIET_POLICY, 8.0), 1e-18,
+                       sigma_angle_rad=50e-6)
+    ref = det.health_lead_study(s, (0.5,), 10, 1, [0, 61, 1], horizon_hours=2.0)
+    got = grid.cells[0.3, 50.0]
+    np.testing.assert_array_equal(got.z_final_m_s, ref.z_final_m_s)
+    np.testing.assert_array_equal(got.residual_epoch, ref.residual_epoch)
+
+
+def test_exact_accuracy_tests_against_hand_sums():
+    from math import comb
+
+    # 196 of 200 (4 errors) against 99.5 %: P(X >= 4) for X ~ Binomial(200, 0.005), summed by hand
+    p_bin = 1 - sum(comb(200, k) * 0.005**k * 0.995**(200 - k) for k in range(4))
+    # Fisher's exact test of 196/200 against 200/200: the hypergeometric tail of 4 errors among 400 runs, both sides
+    # (the table with all errors in the paper's column is as extreme)
+    p_one = comb(200, 4) / comb(400, 4)
+    text = ds.accuracy_exact_text(0.98, 1.0, 200)
+    assert text.startswith("4 errors;") and f"= {p_bin:.3f};" in text and f"p = {2 * p_one:.2f}" in text
+    assert "against the paper's 194/200" in ds.accuracy_exact_text(0.96, 0.97, 200)
+    assert "P(>= 0 errors" in ds.accuracy_exact_text(1.0, 1.0, 200) and "p = 1.00" in ds.accuracy_exact_text(1.0, 1.0, 200)
+
+
+def test_joint_search_and_race_grid_figures_draw_every_setting():
+    import matplotlib.pyplot as plt
+
+    from cislunar.papers.greaves_scheeres_2021 import figures
+
+    k8, k4 = (8.0, 0.2, 1e-18, 10.0, 0.0), (4.0, 0.2, 1e-18, 10.0, 0.0)
+    js = ds.JointSearch({k8: _joint_cells(0.3, 0.2), k4: _joint_cells(0.1, 0.0)}, {k4: _joint_cells(0.1, 0.0)},
+                        dict(PAPER_ZLIM), (40, 80), (500, 3000), 40)
+    fig = figures.joint_search(js)
+    # one marker per screened setting on the left, one error bar per policy and confirmed setting on the right
+    assert sum(len(c.get_offsets()) for c in fig.axes[0].collections) == 2
+    assert fig.axes[1].get_xticklabels()[0].get_text().startswith("* 4 h")
+    plt.close(fig)
+    grid = ds.LeadGrid({(0.1, 20.0): _lead([0] * 6 + [-1] * 4, [1] * 4 + [-1] * 6, 0.5),
+                        (0.3, 20.0): _lead([0] * 6 + [-1] * 4, [1] * 4 + [-1] * 6, 0.9)}, 0.5)
+    fig = figures.lead_grid(grid)
+    assert list(fig.axes[2].lines[0].get_ydata()) == pytest.approx([0.5, 0.9])
+    plt.close(fig)
+    with pytest.raises(TypeError, match="joint"):
+        figures.joint_search({})

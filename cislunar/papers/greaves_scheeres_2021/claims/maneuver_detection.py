@@ -9,6 +9,19 @@ agreement there is "reproduced".  Monte Carlo tolerances are standard errors pas
 errors of the threshold and of the expected error, binomial standard errors of a test accuracy
 (:func:`cislunar.papers.greaves_scheeres_2021.detection_studies.accuracy_standard_error`, on top of half a printed
 point) and of a fraction of inconsistent runs (Fig. 10), single-run spreads of z.
+
+Two limits were changed after their runs had been seen, and how each is then judged (checked 2026-11-26):
+
+* Fig. 10: the limit "10 % plus two binomial standard errors" was declared (2026-11-26 04:27) after runs drawn with
+  the seed ``[SEED, 41]`` had shown 10.5 % inconsistent smoothed runs; notebook 10 therefore judges fresh runs drawn
+  afterwards with the seed ``[SEED, 42]`` (once, whatever they gave).
+* Table 7 accuracy: the tolerance "half a printed point plus two binomial standard errors" replaced (same commit) a
+  one-point floor under which 98.0 % sat exactly on the edge; the change made the row stricter (it now differs).  The
+  row's note adds exact tests (:func:`detection_studies.accuracy_exact_text`): 4 errors in 200 have a binomial
+  probability of 1.9 % at 99.5 % accuracy, but against the paper's own 200 test runs (200/200) Fisher's exact test
+  gives p = 0.12: the paper's sample cannot separate 98 % from 100 %.  The status stays the declared rule's.
+
+The joint search and the race grid (issue 23) had their criteria declared 2026-11-26 before they ran.
 """
 
 from __future__ import annotations
@@ -149,6 +162,27 @@ CLAIMS = {
         kind="beyond paper" if "100" in tag else "comparison",
         tuned=_TUNED_F if tag == "f = 0.1, 10 urad" else "", source="Fig. 22")
        for tag in ("f = 0.1, 10 urad", "f_c, 10 urad", "f = 0.1, 100 urad")},
+    "joint 8h": Claim(
+        "Thresholds and consistency together at the paper's 8-h window (joint search: window 2-8 h, f, base weight, "
+        "noise, burn time)", "both (Eq. 35 thresholds; Figs. 12-13 consistent)",
+        Holds("some 8-h setting whose paper-size Monte Carlo (500 + 3000 per policy) has both thresholds within 25 % "
+              "of the paper's and at most 10 % inconsistent runs in every cell; settings from a reduced screen "
+              "(z_lim within 40 %, worst cell at most 10 % + 2 binomial standard errors), criteria fixed 2026-11-26 "
+              "before the search ran"),
+        tuned="the unstated inputs are searched for agreement with the paper's thresholds",
+        source="Eq. 35 text, Figs. 12-13 (detection_studies.run_joint_search)",
+        reason="no 8-h setting of the search meets both"),
+    "joint windows": Claim(
+        "Joint search: settings meeting both criteria at paper size (z_lim +- bootstrap standard error)",
+        "not discussed", kind="beyond paper"),
+    "race grid": Claim(
+        "Fig. 22 over angle noise 20-50 micro-rad and window weight f: benign residuals with a fast control metric",
+        "benign residuals, z a fast health metric (one run)",
+        Holds("some (f, noise) cell where, for the 0.5 m/s burns, the residual test stays silent for 24 h in more "
+              "than half of the runs, the control test fires within 24 h and strictly first in more than half, and "
+              "the median z is at least half the burn (criteria fixed 2026-11-26 before the grid ran)"),
+        tuned="the noise and f are searched for the paper's combination", source="Fig. 22 text",
+        reason="no cell of the grid shows the combination"),
     "residuals benign": Claim(
         "Health metric: residuals benign while the estimate diverges (Fig. 22)", "yes",
         Holds("one run at our noise: smoothed NEES mean above 20 and residual median below 3"), source="Fig. 22",
