@@ -1,6 +1,8 @@
 """Malformed-argument specs for :mod:`cislunar.papers.wolf_jones.keep_out_diagnosis`, the printed-method study of
 :mod:`cislunar.papers.wolf_jones.scvx_study` and :func:`cislunar.sensing.information.range_noise_scale` (plugin of
-tests/reliability/test_reliability.py; issue 22, item 4).
+tests/reliability/test_reliability.py; issue 22, item 4), with the diagnosis figure, now
+:func:`cislunar.papers.wolf_jones.figures.figure_keep_out_diagnosis` (found by its label; the figures module is swept
+by reliability_specs_wolf_jones_studies.py).
 
 Valid baselines: test case 2 on 6 Sundman nodes with one SCvx iteration (the runs end unconverged, which the
 functions report rather than raise), passes at 100 km, and test case 1's printed-method study on 6 nodes with two
@@ -16,9 +18,9 @@ from spec_helpers import closed
 
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.cr3bp.propagation import propagate
+from cislunar.papers.wolf_jones import figures, scvx_study
 from cislunar.papers.wolf_jones import keep_out_diagnosis as kd
 from cislunar.papers.wolf_jones import scenarios as wj
-from cislunar.papers.wolf_jones import scvx_study
 from cislunar.sensing import information
 
 MODULES = [kd]
@@ -107,7 +109,7 @@ def specs(S, lazy):
                dict(sc="instance", k_ws="int1", info="instance", range_scale_km="pos", alphas="vec", max_iter="int1",
                     keep_out="bool")))
     s.append(S("remedy_table", kd.remedy_table, dict(runs=lz(remedy2)), dict(runs="instance")))
-    s.append(S("figure_keep_out_diagnosis", closed(kd.figure_keep_out_diagnosis),
+    s.append(S("figure_keep_out_diagnosis", closed(figures.figure_keep_out_diagnosis),
                dict(diagnosis=lz(diag2), plain=lz(scan2), remedy=lz(scan2), range_scale_km=141.0),
                dict(diagnosis="instance", plain="instance", remedy="instance", range_scale_km="pos")))
     return s

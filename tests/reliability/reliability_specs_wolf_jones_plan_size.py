@@ -3,7 +3,9 @@ issue 22, item 2).
 
 Covers :mod:`cislunar.papers.wolf_jones.plan_size_study` and the control-term normalisation added to
 :mod:`cislunar.papers.wolf_jones.scenarios` (``control_scale``; the scenarios module itself is swept by
-reliability_specs_wolf_jones.py, which finds this spec by its label).  The sweep's valid call is the smallest that
+reliability_specs_wolf_jones.py, which finds this spec by its label) and the study's figure
+:func:`cislunar.papers.wolf_jones.figures.departure_figure` (the figures module is swept by
+reliability_specs_wolf_jones_studies.py, which finds it the same way).  The sweep's valid call is the smallest that
 reaches every stage: 6 nodes, one combination, one weight, SCvx limited to 3 iterations (the solve then fails the
 same way each time, which the sweep records as a row), so it also serves the Dask bit-identity test of
 tests/utils/test_every_executor_on_dask.py.
@@ -17,6 +19,7 @@ from spec_helpers import closed as _closed
 
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.guidance import scvx
+from cislunar.papers.wolf_jones import figures
 from cislunar.papers.wolf_jones import plan_size_study as ps
 from cislunar.papers.wolf_jones import scenarios as wj
 
@@ -63,6 +66,6 @@ def specs(Spec, lazy):
                     fraction=0.05, executor=None, progress=False),
                dict(n_nodes="int2", normalisations="names_opt", readings="names_opt", alphas="vec", sigma="real",
                     forward_hessian="bool", settings="instance_opt", fraction="range:0:1", progress="bool")))
-    s.append(S("departure_figure", _closed(ps.departure_figure), dict(study=lazy(toy_study)),
+    s.append(S("departure_figure", _closed(figures.departure_figure), dict(study=lazy(toy_study)),
                dict(study="instance")))
     return s

@@ -1,7 +1,9 @@
 """Malformed-argument specs for the Wolf & Jones process-noise readings study (plugin of
 tests/reliability/test_reliability.py; issue 22, item 3).
 
-Covers :mod:`cislunar.papers.wolf_jones.readings_study`.  Valid baselines: test case 2's ballistic window start and
+Covers :mod:`cislunar.papers.wolf_jones.readings_study` and its figure, now
+:func:`cislunar.papers.wolf_jones.figures.figure_readings` (found by its label; the figures module is swept by
+reliability_specs_wolf_jones_studies.py).  Valid baselines: test case 2's ballistic window start and
 the same pushed 2 m/s out of the plane (no solve) for :func:`evaluate_readings` and the figure; the two sweep
 adaptors run on the smallest sweeps that exist (6 Sundman nodes, alpha_h = 0 only).
 """
@@ -16,6 +18,7 @@ from spec_helpers import closed as _closed
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.cr3bp.propagation import propagate
 from cislunar.guidance import scvx
+from cislunar.papers.wolf_jones import figures
 from cislunar.papers.wolf_jones import readings_study as rs
 from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.papers.wolf_jones import test_case_studies as tcs
@@ -67,6 +70,7 @@ def specs(Spec, lazy):
                readings="instance_opt")),
         S("case2_readings", rs.case2_readings, dict(case=lazy(case2)), dict(case="instance")),
         S("case1_readings", rs.case1_readings, dict(case=lazy(case1)), dict(case="instance")),
-        S("figure_readings", _closed(rs.figure_readings), dict(study=lazy(study), system=em, show_alphas=[0.0, 1e-2]),
+        S("figure_readings", _closed(figures.figure_readings),
+          dict(study=lazy(study), system=em, show_alphas=[0.0, 1e-2]),
           dict(study="instance", system="system", show_alphas="vec_opt")),
     ]

@@ -14,15 +14,18 @@ from matplotlib.collections import LineCollection
 
 from cislunar.cr3bp.dynamics import check_system
 from cislunar.cr3bp.propagation import propagate
-from cislunar.papers.wolf_jones import _checks, global_search
+from cislunar.papers.wolf_jones import _checks, global_search, plan_size_study, readings_study
+from cislunar.papers.wolf_jones import keep_out_diagnosis as kod
 from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.papers.wolf_jones import test_case_studies as studies
+from cislunar.papers.wolf_jones.claims.process_noise_readings import CORR_LIMIT, WEAK_FACTOR
 from cislunar.publish import plotting
 from cislunar.utils import validation
 
 __all__ = ["convergence", "trajectories", "relative_motion", "thrust", "crlb_axes", "pareto", "equal_impulse",
            "keep_out_motivation", "absolute_trajectory", "relative_three_planes", "z_mirror", "thrust_profiles",
-           "crlb_objects", "noise_readings", "pareto_fronts", "keep_out_sweep"]
+           "crlb_objects", "noise_readings", "pareto_fronts", "keep_out_sweep", "figure_readings", "departure_figure",
+           "figure_keep_out_diagnosis"]
 
 
 def _floor(v):
@@ -514,4 +517,118 @@ def keep_out_sweep(radius_rows, neighbours, keep_out_km, alpha):
     fig.suptitle(rf"Keep-out radius swept at $\alpha_h$ = {alpha:g} (dotted: adopted 424 km; dashed: the neighbouring "
                  r"$\alpha_h$ of the grid, for scale)")
     fig.tight_layout(rect=(0, 0.07, 1, 1))
+    return fig
+
+
+# ------------------------------------------------------------------------------------------------------------
+# process-noise readings (notebooks 05 section 8, 06 section 10b; readings_study)
+def figure_readings(study: readings_study.ReadingsStudy, system, show_alphas=None):
+    """Figs. 9 and 10 under each reading, a small-multiples panel.
+
+    Top row: the observer's CRLB (position RMS, km) over the window (days) for the plans nearest to
+    ``show_alphas`` (default: every plan; alpha_h = 0 grey), the alpha_h = 0 ratio in the title; bottom row: MI
+    under that reading (nats) against the terminal observer RMS (km), every plan, with the Spearman coefficient.
+    ``system`` is the CR3BP of the study's scenario (time units).
+    """
+    validation.instance(study, "study", readings_study.ReadingsStudy)
+    check_system(system, "system")
+    alphas = np.array(study.alphas)
+    show = alphas if show_alphas is None else validation.as_array(show_alphas, "show_alphas", ndim=(1,), min_size=1)
+    idx = [int(np.argmin(np.abs(alphas - a))) for a in show]
+    ncol = len(study.rows)
+    fig, axes = plt.subplots(2, ncol, figsize=(4.2 * ncol, 6.6), squeeze=False)
+    for ax in axes[0, 1:]:
+        ax.sharey(axes[0, 0])  # the CRLB levels of the readings on one scale; the MI levels differ by reading
+    for ax in axes[1, 1:]:
+        ax.sharex(axes[1, 0])  # terminal RMS on one scale, so the literal reading's level shows
+    ramp = plt.cm.viridis(np.linspace(0.1, 0.9, max(int(np.sum(alphas > 0)), 2)))
+    colors = [(0.6, 0.6, 0.6, 1.0) if a == 0 else ramp[int(np.sum(alphas[:i] > 0))] for i, a in enumerate(alphas)]
+    for j, r in enumerate(study.rows):
+        name = re.sub(r"\^(\d)", r"$^\1$", r.name)
+        ax = axes[0, j]
+        days = system.tu_to_days(r.t)
+        for i in idx:
+            ax.semilogy(days, r.rms_km[i, 0], "o-", ms=2, lw=1, color=colors[i], label=rf"$\alpha_h$ = {alphas[i]:g}")
+        wr = study.weak_ratio(r)
+        verdict = ("" if study.case != 2 else  # the paper says "weakly observable" of test case 2 only
+                   ": weakly observable" if wr >= WEAK_FACTOR else ": not weakly observable")
+        ax.set_title("\n".join([name] + ([f"$\\alpha_h$ = 0 ends {wr:.1f}x the worst $\\alpha_h$ > 0{verdict}"]
+                                          if np.isfinite(wr) else [])), fontsize=8)
+        ax.set(xlabel="time [days]", ylabel="observer position RMS [km]")
+        ax = axes[1, j]
+        ax.scatter(r.terminal_obs_km, r.mi, color=colors, s=18)
+        ax.set_xscale("log")
+        c = study.corr(r)
+        ax.set_title(f"Spearman(MI, RMS) {c:+.2f}: " + ("correlates well" if c <= CORR_LIMIT else "does not"),
+                     fontsize=8)
+        ax.set(xlabel="terminal observer RMS [km]", ylabel="MI under this reading [nats]")
+    fig.legend(*axes[0, 0].get_legend_handles_labels(), loc="lower center", ncol=min(len(idx), 10), fontsize=7,
+               bbox_to_anchor=(0.5, -0.01))
+    figs = "Figs. 9-10" if study.case == 2 else "Figs. 4-5"
+    fig.suptitle(f"Test case {study.case}: {figs} (CRLB, MI against RMS) under each reading of Q", fontsize=10)
+    fig.tight_layout(rect=(0, 0.05, 1, 0.97))
+    return fig
+
+
+# ------------------------------------------------------------------------------------------------------------
+# plan size (notebook 05 section 8b; plan_size_study)
+def departure_figure(study: plan_size_study.PlanSizeStudy):
+    """Largest departure from the reference DRO against the control-term scale :math:`c`, one curve per
+    process-noise reading, one panel per weight; the "not immediately apparent" threshold dashed."""
+    validation.instance(study, "study", plan_size_study.PlanSizeStudy)
+    fig, axes = plt.subplots(1, len(study.alphas), figsize=(6.0 * len(study.alphas), 4.5), sharey=True,
+                             layout="constrained", squeeze=False)
+    scales = np.array([study.row(n, study.readings[0], study.alphas[0]).control_scale for n in study.normalisations])
+    order = np.argsort(scales)
+    for ax, a in zip(axes[0], study.alphas):
+        dep = study.departures(a)
+        for j, q in enumerate(study.readings):  # the small readings nearly coincide: markers and dashes tell them apart
+            ax.plot(scales[order], dep[order, j], marker="osd^v"[j % 5], ls=("-", "--", "-.", ":")[j % 4], lw=1.2,
+                    ms=5 + 1.5 * (len(study.readings) - 1 - j), mfc="none", label=q)
+        ax.axhline(study.threshold_km, color="k", ls="--", lw=1,
+                   label=f"'not immediately apparent': {100 * study.fraction:g} % of the DRO's size")
+        ax.axhline(study.baseline.departure_km, color="0.5", ls=":", lw=1, label=r"$\alpha_h$ = 0 plan")
+        bad = [i for i in range(len(scales)) if np.all(np.isnan(dep[i]))]
+        if bad:
+            ax.plot(scales[bad], np.full(len(bad), 0.97), "kx", ms=7, transform=ax.get_xaxis_transform(),
+                    label="no converged plan (see the table)")
+        for i in order:
+            ax.annotate(study.normalisations[i].split(" (")[0], (scales[i], 0.0), fontsize=6,
+                        rotation=90, va="bottom", ha="right", xycoords=("data", "axes fraction"),
+                        xytext=(0, 3), textcoords="offset points")
+        ax.set(xscale="log", yscale="log", xlabel="control term / total impulse in LU/TU, c [-]",
+               title=rf"$\alpha_h$ = {a:g}")
+    axes[0, 0].set_ylabel("largest departure from the reference DRO [km]")
+    axes[0, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
+    return fig
+
+
+# ------------------------------------------------------------------------------------------------------------
+# keep-out diagnosis and remedy (notebook 06 section 11; keep_out_diagnosis)
+def figure_keep_out_diagnosis(diagnosis: kod.FreeRunDiagnosis, plain: kod.PassScan, remedy: kod.PassScan,
+                              range_scale_km: float):
+    """Left: closest approach of each SCvx reference to a target without a keep-out (km, log), the failure marked.
+    Right: along passes at a chosen distance, the position part of the MI gradient (nats/LU) with the paper's
+    noise and with the range-dependent noise, and the whitened range-rate row (per LU)."""
+    validation.instance(diagnosis, "diagnosis", kod.FreeRunDiagnosis)
+    validation.instance(plain, "plain", kod.PassScan)
+    validation.instance(remedy, "remedy", kod.PassScan)
+    rc = validation.positive(range_scale_km, "range_scale_km")
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.6), layout="constrained")
+    ref = np.arange(diagnosis.ref_range_km.size)
+    ax1.semilogy(ref, diagnosis.ref_range_km, ".-", color="C0", label="closest approach of the reference")
+    if diagnosis.failed and ref.size:
+        ax1.semilogy(ref[-1], diagnosis.ref_range_km[-1], "x", color="C3", ms=10, mew=2,
+                     label=f"last reference: {diagnosis.status or 'failure'}")
+    ax1.axhline(424.0, color="0.5", ls="--", lw=0.8, label="the adopted keep-out (424 km), not imposed here")
+    ax1.set(xlabel="SCvx reference (accepted step) [-]", ylabel="closest approach to a target [km]",
+            title="SCvx without a keep-out")
+    ax2.loglog(plain.d_km, plain.grad_position, "o-", color="C3", label=r"$|\partial I/\partial r|$, paper's noise")
+    ax2.loglog(remedy.d_km, remedy.grad_position, "s-", color="C2",
+               label=rf"$|\partial I/\partial r|$, range noise ($\rho_c$ = {rc:g} km)")
+    ax2.loglog(plain.d_km, plain.range_rate_row, ":", color="0.3", label="whitened range-rate row [1/LU]")
+    ax2.set(xlabel="pass distance [km]", ylabel="norm [nats/LU or 1/LU]", title="the reward's slope near a target")
+    for ax in (ax1, ax2):
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
+    fig.suptitle("Test case 2 without a keep-out: what the convex subproblem hits, and the range-dependent noise")
     return fig

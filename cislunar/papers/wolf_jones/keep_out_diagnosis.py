@@ -31,7 +31,6 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from cislunar.cr3bp.propagation import propagate, propagate_stm
@@ -45,7 +44,6 @@ __all__ = [
     "PassScan",
     "RangeNoiseInformation",
     "RemedyRun",
-    "figure_keep_out_diagnosis",
     "free_run_diagnosis",
     "pass_scan",
     "passing_state",
@@ -412,32 +410,3 @@ def remedy_table(runs) -> str:
                      f"{r.dv_mps:8.2f} {r.mi:8.3f} {r.mi_remedy:10.3f} {r.closest_km:11.1f} {r.rms_km:8.2f} {r.cost:11.6f}"
                      + ("" if r.converged else f"  ({r.outcome[:60]})"))
     return "\n".join(lines)
-
-
-# --- figures (the lead moves these into figures.py)
-def figure_keep_out_diagnosis(diagnosis: FreeRunDiagnosis, plain: PassScan, remedy: PassScan, range_scale_km: float):
-    """Left: closest approach of each SCvx reference to a target without a keep-out (km, log), the failure marked.
-    Right: along passes at a chosen distance, the position part of the MI gradient (nats/LU) with the paper's
-    noise and with the range-dependent noise, and the whitened range-rate row (per LU)."""
-    validation.instance(diagnosis, "diagnosis", FreeRunDiagnosis)
-    validation.instance(plain, "plain", PassScan)
-    validation.instance(remedy, "remedy", PassScan)
-    rc = validation.positive(range_scale_km, "range_scale_km")
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.6), layout="constrained")
-    ref = np.arange(diagnosis.ref_range_km.size)
-    ax1.semilogy(ref, diagnosis.ref_range_km, ".-", color="C0", label="closest approach of the reference")
-    if diagnosis.failed and ref.size:
-        ax1.semilogy(ref[-1], diagnosis.ref_range_km[-1], "x", color="C3", ms=10, mew=2,
-                     label=f"last reference: {diagnosis.status or 'failure'}")
-    ax1.axhline(424.0, color="0.5", ls="--", lw=0.8, label="the adopted keep-out (424 km), not imposed here")
-    ax1.set(xlabel="SCvx reference (accepted step) [-]", ylabel="closest approach to a target [km]",
-            title="SCvx without a keep-out")
-    ax2.loglog(plain.d_km, plain.grad_position, "o-", color="C3", label=r"$|\partial I/\partial r|$, paper's noise")
-    ax2.loglog(remedy.d_km, remedy.grad_position, "s-", color="C2",
-               label=rf"$|\partial I/\partial r|$, range noise ($\rho_c$ = {rc:g} km)")
-    ax2.loglog(plain.d_km, plain.range_rate_row, ":", color="0.3", label="whitened range-rate row [1/LU]")
-    ax2.set(xlabel="pass distance [km]", ylabel="norm [nats/LU or 1/LU]", title="the reward's slope near a target")
-    for ax in (ax1, ax2):
-        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
-    fig.suptitle("Test case 2 without a keep-out: what the convex subproblem hits, and the range-dependent noise")
-    return fig

@@ -44,7 +44,6 @@ import dataclasses
 import time
 from dataclasses import dataclass, field
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from cislunar.cr3bp.propagation import ImpactError, propagate
@@ -54,8 +53,7 @@ from cislunar.sensing import covariance as cov
 from cislunar.utils import montecarlo, validation
 
 __all__ = ["NORMALISATIONS", "ADOPTED_NORMALISATION", "ADOPTED_READING", "LITERAL_READING", "FIT_FRACTION",
-           "PAPER_ALPHAS", "PlanSizeRow", "PlanSizeStudy", "q_reading_nd", "dro_size_km", "plan_size_sweep",
-           "departure_figure"]
+           "PAPER_ALPHAS", "PlanSizeRow", "PlanSizeStudy", "q_reading_nd", "dro_size_km", "plan_size_sweep"]
 
 #: Readings of Eq. 42's control term: label -> (``control_unit``, ``control_average``) of ScenarioSolver.  The total
 #: in km/s differs from the adopted total in LU/TU by the factor 1.0245 only, so it is not swept.
@@ -364,35 +362,3 @@ def _sequence(value, name: str) -> list:
     if not out:
         raise ValueError(f"{name} must not be empty")
     return out
-
-
-# --- figures (the lead moves these into figures.py)
-def departure_figure(study: PlanSizeStudy):
-    """Largest departure from the reference DRO against the control-term scale :math:`c`, one curve per
-    process-noise reading, one panel per weight; the "not immediately apparent" threshold dashed."""
-    validation.instance(study, "study", PlanSizeStudy)
-    fig, axes = plt.subplots(1, len(study.alphas), figsize=(6.0 * len(study.alphas), 4.5), sharey=True,
-                             layout="constrained", squeeze=False)
-    scales = np.array([study.row(n, study.readings[0], study.alphas[0]).control_scale for n in study.normalisations])
-    order = np.argsort(scales)
-    for ax, a in zip(axes[0], study.alphas):
-        dep = study.departures(a)
-        for j, q in enumerate(study.readings):  # the small readings nearly coincide: markers and dashes tell them apart
-            ax.plot(scales[order], dep[order, j], marker="osd^v"[j % 5], ls=("-", "--", "-.", ":")[j % 4], lw=1.2,
-                    ms=5 + 1.5 * (len(study.readings) - 1 - j), mfc="none", label=q)
-        ax.axhline(study.threshold_km, color="k", ls="--", lw=1,
-                   label=f"'not immediately apparent': {100 * study.fraction:g} % of the DRO's size")
-        ax.axhline(study.baseline.departure_km, color="0.5", ls=":", lw=1, label=r"$\alpha_h$ = 0 plan")
-        bad = [i for i in range(len(scales)) if np.all(np.isnan(dep[i]))]
-        if bad:
-            ax.plot(scales[bad], np.full(len(bad), 0.97), "kx", ms=7, transform=ax.get_xaxis_transform(),
-                    label="no converged plan (see the table)")
-        for i in order:
-            ax.annotate(study.normalisations[i].split(" (")[0], (scales[i], 0.0), fontsize=6,
-                        rotation=90, va="bottom", ha="right", xycoords=("data", "axes fraction"),
-                        xytext=(0, 3), textcoords="offset points")
-        ax.set(xscale="log", yscale="log", xlabel="control term / total impulse in LU/TU, c [-]",
-               title=rf"$\alpha_h$ = {a:g}")
-    axes[0, 0].set_ylabel("largest departure from the reference DRO [km]")
-    axes[0, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
-    return fig

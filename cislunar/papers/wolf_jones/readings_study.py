@@ -21,14 +21,11 @@ barycentric CR3BP states in LU and LU/TU.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 
-import matplotlib.pyplot as plt
 import numpy as np
 from scipy.stats import spearmanr
 
-from cislunar.cr3bp.dynamics import check_system
 from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.papers.wolf_jones import test_case_studies as studies
 from cislunar.papers.wolf_jones.case_2_closing import Measurement
@@ -36,8 +33,7 @@ from cislunar.papers.wolf_jones.claims.process_noise_readings import CORR_LIMIT,
 from cislunar.sensing import covariance as cov
 from cislunar.utils import validation
 
-__all__ = ["ReadingRow", "ReadingsStudy", "evaluate_readings", "case2_readings", "case1_readings",
-           "figure_readings"]
+__all__ = ["ReadingRow", "ReadingsStudy", "evaluate_readings", "case2_readings", "case1_readings"]
 
 #: Short names of the four readings, in the order of ``PROCESS_NOISE_READINGS_KM2_S3``.
 _SHORT = {1e-11: "1e-11 km^2/s^3 (literal)", 1e-17: "1e-11 m^2/s^3", 1e-22: "(1e-11)^2 km^2/s^3"}
@@ -305,52 +301,3 @@ def case1_readings(case: studies.Case1Sweep) -> ReadingsStudy:
     validation.instance(case, "case", studies.Case1Sweep)
     return evaluate_readings(case.scenario, case.alphas, [r.x[case.k_ws] for r in case.best],
                              dv_mps=case.impulse_mps, mi_planned=case.mi)
-
-
-# --- figures (the lead moves these into figures.py)
-def figure_readings(study: ReadingsStudy, system, show_alphas=None):
-    """Figs. 9 and 10 under each reading, a small-multiples panel.
-
-    Top row: the observer's CRLB (position RMS, km) over the window (days) for the plans nearest to
-    ``show_alphas`` (default: every plan; alpha_h = 0 grey), the alpha_h = 0 ratio in the title; bottom row: MI
-    under that reading (nats) against the terminal observer RMS (km), every plan, with the Spearman coefficient.
-    ``system`` is the CR3BP of the study's scenario (time units).
-    """
-    validation.instance(study, "study", ReadingsStudy)
-    check_system(system, "system")
-    alphas = np.array(study.alphas)
-    show = alphas if show_alphas is None else validation.as_array(show_alphas, "show_alphas", ndim=(1,), min_size=1)
-    idx = [int(np.argmin(np.abs(alphas - a))) for a in show]
-    ncol = len(study.rows)
-    fig, axes = plt.subplots(2, ncol, figsize=(4.2 * ncol, 6.6), squeeze=False)
-    for ax in axes[0, 1:]:
-        ax.sharey(axes[0, 0])  # the CRLB levels of the readings on one scale; the MI levels differ by reading
-    for ax in axes[1, 1:]:
-        ax.sharex(axes[1, 0])  # terminal RMS on one scale, so the literal reading's level shows
-    ramp = plt.cm.viridis(np.linspace(0.1, 0.9, max(int(np.sum(alphas > 0)), 2)))
-    colors = [(0.6, 0.6, 0.6, 1.0) if a == 0 else ramp[int(np.sum(alphas[:i] > 0))] for i, a in enumerate(alphas)]
-    for j, r in enumerate(study.rows):
-        name = re.sub(r"\^(\d)", r"$^\1$", r.name)
-        ax = axes[0, j]
-        days = system.tu_to_days(r.t)
-        for i in idx:
-            ax.semilogy(days, r.rms_km[i, 0], "o-", ms=2, lw=1, color=colors[i], label=rf"$\alpha_h$ = {alphas[i]:g}")
-        wr = study.weak_ratio(r)
-        verdict = ("" if study.case != 2 else  # the paper says "weakly observable" of test case 2 only
-                   ": weakly observable" if wr >= WEAK_FACTOR else ": not weakly observable")
-        ax.set_title("\n".join([name] + ([f"$\\alpha_h$ = 0 ends {wr:.1f}x the worst $\\alpha_h$ > 0{verdict}"]
-                                          if np.isfinite(wr) else [])), fontsize=8)
-        ax.set(xlabel="time [days]", ylabel="observer position RMS [km]")
-        ax = axes[1, j]
-        ax.scatter(r.terminal_obs_km, r.mi, color=colors, s=18)
-        ax.set_xscale("log")
-        c = study.corr(r)
-        ax.set_title(f"Spearman(MI, RMS) {c:+.2f}: " + ("correlates well" if c <= CORR_LIMIT else "does not"),
-                     fontsize=8)
-        ax.set(xlabel="terminal observer RMS [km]", ylabel="MI under this reading [nats]")
-    fig.legend(*axes[0, 0].get_legend_handles_labels(), loc="lower center", ncol=min(len(idx), 10), fontsize=7,
-               bbox_to_anchor=(0.5, -0.01))
-    figs = "Figs. 9-10" if study.case == 2 else "Figs. 4-5"
-    fig.suptitle(f"Test case {study.case}: {figs} (CRLB, MI against RMS) under each reading of Q", fontsize=10)
-    fig.tight_layout(rect=(0, 0.05, 1, 0.97))
-    return fig

@@ -10,6 +10,7 @@ import pytest
 
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.cr3bp.propagation import propagate
+from cislunar.papers.wolf_jones import figures
 from cislunar.papers.wolf_jones import plan_size_study as ps
 from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.publish import plotting
@@ -100,7 +101,7 @@ def test_executor_gives_the_same_rows(small):
 
 
 def test_figure_has_units(small):
-    fig = ps.departure_figure(small)
+    fig = figures.departure_figure(small)
     try:
         assert plotting.axis_label_problems(fig) == []
         assert len(fig.axes[0].lines) >= 3

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from cislunar.cr3bp.propagation import propagate
+from cislunar.papers.wolf_jones import figures
 from cislunar.papers.wolf_jones import readings_study as rs
 from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.papers.wolf_jones.claims.process_noise_readings import CLAIMS, CORR_LIMIT, WEAK_FACTOR
@@ -112,7 +113,7 @@ def test_the_study_pickles_and_draws(case2):
     sc, _, st = case2
     back = pickle.loads(pickle.dumps(st))
     np.testing.assert_array_equal(back.rows[0].rms_km, st.rows[0].rms_km)
-    fig = rs.figure_readings(st, sc.system, [0.0, 1e-2])
+    fig = figures.figure_readings(st, sc.system, [0.0, 1e-2])
     assert plotting.axis_label_problems(fig) == []
     assert len(fig.axes) == 2 * len(st.rows)
     assert "adopted" in st.summary()
