@@ -53,6 +53,19 @@ def full_setup():
 
 
 @functools.lru_cache(maxsize=None)
+def small_joint():
+    return ds.run_joint_search(em, nrho(), {"quiet": det.QUIET_POLICY}, windows_hours=(8.0,), factors=(0.3,),
+                               q_bases_km2_s3=(1e-18,), noise_urad=(10.0,), burn_offsets_hours=(0.0,), n_screen=(6, 6),
+                               n_paper=(6, 8), n_boot=2, seed=[0, 95], paper_zlim={"quiet": 0.022}, batch_size=4)
+
+
+@functools.lru_cache(maxsize=None)
+def small_lead_grid():
+    return ds.run_lead_grid(em, nrho(), factors=(0.3,), noise_urad=(20.0,), magnitudes_m_s=(0.5,), n_h0=10, n_h1=1,
+                            seed=[0, 61], q_base_km2_s3=1e-18, window_hours=8.0, horizon_hours=2.0)
+
+
+@functools.lru_cache(maxsize=None)
 def burn_inputs():
     return det.draw_trial(np.random.default_rng(0), setup(), magnitude_m_s=3.0)
 
@@ -276,6 +289,26 @@ def specs(Spec, lazy):
     for name in ("adaptive_errors", "adaptive_control_metric"):
         s.append(S(name, _closed(getattr(figures, name)), dict(setup=lazy(setup), run=lazy(big_run), title="3 m/s"),
                    dict(setup="instance", run="instance", title="instance_str")))
+    s.append(S("accuracy_exact_text", ds.accuracy_exact_text, dict(accuracy=0.98, paper=1.0, n=200),
+               dict(accuracy="real", paper="real", n="int1")))
+    s.append(S("run_joint_search", ds.run_joint_search,
+               dict(system=em, orbit=lazy(nrho), policies={"quiet": det.QUIET_POLICY}, windows_hours=(8.0,),
+                    factors=(0.3,), q_bases_km2_s3=(1e-18,), noise_urad=(10.0,), burn_offsets_hours=(0.0,),
+                    n_screen=(6, 6), n_paper=(6, 8), n_boot=2, seed=[0, 95], paper_zlim={"quiet": 0.022},
+                    batch_size=4, executor=None),
+               dict(system="system", orbit="instance", policies="instance", windows_hours="vec", factors="vec",
+                    q_bases_km2_s3="vec", noise_urad="vec", burn_offsets_hours="vec", n_screen="instance",
+                    n_paper="instance", n_boot="int2", seed="seed", paper_zlim="instance", batch_size="int1",
+                    executor="instance_opt"), baseline=False))
+    s.append(S("run_lead_grid", ds.run_lead_grid,
+               dict(system=em, orbit=lazy(nrho), factors=(0.3,), noise_urad=(20.0,), magnitudes_m_s=(0.5,), n_h0=10,
+                    n_h1=1, seed=[0, 61], q_base_km2_s3=1e-18, window_hours=8.0, judged_m_s=0.5, horizon_hours=2.0),
+               dict(system="system", orbit="instance", factors="vec", noise_urad="vec", magnitudes_m_s="vec",
+                    n_h0="int1", n_h1="int1", seed="seed", q_base_km2_s3="pos", window_hours="pos", judged_m_s="pos",
+                    horizon_hours="pos"), baseline=False))
+    s.append(S("joint_search", _closed(figures.joint_search), dict(joint=lazy(small_joint)),
+               dict(joint="instance")))
+    s.append(S("lead_grid", _closed(figures.lead_grid), dict(grid=lazy(small_lead_grid)), dict(grid="instance")))
     s.append(S("delays", _closed(figures.delays), dict(study=lazy(delays)), dict(study="instance")))
     s.append(S("reset_rules", _closed(figures.reset_rules), dict(study=lazy(rules)), dict(study="instance")))
     pols = {"active": det.ACTIVE_POLICY, "quiet": det.QUIET_POLICY}

@@ -128,6 +128,14 @@ CALLS = {
     GS21 + "detection.filter_trial_sets":
         lambda: dict(sets=[(_setup(), [detection.draw_trial(np.random.default_rng(k), _setup(), detection.ACTIVE_POLICY)
                                       for k in range(2)])]),
+    GS21 + "detection_studies.run_joint_search":
+        lambda: dict(system=em, orbit=orbits.nrho_9_2(em), policies={"quiet": detection.QUIET_POLICY},
+                     windows_hours=(8.0,), factors=(0.3,), q_bases_km2_s3=(1e-18,), noise_urad=(10.0,),
+                     burn_offsets_hours=(0.0,), n_screen=(6, 6), n_paper=(6, 8), n_boot=2, seed=0,
+                     paper_zlim={"quiet": 0.022}, batch_size=2),
+    GS21 + "detection_studies.run_lead_grid":
+        lambda: dict(system=em, orbit=orbits.nrho_9_2(em), factors=(0.3,), noise_urad=(20.0,), magnitudes_m_s=(0.5,),
+                     n_h0=10, n_h1=1, seed=0, q_base_km2_s3=1e-18, window_hours=8.0, horizon_hours=2.0),
     "cislunar.utils.montecarlo.run_monte_carlo":
         lambda: dict(trial=_trial, n_trials=7, seed=3, args=(2.0,), chunk_size=2, progress=False),
     "cislunar.utils.montecarlo.map_tasks": lambda: dict(fn=_square, tasks=range(5), progress=False),
