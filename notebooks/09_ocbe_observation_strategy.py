@@ -89,8 +89,8 @@ from cislunar.cr3bp import orbits
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.papers.greaves_scheeres_2021 import custody as cu
 from cislunar.papers.greaves_scheeres_2021 import detection as det
+from cislunar.papers.greaves_scheeres_2021 import figures, tracking
 from cislunar.papers.greaves_scheeres_2021 import observation_strategy as obs
-from cislunar.papers.greaves_scheeres_2021 import tracking
 from cislunar.papers.greaves_scheeres_2021.claims.observation_strategy import CLAIMS
 from cislunar.papers.greaves_scheeres_2021.claims.operations import CLAIMS as OPS
 from cislunar.publish import plotting
@@ -546,7 +546,7 @@ for c in custody.values():
 if custody_weak is not None:  # full mode only
     print("the same quiet-policy runs with the window weight ten times weaker (notebook 10's threshold reading):")
     print(custody_weak.report())
-_ = plotting.save_figure(cu.figure_custody(custody.values()), "09_custody_multi_period", output_dir=out)
+_ = plotting.save_figure(figures.figure_custody(custody.values()), "09_custody_multi_period", output_dir=out)
 
 # %% [markdown]
 # **Reading the custody runs** (the sentences describe the full run, 32 runs of 10 periods per policy; the printed
@@ -598,7 +598,7 @@ conditioning = {name: cu.conditioning_case(cu.linear_problem(em, nrho, **LADDER[
 for case in conditioning.values():
     print(case.report())
 worst = conditioning[ladder[-1]]
-_ = plotting.save_figure(cu.figure_conditioning(worst), "09_sri_vs_covariance_form", output_dir=out)
+_ = plotting.save_figure(figures.figure_conditioning(worst), "09_sri_vs_covariance_form", output_dir=out)
 
 # %% [markdown]
 # **Reading the ladder** (the printed lines; the figure shows the last case). On the chapter's own case the three
@@ -633,7 +633,7 @@ cost = cu.cadence_cost_study(em, nrho, cadences_cost, CONTROL_WEIGHT_KM2_S3, see
                              repeats=1 if QUICK else 3)
 print(f"cadence costs measured in {time.perf_counter() - t_cost:.0f} s")
 print(cost.report())
-_ = plotting.save_figure(cu.figure_cadence_cost(cost), "09_cadence_run_time", output_dir=out)
+_ = plotting.save_figure(figures.figure_cadence_cost(cost), "09_cadence_run_time", output_dir=out)
 
 # %% [markdown]
 # **Reading the cost curve** (the full run: 1 minute to 12 hours; the printed lines are this run's, and the

@@ -383,7 +383,7 @@ with open_executor(workers, SCHEDULER) as executor:
 print(f"{len(variants.runs)} adaptive runs ({n_variant} per burn size x 3 measurement sets x 2 resets) in "
       f"{time.perf_counter() - t_var:.0f} s")
 print(variants.report())
-_ = plotting.save_figure(ads.variant_figure(variants), "09b_adaptive_measurement_sets", output_dir=out)
+_ = plotting.save_figure(figures.variant_figure(variants), "09b_adaptive_measurement_sets", output_dir=out)
 
 # %% [markdown]
 # **Reading** (the sentences describe the full run, 12 runs per size and set; quick mode runs one and shows the

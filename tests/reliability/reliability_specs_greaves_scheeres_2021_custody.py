@@ -16,6 +16,7 @@ from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.estimation import srif
 from cislunar.papers.greaves_scheeres_2021 import custody as cu
 from cislunar.papers.greaves_scheeres_2021 import detection as det
+from cislunar.papers.greaves_scheeres_2021 import figures
 
 MODULES = [cu]
 EXEMPT: dict = {}
@@ -89,9 +90,9 @@ def specs(S, lazy):
                     sigma_angle_rad=1e-5, max_repeat_seconds=2.0),
                dict(system="system", orbit="instance", cadences="vec", control_weight_km2_s3="pos", seed="int0",
                     repeats="int1", sigma_angle_rad="pos", max_repeat_seconds="pos")))
-    s.append(S("figure_custody", cu.figure_custody, dict(studies=lz(lambda: [study()])), dict(studies="iterable")))
-    s.append(S("figure_conditioning", cu.figure_conditioning, dict(case=lz(case)), dict(case="instance")))
-    s.append(S("figure_cadence_cost", cu.figure_cadence_cost, dict(cost=lz(cost)), dict(cost="instance")))
+    s.append(S("figure_custody", figures.figure_custody, dict(studies=lz(lambda: [study()])), dict(studies="iterable")))
+    s.append(S("figure_conditioning", figures.figure_conditioning, dict(case=lz(case)), dict(case="instance")))
+    s.append(S("figure_cadence_cost", figures.figure_cadence_cost, dict(cost=lz(cost)), dict(cost="instance")))
     s.append(S("filter_many", srif.filter_many,
                dict(x0s=np.zeros((2, 3)), P0=_SPD3, Phis=np.array([np.eye(3)]), Hs=[np.eye(3), np.eye(3)],
                     ys=np.ones((2, 2, 3)), meas_covs=[np.eye(3), np.eye(3)], Gammas=[np.eye(3)], Qs=[_SPD3]),

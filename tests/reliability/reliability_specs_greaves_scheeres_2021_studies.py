@@ -309,6 +309,7 @@ def specs(Spec, lazy):
     s.append(S("joint_search", _closed(figures.joint_search), dict(joint=lazy(small_joint)),
                dict(joint="instance")))
     s.append(S("lead_grid", _closed(figures.lead_grid), dict(grid=lazy(small_lead_grid)), dict(grid="instance")))
+    s.append(S("variant_figure", _closed(figures.variant_figure), dict(study=lazy(variants)), dict(study="instance")))
     s.append(S("delays", _closed(figures.delays), dict(study=lazy(delays)), dict(study="instance")))
     s.append(S("reset_rules", _closed(figures.reset_rules), dict(study=lazy(rules)), dict(study="instance")))
     pols = {"active": det.ACTIVE_POLICY, "quiet": det.QUIET_POLICY}

@@ -26,7 +26,6 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-import matplotlib.pyplot as plt
 import numpy as np
 from scipy import stats
 
@@ -1055,32 +1054,3 @@ def variant_rows(variants: VariantStudy, fig8) -> dict:
                      f"{100 * s_['detected']:.0f} %")
     rows["delay by measurement set"] = dict(measured=f"{small * 1e3:g} mm/s: " + "; ".join(parts))
     return rows
-
-
-# --- figures (the lead moves these into figures.py)
-
-
-def variant_figure(study: VariantStudy):
-    """Resets per detection, runs inconsistent after the burn and detected runs re-converged, per burn size, for
-    every measurement set (colour) and reset rule (solid: the paper's, dashed: the state-covariance inflation)."""
-    validation.instance(study, "study", VariantStudy)
-    mm = np.array(study.magnitudes_m_s) * 1e3
-    fig, ax = plt.subplots(1, 3, figsize=(14, 4))
-    for i, ms in enumerate(MEASUREMENT_SETS):
-        for j, rule in enumerate(VARIANT_RULES):
-            S = [study.summary(ms, rule, (m,)) for m in study.magnitudes_m_s]
-            sty = dict(color=f"C{i}", ls="-" if j == 0 else "--", marker="o" if j == 0 else "s",
-                       mfc=None if j == 0 else "none", label=f"{ms}, {rule}")
-            ax[0].plot(mm, [s["resets_per_detection"] for s in S], **sty)
-            ax[1].plot(mm, [100 * s["inconsistent"] for s in S], **sty)
-            ax[2].plot(mm, [100 * s["reconverged"] for s in S], **sty)
-    ax[0].set(xscale="log", xlabel="burn size [mm/s]", ylabel="resets per detection [-]",
-              title="chain rate")
-    ax[1].set(xscale="log", xlabel="burn size [mm/s]", ylabel="runs [%]", ylim=(-5, 105),
-              title="inconsistent after the burn (NEES)")
-    ax[2].set(xscale="log", xlabel="burn size [mm/s]", ylabel="detected runs [%]", ylim=(-5, 105),
-              title="final estimate consistent (re-converged)")
-    handles, labels = ax[0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=3, bbox_to_anchor=(0.5, 0.0))
-    fig.tight_layout(rect=(0, 0.14, 1, 1))
-    return fig

@@ -49,7 +49,6 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-import matplotlib.pyplot as plt
 import numpy as np
 from scipy import stats
 
@@ -74,9 +73,6 @@ __all__ = [
     "conditioning_case",
     "covariance_filter",
     "custody_study",
-    "figure_cadence_cost",
-    "figure_conditioning",
-    "figure_custody",
     "linear_problem",
     "pointing_error",
     "sri_filter",
@@ -785,68 +781,3 @@ def cadence_cost_study(system: CR3BP, orbit: PeriodicOrbit, cadences, control_we
         out["nees_mean"].append(s.nees_mean)
     return CadenceCost(cads, *(np.array(out[k]) for k in ("updates", "seconds", "sigma3_km", "sigma3_m_s",
                                                            "nees_mean")))
-
-
-# --- figures (the lead moves these into figures.py)
-def figure_custody(studies):
-    """Per period: fraction of runs keeping custody and inconsistent (left); worst and median pointing error of the
-    predicted estimate against the custody bound (right).  ``studies``: a sequence of :class:`CustodyStudy`."""
-    if isinstance(studies, (str, bytes)) or not hasattr(studies, "__iter__"):
-        raise validation.ArgumentTypeError(f"studies must be a sequence of CustodyStudy; got {type(studies).__name__}")
-    studies = list(studies)
-    if not studies:
-        raise ValueError("studies must hold at least one CustodyStudy")
-    for i, st in enumerate(studies):
-        validation.instance(st, f"studies[{i}]", CustodyStudy, "a CustodyStudy (custody_study)")
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True)
-    for s, mk in zip(studies, "os^v"):
-        k = np.arange(1, s.periods + 1)
-        a1.plot(k, 100 * s.custody_fraction, marker=mk, label=f"custody kept, {s.policy_name}")
-        a1.plot(k, 100 * s.inconsistent_fraction, marker=mk, ls="--", label=f"inconsistent, {s.policy_name}")
-        pe = np.rad2deg(np.where(np.isfinite(s.max_pointing_rad), s.max_pointing_rad, np.nan))
-        a2.semilogy(k, np.nanmax(pe, axis=0), marker=mk, label=f"worst run, {s.policy_name}")
-        a2.semilogy(k, np.nanmedian(pe, axis=0), marker=mk, ls="--", label=f"median run, {s.policy_name}")
-    a1.axhspan(0, 10, color="0.9", zorder=0)
-    a1.set(xlabel="period since hand-off (-)", ylabel="runs (%)", ylim=(-5, 105))
-    a2.axhline(np.rad2deg(studies[0].half_angle_rad), color="k", ls=":", label="custody bound")
-    a2.set(xlabel="period since hand-off (-)", ylabel="max pointing error (deg)")
-    for a in (a1, a2):
-        a.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7)
-    return fig
-
-
-def figure_conditioning(case: ConditioningCase):
-    """The three forms on one case: smallest eigenvalue ratio of P (left) and mean NEES over the draws (right)."""
-    validation.instance(case, "case", ConditioningCase, "a ConditioningCase (conditioning_case)")
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True)
-    days = case.t * 0 + np.arange(case.t.size)
-    for f, ls in zip(case.forms, ("-", "--", ":")):
-        a1.semilogy(days, np.abs(case.min_eig_ratio[f]), ls=ls, label=f"|min/max eigenvalue|, {f}")
-        neg = case.min_eig_ratio[f] < 0
-        if neg.any():
-            a1.semilogy(days[neg], np.abs(case.min_eig_ratio[f][neg]), "x", label=f"negative eigenvalue, {f}")
-        a2.semilogy(days, np.where(case.nees_mean[f] > 0, case.nees_mean[f], np.nan), ls=ls, label=f)
-    a2.axhspan(*case.band, color="0.85", zorder=0, label="99.9 % band (consistent)")
-    a1.set(xlabel="epoch index (-)", ylabel="eigenvalue ratio of P (-)")
-    a2.set(xlabel="epoch index (-)", ylabel="mean NEES over draws (-)")
-    for a in (a1, a2):
-        a.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7)
-    fig.suptitle(case.label, fontsize=9)
-    return fig
-
-
-def figure_cadence_cost(cost: CadenceCost):
-    """Final 3-sigma position against run time per period, one point per cadence (log-log)."""
-    validation.instance(cost, "cost", CadenceCost, "a CadenceCost (cadence_cost_study)")
-    fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
-    ax.loglog(cost.seconds, cost.sigma3_km, "o-", label="OCBE filter, one period")
-    for c, s, a in zip(cost.cadences_h, cost.seconds, cost.sigma3_km):
-        ax.annotate(_label(c), (s, a), textcoords="offset points", xytext=(4, 4), fontsize=7)
-    i = int(np.argmin(np.abs(cost.cadences_h - cost.knee_h)))
-    ax.loglog(cost.seconds[i], cost.sigma3_km[i], "s", ms=10, mfc="none", label=f"knee ({_label(cost.knee_h)})")
-    s0 = cost.seconds[0]
-    ax.loglog(cost.seconds, cost.sigma3_km[0] * s0 / cost.seconds, ":", color="0.5",
-              label="accuracy ~ 1/cost (elasticity 1)")
-    ax.set(xlabel="filter CPU time per tracking period (s)", ylabel="final 3-sigma position (km)")
-    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7)
-    return fig

@@ -14,12 +14,13 @@ from scipy import stats
 from cislunar.estimation import adaptive_ocbe as ad
 from cislunar.estimation.ocbe import OCBEResult
 from cislunar.papers.greaves_scheeres_2021 import adaptive_studies as ads
+from cislunar.papers.greaves_scheeres_2021 import custody as cu
 from cislunar.papers.greaves_scheeres_2021 import detection as det
 from cislunar.papers.greaves_scheeres_2021 import detection_studies as dstudies
 from cislunar.papers.greaves_scheeres_2021 import panels as ocbe_panels
 from cislunar.utils import validation
 
-__all__ = ["metric_law", "adaptive_errors", "adaptive_control_metric", "delays", "reset_rules", "station_keeping_policy",
+__all__ = ["variant_figure", "figure_custody", "figure_conditioning", "figure_cadence_cost", "metric_law", "adaptive_errors", "adaptive_control_metric", "delays", "reset_rules", "station_keeping_policy",
            "control_integral_pdfs", "z_vs_maneuver", "pm_j_search", "health_lead", "health_metric", "tuning_map",
            "joint_search", "lead_grid"]
 
@@ -489,4 +490,100 @@ def lead_grid(grid: dstudies.LeadGrid):
     ax[2].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
     fig.suptitle(f"{grid.magnitude_m_s:g} m/s burns at the quiet tuning", fontsize=10)
     fig.tight_layout()
+    return fig
+
+
+# ------------------------------------------------------------ notebook 09b: measurement sets and reset rules
+def variant_figure(study: ads.VariantStudy):
+    """Resets per detection, runs inconsistent after the burn and detected runs re-converged, per burn size, for
+    every measurement set (colour) and reset rule (solid: the paper's, dashed: the state-covariance inflation)."""
+    validation.instance(study, "study", ads.VariantStudy)
+    mm = np.array(study.magnitudes_m_s) * 1e3
+    fig, ax = plt.subplots(1, 3, figsize=(14, 4))
+    for i, ms in enumerate(ads.MEASUREMENT_SETS):
+        for j, rule in enumerate(ads.VARIANT_RULES):
+            S = [study.summary(ms, rule, (m,)) for m in study.magnitudes_m_s]
+            sty = dict(color=f"C{i}", ls="-" if j == 0 else "--", marker="o" if j == 0 else "s",
+                       mfc=None if j == 0 else "none", label=f"{ms}, {rule}")
+            ax[0].plot(mm, [s["resets_per_detection"] for s in S], **sty)
+            ax[1].plot(mm, [100 * s["inconsistent"] for s in S], **sty)
+            ax[2].plot(mm, [100 * s["reconverged"] for s in S], **sty)
+    ax[0].set(xscale="log", xlabel="burn size [mm/s]", ylabel="resets per detection [-]",
+              title="chain rate")
+    ax[1].set(xscale="log", xlabel="burn size [mm/s]", ylabel="runs [%]", ylim=(-5, 105),
+              title="inconsistent after the burn (NEES)")
+    ax[2].set(xscale="log", xlabel="burn size [mm/s]", ylabel="detected runs [%]", ylim=(-5, 105),
+              title="final estimate consistent (re-converged)")
+    handles, labels = ax[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=3, bbox_to_anchor=(0.5, 0.0))
+    fig.tight_layout(rect=(0, 0.14, 1, 1))
+    return fig
+
+
+# ------------------------------------------------------------ notebook 09: custody, SRI form, cadence
+def figure_custody(studies):
+    """Per period: fraction of runs keeping custody and inconsistent (left); worst and median pointing error of the
+    predicted estimate against the custody bound (right).  ``studies``: a sequence of :class:`CustodyStudy`."""
+    if isinstance(studies, (str, bytes)) or not hasattr(studies, "__iter__"):
+        raise validation.ArgumentTypeError(f"studies must be a sequence of CustodyStudy; got {type(studies).__name__}")
+    studies = list(studies)
+    if not studies:
+        raise ValueError("studies must hold at least one CustodyStudy")
+    for i, st in enumerate(studies):
+        validation.instance(st, f"studies[{i}]", cu.CustodyStudy, "a CustodyStudy (custody_study)")
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True)
+    for s, mk in zip(studies, "os^v"):
+        k = np.arange(1, s.periods + 1)
+        a1.plot(k, 100 * s.custody_fraction, marker=mk, label=f"custody kept, {s.policy_name}")
+        a1.plot(k, 100 * s.inconsistent_fraction, marker=mk, ls="--", label=f"inconsistent, {s.policy_name}")
+        pe = np.rad2deg(np.where(np.isfinite(s.max_pointing_rad), s.max_pointing_rad, np.nan))
+        a2.semilogy(k, np.nanmax(pe, axis=0), marker=mk, label=f"worst run, {s.policy_name}")
+        a2.semilogy(k, np.nanmedian(pe, axis=0), marker=mk, ls="--", label=f"median run, {s.policy_name}")
+    a1.axhspan(0, 10, color="0.9", zorder=0)
+    a1.set(xlabel="period since hand-off (-)", ylabel="runs (%)", ylim=(-5, 105))
+    a2.axhline(np.rad2deg(studies[0].half_angle_rad), color="k", ls=":", label="custody bound")
+    a2.set(xlabel="period since hand-off (-)", ylabel="max pointing error (deg)")
+    for a in (a1, a2):
+        a.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7)
+    return fig
+
+
+def figure_conditioning(case: cu.ConditioningCase):
+    """The three forms on one case: smallest eigenvalue ratio of P (left) and mean NEES over the draws (right)."""
+    validation.instance(case, "case", cu.ConditioningCase, "a ConditioningCase (conditioning_case)")
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True)
+    days = case.t * 0 + np.arange(case.t.size)
+    for f, ls in zip(case.forms, ("-", "--", ":")):
+        a1.semilogy(days, np.abs(case.min_eig_ratio[f]), ls=ls, label=f"|min/max eigenvalue|, {f}")
+        neg = case.min_eig_ratio[f] < 0
+        if neg.any():
+            a1.semilogy(days[neg], np.abs(case.min_eig_ratio[f][neg]), "x", label=f"negative eigenvalue, {f}")
+        a2.semilogy(days, np.where(case.nees_mean[f] > 0, case.nees_mean[f], np.nan), ls=ls, label=f)
+    a2.axhspan(*case.band, color="0.85", zorder=0, label="99.9 % band (consistent)")
+    a1.set(xlabel="epoch index (-)", ylabel="eigenvalue ratio of P (-)")
+    a2.set(xlabel="epoch index (-)", ylabel="mean NEES over draws (-)")
+    for a in (a1, a2):
+        a.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7)
+    fig.suptitle(case.label, fontsize=9)
+    return fig
+
+
+def _cadence_label(hours):
+    return f"{hours * 60:.0f} min" if hours < 1 else f"{hours:g} h"
+
+
+def figure_cadence_cost(cost: cu.CadenceCost):
+    """Final 3-sigma position against run time per period, one point per cadence (log-log)."""
+    validation.instance(cost, "cost", cu.CadenceCost, "a CadenceCost (cadence_cost_study)")
+    fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
+    ax.loglog(cost.seconds, cost.sigma3_km, "o-", label="OCBE filter, one period")
+    for c, s, a in zip(cost.cadences_h, cost.seconds, cost.sigma3_km):
+        ax.annotate(_cadence_label(c), (s, a), textcoords="offset points", xytext=(4, 4), fontsize=7)
+    i = int(np.argmin(np.abs(cost.cadences_h - cost.knee_h)))
+    ax.loglog(cost.seconds[i], cost.sigma3_km[i], "s", ms=10, mfc="none", label=f"knee ({_cadence_label(cost.knee_h)})")
+    s0 = cost.seconds[0]
+    ax.loglog(cost.seconds, cost.sigma3_km[0] * s0 / cost.seconds, ":", color="0.5",
+              label="accuracy ~ 1/cost (elasticity 1)")
+    ax.set(xlabel="filter CPU time per tracking period (s)", ylabel="final 3-sigma position (km)")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7)
     return fig
