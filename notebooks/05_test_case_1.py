@@ -50,6 +50,7 @@ MS_RANDOM = None  # random perturbation starts per weight in the multi-start (No
 MS_SEEDS_Z = None  # +z and -z seeded starts in the multi-start (None: False quick, True full)
 MESH_NODES = None  # node counts of the mesh study besides N_NODES, Section 5 (None: [14] quick, [20, 30, 60] full)
 MESH_ALPHAS = None  # weights of the mesh study, in ALPHAS (None: [5e-3] quick, [5e-3, 2e-2] full)
+MESH_COLD = None  # also solve the mesh study's grids from the ballistic guess (None: no quick, yes full)
 MESH_RTOL = 0.05  # a weight's plan has converged in the mesh when impulse, MI and RMS change by at most this much
 #                   between the two finest grids (fixed before solving)
 WORKERS = None  # local processes for the multi-start, the mesh study and the exact-penalty runs, 1 runs serially
@@ -77,6 +78,7 @@ ms_random = MS_RANDOM if MS_RANDOM is not None else 1
 ms_seeds_z = MS_SEEDS_Z if MS_SEEDS_Z is not None else not QUICK
 mesh_nodes = MESH_NODES if MESH_NODES is not None else ([14] if QUICK else [20, 30, 60])
 mesh_alphas = MESH_ALPHAS if MESH_ALPHAS is not None else ([5e-3] if QUICK else [5e-3, alphas[-1]])
+mesh_cold = MESH_COLD if MESH_COLD is not None else not QUICK
 if 5e-3 not in alphas:
     raise ValueError(f"ALPHAS must contain 5e-3 (Figs. 1 and 3, Section 4, the mesh check); got {alphas}")
 
@@ -278,7 +280,7 @@ print(mesh.summary())
 # %%
 with open_executor(workers, SCHEDULER) as executor:
     mstudy = global_search.mesh_study(case.solver, {a: best[alphas.index(a)] for a in mesh_alphas}, mesh_nodes,
-                                      sigma=SIGMA, rtol=MESH_RTOL, cold=not QUICK, executor=executor)
+                                      sigma=SIGMA, rtol=MESH_RTOL, cold=mesh_cold, executor=executor)
 print(mstudy.summary())
 
 # %% [markdown]

@@ -61,12 +61,15 @@ MS_RANDOM = None  # random perturbation starts per weight in the multi-start (No
 MS_SEEDS_Z = None  # +z and -z seeded starts in the multi-start (None: False quick, True full)
 MESH_NODES = None  # node counts of the mesh study besides N_NODES, Section 6 (None: [12] quick, [20, 45, 60] full)
 MESH_ALPHAS = None  # weights of the mesh study, in ALPHAS (None: [1e-2], the Fig. 6 weight, in both modes)
+MESH_COLD = None  # also solve the mesh study's grids from the ballistic guess (None: no quick, yes full)
 MESH_RTOL = 0.05  # a weight's plan has converged in the mesh when impulse, MI and RMS change by at most this much
 #                   between the two finest grids (fixed before solving)
 DIAG_ALPHA = None  # weight of the diagnosed SCvx run without keep-out, Section 11
 #                    (None: 1e-2, the Fig. 6 weight, quick; 2e-2 full)
 REMEDY_ALPHAS = None  # weights solved with the range-dependent noise and no keep-out, Section 11
 #                       (None: [1e-2] quick, [5e-3, 1e-2, 2e-2] full)
+D_SCAN_KM = None  # closest approaches of the pass scan without keep-out, Section 11, km
+#                   (None: [0.3, 3, 30, 424] quick, [0.1, 0.3, 1, 3, 10, 30, 100, 424] full)
 REMEDY_RANGE_KM = 141.0  # range scale rho_c of that range-dependent noise, km (fixed before any run)
 WORKERS = None  # local processes for the independent SCvx runs, 1 runs serially (None: 1 quick, 2 full)
 SCHEDULER = ""  # address of a Dask scheduler to run them on, e.g. "tcp://10.0.0.5:8786" ("": none; WORKERS applies)
@@ -88,7 +91,10 @@ ms_random = MS_RANDOM if MS_RANDOM is not None else 1
 ms_seeds_z = MS_SEEDS_Z if MS_SEEDS_Z is not None else not QUICK
 mesh_nodes = MESH_NODES if MESH_NODES is not None else ([12] if QUICK else [20, 45, 60])
 mesh_alphas = MESH_ALPHAS if MESH_ALPHAS is not None else [1e-2]
+mesh_cold = MESH_COLD if MESH_COLD is not None else not QUICK
 diag_alpha = DIAG_ALPHA if DIAG_ALPHA is not None else (1e-2 if QUICK else 2e-2)
+d_scan_km = D_SCAN_KM if D_SCAN_KM is not None else ([0.3, 3.0, 30.0, 424.0] if QUICK else
+                                                       [0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 424.0])
 remedy_alphas = REMEDY_ALPHAS if REMEDY_ALPHAS is not None else ([1e-2] if QUICK else [5e-3, 1e-2, 2e-2])
 
 import time
@@ -327,7 +333,7 @@ print(f"Spearman(alpha_h, departure) above 0.8 on {dep_pass} of {len(rho_grids)}
 # %%
 with open_executor(workers, SCHEDULER) as executor:
     mstudy = global_search.mesh_study(solver, {a: by_alpha[a].res for a in mesh_alphas if a in by_alpha}, mesh_nodes,
-                                      sigma=SIGMA, rtol=MESH_RTOL, cold=not QUICK, executor=executor)
+                                      sigma=SIGMA, rtol=MESH_RTOL, cold=mesh_cold, executor=executor)
 print(mstudy.summary())
 
 # %% [markdown]
@@ -596,7 +602,7 @@ print(f"MI gradient (position) on the ballistic guess: {g_ball:.3g} nats/LU; at 
 # with it:
 
 # %%
-d_scan = np.array([0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 424.0] if not QUICK else [0.3, 3.0, 30.0, 424.0])
+d_scan = np.array(d_scan_km, dtype=float)
 remedy_info = kod.RangeNoiseInformation(info, REMEDY_RANGE_KM)
 scan_plain = kod.pass_scan(sc, info, x_ws_ball, d_scan)
 scan_remedy = kod.pass_scan(sc, remedy_info, x_ws_ball, d_scan)

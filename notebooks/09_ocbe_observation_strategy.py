@@ -54,6 +54,9 @@ N_AXES = None  # runs per filter-axis cell (None: 2 quick, 10 full)
 N_DRAWS_EXAMPLE = 10  # fresh draws per Fig. 4 analogue (the clearest divergence is shown)
 CUSTODY_PERIODS = None  # custody tracks (Section 5d): NRHO periods, a burn at every apoapsis (None: 5 quick, 10 full)
 N_CUSTODY = None  # custody runs per station-keeping policy (None: 2 quick, 32 full)
+CUSTODY_WEAK = None  # also run custody with a window weight 10x weaker, Section 5d (None: no quick, yes full)
+LADDER_RUNGS = None  # rungs of the conditioning ladder run, by index 0-3 (None: [0, 2] quick, [0, 1, 2, 3] full)
+COST_REPEATS = None  # timed repeats per cadence of the run-time study (None: 1 quick, 3 full)
 N_DRAWS_CONDITIONING = None  # Monte Carlo draws per case of the SRI / covariance comparison (None: 20 quick, 50 full)
 CADENCES_COST = None  # run time against cadence, hours (None: [2, 6, 12] quick; 1 min, 10 min, 30 min, 1-12 h full)
 WORKERS = None  # local processes for the Monte Carlo, 1 runs serially (None: 1 quick, 2 full)
@@ -74,6 +77,9 @@ cadence_axes = CADENCE_AXES if CADENCE_AXES is not None else ([12.0] if QUICK el
 n_runs_axes = N_AXES if N_AXES is not None else (2 if QUICK else 10)
 custody_periods = CUSTODY_PERIODS if CUSTODY_PERIODS is not None else (5 if QUICK else 10)
 n_custody = N_CUSTODY if N_CUSTODY is not None else (2 if QUICK else 32)
+custody_weak_run = CUSTODY_WEAK if CUSTODY_WEAK is not None else not QUICK
+ladder_rungs = LADDER_RUNGS if LADDER_RUNGS is not None else ([0, 2] if QUICK else [0, 1, 2, 3])
+cost_repeats = COST_REPEATS if COST_REPEATS is not None else (1 if QUICK else 3)
 n_draws_conditioning = N_DRAWS_CONDITIONING if N_DRAWS_CONDITIONING is not None else (20 if QUICK else 50)
 cadences_cost = CADENCES_COST if CADENCES_COST is not None else (
     [2.0, 6.0, 12.0] if QUICK else [1 / 60, 10 / 60, 0.5, 1.0, 2.0, 4.0, 6.0, 12.0])
@@ -538,7 +544,7 @@ custody = {p.name: cu.custody_study(em, nrho, periods=custody_periods, policy=p,
                                     sigma_angle_rad=sigma_angle, executor=executor)
            for p in (det.QUIET_POLICY, det.ACTIVE_POLICY)}
 print(f"custody: {2 * n_custody} runs of {custody_periods} periods in {time.perf_counter() - t_custody:.0f} s")
-custody_weak = None if QUICK else cu.custody_study(
+custody_weak = None if not custody_weak_run else cu.custody_study(
     em, nrho, periods=custody_periods, policy=det.QUIET_POLICY, n_runs=n_custody, seed=SEED,
     q_window_km2_s3=0.1 * det.window_control_weight(det.QUIET_POLICY), sigma_angle_rad=sigma_angle, executor=executor)
 for c in custody.values():
@@ -591,7 +597,7 @@ LADDER = {"well conditioned (the chapter's case)": dict(),
                                                  q_km2_s3=1e-26),
           "prior x1e5, 10 nrad, 3-day gap": dict(prior_scale=1e5, sigma_angle_rad=1e-8, gap_hours=72.0,
                                                  q_km2_s3=1e-26)}
-ladder = list(LADDER) if not QUICK else [list(LADDER)[0], list(LADDER)[2]]
+ladder = [list(LADDER)[i] for i in ladder_rungs]
 rng_cond = np.random.default_rng([SEED, 95])
 conditioning = {name: cu.conditioning_case(cu.linear_problem(em, nrho, **LADDER[name]), n_draws_conditioning,
                                            rng_cond, label=name) for name in ladder}
@@ -630,7 +636,7 @@ _ = plotting.save_figure(figures.figure_conditioning(worst), "09_sri_vs_covarian
 # %%
 t_cost = time.perf_counter()
 cost = cu.cadence_cost_study(em, nrho, cadences_cost, CONTROL_WEIGHT_KM2_S3, seed=SEED, sigma_angle_rad=sigma_angle,
-                             repeats=1 if QUICK else 3)
+                             repeats=cost_repeats)
 print(f"cadence costs measured in {time.perf_counter() - t_cost:.0f} s")
 print(cost.report())
 _ = plotting.save_figure(figures.figure_cadence_cost(cost), "09_cadence_run_time", output_dir=out)
