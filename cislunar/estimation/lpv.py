@@ -867,7 +867,7 @@ class PrecisionLMI:
 
     @classmethod
     def for_cr3bp(cls, model: CR3BPLPV, vertices, norm: str = "h2", *, disturbance=None, **kwargs) -> PrecisionLMI:
-        """The LMI for the planar CR3BP LPV model at the polytope ``vertices`` (n_v, 6) of :math:`\rho`.
+        """The LMI for the planar CR3BP LPV model at the polytope ``vertices`` (n_v, 6) of :math:`\\rho`.
 
         ``disturbance`` defaults to :func:`default_disturbance`; other keywords go to the constructor.
         """

@@ -810,7 +810,7 @@ def window_information(lin: AugmentedLinearization, *, method: str = "structured
     method : {"structured", "dense"}
     gradient : bool
     range_scale : float, optional
-        :math:`\rho_c` of a range-dependent noise (:func:`range_noise_scale`), LU; default none (the noise of
+        :math:`\\rho_c` of a range-dependent noise (:func:`range_noise_scale`), LU; default none (the noise of
         ``lin.R``, bit-for-bit the plain value).  Structured method only.
 
     Returns

@@ -80,13 +80,13 @@ class Exactness:
     ----------
     n_states : int
     dynamics : float
-        Max relative :math:`|A(\rho)x + b(\rho) - f(x)|` (Eqs. 21/23 against Eq. 20).
+        Max relative :math:`|A(\\rho)x + b(\\rho) - f(x)|` (Eqs. 21/23 against Eq. 20).
     sensors_eq22 : float
-        Max :math:`|C(\rho)x + d(\rho) - y(x)|` with Eq. 22's :math:`d`.
+        Max :math:`|C(\\rho)x + d(\\rho) - y(x)|` with Eq. 22's :math:`d`.
     sensors_eq23 : float
         The same with Eq. 23's :math:`d` as printed.
     triangulation : float
-        Max relative error of :math:`\rho` recovered from the two angles (law of sines).
+        Max relative error of :math:`\\rho` recovered from the two angles (law of sines).
     """
 
     n_states: int
