@@ -75,7 +75,7 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from cislunar.cr3bp.dynamics import CR3BP, check_system
-from cislunar.cr3bp.propagation import DEFAULT_TOL
+from cislunar.cr3bp.propagation import DEFAULT_TOL, ImpactError, _inside_primaries
 from cislunar.guidance.discretization import _check_outside, _foh_discretize
 from cislunar.utils import validation
 from cislunar.utils.progress import progress as _progress
@@ -711,7 +711,28 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
             slack = [np.maximum(c["s"].value, 0.0) for c in sub.con]
             pen_model = penalty(nu, slack)
             L_new = (1.0 - alpha) * _impulse(dt, u_new) - alpha * info_model + pen_model
-            ev_new = evaluate(x_new, u_new, 0)
+            try:
+                if _inside_primaries(system, x_new[:, :3]):
+                    raise ImpactError("a primary", float(t[0]), started_inside=True,
+                                      detail="a node of the trial step lies inside it")
+                ev_new = evaluate(x_new, u_new, 0)
+            except ImpactError as exc:
+                # A trial step through a primary has no nonlinear cost to compare: rejected like a step that raises
+                # the cost (rho = -inf), the trust region shrinks, and the reference is kept.
+                history.append(dict(iteration=it, cost=J_ref, new_cost=np.inf, predicted=J_ref - L_new,
+                                    actual=-np.inf, rho=-np.inf, eta=eta, accepted=False, tr_active=bool(tr_active),
+                                    step=step, max_defect=np.nan, max_violation=np.nan, model_error_defect=np.nan,
+                                    model_error_info=np.nan, penalty_weight=w, multiplier_update=False,
+                                    information=np.nan, impulse=_impulse(dt, u_new), t_discretize=0.0, t_info=0.0,
+                                    t_solve=t_solve, t_hessian=0.0, status=f"impact: {exc}"))
+                eta = eta / st.beta_shrink
+                if st.stall_iter and it - last_progress >= st.stall_iter:
+                    raise SCvxError(f"stalled: no progress in {st.stall_iter} iterations (eta = {eta:.1e}, largest "
+                                    f"defect {feasibility(ev)[0]:.2e})", history) from exc
+                if eta < st.eta_min:
+                    raise SCvxError(f"trust region collapsed (eta < {st.eta_min:g}) at iteration {it}: every trial "
+                                    f"step passes through a primary ({exc})", history) from exc
+                continue
             J_new, obj_new = cost_of(x_new, u_new, ev_new)
             pen_new = J_new - obj_new
             predicted = J_ref - L_new

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
-from cislunar.cr3bp.propagation import propagate
+from cislunar.cr3bp.propagation import ImpactError, propagate
 from cislunar.guidance import discretization as D
 from cislunar.guidance import scvx
 from cislunar.papers.wolf_jones import scenarios as wolf_jones
@@ -536,3 +536,44 @@ def test_practical_stop_validates_every_field(field, value, exc):
         scvx.solve_scvx(em, t, propagate(em, dro.x0, t).x, np.zeros((t.size, 3)), np.full(t.size, A_MAX),
                         x_final=xf, practical_stop=dict(window=5))
 
+
+
+def test_a_trial_step_through_a_primary_is_rejected_not_raised(monkeypatch):
+    """A trial step whose arcs hit a primary (ImpactError from the discretisation) is a rejected step: the run
+    records it, shrinks the trust region and goes on to the same optimum as a run that never met it."""
+    dro, xf, t = _transfer()
+    x0, u0 = propagate(em, dro.x0, t).x, np.zeros((t.size, 3))
+    ref = scvx.solve_scvx(em, t, x0, u0, np.full(t.size, A_MAX), x_final=xf)
+    calls = {"n": 0}
+    real = scvx._foh_discretize
+
+    def fails_once(*args):
+        calls["n"] += 1
+        if calls["n"] == 2:  # the first trial step (call 1 evaluates the initial reference)
+            raise ImpactError("Moon", 1.0)
+        return real(*args)
+
+    monkeypatch.setattr(scvx, "_foh_discretize", fails_once)
+    res = scvx.solve_scvx(em, t, x0, u0, np.full(t.size, A_MAX), x_final=xf)
+    first = res.history[0]
+    assert not first["accepted"] and first["rho"] == -np.inf and first["status"].startswith("impact")
+    assert res.history[1]["eta"] == pytest.approx(first["eta"] / scvx.SCvxSettings().beta_shrink)
+    assert res.max_defect < 1e-9
+    assert res.impulse == pytest.approx(ref.impulse, rel=1e-6)
+
+
+def test_a_trial_step_with_a_node_inside_the_moon_is_rejected(monkeypatch):
+    """The same when the trial step puts a node inside the Moon (no integration is attempted from there)."""
+    dro, xf, t = _transfer()
+    x0, u0 = propagate(em, dro.x0, t).x, np.zeros((t.size, 3))
+    real = scvx._inside_primaries
+    calls = {"n": 0}
+
+    def inside_once(system, positions):
+        calls["n"] += 1
+        return True if calls["n"] == 1 else real(system, positions)
+
+    monkeypatch.setattr(scvx, "_inside_primaries", inside_once)
+    res = scvx.solve_scvx(em, t, x0, u0, np.full(t.size, A_MAX), x_final=xf)
+    assert res.history[0]["status"].startswith("impact") and not res.history[0]["accepted"]
+    assert res.max_defect < 1e-9
