@@ -44,7 +44,7 @@ OUTPUT_DIR = ""
 N_NODES = None  # Sundman nodes over the three periods, window ends moved onto nodes (None: 16 quick, 30 full)
 MAX_ITER = None  # SCvx iteration limit per run (None: 100 quick, 150 full)
 N_NODES_ALT = None  # other node grids on which the whole sweep is solved again (None: [12] quick, [24, 27] full)
-FREE_ITER = None  # iterations granted to the run without keep-out, which does not converge (None: 5 quick, 75 full)
+FREE_ITER = None  # iterations granted to the run without keep-out at the Fig. 6 weight (None: 5 quick, 75 full)
 SIGMA = 1.0  # Sundman exponent of the node spacing dt = r_m^sigma dtau (notebook 04)
 ALPHAS = None  # homotopy weights alpha_h, increasing in [0, 1] (None: [0, 5e-3, 1e-2] quick; 8 values full)
 SEED_ALPHAS = None  # weights solved from +z and -z seeds, Fig. 7's pair (None: [] quick, [5e-3, 7e-3] full)
@@ -190,8 +190,9 @@ print(f"Hessian diagonal (z, vz): {gc.hessian[2, 2]:.3e}, {gc.hessian[5, 5]:.3e}
 # observer's window-start state (Newton on the STM) so that it passes target 1 at a chosen distance at the middle
 # measurement of the window and evaluate the MI: nearly flat down to about a hundred metres, the reward then
 # grows without bound (like $\ln(1/\rho)$), so a maximiser that finds this region could fly through the target
-# (section 11: without a keep-out SCvx does not converge, its cost sinks below the constrained optimum's while the
-# defects stay open, and we print how close its iterates come; smaller keep-outs are tried there too). Well before
+# (section 11: without a keep-out SCvx fails at some weights, the iterates heading for a target until a convex
+# subproblem fails, and only just converges at others; we print how close its iterates come; smaller keep-outs
+# are tried there too). Well before
 # that singularity the reward stops being
 # trustworthy: the MI linearises the measurement about the *true* states, while the prior
 # uncertainty of the relative position is $\sigma_{rel} = \sqrt2\cdot 100$ km = 141 km per axis; the
@@ -523,8 +524,9 @@ _ = plotting.save_figure(figures.figure_readings(rd2, em), "06_fig9_10_readings"
 # optimum that exists without it; trajectories more than 100 km apart anywhere (compared node by node, a threshold
 # fixed in advance) mean another local optimum; a radius whose solve fails
 # leaves the question open there.
-# Without any keep-out the iterates reach a cost below the constrained optimum's with defects still open; the
-# closest approach to a target of its successive references (recorded along the run, printed below) shows whether
+# Without any keep-out the run at the Fig. 6 weight is on a knife edge (on the last full run it converged in 73 of
+# its 75 iterations, passing 13 km from a target on the way; earlier runs ended with defects still open), and at
+# 2e-2 it fails (the diagnosis below); the closest approach to a target of its successive references (recorded along the run, printed below) shows whether
 # they head for the close-approach singularity. Which local optimum a solve finds is fragile: the planar guess is a saddle
 # (section 2) and round-off picks the way out of it, so a change as small as another evaluation order of the MI
 # gradient can move a run of this section, or of the sweep, to a neighbouring optimum. In the figure each radius is
