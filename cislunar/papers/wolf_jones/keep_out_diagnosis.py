@@ -36,6 +36,7 @@ import numpy as np
 from cislunar.cr3bp.propagation import propagate, propagate_stm
 from cislunar.guidance import scvx
 from cislunar.papers.wolf_jones import scenarios as wj
+from cislunar.papers.wolf_jones import test_case_studies as studies
 from cislunar.sensing import information as info_mod
 from cislunar.utils import validation
 
@@ -220,21 +221,6 @@ def pass_scan(sc: wj.Scenario, info, x_ws, d_km, *, hessian: bool = False) -> Pa
 # --------------------------------------------------------------------------------------------------------------
 # the free run, diagnosed
 # --------------------------------------------------------------------------------------------------------------
-class _Recorder:
-    """Information model that records the window-start state of every gradient call (every SCvx reference)."""
-
-    def __init__(self, inner):
-        self.inner, self.refs = inner, []
-
-    def __call__(self, x, order=0):
-        if order >= 1:
-            self.refs.append(np.array(x, dtype=float))
-        return self.inner(x, order)
-
-    def hessian(self, x):
-        return self.inner.hessian(x)
-
-
 @dataclass(frozen=True)
 class FreeRunDiagnosis:
     r"""SCvx on test case 2 without a keep-out, each reference diagnosed.
@@ -302,7 +288,7 @@ def free_run_diagnosis(sc: wj.Scenario, t, k_ws: int, info, alpha: float, x_gues
     n_hessian = validation.integer(n_hessian, "n_hessian", minimum=0)
     st = scvx.SCvxSettings(max_iter=max_iter) if settings is None else validation.instance(
         settings, "settings", scvx.SCvxSettings)
-    rec = _Recorder(info)
+    rec = studies.RecordingInformation(info)
     solver = wj.ScenarioSolver(sc, t, k_ws, information=rec, keep_out=False, settings=st)
     try:
         res = solver(alpha, x_guess, u_guess)
