@@ -592,14 +592,14 @@ def departure_figure(study: plan_size_study.PlanSizeStudy):
         if bad:
             ax.plot(scales[bad], np.full(len(bad), 0.97), "kx", ms=7, transform=ax.get_xaxis_transform(),
                     label="no converged plan (see the table)")
-        for i in order:
-            ax.annotate(study.normalisations[i].split(" (")[0], (scales[i], 0.0), fontsize=6,
-                        rotation=90, va="bottom", ha="right", xycoords=("data", "axes fraction"),
-                        xytext=(0, 3), textcoords="offset points")
         ax.set(xscale="log", yscale="log", xlabel="control term / total impulse in LU/TU, c [-]",
                title=rf"$\alpha_h$ = {a:g}")
     axes[0, 0].set_ylabel("largest departure from the reference DRO [km]")
     axes[0, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
+    # which normalisation each c is: listed beside the panels (labels inside would collide, two c lie close)
+    key = "\n".join(f"c = {scales[i]:.3g}: {study.normalisations[i].split(' (')[0]}" for i in order)
+    axes[0, -1].text(1.04, 0.0, "control-term scale c\n" + key, transform=axes[0, -1].transAxes, fontsize=7,
+                     va="bottom", ha="left")
     return fig
 
 
