@@ -139,13 +139,17 @@ def check_outside_primaries(system: CR3BP, states, name: str = "states", *, t0: 
                                      f"radius {radius * system.length_unit_km:.6g} km")
 
 
-#: Hermite sample points of :func:`_check_arcs_outside_primaries` (fraction of a grid interval).
-_HERMITE_S = np.linspace(0.0, 1.0, 17)[:, None, None]
-#: Largest of :math:`|h_{10}(s)|` and :math:`|h_{11}(s)|` on [0, 1] (the cubic Hermite velocity weights, at s = 1/3
-#: and 2/3), the factor of the screen's bound on how far the interpolant strays from an end point.
-_HERMITE_VELOCITY_BOUND = 4.0 / 27.0
-#: Round-off margin of the screen, LU (about 0.4 mm): far above the rounding of distances of order 1 LU.
-_SCREEN_SLACK_LU = 1e-9
+#: Pieces of the lower Riemann sum of :func:`_fall_time_bound` on the intervals the one-piece screen does not clear.
+_FALL_PIECES = 16
+#: Margins of the arc check against round-off and the integrator's error at the far end of an interval: the end
+#: distances are shortened by ``_DISTANCE_SLACK_LU`` (about 0.4 m) and the Jacobi constant lowered by
+#: ``_JACOBI_SLACK`` (LU^2/TU^2), far above the rounding of quantities of order 1 and of heyoka's error at the
+#: tolerances in use (both margins only make the bound smaller, i.e. the check more cautious).
+_DISTANCE_SLACK_LU = 1e-9
+_JACOBI_SLACK = 1e-10
+#: Floor of the squared speed bound (LU^2/TU^2) where the shell is forbidden (2 Omega_max < C): the fall time then
+#: becomes astronomically long, as it should (the arc cannot cross that shell).
+_SPEED2_FLOOR = 1e-300
 
 
 def _norm3(a):
@@ -153,76 +157,126 @@ def _norm3(a):
     return np.sqrt(a[..., 0] * a[..., 0] + a[..., 1] * a[..., 1] + a[..., 2] * a[..., 2])
 
 
-def _hermite_spread(r0, r1, v0, v1, h):
-    """Bound (LU) on how far the cubic Hermite interpolant of an interval strays from either end position.
+def _bodies(system: CR3BP):
+    """Per primary (Moon first): name, centre (3,), centre's distance from the barycentre, radius, own mass
+    parameter, the other's mass parameter and the other's radius (LU, non-dimensional masses)."""
+    mu = system.mu
+    return (("Moon", system.secondary_position, 1.0 - mu, system.secondary_radius, mu, 1.0 - mu,
+             system.primary_radius),
+            ("Earth", system.primary_position, mu, system.primary_radius, 1.0 - mu, mu, system.secondary_radius))
 
-    ``r0, r1`` (..., 3) end positions (LU), ``v0, v1`` (..., 3) end velocities (LU/TU), ``h`` (...) the interval
-    (TU).  With :math:`h_{01}\\in[0,1]` and :math:`|h_{10}|, |h_{11}| \\le 4/27` on [0, 1],
-    :math:`|\\mathbf p(s)-\\mathbf r_0| \\le |\\mathbf r_1-\\mathbf r_0| + \\tfrac{4}{27}|h|(|\\mathbf v_0|+|\\mathbf v_1|)`, and the same
-    for :math:`\\mathbf r_1`.  Unchecked (inner kernel).
+
+def _potential_bound(a, b, offset, mass, other_mass, other_radius):
+    r"""Upper bound (LU^2/TU^2) of the pseudo-potential :math:`\Omega = (x^2+y^2)/2 + (1-\mu)/r_1 + \mu/r_2` over
+    every point whose distance :math:`r` from a primary's centre lies in ``[a, b]`` (LU) and that is outside the
+    other primary.
+
+    The primary's centre lies ``offset`` from the barycentre (so :math:`x^2+y^2 \le (\mathrm{offset}+r)^2`), its
+    mass parameter is ``mass``; the other primary (mass parameter ``other_mass``, radius ``other_radius``) is one
+    LU away, so its distance is at least :math:`\max(1-r, R_o)`:
+    :math:`\bar\Omega(a, b) = (\mathrm{offset}+b)^2/2 + m_o/\max(1-b, R_o) + m/a`.  Unchecked (inner kernel).
     """
-    return _norm3(r1 - r0) + _HERMITE_VELOCITY_BOUND * np.abs(h) * (_norm3(v0) + _norm3(v1))
+    return 0.5 * (offset + b) ** 2 + other_mass / np.maximum(1.0 - b, other_radius) + mass / a
+
+
+def _fall_time_bound(d, jacobi, offset, radius, mass, other_mass, other_radius, pieces):
+    r"""Lower bound (TU) on the time a ballistic arc of Jacobi constant ``jacobi`` needs between distance ``d`` (LU)
+    from a primary's centre and its surface (radius ``radius``), while it stays outside both primaries.
+
+    Jacobi's integral bounds the speed on every shell :math:`a \le r \le b` by
+    :math:`\bar v(a, b) = \sqrt{2\bar\Omega(a, b) - C}` (:func:`_potential_bound`, same primary arguments), and
+    :math:`|\dot r| \le |\mathbf v|`, so :math:`T(D) = \int_R^D dr/v_{max}(r)` is a lower bound on the time,
+    bounded from below in turn by the sum over ``pieces`` equal pieces :math:`[a, b]` of :math:`(b - a)/\bar v(a,
+    b)`.  ``d`` shortened by ``_DISTANCE_SLACK_LU`` and ``jacobi`` lowered by ``_JACOBI_SLACK`` first; a forbidden
+    piece (:math:`2\bar\Omega < C`) costs a practically infinite time.  ``d``, ``jacobi`` any broadcastable shapes;
+    unchecked (inner kernel).
+    """
+    top = np.maximum(d - _DISTANCE_SLACK_LU, radius)
+    c = jacobi - _JACOBI_SLACK
+    if pieces == 1:
+        om = _potential_bound(radius, top, offset, mass, other_mass, other_radius)
+        return (top - radius) / np.sqrt(np.maximum(2.0 * om - c, _SPEED2_FLOOR))
+    f = np.arange(pieces + 1) / pieces
+    r = radius + (top - radius)[..., None] * f  # (..., pieces + 1)
+    r[..., 0], r[..., -1] = radius, top
+    lo, hi = r[..., :-1], r[..., 1:]
+    om = _potential_bound(lo, hi, offset, mass, other_mass, other_radius)
+    return np.sum((hi - lo) / np.sqrt(np.maximum(2.0 * om - c[..., None], _SPEED2_FLOOR)), axis=-1)
+
+
+def _uncleared_intervals(system: CR3BP, t, X, screen: bool = True):
+    """Indices ``(k, b)`` of the grid intervals whose arcs the fall-time bound cannot clear (rows of the grid
+    first); see :func:`_check_arcs_outside_primaries`.  ``X`` (m, B, 6).  Unchecked (inner kernel)."""
+    h = np.abs(np.diff(t))[:, None]  # (m-1, 1)
+    mu = system.mu
+    x, v = X[..., :3], X[..., 3:]
+    bodies = _bodies(system)
+    dist = [_norm3(x - centre) for _, centre, *_ in bodies]  # Moon, Earth: (m, B)
+    # Jacobi constant of each sample (the arc from it keeps it exactly), C = 2 Omega - v^2
+    jac = (x[..., 0] ** 2 + x[..., 1] ** 2 + 2.0 * (1.0 - mu) / dist[1] + 2.0 * mu / dist[0]
+           - (v[..., 0] ** 2 + v[..., 1] ** 2 + v[..., 2] ** 2))
+    c0 = jac[:-1]  # the arc of interval k starts at sample k: its Jacobi constant (the end sample's ~ the same)
+
+    def bound(keep, pieces):
+        """min over the primaries of T(D0), plus the same for T(D1), on the intervals ``keep`` (index or slice)."""
+        ends = [np.minimum(*[_fall_time_bound(d[rows][keep], c0[keep], *body[2:], pieces)
+                             for d, body in zip(dist, bodies)])
+                for rows in (slice(None, -1), slice(1, None))]
+        return ends[0] + ends[1]
+
+    if screen:
+        ks, bs = np.nonzero(bound(Ellipsis, 1) <= h)
+    else:
+        ks, bs = np.nonzero(np.ones(c0.shape, dtype=bool))
+    if ks.size == 0:
+        return ks, bs
+    near = bound((ks, bs), _FALL_PIECES) <= h[ks, 0]
+    return ks[near], bs[near]
 
 
 def _check_arcs_outside_primaries(system: CR3BP, t, states, tol: float = DEFAULT_TOL, *, first: int = 0,
                                   screen: bool = True) -> None:
-    r"""Raise :class:`ImpactError` if an arc sampled at ``states`` dips below a primary's surface between samples.
+    r"""Raise :class:`ImpactError` if an arc sampled at ``states`` reaches a primary's surface between samples.
 
     For integrators without impact events (the OCBE transitions, whose steps the events would change at round-off
-    level).  ``t`` (m,) is the grid (TU), ``states`` (m, 6) or (m, B, 6) the ballistic states on it (B arcs).  On
-    every grid interval the cubic Hermite interpolant of the end positions and velocities is sampled at 17
-    points; an interval whose interpolant comes within ``R + h v_max / 2`` of a primary's centre (``h`` the
-    interval, ``v_max`` the larger end speed, ``R`` the radius) is re-propagated from its start with the impact
-    events of :func:`propagate`, which decide.  The results are discarded: this only checks.  Unchecked inputs
-    (inner kernel); ``first`` offsets the arc index reported as ``member``.
+    level).  ``t`` (m,) is the grid (TU), ``states`` (m, 6) or (m, B, 6) the ballistic states on it (B arcs, each
+    sample the end of the arc from the previous one; the samples themselves are checked by the callers).  Every
+    grid interval that the bound below cannot clear is re-propagated from its start with the impact events of
+    :func:`propagate`, which decide; the results are discarded: this only checks.  Unchecked inputs (inner
+    kernel); ``first`` offsets the arc index reported as ``member``.
 
-    ``screen`` (default True) samples the interpolant only on the intervals that a cheap bound cannot clear: with
-    :math:`h_{01}\in[0,1]` and :math:`|h_{10}|, |h_{11}| \le 4/27` on [0, 1], every point of the interpolant lies
-    within :math:`\rho = |\mathbf r_1-\mathbf r_0| + \tfrac{4}{27}|h|(|\mathbf v_0|+|\mathbf v_1|)` of both end
-    positions, so its distance from a centre is at least :math:`\max(|\mathbf r_0-\mathbf c|, |\mathbf r_1-\mathbf
-    c|) - \rho`.  An interval where this exceeds ``R + h v_max / 2`` (plus a round-off margin) cannot be flagged by
-    the 17-point test; the others get that test exactly as without the screen, in the same order.  The
-    decisions (the intervals re-propagated, and so the error raised, if any) are those of ``screen=False``, the
-    unscreened test, kept as the reference: compared in ``tests/cr3bp/test_propagation.py`` and
-    ``tests/papers/greaves_scheeres_2021/test_detection.py``, timed in ``benchmarks/bench_propagation.py`` and
-    ``benchmarks/bench_detection.py`` (about 13x faster per call on the batched OCBE's sub-grids).
+    Guarantee: an interval is cleared without re-propagation only if the ballistic arc from its first sample
+    provably stays outside both primaries over the whole interval, whatever its length (the far sample is taken as
+    that arc's end, to within the margins below).  The arc keeps its Jacobi constant :math:`C` (of the first
+    sample), so on the shell at distance :math:`r` from a primary its speed is at most
+    :math:`v_{max}(r) = \sqrt{2\Omega_{max}(r) - C}`, with :math:`\Omega_{max}` a closed-form bound of the
+    pseudo-potential over the shell (:func:`_potential_bound`); since :math:`|\dot r| \le |\mathbf v|`, going
+    from distance :math:`D` to the surface :math:`R` takes at least :math:`T(D) = \int_R^D dr / v_{max}(r)` while
+    the arc is outside both primaries (:func:`_fall_time_bound`).  An arc that first enters a primary at
+    :math:`t_*` and (its far sample being outside) last leaves one at :math:`t_{**} \ge t_*` needs
+    :math:`|t_* - t_0| \ge T(D_0)` and :math:`|t_1 - t_{**}| \ge T(D_1)` (time reversed), so an interval with
+    :math:`\min_{body} T(D_0) + \min_{body} T(D_1) > |t_1 - t_0|` is cleared with certainty.  :math:`T` is bounded
+    from below by a Riemann sum of :math:`1/v_{max}` taking the largest speed bound of each piece, after shortening
+    the end distances by ``_DISTANCE_SLACK_LU`` and lowering :math:`C` by ``_JACOBI_SLACK`` (round-off and the
+    integrator's error at the far sample).  Every other interval is re-propagated, whatever its true arc does.
+    The 7.8-hour interval through a perilune 584 km under the lunar surface at 2.76 km/s that the 17-point Hermite
+    heuristic used before 2026-11-26d missed raises; a period of the 9:2 NRHO on 15-minute sub-grids is cleared
+    without a re-propagation (margin 1.5 for the one-piece sum, 1.8 for 16 pieces); longer intervals through its
+    perilune are re-propagated (about 1.6 per period from 1-hour to 12-hour intervals, against about 2 for the
+    heuristic).
 
-    Limitation (of both): the 17-point test is a heuristic on the interpolant, not a bound on the true arc; on long
-    intervals through a fast, deep flyby the interpolant can stay clear while the arc hits (a 7.8-hour interval
-    through a perilune 584 km below the lunar surface at 2.76 km/s is missed).  The OCBE sub-grids (15 minutes in
-    the detection study) are far shorter.
+    ``screen`` (default True) first applies the one-piece sum (:math:`(D-R)/\bar v` with the speed bound of the
+    whole shell, the surface's) to every interval, then the 16-piece sum only to the intervals that this cannot
+    clear; the 16-piece sum is never smaller (each piece's speed bound is at most the one-piece bound; up to
+    rounding), so ``screen=False`` (the 16-piece sum everywhere) re-propagates the same intervals and decides
+    alike: compared in ``tests/cr3bp/test_propagation.py``, timed against the heuristic it replaced in
+    ``benchmarks/bench_propagation.py`` (the same cost per call with the screen, about 7x more without).
     """
     if t.size < 2:
         return
     X = states if states.ndim == 3 else states[:, None, :]
-    h = np.diff(t)[:, None]  # (m-1, 1)
-    r0, r1, v0, v1 = X[:-1, :, :3], X[1:, :, :3], X[:-1, :, 3:], X[1:, :, 3:]
-    if screen:
-        spread = _hermite_spread(r0, r1, v0, v1, h)  # (m-1, B)
-        reach = 0.5 * np.abs(h) * np.maximum(_norm3(v0), _norm3(v1))
-        cand = np.zeros(spread.shape, dtype=bool)
-        for centre, radius in ((system.secondary_position, system.secondary_radius),
-                               (system.primary_position, system.primary_radius)):
-            clear = np.maximum(_norm3(r0 - centre), _norm3(r1 - centre)) - spread
-            cand |= clear <= radius + reach + _SCREEN_SLACK_LU
-        ks, bs = np.nonzero(cand)
-        if ks.size == 0:
-            return
-    else:
-        ks, bs = np.nonzero(np.ones(h.shape[:1] + X.shape[1:2], dtype=bool))
-    # the 17-point Hermite test on the remaining intervals (the arithmetic of the unscreened test, element by element)
-    hk = h[ks]  # (n, 1)
-    a0, a1, w0, w1 = r0[ks, bs], r1[ks, bs], v0[ks, bs], v1[ks, bs]  # (n, 3)
-    s = _HERMITE_S  # (17, 1, 1)
-    h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
-    p = h00 * a0 + h10 * hk * w0 + h01 * a1 + h11 * hk * w1  # (17, n, 3)
-    reach = 0.5 * hk[:, 0] * np.maximum(np.linalg.norm(w0, axis=-1), np.linalg.norm(w1, axis=-1))  # (n,)
-    near = np.zeros(ks.shape, dtype=bool)
-    for centre, radius in ((system.secondary_position, system.secondary_radius),
-                           (system.primary_position, system.primary_radius)):
-        d = np.min(np.linalg.norm(p - centre, axis=-1), axis=0)
-        near |= d <= radius + reach
-    for k, b in zip(ks[near], bs[near]):
+    ks, bs = _uncleared_intervals(system, t, X, screen)
+    for k, b in zip(ks, bs):
         grid = np.array([t[k], t[k + 1]])
         try:
             _propagate_chunk(system, X[k, b][None], grid, 0, tol, 1, True, None)
