@@ -578,7 +578,7 @@ def figure_cadence_cost(cost: cu.CadenceCost):
     fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
     ax.loglog(cost.seconds, cost.sigma3_km, "o-", label="OCBE filter, one period")
     for c, s, a in zip(cost.cadences_h, cost.seconds, cost.sigma3_km):
-        ax.annotate(_cadence_label(c), (s, a), textcoords="offset points", xytext=(4, 4), fontsize=7)
+        ax.annotate(_cadence_label(c), (s, a), textcoords="offset points", xytext=(8, 6), fontsize=7)  # clear of the knee box
     i = int(np.argmin(np.abs(cost.cadences_h - cost.knee_h)))
     ax.loglog(cost.seconds[i], cost.sigma3_km[i], "s", ms=10, mfc="none", label=f"knee ({_cadence_label(cost.knee_h)})")
     s0 = cost.seconds[0]
