@@ -2,7 +2,7 @@
 process and reported as RATIOS (old CPU time / new CPU time; the machine is shared, absolute times are noise), and
 the LMI solve time against the number of polytope vertices.
 
-``main()`` runs the ratios (about 30 s of CPU):
+``main()`` runs the ratios (about 40 s of CPU):
 
 * ``hinf_norm``: the Hamiltonian level-set H-infinity norm with the frequency grid evaluated one frequency at a time
   (the old :func:`_hinf_norm_loop`, kept here) against the batched :func:`cislunar.estimation.lpv._hinf_norm`, on the
@@ -11,6 +11,11 @@ the LMI solve time against the number of polytope vertices.
 * ``objective``: the objective-norm study solving the p = 2 H-infinity problem first at its default scaling (old:
   it ends optimal_inaccurate and the retry list re-solves at the first retry scaling) against starting there (new);
   the designs must be bit-identical.
+* ``backend``: notebook 11's eight 64-vertex and theta1-only problems (H2 and H-infinity; six sensors under
+  p = 1, 2, inf and theta1 only under p = 1), each built and solved through cvxpy's canonicalisation (old,
+  ``backend="cvxpy"``) against Clarabel's data built directly in numpy (new, the default).  Not bit-identical: the
+  two reach the optimum along different paths, so the table reports the largest relative change of the used
+  precisions and whether every status agrees.
 
 ``vertex_scaling(max_k)`` is the older benchmark (H2 LMI build and solve time against 2^k vertices, Clarabel and SCS;
 about 8.5 min, almost all SCS) and is not run by ``main``.
@@ -71,6 +76,27 @@ def _objective_old(scenario, designs):
     return out
 
 
+def _backend_set(scenario, backend):
+    """Notebook 11's problems (build + solve) through ``backend``; returns the designs by case."""
+    from cislunar.estimation import lpv
+    from cislunar.papers.nychka_bhattacharya.scenarios import GAMMA, POLE_RADIUS, THETA1_SENSORS
+
+    V = scenario.box.vertices()
+    out = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        for norm in ("h2", "hinf"):
+            kw = {"pole_radius": POLE_RADIUS} if norm == "hinf" else {}
+            for obj in ("l1", "l2", "linf"):
+                lmi = lpv.PrecisionLMI.for_cr3bp(scenario.model, V, norm, objective=obj, backend=backend, **kw)
+                if norm == "hinf" and obj in ("l1", "l2"):
+                    lmi = lmi.rescaled(lpv.RETRY_SCALINGS[0][0], lmi.balanced_state_scale)
+                out[(norm, obj, 6)] = lmi.solve(GAMMA, retry=not (norm == "hinf" and obj == "linf"))
+            out[(norm, "l1", 2)] = lpv.PrecisionLMI.for_cr3bp(scenario.model, V, norm, sensors=THETA1_SENSORS,
+                                                              backend=backend, **kw).solve(GAMMA)
+    return out
+
+
 def _same_design(a, b) -> bool:
     return all(np.array_equal(getattr(a, k), getattr(b, k)) for k in ("L", "X", "beta", "kappa", "used")) and \
         a.status == b.status and a.objective == b.objective
@@ -115,9 +141,21 @@ def main(n_verify: int = 20) -> dict:
     o_new, t_new = _cpu(lambda: sp.objective_norm_study(sc, D).designs)
     results["objective"] = {"old_s": t_old, "new_s": t_new, "ratio": t_old / t_new, "n": 4,
                             "identical": all(_same_design(o_old[k], o_new[k]) for k in o_old)}
+    # cvxpy canonicalisation against the directly built Clarabel data (the same eight problems, built and solved)
+    b_old, t_old = _cpu(_backend_set, sc, "cvxpy")
+    b_new, t_new = _cpu(_backend_set, sc, "direct")
+    change = max(float(np.max(np.abs(b_new[k].kappa[b_old[k].used] / b_old[k].kappa[b_old[k].used] - 1)))
+                 for k in b_old)
+    results["backend"] = {"old_s": t_old, "new_s": t_new, "ratio": t_old / t_new, "n": len(b_old),
+                          "identical": all(_same_design(b_old[k], b_new[k]) for k in b_old),
+                          "statuses_equal": all(b_old[k].status == b_new[k].status for k in b_old),
+                          "max_rel_kappa_change": change}
     print(f"{'case':12s} {'n':>6s} {'old CPU s':>10s} {'new CPU s':>10s} {'old/new':>8s} {'identical':>10s}")
     for k, r in results.items():
         print(f"{k:12s} {r['n']:6d} {r['old_s']:10.2f} {r['new_s']:10.2f} {r['ratio']:8.2f} {str(r['identical']):>10s}")
+    r = results["backend"]
+    print(f"backend: statuses equal {r['statuses_equal']}, largest relative change of a used precision "
+          f"{r['max_rel_kappa_change']:.1e}")
     return results
 
 

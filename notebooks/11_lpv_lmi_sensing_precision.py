@@ -306,8 +306,8 @@ _ = table.add(*r.judged(CLAIMS))
 # %% [markdown]
 # ## 8 · Beyond the paper: required precision against gamma
 #
-# The $\theta_1$-only problems are built once; `gamma` enters only through a `cp.Parameter` ($S_d/\gamma$), so the
-# sweep re-uses the canonicalised problems. Without disturbance $\kappa\gamma$ would be exactly constant (the
+# The $\theta_1$-only problems are built once; `gamma` enters only through the ratio $S_d/\gamma$, which scales one
+# affine part of the solver's data, so the sweep re-uses the built problems. Without disturbance $\kappa\gamma$ would be exactly constant (the
 # scaled problem does not depend on $\gamma$); the small $S_d$ bends the H2 curve only at small gamma, where
 # $S_d/\gamma$ is largest.
 
@@ -325,7 +325,7 @@ _ = table.add(*r.judged(CLAIMS))
 # both $\theta_1$-only theorems at $\gamma = 0.0013$ for eight planar Earth-Moon resonant orbits (4:1, 3:1, 5:2,
 # 2:1 with several perigee radii), two disturbance structures (accelerations on the velocities; independent
 # perturbations of all four states) and disturbance levels $0$ to $10^{-2}$ (LU/TU² for accelerations); each
-# (orbit, structure, norm) problem is built once and the level is a `cp.Parameter`. The sampling interval enters
+# (orbit, structure, norm) problem is built once and the level only rescales part of its data. The sampling interval enters
 # afterwards, through the per-sample conversion of Section 7. We ask: where does H-infinity allow
 # $[0.075, 0.085)$ deg, H2 per sample $[0.05, 0.15)$ deg, and H2 more than H-infinity?
 

@@ -56,7 +56,9 @@ import warnings
 from dataclasses import dataclass, field
 from itertools import product
 
+import clarabel
 import numpy as np
+from scipy import sparse
 
 from cislunar.cr3bp.dynamics import CR3BP, EARTH_MOON, check_system
 from cislunar.cr3bp.orbits import correct_symmetric
@@ -601,7 +603,8 @@ class ObserverDesign:
     status, solver : str
         Solver status and name.
     solve_time : float
-        Wall-clock seconds of the solve (including canonicalisation on the first call).
+        Wall-clock seconds of the solve (with ``backend="cvxpy"`` or SCS, including canonicalisation on the first
+        call).
     objective : float
         Optimal :math:`\\|\\beta\\|_p`.
     Bw, Dd : ndarray
@@ -672,10 +675,29 @@ RETRY_SCALINGS = ((100.0, True), (1.0, False), (10.0, False), (100.0, False), (3
                   (0.3, False))
 _NORMS = ("h2", "hinf")
 _OBJECTIVES = {"l1": 1, "l2": 2, "linf": np.inf}
+#: How :class:`PrecisionLMI` reaches Clarabel: its conic data built directly in numpy ("direct", the default) or
+#: through cvxpy's canonicalisation ("cvxpy", the older path; SCS always goes through cvxpy).
+_BACKENDS = ("direct", "cvxpy")
+#: Clarabel status -> the cvxpy status name cvxpy's Clarabel interface reports for it.
+_CLARABEL_STATUS = {"Solved": "optimal", "AlmostSolved": "optimal_inaccurate", "PrimalInfeasible": "infeasible",
+                    "AlmostPrimalInfeasible": "infeasible_inaccurate", "DualInfeasible": "unbounded",
+                    "AlmostDualInfeasible": "unbounded_inaccurate", "MaxIterations": "user_limit",
+                    "MaxTime": "user_limit"}
+
+
+#: Clarabel cone constructors by the kind names of :meth:`PrecisionLMI._conic_data`.
+_CLARABEL_CONES = {"nonneg": clarabel.NonnegativeConeT, "soc": clarabel.SecondOrderConeT,
+                   "psd": clarabel.PSDTriangleConeT}
+
+
+def _svec_indices(k):
+    """Row and column indices of the upper triangle of a k x k matrix, by columns (Clarabel's PSD triangle)."""
+    a, b = np.tril_indices(k)  # a >= b, ordered by a: as (row b, column a) the upper triangle column by column
+    return b, a
 
 
 class PrecisionLMI:
-    r"""Theorem 1 (H2) or Theorem 2 (H-infinity) of the paper as a cvxpy problem, built once.
+    r"""Theorem 1 (H2) or Theorem 2 (H-infinity) of the paper as a conic program, built once.
 
     Decision variables :math:`X = X^T \succ 0` (4x4), :math:`Y` (4x6), :math:`\beta \ge 0` (6) and, for H2,
     :math:`Q = Q^T` (2x2).  At every vertex :math:`\rho_v` of the parameter polytope (the LMIs are affine in
@@ -704,8 +726,9 @@ class PrecisionLMI:
        Q/\gamma^2`, with :math:`\mathrm{tr}\,\tilde Q < 1`.  H-infinity is solved after the congruence
        :math:`\mathrm{diag}(I, I/\gamma, I, I)` of Eq. 19: :math:`X` and :math:`Y` unchanged, the disturbance block
        :math:`(XB_d+YD_d)S_d/\gamma` against :math:`-I`, and :math:`\tilde\beta = \gamma^2\beta`.  In both,
-       :math:`\gamma` only scales the disturbance, :math:`S_d \to S_d/\gamma`.  The ratio ``disturbance_scale / gamma`` is one ``cp.Parameter``, so
-       sweeps over gamma and over the disturbance level re-use the canonicalised problem.
+       :math:`\gamma` only scales the disturbance, :math:`S_d \to S_d/\gamma`.  The ratio ``disturbance_scale / gamma`` enters the solver's data
+       affinely (and as one ``cp.Parameter`` on the cvxpy path), so sweeps over gamma and over the disturbance
+       level re-use the built problem.
     2. State coordinates (optional).  The error may be written :math:`e = T\hat e` with :math:`T =
        \mathrm{diag}(\mathrm{state\_scale})`; default :math:`T = I`.  :meth:`for_cr3bp` also records the
        velocity-balanced :math:`T = \mathrm{diag}(1, 1, v, v)`, :math:`v = 1/\sqrt{\max|a(\rho)|}` (inverse
@@ -761,16 +784,23 @@ class PrecisionLMI:
         Diagonal of the coordinate scaling T (default ones; :meth:`for_cr3bp` balances it).
     variable_scale : float, optional
         Magnitude s of the scaled Lyapunov variables (default ``max(1, R/10)`` or 1).
+    backend : {"direct", "cvxpy"}
+        How the problem reaches Clarabel.  ``"direct"`` (default): the conic data (the LMI matrices' upper
+        triangles, column by column with off-diagonals times :math:`\sqrt2`, Clarabel's PSD triangle) are read off
+        in numpy by evaluating the affine LMI maps at the unit vectors of the decision variables, once per
+        problem, and handed to Clarabel; no cvxpy canonicalisation (measured 3.6x less CPU on notebook 11's
+        problems, ``benchmarks/bench_lpv.py``).  ``"cvxpy"``: the older path through cvxpy.  Both describe the
+        same problem and agree to solver tolerance (tests: precisions within 1e-5 relative); SCS always goes
+        through cvxpy.
     """
 
     def __init__(self, A_vertices, C_vertices, norm: str = "h2", *, disturbance, Cz=None,
                  objective: str = "l1", eps: float = 1e-8, sensors=None, pole_radius: float | None = None,
-                 state_scale=None, variable_scale: float | None = None):
-        import cvxpy as cp
-
+                 state_scale=None, variable_scale: float | None = None, backend: str = "direct"):
         self._init = {"A_vertices": A_vertices, "C_vertices": C_vertices, "norm": norm, "disturbance": disturbance, "Cz": Cz,
                           "objective": objective, "eps": eps, "sensors": sensors, "pole_radius": pole_radius,
-                          "state_scale": state_scale}
+                          "state_scale": state_scale, "backend": backend}
+        self.backend = validation.choice(backend, "backend", _BACKENDS)
         self._rescaled = {}
         A_v = validation.as_array(A_vertices, "A_vertices", ndim=(3,))
         nx = A_v.shape[1]
@@ -819,7 +849,6 @@ class PrecisionLMI:
         self.A_vertices, self.C_vertices, self.norm, self.objective = A_v, C_all, norm, objective
         self.Bd, self.Sd, self.Dd, self.Cz, self.sensors = Bd, Sd, Dd, Cz, sensors
         self.state_scale, self.variable_scale = tvec, xs
-        ns, nz = len(sensors), Cz.shape[0]
         # exact de-duplication: vertices that differ only in parameters the offered sensors do not see
         flat = np.concatenate([A_v.reshape(A_v.shape[0], -1), C_all[:, sensors, :].reshape(A_v.shape[0], -1)], 1)
         _, keep = np.unique(flat, axis=0, return_index=True)
@@ -830,10 +859,145 @@ class PrecisionLMI:
         C_h = C_all[keep][:, sensors, :] @ T
         Bd_h, Cz_h, Dd_s = Ti @ Bd, Cz @ T, Dd[sensors]
 
+        self._data = (A_h, C_h, Bd_h, Cz_h, Dd_s, Sd)
+        self._cvx = None
+        self._conic = self._conic_data()
+
+    def _blocks(self, Xh, Yh, beta, Q, dog):
+        """``(psd, lin)``: the constraint matrices of the problem (each must be PSD) and its linear inequality rows
+        (each >= 0: beta, and for H2 1 - tr Q), evaluated in numpy on the same expressions as
+        :meth:`_cvxpy_problem` for decision variables batched on a leading axis (the objective's cone rows are
+        added by :meth:`_conic_data`)."""
+        A_h, C_h, Bd_h, Cz_h, Dd_s, Sd = self._data
+        nx, ns, nd, nz = self.n_x, len(self.sensors), Sd.shape[0], Cz_h.shape[0]
+        nb, eps, xs = Xh.shape[0], self.eps, self.variable_scale
+        X, Y = xs * Xh, xs * Yh
+        XAcl = np.einsum("bij,vjk->bvik", X, A_h) + np.einsum("bij,vjk->bvik", Y, C_h)
+        M11 = XAcl + np.swapaxes(XAcl, -1, -2)
+        M12 = dog * ((X @ Bd_h + Y @ Dd_s) @ Sd)
+        nv = A_h.shape[0]
+        if self.norm == "h2":
+            k = nx + nd + ns
+            blk = np.zeros((nb, nv, k, k))
+            o = nx + nd
+        else:
+            k = nx + nd + nz + ns
+            blk = np.zeros((nb, nv, k, k))
+            o = nx + nd + nz
+            blk[:, :, :nx, nx + nd:o] = Cz_h.T
+            blk[:, :, nx + nd:o, :nx] = Cz_h
+            blk[:, :, nx + nd:o, nx + nd:o] = -np.eye(nz)
+        blk[:, :, :nx, :nx] = M11
+        blk[:, :, :nx, nx:nx + nd] = M12[:, None]
+        blk[:, :, nx:nx + nd, :nx] = np.swapaxes(M12, -1, -2)[:, None]
+        blk[:, :, nx:nx + nd, nx:nx + nd] = -np.eye(nd)
+        blk[:, :, :nx, o:] = Y[:, None]
+        blk[:, :, o:, :nx] = np.swapaxes(Y, -1, -2)[:, None]
+        idx = np.arange(ns)
+        blk[:, :, o + idx, o + idx] = -beta[:, None, :]
+        psd = [Xh - eps * np.eye(nx), -0.5 * (blk + np.swapaxes(blk, -1, -2)) - eps * np.eye(k)]
+        if self.pole_radius is not None:
+            R = self.pole_radius
+            disk = np.zeros((nb, nv, 2 * nx, 2 * nx))
+            disk[:, :, :nx, :nx] = -X[:, None]
+            disk[:, :, nx:, nx:] = -X[:, None]
+            disk[:, :, :nx, nx:] = XAcl / R
+            disk[:, :, nx:, :nx] = np.swapaxes(XAcl, -1, -2) / R
+            psd.append(-0.5 * (disk + np.swapaxes(disk, -1, -2)) - eps * np.eye(2 * nx))
+        lin = [beta]
+        if self.norm == "h2":
+            qb = np.zeros((nb, nz + nx, nz + nx))
+            qb[:, :nz, :nz] = Q
+            qb[:, :nz, nz:] = Cz_h
+            qb[:, nz:, :nz] = Cz_h.T
+            qb[:, nz:, nz:] = X
+            psd.append(qb - eps * np.eye(nz + nx))
+            lin.append(1.0 - np.trace(Q, axis1=-2, axis2=-1)[:, None])
+        return psd, lin
+
+    def _layout(self):
+        """Positions of the decision variables in the solver's vector: (X upper triangle, Y, beta, Q, t)."""
+        nx, ns, nz = self.n_x, len(self.sensors), self.Cz.shape[0]
+        iu = np.triu_indices(nx)
+        sizes = {"X": iu[0].size, "Y": nx * ns, "beta": ns, "Q": nz * (nz + 1) // 2 if self.norm == "h2" else 0,
+                 "t": 0 if self.objective == "l1" else 1}
+        out, at = {}, 0
+        for key, n in sizes.items():
+            out[key] = slice(at, at + n)
+            at += n
+        return out, at
+
+    def _unpack(self, z):
+        """Decision variables from the solver vector(s) ``z`` (..., n): Xh, Yh, beta, Q (scaled variables)."""
+        nx, ns, nz = self.n_x, len(self.sensors), self.Cz.shape[0]
+        lay, _ = self._layout()
+        z = np.atleast_2d(z)
+        Xh = np.zeros((z.shape[0], nx, nx))
+        iu = np.triu_indices(nx)
+        Xh[:, iu[0], iu[1]] = z[:, lay["X"]]
+        Xh[:, iu[1], iu[0]] = z[:, lay["X"]]
+        Yh = z[:, lay["Y"]].reshape(-1, nx, ns)
+        beta = z[:, lay["beta"]]
+        Q = np.zeros((z.shape[0], nz, nz))
+        if self.norm == "h2":
+            iq = np.triu_indices(nz)
+            Q[:, iq[0], iq[1]] = z[:, lay["Q"]]
+            Q[:, iq[1], iq[0]] = z[:, lay["Q"]]
+        return Xh, Yh, beta, Q
+
+    def _conic_data(self):
+        """The problem in Clarabel's form, min q'z s.t. A z + s = b, s in K, with A and b affine in the
+        ``disturbance / gamma`` ratio: ``(q, (A0, b0), (A1, b1), cones)`` with A = A0 + r A1, b = b0 + r b1 and
+        ``cones`` a list of ``(kind, dimension)``, kind "nonneg", "soc" or "psd" (plain tuples: the problem pickles).
+
+        The constraint maps are read off by evaluating :meth:`_blocks` at z = 0 and at each unit vector (they are
+        affine in z); a PSD block enters as the upper triangle by columns with off-diagonals times sqrt(2)
+        (Clarabel's ``PSDTriangleConeT``)."""
+        lay, n = self._layout()
+        basis = np.vstack([np.zeros(n), np.eye(n)])
+        parts = {}
+        for dog in (0.0, 1.0):
+            psd, lin = self._blocks(*self._unpack(basis), dog)
+            rows, cones = [], []
+            lin_rows = np.concatenate([v.reshape(n + 1, -1) for v in lin], axis=1)
+            if self.objective == "linf":  # t - beta_i >= 0
+                t = basis[:, lay["t"]]
+                lin_rows = np.concatenate([lin_rows, t - basis[:, lay["beta"]]], axis=1)
+            rows.append(lin_rows)
+            cones.append(("nonneg", lin_rows.shape[1]))
+            if self.objective == "l2":  # (t, beta) in the second-order cone
+                soc = np.concatenate([basis[:, lay["t"]], basis[:, lay["beta"]]], axis=1)
+                rows.append(soc)
+                cones.append(("soc", soc.shape[1]))
+            for M in psd:
+                k = M.shape[-1]
+                iu = _svec_indices(k)
+                w = np.where(iu[0] == iu[1], 1.0, np.sqrt(2.0))
+                S = M[..., iu[0], iu[1]] * w
+                S = S.reshape(n + 1, -1, iu[0].size)
+                rows.append(S.reshape(n + 1, -1))
+                cones.extend(("psd", k) for _ in range(S.shape[1]))
+            F = np.concatenate(rows, axis=1)  # (1 + n, m): s(z) = F[0] + sum_i z_i (F[i] - F[0])
+            parts[dog] = (-(F[1:] - F[0]).T, F[0].copy())
+        (A0, b0), (A1_, b1_) = parts[0.0], parts[1.0]
+        q = np.zeros(n)
+        q[lay["beta"] if self.objective == "l1" else lay["t"]] = 1.0
+        return q, (A0, b0), (A1_ - A0, b1_ - b0), cones
+
+    def _cvxpy_problem(self):
+        """The same problem as a cvxpy ``Problem`` (built on first use: the SCS path and ``backend="cvxpy"``);
+        returns ``(problem, X, Y, beta, disturbance_over_gamma)``."""
+        import cvxpy as cp
+
+        if self._cvx is not None:
+            return self._cvx
+        A_h, C_h, Bd_h, Cz_h, Dd_s, Sd = self._data
+        nx, ns, nd, nz = self.n_x, len(self.sensors), Sd.shape[0], Cz_h.shape[0]
+        norm, xs = self.norm, self.variable_scale
         Xh = cp.Variable((nx, nx), symmetric=True, name="X_hat")
         Yh = cp.Variable((nx, ns), name="Y_hat")
         beta = cp.Variable(ns, nonneg=True, name="beta_scaled")
-        self.dist_over_gamma = cp.Parameter(nonneg=True, name="disturbance_over_gamma", value=1.0)
+        dist_over_gamma = cp.Parameter(nonneg=True, name="disturbance_over_gamma", value=1.0)
         X, Y = xs * Xh, xs * Yh
         eps = self.eps
         cons = [Xh >> eps * np.eye(nx)]
@@ -841,7 +1005,7 @@ class PrecisionLMI:
         for Av, Cv in zip(A_h, C_h):
             XAcl = X @ Av + Y @ Cv
             M11 = XAcl + XAcl.T
-            M12 = self.dist_over_gamma * ((X @ Bd_h + Y @ Dd_s) @ Sd)
+            M12 = dist_over_gamma * ((X @ Bd_h + Y @ Dd_s) @ Sd)
             if norm == "h2":
                 blk = cp.bmat([[M11, M12, Y],
                                [M12.T, -Ind, np.zeros((nd, ns))],
@@ -857,13 +1021,13 @@ class PrecisionLMI:
                 R = self.pole_radius
                 disk = cp.bmat([[-X, XAcl / R], [XAcl.T / R, -X]])
                 cons.append(0.5 * (disk + disk.T) << -eps * np.eye(2 * nx))
-        Q = None
         if norm == "h2":
             Q = cp.Variable((nz, nz), symmetric=True, name="Q_scaled")
             cons.append(cp.bmat([[Q, Cz_h], [Cz_h.T, X]]) >> eps * np.eye(nz + nx))
             cons.append(cp.trace(Q) <= 1.0)
-        self._X, self._Y, self._beta, self._Q = X, Y, beta, Q
-        self.problem = cp.Problem(cp.Minimize(cp.norm(beta, _OBJECTIVES[objective])), cons)
+        problem = cp.Problem(cp.Minimize(cp.norm(beta, _OBJECTIVES[self.objective])), cons)
+        self._cvx = (problem, X, Y, beta, dist_over_gamma)
+        return self._cvx
 
     @classmethod
     def for_cr3bp(cls, model: CR3BPLPV, vertices, norm: str = "h2", *, disturbance=None, **kwargs) -> PrecisionLMI:
@@ -996,39 +1160,78 @@ class PrecisionLMI:
 
     def _solve_once(self, gamma, solver, dscale, sparsity_tol, solver_options) -> ObserverDesign:
         """Kernel of :meth:`solve_once` (arguments already checked by :meth:`_solve_arguments`)."""
-        import cvxpy as cp
-
-        self.dist_over_gamma.value = dscale / gamma
         t0 = time.perf_counter()
-        try:
-            self.problem.solve(solver=solver, **solver_options)
-        except cp.error.SolverError as exc:
-            raise InfeasibleLMIError(f"{self.norm} precision LMI: solver {solver} failed at gamma = {gamma:g} "
-                                     f"({exc})", gamma, "solver_error") from exc
+        if solver == "CLARABEL" and self.backend == "direct":
+            status, Xv, Yv, bv, value = self._solve_direct(gamma, dscale / gamma, solver_options)
+        else:
+            status, Xv, Yv, bv, value = self._solve_cvxpy(gamma, solver, dscale / gamma, solver_options)
         elapsed = time.perf_counter() - t0
-        status = self.problem.status
-        if status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or self._X.value is None:
+        if status not in ("optimal", "optimal_inaccurate") or Xv is None:
             raise InfeasibleLMIError(
                 f"{self.norm} precision LMI infeasible or unsolved at gamma = {gamma:g}: solver {solver} status "
                 f"{status!r} ({self.n_unique_vertices} distinct vertices)", gamma, str(status))
-        if status == cp.OPTIMAL_INACCURATE:
+        if status == "optimal_inaccurate":
             warnings.warn(f"{self.norm} precision LMI at gamma = {gamma:g}: solver {solver} returned "
                           "optimal_inaccurate; verify the design (verify_observer) before trusting it", stacklevel=2)
+        return self._design(gamma, dscale, sparsity_tol, solver, status, elapsed, Xv, Yv, bv, value)
+
+    def _solve_direct(self, gamma, ratio, solver_options):
+        """Clarabel on the data of :meth:`_conic_data`; returns ``(status, X, Y, beta, objective)`` as cvxpy would
+        (status names of cvxpy; a solver failure raises :class:`InfeasibleLMIError` with status "solver_error")."""
+        q, (A0, b0), (A1, b1), cones = self._conic
+        A = sparse.csc_matrix(A0 + ratio * A1)
+        n = q.size
+        settings = clarabel.DefaultSettings()
+        settings.verbose = False
+        for key, val in solver_options.items():
+            try:
+                setattr(settings, key, val)
+            except (AttributeError, TypeError) as exc:
+                raise ValueError(f"solver_options: Clarabel has no setting {key!r} of that type ({exc})") from exc
+        cones = [_CLARABEL_CONES[kind](dim) for kind, dim in cones]
+        sol = clarabel.DefaultSolver(sparse.csc_matrix((n, n)), q, A, b0 + ratio * b1, cones, settings).solve()
+        status = _CLARABEL_STATUS.get(str(sol.status), "solver_error")
+        if status == "solver_error":
+            raise InfeasibleLMIError(f"{self.norm} precision LMI: solver CLARABEL failed at gamma = {gamma:g} "
+                                     f"(status {sol.status})", gamma, "solver_error")
+        if status not in ("optimal", "optimal_inaccurate"):
+            return status, None, None, None, None
+        Xh, Yh, beta, _ = self._unpack(np.asarray(sol.x))
+        xs = self.variable_scale
+        return status, xs * Xh[0], xs * Yh[0], beta[0], float(sol.obj_val)
+
+    def _solve_cvxpy(self, gamma, solver, ratio, solver_options):
+        """The same through cvxpy (SCS, or ``backend="cvxpy"``)."""
+        import cvxpy as cp
+
+        problem, X, Y, beta, dog = self._cvxpy_problem()
+        dog.value = ratio
+        try:
+            problem.solve(solver=solver, **solver_options)
+        except cp.error.SolverError as exc:
+            raise InfeasibleLMIError(f"{self.norm} precision LMI: solver {solver} failed at gamma = {gamma:g} "
+                                     f"({exc})", gamma, "solver_error") from exc
+        if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or X.value is None:
+            return str(problem.status), None, None, None, None
+        return str(problem.status), X.value, Y.value, beta.value, float(problem.value)
+
+    def _design(self, gamma, dscale, sparsity_tol, solver, status, elapsed, Xval, Yval, beta_val, value):
+        """The :class:`ObserverDesign` from the scaled solution."""
         T = np.diag(self.state_scale)
-        Xh = 0.5 * (self._X.value + self._X.value.T)
-        Ls = T @ np.linalg.solve(Xh, self._Y.value)
+        Xh = 0.5 * (Xval + Xval.T)
+        Ls = T @ np.linalg.solve(Xh, Yval)
         Xv = np.diag(1.0 / self.state_scale) @ Xh @ np.diag(1.0 / self.state_scale)
         L = np.zeros((self.n_x, self.n_y))
         L[:, self.sensors] = Ls
         beta = np.zeros(self.n_y)
-        beta[self.sensors] = np.maximum(self._beta.value, 0.0) / gamma**2
+        beta[self.sensors] = np.maximum(beta_val, 0.0) / gamma**2
         kappa = np.sqrt(beta)
         used = np.zeros(self.n_y, dtype=bool)
         used[self.sensors] = beta[self.sensors] > sparsity_tol * beta.max()
         Sd = dscale * self.Sd
         return ObserverDesign(norm=self.norm, gamma=gamma, L=L, X=Xv, beta=beta, kappa=kappa,
                               noise_deg=_precision_to_noise_deg(kappa), used=used, status=str(status),
-                              solver=solver, solve_time=elapsed, objective=float(self.problem.value) / gamma**2,
+                              solver=solver, solve_time=elapsed, objective=value / gamma**2,
                               Bw=self.Bd @ Sd, Dd=self.Dd @ Sd, pole_radius=self.pole_radius,
                               variable_scale=self.variable_scale)
 
@@ -1045,7 +1248,7 @@ def design_observer(model: CR3BPLPV, vertices, gamma: float, norm: str = "h2", *
 
 
 def gamma_sweep(lmi: PrecisionLMI, gammas, *, solver: str = "CLARABEL") -> list:
-    """Solve ``lmi`` for each gamma (re-using the canonicalised problem); infeasible points give ``None``."""
+    """Solve ``lmi`` for each gamma (re-using the built problem); infeasible points give ``None``."""
     lmi = validation.instance(lmi, "lmi", PrecisionLMI)
     g = validation.as_array(gammas, "gammas", ndim=(1,), min_size=1)
     out = []

@@ -344,10 +344,10 @@ def specs(Spec, lazy):
     s.append(S("PrecisionLMI", lpv.PrecisionLMI,
                dict(A_vertices=MODEL.A(RHO2), C_vertices=MODEL.C(RHO2), norm="h2", disturbance=dist,
                     Cz=np.eye(2, 4), objective="l1", eps=1e-8, sensors=[0, 1], pole_radius=None,
-                    state_scale=np.ones(4), variable_scale=1.0),
+                    state_scale=np.ones(4), variable_scale=1.0, backend="direct"),
                dict(A_vertices="arr", C_vertices="arr", norm="choice", disturbance="instance", Cz="arr_opt",
                     objective="choice", eps="pos", sensors="iterable_opt", pole_radius="pos_opt",
-                    state_scale="arr_opt", variable_scale="pos_opt")))
+                    state_scale="arr_opt", variable_scale="pos_opt", backend="choice")))
     s.append(S("PrecisionLMI.for_cr3bp", lpv.PrecisionLMI.for_cr3bp,
                dict(model=MODEL, vertices=RHO2, norm="h2", disturbance=dist, sensors=[0, 1]),
                dict(model="instance", vertices="arr", norm="choice", disturbance="instance_opt")))

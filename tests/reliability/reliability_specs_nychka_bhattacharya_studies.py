@@ -254,6 +254,9 @@ def specs(Spec, lazy):
     for name in ("rms", "holds", "fix_following"):
         method(f"WindowStudy.{name}", lambda n=name: getattr(_window(), n),
                dict(design="robust", norm="h2", start="large"), dict(design="choice", norm="choice", start="choice"))
+    method("WindowStudy.fix_residual", lambda: _window().fix_residual,
+           dict(design="robust", norm="hinf", start="large", lag=1),
+           dict(design="choice", norm="choice", start="choice", lag="int0"))
 
     # -------------------------------------------------------------------------------------- scenarios (Fig. 1)
     add(nb_scenarios, "fig1_scene", dict(scenario=sc, n_platforms=2, rso=(3, 1, 0.3), rso_phase=0.3, n_samples=10),

@@ -306,6 +306,10 @@ class WindowStudy:
     fix_error : ndarray (m,)
         Position error (LU) of the fix triangulated from each sample's two noisy angles alone (law of sines on the
         Earth-Moon baseline; ``nan`` where :math:`|\\sin\\theta_3|` < the triangulation threshold).
+    fix_vector : ndarray (m, 2)
+        The same as vectors, fix minus truth in the rotating frame (x, y), LU (``nan`` rows as ``fix_error``).
+    error_vectors : dict of (str, str, str) to ndarray (m, 2)
+        Position error vectors, estimate minus truth (x, y), LU, keyed like ``errors``.
     """
 
     t: np.ndarray
@@ -318,6 +322,8 @@ class WindowStudy:
     dt: float
     period: float
     fix_error: np.ndarray | None = None
+    fix_vector: np.ndarray | None = None
+    error_vectors: dict | None = None
 
     def fix_following(self, design: str, norm: str, start: str = "large") -> tuple:
         """How closely a run's error follows the angle-only fix of the sample before, after 10 % of the run.
@@ -337,6 +343,28 @@ class WindowStudy:
         keep = self.settled[1:] & np.isfinite(fix)
         run, fix = run[keep], fix[keep]
         return float(np.corrcoef(run, fix)[0, 1]), float(np.sqrt(np.mean(run**2) / np.mean(fix**2)))
+
+    def fix_residual(self, design: str, norm: str, start: str = "large", lag: int = 1) -> float:
+        r"""RMS of the vector difference between a run's error at sample k + ``lag`` and the angle-only fix error
+        at sample k, after 10 % of the run, LU.
+
+        If the estimate at sample k+1 were the fix of sample k plus an error :math:`d_k` of its own,
+        :math:`e_{k+1} = f_k + d_k`, this is :math:`\mathrm{RMS}|d_k|` (``lag=1``); ``lag=0`` compares with the
+        fix of the same sample (the contrast).  Samples whose fix is undefined (near the Earth-Moon line) are
+        left out.
+        """
+        key = (design, norm, start)
+        if key not in self.errors:
+            raise ValueError(f"(design, norm, start) must be one of {sorted(self.errors)}; got {key}")
+        lag = validation.integer(lag, "lag", minimum=0)
+        if self.fix_vector is None or self.error_vectors is None:
+            raise ValueError("this WindowStudy carries no fix_vector/error_vectors (built without simulate_window)")
+        m = self.t.size
+        if lag >= m:
+            raise ValueError(f"lag must be below the number of samples {m}; got {lag}")
+        run, fix = self.error_vectors[key][lag:], self.fix_vector[:m - lag]
+        keep = self.settled[lag:] & np.all(np.isfinite(fix), axis=-1)
+        return float(np.sqrt(np.mean(np.sum((run[keep] - fix[keep]) ** 2, axis=-1))))
 
     @property
     def settled(self) -> np.ndarray:
@@ -375,15 +403,16 @@ def simulate_window(scenario: Scenario, nominal: ObserverDesigns, robust: Robust
     truth = m.planar(propagate(m.system, scenario.orbit.x0, t).x)
     meas = make_measurements(m, t, truth, robust.sigma_deg, rng)
     starts = {"large": truth[0] + INITIAL_ERROR, "small": truth[0] + small_scale * INITIAL_ERROR}
-    errors, runs = {}, {}
+    errors, vectors, runs = {}, {}, {}
     for start, x0 in starts.items():
         for norm in ("h2", "hinf"):
             gn, gr = nominal.designs[norm].gain(), robust.designs[norm].gain()
-            errors[("nominal", norm, start)] = simulate_lpv_observer(m, gn, meas, x0, truth).position_error
-            errors[("nominal, exact rho", norm, start)] = simulate_lpv_observer(
-                m, gn, meas, x0, truth, exact_rho=True).position_error
             runs[(norm, start)] = simulate_lpv_observer(m, gr, meas, x0, truth)
-            errors[("robust", norm, start)] = runs[(norm, start)].position_error
+            for design, run in (("nominal", simulate_lpv_observer(m, gn, meas, x0, truth)),
+                                ("nominal, exact rho", simulate_lpv_observer(m, gn, meas, x0, truth, exact_rho=True)),
+                                ("robust", runs[(norm, start)])):
+                errors[(design, norm, start)] = run.position_error
+                vectors[(design, norm, start)] = run.x_hat[:, :2] - truth[:, :2]
     dth = np.angle(np.exp(1j * (meas.theta1 - m._angles(truth)[0])))
     noise_rms = float(np.degrees(np.sqrt(np.mean(dth**2))))
     guarantee = {("nominal", "h2"): lpv.guaranteed_error_rms(nominal.designs["h2"], robust.sigma_deg, dt),
@@ -402,7 +431,8 @@ def simulate_window(scenario: Scenario, nominal: ObserverDesigns, robust: Robust
     e0 = {s: float(np.hypot(*(x0 - truth[0])[:2])) for s, x0 in starts.items()}
     s3 = np.sin(meas.theta1 + meas.theta2)
     fixes = m._rho_from_angles(meas.theta1, meas.theta2, np.where(np.abs(s3) < SIN3_THRESHOLD, 1.0, s3))[:, 4:6]
-    fix_error = np.where(np.abs(s3) < SIN3_THRESHOLD, np.nan, np.hypot(*(fixes - truth[:, :2]).T))
+    fix_vector = np.where((np.abs(s3) < SIN3_THRESHOLD)[:, None], np.nan, fixes - truth[:, :2])
+    fix_error = np.hypot(*fix_vector.T)
     return WindowStudy(t, truth, errors, guarantee, posterior, inside, e0, float(dt), float(scenario.orbit.period),
-                       fix_error)
+                       fix_error, fix_vector, vectors)
 

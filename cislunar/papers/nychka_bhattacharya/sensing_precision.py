@@ -421,7 +421,7 @@ class TradeCurve:
 
 
 def trade_curve(designs: Designs, gammas) -> TradeCurve:
-    """Sweep gamma on the built theta1-only problems (``gamma`` is a ``cp.Parameter``: no rebuild)."""
+    """Sweep gamma on the built theta1-only problems (``gamma`` enters through the disturbance ratio: no rebuild)."""
     designs = validation.instance(designs, "designs", Designs)
     g = validation.as_array(gammas, "gammas", ndim=(1,), min_size=2)
     if np.any(g <= 0):
@@ -547,7 +547,7 @@ def sensitivity_study(gamma: float = 0.0013, *, orbits=RESONANT_CANDIDATES, stru
     For every resonant orbit (its :math:`\rho` box from ``n_samples`` points over one period), disturbance
     structure (:func:`~cislunar.estimation.lpv.disturbance_model`) and level, the :math:`\theta_1`-only H2 problem and the
     bandwidth-bounded H-infinity problem are solved at ``gamma``.  Each (orbit, structure, norm) problem is built
-    once; the level is a ``cp.Parameter``.
+    once; the level only rescales the disturbance part of its data.
 
     Parameters
     ----------

@@ -125,13 +125,44 @@ def test_fix_following_detects_a_one_sample_lag_and_nothing_else():
         ws.fix_following("robust", "h2")
 
 
+def test_fix_residual_is_the_rms_of_the_lagged_vector_difference():
+    """An error that is the previous sample's fix plus an independent d of known RMS gives fix_residual = RMS|d|
+    (lag 1) and about sqrt(2 RMS|f|^2 + RMS|d|^2) against the same sample's fix (lag 0); NaN fixes are left out,
+    the first 10 % of the run too; the vectors must match the norms the study stores."""
+    rng = np.random.default_rng(11)
+    t = np.linspace(0.0, 1.0, 4000)
+    fix = rng.normal(size=(t.size, 2))
+    fix[100] = np.nan
+    d = 0.1 * rng.normal(size=(t.size, 2))
+    err = np.vstack([[[5.0, 5.0]], np.nan_to_num(fix[:-1], nan=9.0)]) + d
+    errors = {("nominal", "hinf", "large"): np.hypot(*err.T)}
+    ws = rb.WindowStudy(t, np.zeros((t.size, 4)), errors, {}, {}, 1.0, {}, 0.01, 1.0, np.hypot(*fix.T), fix,
+                        {("nominal", "hinf", "large"): err})
+    keep = ws.settled[1:] & np.isfinite(fix[:-1, 0])
+    assert ws.fix_residual("nominal", "hinf") == pytest.approx(np.sqrt(np.mean(np.sum(d[1:][keep] ** 2, -1))), rel=1e-12)
+    assert ws.fix_residual("nominal", "hinf", lag=0) == pytest.approx(np.sqrt(2 * 2.0 + 0.02), rel=0.05)
+    with pytest.raises(ValueError, match="design, norm, start"):
+        ws.fix_residual("robust", "hinf")
+    with pytest.raises(ValueError, match="lag"):
+        ws.fix_residual("nominal", "hinf", lag=t.size)
+    bare = rb.WindowStudy(t, np.zeros((t.size, 4)), errors, {}, {}, 1.0, {}, 0.01, 1.0, np.hypot(*fix.T))
+    with pytest.raises(ValueError, match="fix_vector"):
+        bare.fix_residual("nominal", "hinf")
+
+
 def test_window_study_hinf_error_follows_the_angle_fix(setup):
-    """At 233 min the Hinf gains (||L|| dt >> 1) put the estimate on the previous sample's angle-only fix."""
+    """At 233 min the Hinf gains (||L|| dt >> 1) put the estimate on the previous sample's angle-only fix: the
+    lagged vector difference is below the nominal Hinf guarantee and well below the same-sample difference."""
     sc, od, _, rd = setup
     ws = rb.simulate_window(sc, od, rd, 0.3, np.random.default_rng(4))
     assert ws.fix_error.shape == ws.t.shape and np.nanmax(ws.fix_error) > 0
     c, r = ws.fix_following("nominal", "hinf")
     assert c > 0.9 and 0.8 < r < 1.3
+    for key, vec in ws.error_vectors.items():
+        np.testing.assert_allclose(np.hypot(*vec.T), ws.errors[key], rtol=1e-12)
+    np.testing.assert_allclose(np.hypot(*ws.fix_vector.T), ws.fix_error, rtol=1e-12)
+    lag1 = ws.fix_residual("nominal", "hinf")
+    assert lag1 < ws.guarantee[("nominal", "hinf")] and lag1 < 0.5 * ws.fix_residual("nominal", "hinf", lag=0)
 
 
 def test_fig1_scene_places_platforms_on_the_orbit():
