@@ -18,7 +18,8 @@ reference; the public ``mutual_information_gradient`` as the SCvx information mo
 (every call re-checks F, H, dF, dH and looks P0, Q, R up in the module's checked-noise cache, the noise roots in
 its root cache); and :class:`cislunar.sensing.information.InformationKernel`, which the information model now
 builds once per window (P0, Q, R checked, R factored and Q's square roots taken once; bit-for-bit the same value
-and gradient).  Test-case-2 size is the window above; test-case-1 size is the window of
+and gradient); and the kernel with ``one_qr=True`` (time and measurement updates in one QR per time; gradient not
+bit for bit).  Test-case-2 size is the window above; test-case-1 size is the window of
 :func:`cislunar.papers.wolf_jones.scenarios.test_case_1` (observer and one target, relative position, 13 daily
 epochs, 12 states).
 
@@ -144,15 +145,18 @@ def window_kernel(label: str, lin) -> dict:
     P0, F, Q, H, R = lin.arrays
     dF, dH = lin.dF, lin.dH
     kernel = I.InformationKernel(P0, Q, R, H.shape[0])
+    kernel_1qr = I.InformationKernel(P0, Q, R, H.shape[0], one_qr=True)
     v_k, g_k = kernel.value_gradient(F, H, dF, dH)
+    v_1, g_1 = kernel_1qr.value_gradient(F, H, dF, dH)
     v_p, g_p = I.mutual_information_gradient(P0, F, Q, H, R, dF, dH)
     v_d, g_d = I.mutual_information_gradient_dense(P0, F, Q, H, R, dF, dH)
-    t_dense, t_public, t_kernel, t_value_public, t_value_kernel = I._interleaved_best([
+    t_dense, t_public, t_kernel, t_value_public, t_value_kernel, t_1qr = I._interleaved_best([
         lambda: I.mutual_information_gradient_dense(P0, F, Q, H, R, dF, dH),
         lambda: I.mutual_information_gradient(P0, F, Q, H, R, dF, dH),
         lambda: kernel.value_gradient(F, H, dF, dH),
         lambda: I.mutual_information(P0, F, Q, H, R),
-        lambda: kernel.value(F, H)], 9, 0.1)
+        lambda: kernel.value(F, H),
+        lambda: kernel_1qr.value_gradient(F, H, dF, dH)], 9, 0.1)
     N, M_, n = H.shape
     p = f"{label}_kernel_"
     out = {p + "shape": (int(N), int(M_), int(n)), p + "bit_identical_to_public": bool(v_k == v_p and np.array_equal(g_k, g_p)),
@@ -161,7 +165,9 @@ def window_kernel(label: str, lin) -> dict:
            p + "kernel_value_grad_ms": 1e3 * t_kernel, p + "public_value_ms": 1e3 * t_value_public,
            p + "kernel_value_ms": 1e3 * t_value_kernel,
            p + "ratio_dense_over_public": t_dense / t_public, p + "ratio_dense_over_kernel": t_dense / t_kernel,
-           p + "ratio_public_over_kernel": t_public / t_kernel}
+           p + "ratio_public_over_kernel": t_public / t_kernel,
+           p + "one_qr_value_grad_ms": 1e3 * t_1qr, p + "ratio_dense_over_one_qr": t_dense / t_1qr,
+           p + "one_qr_grad_rel_diff": _rel(g_1, g_k), p + "one_qr_mi_rel_diff": abs(v_1 - v_k) / abs(v_k)}
     print(f"{label} size ({N} times x {M_} measurements, {n} states), MI + gradient: dense {1e3 * t_dense:.3f} ms, "
           f"old path (public, re-checking) {1e3 * t_public:.3f} ms, InformationKernel {1e3 * t_kernel:.3f} ms "
           f"(bit-identical to the old path: {out[p + 'bit_identical_to_public']}; gradient vs dense "
@@ -169,6 +175,9 @@ def window_kernel(label: str, lin) -> dict:
     print(f"  ratios: dense / old {t_dense / t_public:.1f}x, dense / kernel {t_dense / t_kernel:.1f}x, old / kernel "
           f"{t_public / t_kernel:.2f}x; MI alone: old {1e3 * t_value_public:.3f} ms, kernel "
           f"{1e3 * t_value_kernel:.3f} ms")
+    print(f"  one QR per time (InformationKernel(one_qr=True), not bit-identical): {1e3 * t_1qr:.3f} ms, dense / one-QR "
+          f"{t_dense / t_1qr:.1f}x; gradient moves {out[p + 'one_qr_grad_rel_diff']:.1e} relative, MI "
+          f"{out[p + 'one_qr_mi_rel_diff']:.1e}")
     return out
 
 

@@ -19,7 +19,8 @@ minimum-range keep-out) on 30 nodes.
    * ``new``: :class:`~cislunar.papers.wolf_jones.scenarios.ScenarioSolver` as the notebooks call it (one
      :class:`~cislunar.guidance.scvx.SCvxWorkspace`: canonicalised once per sweep, stacked FOH Parameters; the
      window's fixed ingredients checked once; no gradient or Hessian on the converged step; the FOH parameters
-     set in place).
+     set in place; since 2026-11-26d each re-solve hands cvxpy's canonical data straight to Clarabel
+     (``_Subproblem._solve_clarabel``) instead of going through ``Problem.solve``).
 
    Both paths visit the same iterates (the solutions are compared bit for bit and the iteration counts printed);
    one saving is not rebuilt in the old path (the gradient and Hessian it computed on the converged step of every
@@ -28,7 +29,8 @@ minimum-range keep-out) on 30 nodes.
 2. **Per iteration** (new path): the FOH discretisation, the information model (value, gradient, Hessian) and the
    convex solve, in isolation and averaged over an SCvx run at alpha_h = 5e-3.
 3. **Re-solve vs rebuild**: the subproblem built once with ``cvxpy.Parameter`` objects (DPP, canonicalised once)
-   and re-solved with new values, against building and solving a fresh problem each time.
+   and re-solved with new values (direct Clarabel path; the per-interval old subproblem through
+   ``Problem.solve``), against building and solving a fresh problem each time.
 
 ``python -m benchmarks scvx`` prints the numbers; ``main()`` returns them.  Ratios are within one run.
 """
@@ -56,11 +58,13 @@ ALPHAS_CASE_2 = [0.0, 5e-4, 1e-3, 2e-3, 5e-3, 7e-3, 1e-2, 2e-2]
 # the old path, rebuilt (reference implementations; same numbers, the old costs)
 # ------------------------------------------------------------------------------------------------------------------
 class _PerIntervalSubproblem(scvx._Subproblem):
-    """The subproblem as built before 2026-11-26: one Parameter per A_k, B-_k, B+_k (117 at 40 nodes)."""
+    """The subproblem as built before 2026-11-26: one Parameter per A_k, B-_k, B+_k (117 at 40 nodes), solved
+    through cvxpy's ``Problem.solve`` (before 2026-11-26d; now a direct Clarabel re-solve)."""
 
     def __init__(self, n, has_terminal, k_star, con_specs, coast=None):
         import cvxpy as cp
 
+        self._clarabel = False  # cvxpy's Problem.solve at every solve (the old path)
         self.n = n
         self.x = cp.Variable((n, 6))
         self.u = cp.Variable((n, 3))
@@ -280,7 +284,7 @@ def resolve_vs_rebuild(t, k_ws, x0, u0, u_max, x_final, info, repeat=3):
     w_u = np.zeros(n)
     w_u[:-1] += dt / 2
     w_u[1:] += dt / 2
-    opts = dict(tol_gap_abs=1e-10, tol_gap_rel=1e-10, tol_feas=1e-10)
+    opts = dict(tol_gap_abs=1e-10, tol_gap_rel=1e-10, tol_feas=1e-10, tol_ktratio=1e-8, max_iter=500)  # SCvx's
 
     def build(cls=scvx._Subproblem):
         sub = cls(n, True, k_ws, [], coast=u_max == 0)
@@ -291,26 +295,34 @@ def resolve_vs_rebuild(t, k_ws, x0, u0, u_max, x_final, info, repeat=3):
     t0 = time.perf_counter()
     sub = build()
     _load(sub, model, x0, u0, 0.05, 5e-3, grad, L)
-    sub.problem.solve(solver="CLARABEL", **opts)
+    sub.solve("CLARABEL", True, opts)
     first = time.perf_counter() - t0
     old = build(_PerIntervalSubproblem)
     _load(old, model, x0, u0, 0.05, 5e-3, grad, L)
-    old.problem.solve(solver="CLARABEL", **opts)
+    old.solve("CLARABEL", True, opts)
+    via_cvxpy = build()  # stacked Parameters, solved through Problem.solve
+    via_cvxpy._clarabel = False
+    _load(via_cvxpy, model, x0, u0, 0.05, 5e-3, grad, L)
+    via_cvxpy.solve("CLARABEL", True, opts)
     etas = iter(np.geomspace(0.05, 0.01, 100))
 
     def resolve(s=sub):
         _load(s, model, x0, u0, next(etas), 5e-3, grad, L)
-        s.problem.solve(solver="CLARABEL", **opts)
+        s.solve("CLARABEL", False, opts)
 
     def rebuild():
         s2 = build()
         _load(s2, model, x0, u0, next(etas), 5e-3, grad, L)
-        s2.problem.solve(solver="CLARABEL", **opts)
+        s2.solve("CLARABEL", True, opts)
 
     set_new = _best_time(lambda: _load(sub, model, x0, u0, 0.05, 5e-3, grad, L), 20)
     set_old = _best_time(lambda: _load(old, model, x0, u0, 0.05, 5e-3, grad, L), 20)
-    return (_best_time(resolve, repeat), _best_time(lambda: resolve(old), repeat), first, _best_time(rebuild, repeat),
-            set_new, set_old)
+    direct, cvx = np.inf, np.inf  # interleaved: the same problem data through both solve paths
+    for _ in range(max(repeat, 5)):
+        direct = min(direct, _best_time(resolve, 1))
+        cvx = min(cvx, _best_time(lambda: resolve(via_cvxpy), 1))
+    return (direct, _best_time(lambda: resolve(old), repeat), first, _best_time(rebuild, repeat),
+            set_new, set_old, cvx)
 
 
 def main() -> dict:
@@ -332,8 +344,8 @@ def main() -> dict:
         "mi_gradient_s": _best_time(lambda: info(fresh(), 1)),
         "mi_hessian_s": _best_time(lambda: info.hessian(fresh()), 3),
     }
-    resolve, resolve_old, first, rebuild, set_new, set_old = resolve_vs_rebuild(t, k_ws, x0, u0, u_max,
-                                                                                sc.observer_xf, info)
+    resolve, resolve_old, first, rebuild, set_new, set_old, resolve_cvxpy = resolve_vs_rebuild(
+        t, k_ws, x0, u0, u_max, sc.observer_xf, info)
     t0 = time.perf_counter()
     res = scvx.solve_scvx(em, t, x0, u0, u_max, x_final=sc.observer_xf, info=info, info_node=k_ws, alpha=5e-3)
     run_s = time.perf_counter() - t0
@@ -344,6 +356,8 @@ def main() -> dict:
         **pieces,
         subproblem_resolve_s=resolve,
         subproblem_resolve_per_interval_parameters_s=resolve_old,
+        subproblem_resolve_problem_solve_s=resolve_cvxpy,
+        direct_over_problem_solve=resolve / resolve_cvxpy,
         parameter_setting_stacked_s=set_new,
         parameter_setting_per_interval_s=set_old,
         subproblem_first_solve_s=first,
@@ -359,6 +373,8 @@ def main() -> dict:
     print(f"  in isolation: FOH discretisation {1e3 * pieces['discretize_s']:.1f} ms, MI value "
           f"{1e3 * pieces['mi_value_s']:.1f} ms, MI gradient {1e3 * pieces['mi_gradient_s']:.1f} ms, MI Hessian "
           f"{1e3 * pieces['mi_hessian_s']:.1f} ms")
+    print(f"  convex subproblem: re-solve {1e3 * resolve:.1f} ms (through Problem.solve {1e3 * resolve_cvxpy:.1f} ms: "
+          f"direct / Problem.solve {resolve / resolve_cvxpy:.2f})")
     print(f"  convex subproblem: re-solve {1e3 * resolve:.1f} ms (per-interval Parameters {1e3 * resolve_old:.1f} ms; "
           f"setting the Parameters {1e3 * set_new:.2f} vs {1e3 * set_old:.2f} ms), first solve (canonicalisation) "
           f"{1e3 * first:.0f} ms, rebuild + solve {1e3 * rebuild:.0f} ms ({rebuild / resolve:.1f} x re-solve)")

@@ -57,8 +57,11 @@ Cost of a run
 -------------
 The subproblem is built once per structure with cvxpy Parameters (DPP; the FOH model of every interval in one
 stacked Parameter) and re-solved with new values; :class:`SCvxWorkspace` keeps it between runs, so a homotopy sweep
-canonicalises once (bit-for-bit the solutions of fresh problems).  The gradient and Hessian at a new reference are
-computed only when the iteration goes on (not on the converged step).
+canonicalises once (bit-for-bit the solutions of fresh problems).  With Clarabel, each solve hands cvxpy's
+canonical data (the cached parameter program applied to the current values) straight to the solver and copies the
+solution into the variables, the steps of cvxpy's warm re-solve without ``Problem.solve``'s bookkeeping (bit for
+bit the same; a test compares the two paths).  The gradient and Hessian at a new reference are computed only when
+the iteration goes on (not on the converged step).
 
 Extra nonconvex inequality constraints (e.g. a keep-out) are objects with ``node``, ``size`` and
 ``__call__(x) -> (c, C)`` (values that must be :math:`\le 0` and their Jacobian with respect to the state at
@@ -449,6 +452,89 @@ class _Subproblem:
         self.AB.value = np.concatenate([model.A, model.Bm, model.Bp], axis=2).reshape(6 * (self.n - 1), 12)
         self.r.value = model.r
 
+    def solve(self, solver: str, new: bool, opts: dict) -> str:
+        """Solve with the current Parameter values; returns the cvxpy status (variable values set as by cvxpy).
+
+        ``new``: start a new solver object (else the previous one is updated with the new data, as cvxpy's
+        ``warm_start=True``).  For Clarabel, :meth:`_solve_clarabel` replays cvxpy's own re-solve steps (the same
+        parameter application, the same matrices handed to the same Clarabel calls, the same solution entries
+        copied into the variables) without the per-call bookkeeping of ``Problem.solve``; other solvers go
+        through ``Problem.solve``.
+        """
+        if solver.upper() != "CLARABEL":
+            self.problem.solve(solver=solver, warm_start=not new, **opts)
+            return self.problem.status
+        return self._solve_clarabel(new, opts)
+
+    def _prepare_clarabel(self, opts):
+        """Canonicalise (once per problem: cvxpy's DPP cache) and record, for each variable, which entries of the
+        solver's primal vector cvxpy copies into it (found by inverting a solution whose entries are their own
+        indices)."""
+        from cvxpy.reductions.solvers.conic_solvers.clarabel_conif import CLARABEL, dims_to_solver_cones
+
+        data, chain, inverse = self.problem.get_problem_data("CLARABEL", solver_opts=opts)
+        nx = data["c"].size
+
+        class _Probe:  # the attributes of a Clarabel solution that cvxpy's inversion reads
+            status, x, z, obj_val, solve_time, iterations = "Solved", np.arange(nx, dtype=float), None, 0.0, 0.0, 0
+
+        primal = chain.invert(_Probe(), inverse).primal_vars
+        slices = []
+        for v in self.problem.variables():
+            val = np.asarray(primal[v.id])
+            flat = val.ravel(order="F")
+            a = int(flat[0]) if flat.size else 0
+            if val.shape != v.shape or not np.array_equal(flat, np.arange(a, a + flat.size)):
+                return None  # not a plain slice (a transformed variable): keep cvxpy's path
+            slices.append((v, a, a + flat.size, v.shape))
+        self._clarabel = dict(chain=chain, pp=self.problem._cache.param_prog, cones=dims_to_solver_cones(data["dims"]),
+                              slices=slices, status_map=CLARABEL.STATUS_MAP, parse=CLARABEL.parse_solver_opts,
+                              solver=None)
+        return self._clarabel
+
+    def _solve_clarabel(self, new: bool, opts: dict) -> str:
+        """cvxpy's warm re-solve for Clarabel (cvxpy 1.9: ``Problem.get_problem_data`` on the cached parameter
+        program, ``CLARABEL.solve_via_data``, ``Problem.unpack_results``), step by step, primal values only."""
+        import clarabel
+        import cvxpy as cp
+        import scipy.sparse as sp
+        from cvxpy import settings as cps
+
+        fast = getattr(self, "_clarabel", None)
+        if fast is None:
+            fast = self._prepare_clarabel(opts)
+            if fast is None:
+                self._clarabel = False
+        if not fast:
+            self.problem.solve(solver="CLARABEL", warm_start=not new, **opts)
+            return self.problem.status
+        for reduction in fast["chain"].reductions:  # e.g. the nonneg Parameters' reduced copies
+            reduction.update_parameters(self.problem)
+        P, q, _, A, b = fast["pp"].apply_parameters(quad_obj=True)
+        A = -A
+        P = sp.triu(P).tocsc()
+        solver = None if new else fast["solver"]
+        if solver is not None:
+            if not solver.is_data_update_allowed():
+                solver = None
+            else:
+                try:
+                    solver.update(P=P, q=q, A=A, b=b, settings=fast["parse"](False, opts, solver.get_settings()))
+                except Exception:  # noqa: BLE001 - as cvxpy: a structure change needs a new solver
+                    solver = None
+        if solver is None:
+            solver = clarabel.DefaultSolver(P, q, A, b, fast["cones"], fast["parse"](False, opts))
+        fast["solver"] = solver
+        res = solver.solve()
+        status = fast["status_map"].get(str(res.status), cps.SOLVER_ERROR)
+        if status in cps.ERROR:
+            raise cp.error.SolverError("Solver 'CLARABEL' failed. Try another solver, or solve with verbose=True for "
+                                       "more information.")
+        x = np.asarray(res.x) if status in cps.SOLUTION_PRESENT else None
+        for v, a, e, shape in fast["slices"]:
+            v.save_value(None if x is None else x[a:e].reshape(shape, order="F"))
+        return status
+
 
 class SCvxWorkspace:
     """Convex subproblems of :func:`solve_scvx` kept between runs, so that a sweep canonicalises once.
@@ -693,12 +779,12 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
                     warnings.simplefilter("ignore", UserWarning)
                     # Clarabel reuses its solver object (data update) from the second solve of a run on; the first
                     # solve of every run starts a new one, so a reused (workspace) problem solves as a fresh one
-                    sub.problem.solve(solver=solver, warm_start=it > 0, **solve_opts)
+                    status = sub.solve(solver, it == 0, solve_opts)
             except cp.error.SolverError as exc:
                 raise SCvxError(f"convex subproblem failed at iteration {it}: {exc}", history) from exc
             t_solve = time.perf_counter() - t0
-            if sub.problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
-                raise SCvxError(f"convex subproblem {sub.problem.status} at iteration {it} (eta = {eta:g})", history)
+            if status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
+                raise SCvxError(f"convex subproblem {status} at iteration {it} (eta = {eta:g})", history)
             x_new, u_new, nu = sub.x.value.copy(), sub.u.value.copy(), sub.nu.value
             unew = np.linalg.norm(u_new, axis=1)  # onto the bounds (solver round-off only)
             over = unew > umax
@@ -753,7 +839,7 @@ def solve_scvx(system: CR3BP, t_nodes, x_guess, u_guess, u_max, *, x_final=None,
                        model_error_info=(-alpha * (ev_new["info"] - info_model)) if use_info else 0.0,
                        penalty_weight=w, multiplier_update=False, information=ev_new["info"],
                        impulse=_impulse(dt, u_new), t_discretize=ev_new["t_discretize"], t_info=ev_new["t_info"],
-                       t_solve=t_solve, t_hessian=0.0, status=str(sub.problem.status))
+                       t_solve=t_solve, t_hessian=0.0, status=str(status))
             history.append(rec)
             if rho < st.rho1:
                 eta = eta / st.beta_shrink

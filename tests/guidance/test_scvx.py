@@ -577,3 +577,47 @@ def test_a_trial_step_with_a_node_inside_the_moon_is_rejected(monkeypatch):
     res = scvx.solve_scvx(em, t, x0, u0, np.full(t.size, A_MAX), x_final=xf)
     assert res.history[0]["status"].startswith("impact") and not res.history[0]["accepted"]
     assert res.max_defect < 1e-9
+
+
+def test_direct_clarabel_resolve_equals_cvxpy_solve():
+    """The subproblem's direct Clarabel path (cvxpy's re-solve replayed without Problem.solve's bookkeeping) sets
+    every variable to exactly the values cvxpy's ``Problem.solve`` sets, for a new solver and for data updates, with
+    a nonneg slack variable and a window node (all variable kinds of the SCvx subproblem)."""
+    sc = wolf_jones.test_case_1()
+    t = np.linspace(0.0, sc.period, 12)
+    n = t.size
+    x0 = propagate(em, sc.observer_x0, t).x
+    u0 = np.zeros((n, 3))
+    model = D.foh_discretize(em, t, x0, u0)
+    rng = np.random.default_rng(3)
+    opts = dict(tol_gap_abs=1e-10, tol_gap_rel=1e-10, tol_feas=1e-10, tol_ktratio=1e-8, max_iter=500)
+    coast = np.zeros(n, dtype=bool)
+    coast[6:8] = True
+    subs = [scvx._Subproblem(n, True, 5, [(4, 3)], coast=coast) for _ in range(2)]
+    subs[1]._clarabel = False  # cvxpy's Problem.solve
+    dt = np.diff(t)
+    for it, (eta, alpha) in enumerate([(0.05, 0.02), (0.02, 0.05), (0.01, 0.1), (0.03, 0.0)]):
+        g = rng.standard_normal(6)
+        L = 0.1 * rng.standard_normal((6, 6))
+        c = np.array([-1e-3, 2e-4, -5e-4])
+        C = rng.standard_normal((3, 6))
+        for sub in subs:
+            sub.set_model(model)
+            sub.xbar.value, sub.ubar.value, sub.eta.value = x0 + 1e-4 * it, u0, eta
+            sub.umax.value = np.where(coast, 0.0, A_MAX)
+            sub.x_ic.value, sub.x_tc.value = x0[0], x0[-1]
+            sub.w_u.value = (1 - alpha) * np.r_[dt / 2, 0.0] + np.r_[0.0, dt / 2] * (1 - alpha)
+            sub.lam.value = 1e-3 * it * np.ones((n - 1, 6))
+            sub.half_w.value = 500.0
+            sub.gamma_dt.value = np.zeros(n - 1)
+            sub.g.value, sub.L.value = alpha * g, np.sqrt(alpha) * L
+            con = sub.con[0]
+            con["c"].value, con["C"].value, con["mu"].value, con["gamma"].value = c, C, np.full(3, 1e-2), 0.0
+        statuses = [sub.solve("CLARABEL", it % 2 == 0, opts) for sub in subs]
+        assert statuses[0] == statuses[1] == subs[1].problem.status
+        assert statuses[0] in ("optimal", "optimal_inaccurate")
+        assert isinstance(subs[0]._clarabel, dict)  # the direct path was taken
+        for a, b in zip(subs[0].problem.variables(), subs[1].problem.variables()):
+            assert a.shape == b.shape and np.array_equal(a.value, b.value), (it, a.name())
+        assert np.array_equal(subs[0].step.value, subs[1].step.value)
+        assert np.max(subs[0].step.value) <= eta * (1 + 1e-6)

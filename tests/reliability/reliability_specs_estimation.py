@@ -232,8 +232,8 @@ def specs(Spec, lazy):
     s.append(S("mutual_information_gradient", I.mutual_information_gradient, dict(lin, **der, method="sqrt"),
                dict(LIN_KINDS, **DER_KINDS, method="choice")))
     s.append(S("InformationKernel", I.InformationKernel,
-               dict(P0=lin["P0"], Q=lin["Q"], R=lin["R"], n_times=lin["H"].shape[0]),
-               dict(P0="spd", Q="psd", R="spd", n_times="int1")))
+               dict(P0=lin["P0"], Q=lin["Q"], R=lin["R"], n_times=lin["H"].shape[0], one_qr=True),
+               dict(P0="spd", Q="psd", R="spd", n_times="int1", one_qr="bool")))
     kernel = lazy(lambda: I.InformationKernel(lin["P0"], lin["Q"], lin["R"], lin["H"].shape[0]))
     s.append(S("InformationKernel.value", lazy(lambda: kernel().value), dict(F=lin["F"], H=lin["H"]),
                dict(F="arr", H="arr")))

@@ -494,3 +494,35 @@ def test_range_noise_refuses_bad_input_by_name(window):
         I.range_noise_scale(lin, 0.0)
     with pytest.raises(ValueError, match="range_scale"):
         I.window_information(lin, range_scale=0.01, method="dense")
+
+
+@given(seed=st.integers(0, 2**32 - 1), N=st.integers(1, 7), M=st.integers(1, 4), n=st.integers(1, 6),
+       logcond=st.floats(-3, 6))
+def test_one_qr_kernel_agrees_with_dense_and_two_qr(seed, N, M, n, logcond):
+    """``one_qr=True`` (time and measurement updates in one QR per time): the value of dense Eq. 18 and the gradient
+    of dense Eqs. 47-48 (independent formulas), the two-QR value to round-off; ``value`` unchanged bit for bit."""
+    P0, F, Q, H, R, dF, dH = random_system(seed, N, M, n, 2, 10.0**logcond)
+    K1 = I.InformationKernel(P0, Q, R, N, one_qr=True)
+    K2 = I.InformationKernel(P0, Q, R, N)
+    info_1, g_1 = K1.value_gradient(F, H, dF, dH)
+    info_2, g_2 = K2.value_gradient(F, H, dF, dH)
+    info_d, g_d = I.mutual_information_gradient_dense(P0, F, Q, H, R, dF, dH)
+    assert info_1 == pytest.approx(info_2, rel=1e-11, abs=1e-13)
+    assert info_1 == pytest.approx(info_d, rel=1e-10, abs=1e-12)
+    np.testing.assert_allclose(g_1, g_d, rtol=1e-7, atol=1e-8 * max(1.0, np.max(np.abs(g_d))))
+    assert K1.value(F, H) == K2.value(F, H)
+
+
+def test_one_qr_kernel_on_case2_sized_window(case2_sized_window):
+    """Test-case-2 size: the one-QR gradient is within the square-root floor (~4e-8 relative) of the two-QR one and
+    of the forward mode, and its value within 1e-13 relative."""
+    lin = case2_sized_window
+    P0, F, Q, H, R = lin.arrays
+    info_1, g_1 = I.InformationKernel(P0, Q, R, H.shape[0], one_qr=True).value_gradient(F, H, lin.dF, lin.dH)
+    info_2, g_2 = I.InformationKernel(P0, Q, R, H.shape[0]).value_gradient(F, H, lin.dF, lin.dH)
+    g_f = I.mutual_information_gradient(*lin.arrays, lin.dF, lin.dH, method="sqrt-forward")[1]
+    assert abs(info_1 - info_2) <= 1e-13 * abs(info_2)
+    scale = np.max(np.abs(g_2))
+    assert np.max(np.abs(g_1 - g_2)) <= 2e-7 * scale and np.max(np.abs(g_1 - g_f)) <= 2e-7 * scale
+    with pytest.raises(ValueError, match="one_qr"):
+        I.InformationKernel(P0, Q, R, H.shape[0], one_qr="yes")
