@@ -9,6 +9,13 @@ calls, with a leading trial axis).  The result equals the single-trial filter
 which integrated the full 12x12 variational system and is kept as a test oracle in
 ``tests/estimation/reference_batched_ocbe.py``.
 
+The transitions integrate 78 states per trial: :math:`\Phi_{pp} = \Phi_{xx}^{-\top}` is formed from
+:math:`\Phi_{xx}` through the CR3BP's invariant form (``costate_block=False`` of
+:func:`cislunar.estimation.ocbe.block_integrator`), equal to the integrated one to round-off.  With ``smooth_ends``
+one forward pass gives the smoothed control integral of every growing data arc ``t[0] .. t[e]`` (each arc its own
+backward pass), bit for bit what separate calls on each arc give.  The loop before these changes (2026-11-26c: 114
+states, the generic SRI kernels) is kept in ``tests/estimation/reference_lockstep_ocbe.py``.
+
 A trial that fails numerically (a diverged filter) either stops the whole batch (``on_failure="raise"``, the
 default) or is flagged and dropped while the others go on (``on_failure="flag"``): then each trial ends exactly as
 the single-trial filter would, with results or with the :class:`cislunar.estimation.ocbe.FilterDivergenceError`
@@ -58,6 +65,10 @@ class BatchOCBEResult:
     z_step, z_smooth : ndarray, shape (B,)
         Eq. 33, LU/TU (both None in the filter-only mode).
     residual_norms : ndarray, shape (B, N)
+    z_smooth_ends : ndarray, shape (B, E) or None
+        With ``smooth_ends`` (E end epochs :math:`e`): column ``j`` is the smoothed Eq. 33 of the arc
+        ``t[0] .. t[e_j]`` alone, LU/TU (what ``z_smooth`` of the filter and smoother run on the first
+        :math:`e_j + 1` epochs gives), from the one forward pass; None without ``smooth_ends``.
     failure_epoch : ndarray of int, shape (B,)
         Epoch at which each trial failed numerically (``on_failure="flag"``), -1 for a trial that did not; the
         epoch of the :class:`cislunar.estimation.ocbe.FilterDivergenceError` the single-trial filter raises.  A
@@ -79,6 +90,7 @@ class BatchOCBEResult:
     residual_norms: np.ndarray
     failure_epoch: np.ndarray | None = None
     failure: np.ndarray | None = None
+    z_smooth_ends: np.ndarray | None = None
 
     @property
     def failed(self) -> np.ndarray:
@@ -91,13 +103,14 @@ class BatchOCBEResult:
 def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, control_weight, *, n_sub: int = 9,
                tol: float = DEFAULT_TOL, available=None, smooth: bool = True,
                on_failure: str = "raise", wrap_azimuth: bool = True, relinearize: bool = True,
-               coarse_stm: bool = False) -> BatchOCBEResult:
+               coarse_stm: bool = False, smooth_ends=None) -> BatchOCBEResult:
     """The extended SRI OCBE filter and full smoother of :func:`cislunar.estimation.ocbe.ocbe_filter_smoother` for B trials.
 
     Same algorithm, step for step (Eqs. 17, 21-32 and the backward SRI smoother with costates
     :math:`\\mathbf p_{n|N} = \\Phi_{xp}^{-1}\\hat{\\mathbf w}_n`), with all trials sharing the epochs, observers,
     availability, measurement model and noise; the transition blocks of all trials come from heyoka batch integrators
-    (:func:`cislunar.estimation.ocbe.block_integrator`, :data:`_LANES` trials each) and the square-root-information
+    (:func:`cislunar.estimation.ocbe.block_integrator`, :data:`_LANES` trials each; :math:`\\Phi_{pp}` formed from
+    :math:`\\Phi_{xx}` through the CR3BP's invariant form, 78 states per trial) and the square-root-information
     updates are the stacked kernels of :mod:`cislunar.estimation.srif`.  Each trial's result does not depend on the
     other trials of the batch.
 
@@ -153,6 +166,13 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
         :math:`\\Phi = \\exp(M\\Delta t)`, :math:`M = [A(\\mathbf x_n),\\ -B\\tilde QB^\\top;\\ 0,\\ -A(\\mathbf x_n)^\\top]`
         (:func:`_frozen_transition`), which ignores how :math:`A` changes through the interval (through perilune at
         long cadences).  The mean is still integrated.  Filter only (``smooth=False``).
+    smooth_ends : sequence of int, optional
+        End epochs :math:`e` (each in ``1 .. N-1``) of growing data arcs ``t[0] .. t[e]``: the smoothed control
+        integral of each arc alone is returned in ``z_smooth_ends`` (with ``smooth=True``).  The forward filter on
+        an arc is the first :math:`e + 1` epochs of the forward filter on the whole track, so one forward pass
+        serves every arc; each arc gets only its own backward (smoother) pass, with the same kernels on the same
+        stored quantities: equal, bit for bit, to ``z_smooth`` of a call on the first :math:`e + 1` epochs
+        (``tests/estimation/test_batched_ocbe.py``).
     """
     check_system(system)
     model = ocbe.check_model(model)
@@ -197,13 +217,60 @@ def ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x0, P0, co
         raise ValueError("relinearize=False (the fixed-reference filter) is filter only: pass smooth=False")
     if coarse_stm and smooth:
         raise ValueError("coarse_stm=True (the frozen-Jacobian time update) is filter only: pass smooth=False")
+    if smooth_ends is not None:
+        ends = validation.as_array(smooth_ends, "smooth_ends", ndim=(1,), min_size=1)
+        if not np.all(ends == np.round(ends)) or np.any(ends < 1) or np.any(ends > N - 1):
+            raise ValueError(f"smooth_ends must hold integer epochs in 1..{N - 1}; got {smooth_ends!r:.80}")
+        if not smooth:
+            raise ValueError("smooth_ends needs the smoother: pass smooth=True")
+        smooth_ends = ends.astype(int)
     return _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smooth, on_failure == "flag",
-                       wrap_azimuth, relinearize, coarse_stm)
+                       wrap_azimuth, relinearize, coarse_stm, smooth_ends)
 
 
 #: Trials per heyoka batch integrator (larger lockstep batches are integrated in groups of
-#: this size: the Taylor integrator's cost per trial grows again beyond a few SIMD widths).
+#: this size: the Taylor integrator's cost per trial grows again beyond a few SIMD widths).  Measured 2026-11-26d on
+#: a 128-trial lockstep group (``benchmarks/bench_detection.py``): 32 lanes were about 7 % faster than 16 with the
+#: 114-state integrator, 64 slower; with today's 78 states 32 and 16 cost the same (4.58 vs 4.60 ms per trial).
+#: Results are bit-identical between 16 and 32 for full lane groups.
 _LANES = 16
+
+
+def _time_update_identity(R, Phi, Q):
+    """:func:`cislunar.estimation.srif._time_update` with ``z = 0`` and ``Gamma = I`` (the OCBE's Eq. 23), the
+    stacked array assembled in place instead of through :func:`srif._blocks`: the same entries, the same
+    triangularisation, bit for bit the same result.  ``R``, ``Phi``, ``Q`` (B, 6, 6); unchecked (inner kernel)."""
+    nb = R.shape[0]
+    Rt = np.swapaxes(np.linalg.solve(np.swapaxes(Phi, -1, -2), np.swapaxes(R, -1, -2)), -1, -2)  # R Phi^{-1}
+    A = np.zeros((nb, 12, 13))
+    A[:, :6, :6] = srif._sri_of_cov(Q)
+    A[:, 6:, :6] = -Rt @ _EYE6
+    A[:, 6:, 6:12] = Rt
+    U = srif._triangularize(A)
+    return U[..., 6:, 6:12], U[..., 6:, 12], (U[..., :6, :6], U[..., :6, 6:12], U[..., :6, 12])
+
+
+def _smoother_step_identity(Rs_next, zs_next, Phi, smoother_terms):
+    """:func:`cislunar.estimation.srif._smoother_step` with ``Gamma = I``, assembled in place (bit for bit the
+    same result).  Shapes (B, 6, 6) and (B, 6); unchecked (inner kernel)."""
+    Rw, Rwx, zw = smoother_terms
+    A = np.empty((Rs_next.shape[0], 12, 13))
+    A[:, :6, :6] = Rw + Rwx @ _EYE6
+    A[:, :6, 6:12] = Rwx @ Phi
+    A[:, :6, 12] = zw
+    A[:, 6:, :6] = Rs_next @ _EYE6
+    A[:, 6:, 6:12] = Rs_next @ Phi
+    A[:, 6:, 12] = zs_next
+    U = srif._triangularize(A)
+    return U[..., 6:12, 6:12], U[..., 6:12, 12]
+
+
+_EYE6 = np.eye(6)
+
+#: Integrate the costate block :math:`\Phi_{pp}` (114 states per trial) or form it from :math:`\Phi_{xx}` (78
+#: states, ``costate_block=False`` of :func:`cislunar.estimation.ocbe.block_integrator`, about 1.2x faster
+#: integration; equal to round-off, not bit for bit).  A switch for the benchmarks and tests, not an option.
+_COSTATE_BLOCK = False
 
 
 def _check_start_outside(system, x, n, time):
@@ -302,7 +369,7 @@ def _per_trial(fn, B, failures, epoch, *, replicate):
 
 
 def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smooth, flag, wrap_azimuth=True,
-                relinearize=True, coarse_stm=False) -> BatchOCBEResult:
+                relinearize=True, coarse_stm=False, ends=None) -> BatchOCBEResult:
     """:func:`ocbe_batch` after its argument checks: the loop of the single-trial filter with a trial axis.
 
     The SRI algebra is that of :func:`cislunar.estimation.ocbe.ocbe_filter_smoother` step for step, on the same
@@ -313,18 +380,22 @@ def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smoot
     trial by trial (:func:`_per_trial`) so that only the failing trials are dropped, at the epoch where the
     single-trial filter would have raised (0 for the first update, n+1 for interval n, N-1 for the smoother).
     ``wrap_azimuth``, ``relinearize`` and ``coarse_stm``: see :func:`ocbe_batch` (with ``relinearize=False`` the reference of each
-    trial is carried beside its estimate; the deviation is their difference).
+    trial is carried beside its estimate; the deviation is their difference).  ``ends``: the ``smooth_ends`` of
+    :func:`ocbe_batch` (checked), each arc's backward pass in :func:`_arc_z_smooth`.
     """
     B, N = y.shape[0], t.size
     lay = ocbe.BLOCK_LAYOUT
     s_xx, s_xp, s_pp = lay["phi_xx"], lay["phi_xp"], lay["phi_pp"]
     lanes = [(a, min(a + _LANES, B)) for a in range(0, B, _LANES)]
-    integrators = [ocbe.block_integrator(b - a, tol) for a, b in lanes]
+    costate_block = _COSTATE_BLOCK
+    integrators = [ocbe.block_integrator(b - a, tol, costate_block=costate_block) for a, b in lanes]
+    n_state = s_pp.stop if costate_block else s_xp.stop
     t_sub = np.array([np.linspace(t[n], t[n + 1], n_sub) for n in range(N - 1)])  # as the single-trial filter
-    start = np.zeros((s_pp.stop, B))
-    out = np.empty((n_sub, s_pp.stop, B))
-    start[s_xx] = start[s_pp] = np.eye(6).ravel()[:, None]
-    zero, eye = np.zeros(6), np.eye(6)
+    start = np.zeros((n_state, B))
+    out = np.empty((n_sub, n_state, B))
+    start[s_xx] = np.eye(6).ravel()[:, None]
+    if costate_block:
+        start[s_pp] = np.eye(6).ravel()[:, None]
     visible = [np.flatnonzero(avail[k]) for k in range(N)]
     process_noise = _process_noise_per_trial if flag else ocbe._process_noise
     mu = system.mu
@@ -418,7 +489,7 @@ def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smoot
         if coarse_stm:  # one frozen-Jacobian step over the interval instead of the integrated transition
             Phi_xx, Phi_xp = _frozen_transition(system, xs, float(grid[-1] - grid[0]), qs[idx, n])
         Q = process_noise(Phi_xx, Phi_xp)  # Eq. 17
-        S_bar, _, term = srif._time_update(S, zero, Phi_xx, eye, Q)  # Eq. 23 with Gamma = I, b_x = 0
+        S_bar, _, term = _time_update_identity(S, Phi_xx, Q)  # Eq. 23 with Gamma = I, b_x = 0
         x_prior = np.array(end[:, :6])
         if not relinearize:  # the deviation from the fixed reference, carried by Phi_xx
             dx = (Phi_xx @ (x_cur[idx] - xs)[..., None])[..., 0]
@@ -427,9 +498,12 @@ def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smoot
         S_new, x_new, e = update(S_bar, x_prior, n + 1, y[idx, n + 1])  # Eqs. 24-28
         if not smooth:  # filter only: no single-step smoother, no control estimate
             return x_prior, S_new, x_new, e
-        pp_sub = np.moveaxis(out[:, s_pp], -1, 0).reshape(B, n_sub, 6, 6)  # a copy (not a view of out)
+        if costate_block:
+            pp_sub = np.moveaxis(out[:, s_pp], -1, 0).reshape(B, n_sub, 6, 6)  # a copy (not a view of out)
+        else:  # Phi_pp = K Phi_xx K^-1 at the sub-grid points (ocbe.block_integrator, costate_block)
+            pp_sub = ocbe._costate_block(np.moveaxis(out[:, s_xx], -1, 0).reshape(B, n_sub, 6, 6))
         # single-step smoother (Eqs. 29-30) and costate (Eq. 31)
-        S1, b1 = srif._smoother_step(S_new, (S_new @ (x_new - x_prior)[..., None])[..., 0], Phi_xx, eye, term)
+        S1, b1 = _smoother_step_identity(S_new, (S_new @ (x_new - x_prior)[..., None])[..., 0], Phi_xx, term)
         p = -((np.swapaxes(S, -1, -2) @ S) @ srif._solve_upper(S1, b1)[..., None])[..., 0]
         return (x_prior, S_new, x_new, e, Phi_xx, Phi_xp, pp_sub, *term, p)
 
@@ -452,7 +526,7 @@ def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smoot
         nb = idx.size
         P_f = srif._cov_of_sri(S_filt[idx])
         if not smooth:
-            return P_f, None, None, None, None, None, None
+            return P_f, None, None, None, None, None, None, None
         q = qs[idx]
         control_step = -q[:, :, None, None] * np.einsum("bnkij,bnj->bnki", phi_pp_sub[idx], p_step[idx])[..., 3:6]
         z_step = ocbe._control_integral(t_sub, control_step)
@@ -463,23 +537,59 @@ def _ocbe_batch(system, t, y, obs, avail, model, R, x, P0, qs, n_sub, tol, smoot
         x_s[:, -1], P_s[:, -1] = xf[:, -1], P_f[:, -1]
         for n in range(N - 2, -1, -1):
             z_next = bs + (Rs @ (xf[:, n + 1] - xp[:, n + 1])[..., None])[..., 0]
-            Rs, bs = srif._smoother_step(Rs, z_next, pxx[:, n], eye, (Rw[idx, n], Rwx[idx, n], zw[idx, n]))
+            Rs, bs = _smoother_step_identity(Rs, z_next, pxx[:, n], (Rw[idx, n], Rwx[idx, n], zw[idx, n]))
             x_s[:, n] = xf[:, n] + srif._solve_upper(Rs, bs)
             P_s[:, n] = srif._cov_of_sri(Rs)
         w = (x_s[:, 1:] - xp[:, 1:]) - (pxx @ (x_s[:, :-1] - xf[:, :-1])[..., None])[..., 0]
         p_s = np.linalg.solve(phi_xp[idx], w[..., None])[..., 0]
-        control_s = -q[:, :, None, None] * np.einsum("bnkij,bnj->bnki", phi_pp_sub[idx], p_s)[..., 3:6]
-        return P_f, control_step, z_step, x_s, P_s, control_s, ocbe._control_integral(t_sub, control_s)
+        pps = phi_pp_sub[idx]
+        control_s = -q[:, :, None, None] * np.einsum("bnkij,bnj->bnki", pps, p_s)[..., 3:6]
+        z_s = ocbe._control_integral(t_sub, control_s)
+        if ends is None:
+            return P_f, control_step, z_step, x_s, P_s, control_s, z_s, None
+        z_ends = np.stack([z_s if e == N - 1 else
+                           _arc_z_smooth(e, t_sub, q, S_filt[idx, e], xf, xp, pxx, Rw[idx], Rwx[idx], zw[idx],
+                                         phi_xp[idx], pps) for e in ends], axis=-1)
+        return P_f, control_step, z_step, x_s, P_s, control_s, z_s, z_ends
 
     done = stage(closing, N - 1, False) if res is not None else None
     if done is None:  # every trial failed
         full = (np.full((B, N, 6, 6), nan), np.full((B, N - 1, n_sub, 3), nan), np.full(B, nan))
         done = (full + (np.full((B, N, 6), nan),) + full) if smooth else (full[0],) + (None,) * 6
-    P_f, control_step, z_step, x_s, P_s, control_s, z_s = done
+        done += (None if ends is None else np.full((B, ends.size), nan),)
+    P_f, control_step, z_step, x_s, P_s, control_s, z_s, z_ends = done
     dead = failures.epoch >= 0
     if dead.any():
-        for arr in (x_pred, x_filt, resid, P_f, control_step, z_step, x_s, P_s, control_s, z_s):
+        for arr in (x_pred, x_filt, resid, P_f, control_step, z_step, x_s, P_s, control_s, z_s, z_ends):
             if arr is not None:
                 arr[dead] = nan
     return BatchOCBEResult(x_pred, x_filt, P_f, x_s, P_s, t_sub, control_step, control_s, z_step, z_s, resid,
-                           failures.epoch.copy(), np.array(failures.message, dtype=str))
+                           failures.epoch.copy(), np.array(failures.message, dtype=str), z_ends)
+
+
+def _arc_z_smooth(e, t_sub, q, S_e, xf, xp, pxx, Rw, Rwx, zw, phi_xp, phi_pp_sub):
+    """The smoothed Eq. 33 of the arc ``t[0] .. t[e]`` alone (LU/TU, shape (B,)) from the whole track's forward
+    pass: the backward SRI smoother of ``closing`` in :func:`_ocbe_batch` started at epoch ``e`` (``S_e`` the
+    filtered SRI matrix there, (B, 6, 6)), then the costates and controls of the arc's intervals.
+
+    The arrays are the forward pass's stored quantities of the trials (``xf``, ``xp`` (B, N, 6); ``pxx``,
+    ``phi_xp``, ``Rw``, ``Rwx`` (B, N-1, 6, 6); ``zw`` (B, N-1, 6); ``phi_pp_sub`` (B, N-1, n_sub, 6, 6); ``q``
+    (B, N-1)).  Every kernel gets the arc's slice in the layout a call on the first ``e + 1`` epochs gives it
+    (contiguous copies where that call's arrays are contiguous), so the result is that call's ``z_smooth`` bit for
+    bit.  Covariances are not formed (z does not need them).  Unchecked (inner kernel).
+    """
+    nb = xf.shape[0]
+    x_s = np.empty((nb, e + 1, 6))
+    Rs, bs = S_e, np.zeros((nb, 6))
+    x_s[:, -1] = xf[:, e]
+    for n in range(e - 1, -1, -1):
+        z_next = bs + (Rs @ (xf[:, n + 1] - xp[:, n + 1])[..., None])[..., 0]
+        Rs, bs = _smoother_step_identity(Rs, z_next, pxx[:, n], (Rw[:, n], Rwx[:, n], zw[:, n]))
+        x_s[:, n] = xf[:, n] + srif._solve_upper(Rs, bs)
+    pxx_e = np.ascontiguousarray(pxx[:, :e])
+    w = (x_s[:, 1:] - xp[:, 1:e + 1]) - (pxx_e @ (x_s[:, :-1] - xf[:, :e])[..., None])[..., 0]
+    p_s = np.linalg.solve(np.ascontiguousarray(phi_xp[:, :e]), w[..., None])[..., 0]
+    q_e = np.ascontiguousarray(q[:, :e])
+    control_s = -q_e[:, :, None, None] * np.einsum("bnkij,bnj->bnki", np.ascontiguousarray(phi_pp_sub[:, :e]),
+                                                   p_s)[..., 3:6]
+    return ocbe._control_integral(t_sub[:e], control_s)

@@ -333,3 +333,63 @@ def test_coarse_stm_filter_approaches_the_integrated_one_as_the_interval_shrinks
     assert _rel(cq.P_filt[:, 1], fq.P_filt[:, 1]) < d_2h / 4
     with pytest.raises(ValueError, match="smooth=False"):
         batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, coarse_stm=True)
+
+
+def test_growing_arcs_from_one_forward_pass_equal_reruns_on_each_arc_bit_for_bit(batch_run):
+    """smooth_ends: the z of each arc t[0]..t[e] from the whole track's forward pass and one backward pass per arc is
+    the z_smooth of a filter and smoother run on the first e + 1 epochs alone, bit for bit (same kernels, same
+    inputs); flagged failures leave NaN; the option is checked."""
+    (t, y, obs, model, Rm, x0, P0, q), full = batch_run
+    N = t.size
+    ends = [1, 3, N - 2, N - 1, 4]  # any order, the whole track included
+    res = batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, n_sub=5, smooth_ends=ends)
+    assert res.z_smooth_ends.shape == (y.shape[0], len(ends))
+    assert np.array_equal(res.z_smooth, full.z_smooth) and np.array_equal(res.x_smooth, full.x_smooth)
+    for j, e in enumerate(ends):
+        arc = batched_ocbe.ocbe_batch(em, t[:e + 1], y[:, :e + 1], obs[:e + 1], model, Rm, x0, P0, q[:e], n_sub=5)
+        assert np.array_equal(res.z_smooth_ends[:, j], arc.z_smooth), e
+    # the smoothed z of a short arc differs from the whole track's: the backward pass does start at epoch e
+    assert not np.allclose(res.z_smooth_ends[:, 2], full.z_smooth, rtol=1e-6)
+    assert full.z_smooth_ends is None
+    with pytest.raises(ValueError, match="smooth_ends"):
+        batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, n_sub=5, smooth_ends=[0])
+    with pytest.raises(ValueError, match="smooth_ends"):
+        batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, n_sub=5, smooth_ends=[N])
+    with pytest.raises(ValueError, match="smooth_ends"):
+        batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, n_sub=5, smooth_ends=[1.5])
+    with pytest.raises(ValueError, match="smooth=True"):
+        batched_ocbe.ocbe_batch(em, t, y, obs, model, Rm, x0, P0, q, n_sub=5, smooth=False, smooth_ends=[2])
+
+
+def test_in_place_kernels_are_bit_identical_to_the_previous_lockstep_loop(batch_run, monkeypatch):
+    """Today's loop (time-update and smoother arrays assembled in place) against the loop of 2026-11-26c kept in
+    reference_lockstep_ocbe.py (generic srif kernels): every output bit for bit with the integrated costate block,
+    and to round-off with Phi_pp formed from Phi_xx (78 states, today's default)."""
+    from reference_lockstep_ocbe import previous_lockstep
+
+    from cislunar.estimation import srif
+
+    rng = np.random.default_rng(2)
+    R = np.triu(rng.standard_normal((5, 6, 6))) + 3 * np.eye(6)
+    Phi = np.eye(6) + 0.1 * rng.standard_normal((5, 6, 6))
+    Q = np.eye(6) * 1e-3 + (lambda a: a @ np.swapaxes(a, -1, -2))(1e-2 * rng.standard_normal((5, 6, 6)))
+    got, ref = batched_ocbe._time_update_identity(R, Phi, Q), srif._time_update(R, np.zeros(6), Phi, np.eye(6), Q)
+    assert np.array_equal(got[0], ref[0]) and np.array_equal(got[1], ref[1])
+    assert all(np.array_equal(a, b) for a, b in zip(got[2], ref[2]))
+    zs = rng.standard_normal((5, 6))
+    assert all(np.array_equal(a, b) for a, b in zip(batched_ocbe._smoother_step_identity(R, zs, Phi, got[2]),
+                                                    srif._smoother_step(R, zs, Phi, np.eye(6), got[2])))
+    args, fast = batch_run
+    assert not batched_ocbe._COSTATE_BLOCK
+    with previous_lockstep():
+        old = batched_ocbe.ocbe_batch(em, *args, n_sub=5)
+    monkeypatch.setattr(batched_ocbe, "_COSTATE_BLOCK", True)
+    same = batched_ocbe.ocbe_batch(em, *args, n_sub=5)
+    monkeypatch.setattr(batched_ocbe, "_LANES", 3)  # the 4 trials in lane groups of 3 + 1
+    split = batched_ocbe.ocbe_batch(em, *args, n_sub=5)
+    for name in ("x_pred", "x_filt", "P_filt", "x_smooth", "P_smooth", "control_step", "control_smooth", "z_step",
+                 "z_smooth", "residual_norms"):
+        ref = getattr(old, name)
+        assert np.array_equal(getattr(same, name), ref), name
+        assert np.max(np.abs(getattr(split, name) - ref)) <= 1e-12 * np.max(np.abs(ref)), name
+        assert np.max(np.abs(getattr(fast, name) - ref)) <= 1e-10 * np.max(np.abs(ref)), name

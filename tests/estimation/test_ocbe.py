@@ -221,3 +221,37 @@ def test_spike_contrast_of_a_known_spike():
         ocbe.spike_contrast(t, np.ones((2, 3)), 0.5, 0.1)
     with pytest.raises(ValueError, match="t_centre"):
         ocbe.spike_contrast(t, u, 5.0, 0.1)
+
+
+def test_block_integrator_without_the_costate_block_equals_the_full_variational_system(two_hours_near_perilune):
+    """The 78-state block integrator (Phi_pp = K Phi_xx K^-1 from the CR3BP's invariant form, not integrated) equals
+    the 156-state one to round-off, and K Phi_xx K^-1 is the integrated Phi_pp (= Phi_xx^-T) near perilune.
+
+    A wrong entry of the linear Phi_pp rows (a sign, or the factor 2 of the Coriolis term) shows in phi_xp at order
+    one; a wrong K in ``_costate_block`` shows against the integrated phi_pp."""
+    x0, grid, _ = two_hours_near_perilune
+    lay = ocbe.BLOCK_LAYOUT
+    starts = np.array([x0, x0 + np.r_[1e-5, -2e-5, 1e-5, 3e-5, 0.0, -1e-5]])
+    qs = np.array([Q_WEIGHT, 40 * Q_WEIGHT])
+    tb = ocbe.block_integrator(2, costate_block=False)
+    assert tb.state.shape == (lay["phi_xp"].stop, 2)
+    init = np.zeros((lay["phi_xp"].stop, 2))
+    init[lay["x"]] = starts.T
+    init[lay["phi_xx"]] = np.eye(6).ravel()[:, None]
+    tb.set_time(np.full(2, grid[0]))
+    tb.state[:] = init
+    tb.pars[0] = em.mu
+    tb.pars[1] = qs
+    out = tb.propagate_grid(np.repeat(grid[:, None], 2, axis=1))[-1]  # (grid, 78, 2)
+    for b in range(2):
+        full = ocbe.ocbe_transition(em, starts[b], grid, qs[b])
+        # other states, other step sizes: the two integrations agree to the tolerance's level, not to the last bit
+        assert np.max(np.abs(out[:, lay["x"], b] - full.x)) < 1e-13
+        for name, ref in (("phi_xx", full.phi_xx), ("phi_xp", full.phi_xp)):
+            blk = out[:, lay[name], b].reshape(-1, 6, 6)
+            assert np.max(np.abs(blk - ref)) < 1e-12 * np.max(np.abs(ref)), name
+        pp = ocbe._costate_block(out[:, lay["phi_xx"], b].reshape(-1, 6, 6))
+        assert np.max(np.abs(pp - full.phi_pp)) < 1e-12 * np.max(np.abs(full.phi_pp))
+        assert np.max(np.abs(pp - np.swapaxes(np.linalg.inv(full.phi_xx), -1, -2))) < 1e-10 * np.max(np.abs(pp))
+    with pytest.raises(TypeError, match="costate_block"):
+        ocbe.block_integrator(2, costate_block="no")

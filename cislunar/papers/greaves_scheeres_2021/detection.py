@@ -29,7 +29,8 @@ Pieces, in the order of the paper:
 * **Studies beyond the paper's runs**: the control integral of burns in chosen directions, at a chosen time in the
   window (:func:`direction_response`, the conditions of the paper's :math:`\pm\hat j` pattern, Fig. 16), and the
   "health metric" race between the control integral and the measurement residuals after an unexpected burn
-  (:func:`health_lead_study`, Fig. 22).
+  (:func:`health_lead_study`, Fig. 22; the smoothed control integral of every growing data arc from one forward
+  filter pass, ``smooth_ends`` of :func:`ocbe_batch`).
 
 Units: maneuver magnitudes and :math:`z` in m/s in all results; control weights given in km^2/s^3 (acceleration
 power spectral density) and converted to LU^2/TU^3 for the filter; angles in rad.
@@ -46,7 +47,7 @@ from scipy import optimize, stats
 from cislunar.cr3bp.dynamics import CR3BP, check_system
 from cislunar.cr3bp.orbits import PeriodicOrbit
 from cislunar.cr3bp.propagation import DEFAULT_TOL, _check_tol, propagate
-from cislunar.estimation import ocbe
+from cislunar.estimation import batched_ocbe, ocbe
 from cislunar.estimation.batched_ocbe import BatchOCBEResult, ocbe_batch
 from cislunar.estimation.consistency import _nees, nees_limit
 from cislunar.papers.greaves_scheeres_2021 import tracking
@@ -1255,9 +1256,7 @@ def filter_trials(setup: DetectionSetup, inputs, *, n_epochs: int | None = None)
                                 tol=setup.tol))
     if len(parts) == 1:
         return parts[0]
-    fields = {f: np.concatenate([getattr(p, f) for p in parts]) for f in BatchOCBEResult.__dataclass_fields__
-              if f != "t_sub"}
-    return BatchOCBEResult(t_sub=parts[0].t_sub, **fields)
+    return _concat_results(parts)
 
 
 def filter_trial_sets(sets, *, executor=None, progress: bool = False) -> list:
@@ -1337,7 +1336,7 @@ def _filter_group(group) -> list:
 
 
 def _slice_result(res, a, b) -> BatchOCBEResult:
-    fields = {f: (getattr(res, f) if f == "t_sub" else getattr(res, f)[a:b])
+    fields = {f: (getattr(res, f) if f == "t_sub" or getattr(res, f) is None else getattr(res, f)[a:b])
               for f in BatchOCBEResult.__dataclass_fields__}
     return BatchOCBEResult(**fields)
 
@@ -1345,7 +1344,8 @@ def _slice_result(res, a, b) -> BatchOCBEResult:
 def _concat_results(parts) -> BatchOCBEResult:
     if len(parts) == 1:
         return parts[0]
-    fields = {f: (parts[0].t_sub if f == "t_sub" else np.concatenate([getattr(p, f) for p in parts]))
+    fields = {f: (getattr(parts[0], f) if f == "t_sub" or getattr(parts[0], f) is None
+                  else np.concatenate([getattr(p, f) for p in parts]))
               for f in BatchOCBEResult.__dataclass_fields__}
     return BatchOCBEResult(**fields)
 
@@ -1552,7 +1552,11 @@ def health_lead_study(setup: DetectionSetup, magnitudes_m_s, n_h0: int, n_h1: in
     ``n_h0`` no-burn runs calibrate the control test (seed ``[*seed, 0]``), ``n_h0`` more measure both tests'
     false alarms (``[*seed, 1]``), and ``n_h1`` randomly pointed burns of each size (``[*seed, 2, i]``) are
     followed epoch by epoch over the horizon; see :class:`HealthLeadStudy` for the two tests.  The smoother is
-    rerun on the growing data arc at every epoch of the horizon (through ``executor`` when given).
+    rerun on the growing data arc at every epoch of the horizon: one forward filter pass over the track serves
+    every arc (the filter on an arc is the start of the filter on the track) and each arc gets its own backward
+    pass (``smooth_ends`` of :func:`cislunar.estimation.batched_ocbe.ocbe_batch`; bit for bit the filter and
+    smoother rerun on each arc, ``tests/papers/greaves_scheeres_2021/test_detection.py``).  The runs go through
+    ``executor`` in lockstep groups of :data:`LOCKSTEP_TRIALS` (results identical whatever the executor).
 
     Parameters
     ----------
@@ -1592,10 +1596,15 @@ def health_lead_study(setup: DetectionSetup, magnitudes_m_s, n_h0: int, n_h1: in
     burns = [inp for i, m in enumerate(mags) for inp in _draw_trials(np.random.default_rng(base + [2, i]).spawn(n1),
                                                                         setup, None, float(m), None, setup.t_maneuver)]
     everything = cal + val + burns
-    tasks = [(setup, everything, int(k) + 1) for k in ks] + [(setup, everything, None)]
+    # lockstep groups of whole integrator lane groups (so that every trial keeps the lanes filter_trials gives it),
+    # about four per study so that an executor has work to share, at most LOCKSTEP_TRIALS trials each
+    lanes = batched_ocbe._LANES
+    per = min(LOCKSTEP_TRIALS, lanes * -(-len(everything) // (4 * lanes)))
+    tasks = [(setup, everything[a:a + per], ks) for a in range(0, len(everything), per)]
     arcs = map_tasks(_arc_statistics, tasks, executor=executor, progress=progress, desc="health arcs")
-    z_arc = np.array([a[0] for a in arcs[:-1]]).T  # (runs, K) smoothed z of the arc up to each epoch, m/s
-    z_full, resid2 = arcs[-1]
+    z_arc = np.concatenate([a[0] for a in arcs])  # (runs, K) smoothed z of the arc up to each epoch, m/s
+    z_full = np.concatenate([a[1] for a in arcs])
+    resid2 = np.concatenate([a[2] for a in arcs])
     r2 = resid2[:, ks]  # squared whitened innovations at the horizon epochs
     logz = np.log(z_arc[:n0])
     lim_c = np.exp(logz.mean(axis=0) + stats.norm.isf(p) * logz.std(axis=0, ddof=1))
@@ -1610,7 +1619,13 @@ def health_lead_study(setup: DetectionSetup, magnitudes_m_s, n_h0: int, n_h1: in
 
 
 def _arc_statistics(task):
-    """``(z_smooth in m/s, squared whitened innovations)`` of every trial on the first ``n_epochs`` epochs."""
-    setup, inputs, n_epochs = task
-    res = filter_trials(setup, inputs, n_epochs=n_epochs)
-    return res.z_smooth * setup.system.velocity_unit_km_s * 1e3, res.residual_norms**2
+    """One lockstep group of :func:`health_lead_study`: ``task = (setup, inputs, ends)`` (at most
+    :data:`LOCKSTEP_TRIALS` trials, end epochs ``ends``).  Returns ``(z of each arc t[0] .. t[e], shape (B, E);
+    z of the whole track, (B,); squared whitened innovations, (B, N))``, z in m/s, from one forward pass."""
+    setup, inputs, ends = task
+    sc = setup.scenario
+    res = ocbe_batch(setup.system, sc.t, np.array([i.y for i in inputs]), setup.observer_states, sc.model,
+                     sc.meas_cov, np.array([i.x0 for i in inputs]), np.array([i.P0 for i in inputs]),
+                     setup.control_weight, n_sub=setup.n_sub, tol=setup.tol, smooth_ends=ends)
+    v = setup.system.velocity_unit_km_s * 1e3
+    return res.z_smooth_ends * v, res.z_smooth * v, res.residual_norms**2

@@ -92,3 +92,15 @@ def unscreened_arc_check():
         yield
     finally:
         batched_ocbe._check_arcs_outside_primaries = screened
+
+
+def reference_arc_statistics(task):
+    """``detection._arc_statistics`` as it was before 2026-11-26d: the filter and smoother rerun on every growing
+    arc (``filter_trials(n_epochs=e + 1)`` for each end epoch ``e``) and once on the whole track.  Same task and
+    return value as today's (``(setup, inputs, ends)`` -> ``(z of each arc (B, E), z of the track (B,), squared
+    whitened innovations (B, N))``, z in m/s); patch it in for ``detection.health_lead_study``'s old path."""
+    setup, inputs, ends = task
+    v = setup.system.velocity_unit_km_s * 1e3
+    z_arc = np.stack([det.filter_trials(setup, inputs, n_epochs=int(e) + 1).z_smooth * v for e in ends], axis=-1)
+    full = det.filter_trials(setup, inputs)
+    return z_arc, full.z_smooth * v, full.residual_norms**2

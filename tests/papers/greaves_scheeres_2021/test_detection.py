@@ -413,6 +413,43 @@ def test_health_lead_study_outcomes_partition_and_a_large_burn_is_seen_at_once()
         h.median_delay_hours("metric")
 
 
+def test_health_lead_study_one_forward_pass_equals_the_filter_rerun_on_every_arc_whatever_the_executor(monkeypatch):
+    """The race's growing arcs from one forward pass and a backward pass per arc (smooth_ends) equal the filter and
+    smoother rerun on each arc (the path before 2026-11-26d, reference_detection.reference_arc_statistics) bit for
+    bit, whether the runs go in one lockstep group or several, serially or through an executor."""
+    s = det.make_setup(em, orbits.nrho_9_2(em), 0.1 * det.window_control_weight(det.QUIET_POLICY, 16.0), 1e-18,
+                       cadence_hours=8.0, window_hours=16.0, periods=0.8)
+    args = (s, [0.02, 5.0], 10, 3, 2)
+    one = det.health_lead_study(*args, horizon_hours=20.0)  # 26 runs: one lockstep group
+    monkeypatch.setattr(batched_ocbe, "_LANES", 2)  # lane groups of 2: groups of 8 runs, four tasks
+    tasks, today = [], det._arc_statistics
+
+    def spy(task):
+        tasks.append(task)
+        return today(task)
+
+    monkeypatch.setattr(det, "_arc_statistics", spy)
+    serial = det.health_lead_study(*args, horizon_hours=20.0)
+    assert len(tasks) == 4 and [len(t[1]) for t in tasks] == [8, 8, 8, 2]
+    monkeypatch.setattr(det, "_arc_statistics", today)
+    with ThreadPoolExecutor(2) as ex:
+        split = det.health_lead_study(*args, horizon_hours=20.0, executor=ex)
+    monkeypatch.setattr(det, "_arc_statistics", reference_detection.reference_arc_statistics)
+    rerun = det.health_lead_study(*args, horizon_hours=20.0)
+    for f in one.__dataclass_fields__:
+        assert np.array_equal(getattr(split, f), getattr(one, f)), f
+        assert np.array_equal(getattr(serial, f), getattr(one, f)), f
+        assert np.array_equal(getattr(rerun, f), getattr(one, f)), f
+    # the statistics themselves: every run at once through the rerun path against the groups of one forward pass
+    everything = [i for t in tasks for i in t[1]]
+    ks = tasks[0][2]
+    old = reference_detection.reference_arc_statistics((s, everything, ks))
+    new = [np.concatenate(parts) for parts in zip(*(today(t) for t in tasks))]
+    for a, b in zip(old, new):
+        assert np.array_equal(a, b)
+    assert old[0].shape == (26, ks.size) and np.all(np.diff(old[0], axis=1) != 0)
+
+
 def test_control_spike_contrast_of_a_known_spike(short_setup):
     s = short_setup
     N = s.scenario.t.size
