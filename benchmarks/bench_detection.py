@@ -17,8 +17,8 @@ OCBE filter and smoother, z from the smoothed control.
   :func:`~cislunar.papers.greaves_scheeres_2021.detection.run_detection_monte_carlos` sweep, whose lockstep groups
   mix runs of the same track with different tunings (results bit-identical, asserted).
 
-* ``arc check``: the Monte Carlo with the arc impact check of the OCBE transitions unscreened (the 17-point Hermite
-  test of every sub-grid interval of every trial, as before 2026-11-26c; ``reference_detection.unscreened_arc_check``)
+* ``arc check``: the Monte Carlo with the arc impact check of the OCBE transitions unscreened (the rigorous
+  fall-time bound on every sub-grid interval of every trial, ``screen=False``; ``reference_detection.unscreened_arc_check``)
   against the screened check of :func:`cislunar.cr3bp.propagation._check_arcs_outside_primaries` (today's), run
   alternately in one process on the same trials; results bit-identical (asserted).
 

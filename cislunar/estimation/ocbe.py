@@ -345,9 +345,10 @@ def ocbe_transition(system: CR3BP, x0, t, control_weight: float, *, tol: float =
     The OCBE integrator carries no impact events (its reference is the filter's current estimate of a spacecraft
     in orbit, re-linearised every interval): impact events change its steps at round-off level.  A start inside a
     primary raises :class:`cislunar.cr3bp.propagation.ImpactError`, and so does any grid state inside a primary or
-    an arc between two grid points that dips below a surface: every grid interval that the cubic Hermite
-    interpolant of its end states brings near a primary is re-propagated with the impact events of
-    :func:`cislunar.cr3bp.propagation.propagate`.
+    an arc between two grid points that dips below a surface: every grid interval that a fall-time bound from
+    Jacobi's integral cannot clear is re-propagated with the impact events of
+    :func:`cislunar.cr3bp.propagation.propagate` (a sufficient condition: no interval through a primary is missed,
+    whatever its length).
     """
     check_system(system)
     x0 = validation.as_state(x0, "x0", batch=False)

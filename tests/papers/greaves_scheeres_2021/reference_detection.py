@@ -6,9 +6,9 @@ One trial at a time: the magnitude through ``scipy.stats.truncnorm.rvs``, the tr
 measurements and hand-off by the tracking module, then one batched OCBE call per lockstep group and the NEES
 bookkeeping trial by trial.
 
-:func:`unscreened_arc_check` puts back the arc impact check of the OCBE transitions as it was before 2026-11-26c
-(the 17-point Hermite test on every sub-grid interval of every trial, without the screen of
-:func:`cislunar.cr3bp.propagation._check_arcs_outside_primaries`).
+:func:`unscreened_arc_check` runs the arc impact check of the OCBE transitions without its cheap first screen
+(:func:`cislunar.cr3bp.propagation._check_arcs_outside_primaries` with ``screen=False``: the rigorous fall-time
+bound on every sub-grid interval of every trial; the same decisions).
 """
 
 import contextlib
