@@ -449,8 +449,8 @@ for cell, name, what in ((cell_92, "09_fig4_typical_divergence", "9:2 NRHO diver
 #   at long cadences this ignores how fast the dynamics change.
 #
 # Every filter sees the same draws (measurement noise and hand-off), so a difference between rows is the filter's.
-# The full run covers 1-12 h; the 1- and 10-minute cadences (9450 and 945 updates per run) can be added through
-# `CADENCE_AXES` at a cost of minutes per filter.
+# The full run covers 1-12 h; the 1- and 10-minute cadences (about 9450 and 945 updates per run) can be added
+# through `CADENCE_AXES` at a cost of minutes per filter.
 # The contrast reads as in the map: most angles-only runs diverge, at most 10 % of the runs with rates do. The figure
 # shows the diverged fractions against cadence, angles only on the left and with rates on the right, one curve per
 # filter; the shaded band is the 10 % a consistent filter is allowed, the dotted line the 50 % of "most runs".
@@ -471,15 +471,16 @@ _ = plotting.save_figure(obs.figure_filter_axes(axes_study), "09_filter_axes", o
 # * *The chapter's filter and every control weight* from 0.01 to $10^8$ times the chapter's: no diverged run at any
 #   cadence, with or without rates. The truth carries no unmodelled acceleration, so a smaller weight is not wrong,
 #   and a larger one only makes the filter more cautious.
-# * *The unwrapped azimuth:* a fifth to two thirds of the runs diverge, with rates about as often as without, and
+# * *The unwrapped azimuth:* a fifth to seven tenths of the runs diverge, with rates about as often as without, and
 #   every one of them at the first update. At apoapsis the L2 observer sees the target on the $\pm 180°$ cut, and
 #   a measurement on the other branch gives a $2\pi$ residual that no update absorbs. Whether a run fails depends
 #   on the branch its first noisy azimuth falls on, not on the measurement set.
 # * *The fixed reference:* a third of the runs diverge at 1-2 h, almost none at 6-12 h, with rates as often as
-#   without. At 1 and 10 minutes (the paper-size study) most angles-only runs diverge (70-75 %), but so do half
-#   or more of the runs with rates (50-70 %). The runs leave their bound on the approach to perilune, where the deviation from the hand-off
-#   reference has grown enough for the neglected second-order terms to matter; denser tracking makes the filter
-#   more confident, and so more sensitive to them.
+#   without. At 1 and 10 minutes (the paper-size study, a separate run whose lines are not printed here) most
+#   angles-only runs diverge (70-75 %), but so do half or more of the runs with rates (50-70 %). The runs leave
+#   their bound on the approach to perilune, where the deviation from the hand-off reference has grown enough for
+#   the neglected second-order terms to matter; denser tracking makes the filter more confident, and so more
+#   sensitive to them.
 # * *The coarse time update:* every run diverges, with rates and without, at every cadence, on the approach to
 #   perilune, where a Jacobian frozen over the interval misstates how fast the dynamics change.
 #
@@ -555,20 +556,20 @@ if custody_weak is not None:  # full mode only
 _ = plotting.save_figure(figures.figure_custody(custody.values()), "09_custody_multi_period", output_dir=out)
 
 # %% [markdown]
-# **Reading the custody runs** (the sentences describe the full run, 32 runs of 10 periods per policy; the printed
-# lines are this run's). Every run keeps custody through every period with either policy, and by a wide margin:
-# the worst pointing error of the prediction (right panel) is set by the hand-off in the first period (0.011°: a
-# 10-km error seen from about 70,000 km) and then stays at 0.001-0.002° with the quiet burns and 0.005-0.007° with
-# the active ones, a hundred times inside the 0.5° bound; a camera would have to be about a hundred times narrower
-# before custody were at risk. The runs also stay consistent (left panel, dashed): at most one run in 32 (3 %) is
-# inconsistent in the first period and none afterwards, with either policy; the raised window lets the filter
-# absorb each burn, and with the quiet policy the filter's 3-sigma position returns to 1.5-2 km by the end of
-# every period. With the active policy the same holds for seven periods; then the 3-sigma position at the end of
-# a period grows (median 7, 11 and 34 km in periods 8-10) and the worst error reaches about 130 km. The burns are
-# randomly pointed, as in the paper's Eqs. 3-5, not station keeping: after several 1-m/s kicks the true track has
-# left the NRHO, and the filter follows it with less favourable geometry. On this evidence the paper's
-# "indefinitely" holds for as long as we ran it, for either policy, while the active-policy runs show that
-# "indefinitely" also needs the burns to keep the craft on its orbit.
+# **Reading the custody runs** (the sentences describe the full run, 32 runs of 10 periods per policy; the printed lines
+# are this run's). Every run keeps custody through every period with either policy, and by a wide margin: the worst
+# pointing error of the prediction (right panel) is set by the hand-off in the first period (0.011°: about 13 km across
+# the line of sight seen from about 65,000 km, the hand-off error of the worst run) and then stays at 0.001-0.002° with
+# the quiet burns and 0.005-0.007° with the active ones, a hundred times inside the 0.5° bound; a camera would have to
+# be about a hundred times narrower before custody were at risk. The runs also stay consistent (left panel, dashed): at
+# most one run in 32 (3 %) is inconsistent in the first period and none afterwards, with either policy; the raised
+# window lets the filter absorb each burn, and with the quiet policy the filter's 3-sigma position returns to 1.5-2 km
+# by the end of every period. With the active policy the same holds for seven periods; then the 3-sigma position at the
+# end of a period grows (median 7, 11 and 34 km in periods 8-10) and the worst error reaches about 130 km. The burns are
+# randomly pointed, as in the paper's Eqs. 3-5, not station keeping: after several 1-m/s kicks the true track has left
+# the NRHO, and the filter follows it with less favourable geometry. On this evidence the paper's "indefinitely" holds
+# for as long as we ran it, for either policy, while the active-policy runs show that "indefinitely" also needs the
+# burns to keep the craft on its orbit.
 #
 # The tuning matters more than the bound: the window weight is matched to the burns (the white-noise acceleration
 # whose velocity variance over 8 h equals the burn's), a choice we settled after a first probe with a weaker
@@ -607,17 +608,17 @@ worst = conditioning[ladder[-1]]
 _ = plotting.save_figure(figures.figure_conditioning(worst), "09_sri_vs_covariance_form", output_dir=out)
 
 # %% [markdown]
-# **Reading the ladder** (the printed lines; the figure shows the last case). On the chapter's own case the three
-# forms agree to about $10^{-11}$ of the covariance scale, and all are consistent: there is nothing for the SRI
-# form to fix at 10 µrad and the paper's hand-off, even though the information matrix already has a condition
-# number near $10^9$. As the ladder climbs, the conventional form loses symmetry and positive definiteness first
-# (at an information condition number near $10^{12}$) and then consistency (near $10^{16}$, where its NEES leaves
-# the band by many orders of magnitude); the Joseph form holds longer, then loses symmetry (near $10^{16}$) and
-# positive definiteness (near $10^{18}$) while its estimates stay consistent; the SRI form keeps all three on every
-# rung. The covariance it reports is formed only for display, from its square root, and is
-# symmetric by construction (its smallest eigenvalue may round to $-10^{-16}$ of the largest, as the figure's
-# red cross shows, but a Cholesky factor exists throughout). So the SRI form is more stable, as the paper says, but only where the information is
-# conditioned far worse than in the paper's own scenario.
+# **Reading the ladder** (the printed lines; the figure shows the last case). On the chapter's own case the three forms
+# agree to about $10^{-11}$ of the covariance scale, and all are consistent: there is nothing for the SRI form to fix at
+# 10 µrad and the paper's hand-off, even though the information matrix already has a condition number near $10^9$. As
+# the ladder climbs, the conventional form loses symmetry and positive definiteness first (at an information condition
+# number near $10^{12}$) and then consistency (near $10^{16}$: once its covariance stops being positive definite, its
+# mean NEES leaves the band, by many orders of magnitude on that rung); the Joseph form holds longer, then loses
+# symmetry (near $10^{16}$) and positive definiteness (near $10^{18}$) while its estimates stay consistent; the SRI form
+# keeps all three on every rung. The covariance it reports is formed only for display, from its square root, and is
+# symmetric by construction (its smallest eigenvalue may round to $-10^{-16}$ of the largest, as the figure's red cross
+# shows, but a Cholesky factor exists throughout). So the SRI form is more stable, as the paper says, but only where the
+# information is conditioned far worse than in the paper's own scenario.
 #
 # **Re-linearisation.** The fixed-reference filter of Section 5c keeps the hand-off trajectory as its reference
 # for the whole track (a linearised Kalman filter), where the paper's filter re-linearises about every update. The
@@ -648,11 +649,14 @@ _ = plotting.save_figure(figures.figure_cadence_cost(cost), "09_cadence_run_time
 # updates: integrating the transition through the period costs about as much as the updates); from 2 h down to one
 # minute it grows almost in proportion to the number of updates (about 100 times for 121 times the updates), while
 # the final 3-sigma position falls only about like the inverse square root of that number (0.95 km at 2 h, 0.10 km
-# at 1 min). Every step of the grid has an elasticity between about 0.45 and 0.9, below the 1 the definition asks
+# at 1 min). Every step of the grid has an elasticity between about 0.45 and 0.8, below the 1 the definition asks
 # for, so the knee is at 12 h: the curve is a smooth power law without a bend at 2 h. A 2-h cadence is a
 # reasonable point on it (about three times the run time of the 12-h cadence for less than half its
 # uncertainty), but the data do not single it out as a sweet spot; the closing table says so. Two timings of the
-# full grid on a loaded machine gave the same knee and elasticities within about 0.15 of each other.
+# full grid on a loaded machine gave the same knee and elasticities within about 0.15 of each other. The sparse
+# cadences take only a few hundredths of a second, so with a single timing (quick mode) on a loaded machine the
+# first step's elasticity has come out anywhere from 0.76 to 1.01 in two runs of the same day, moving the knee
+# between 12 h and 6 h; neither is 1, 2 or 4 h.
 
 # %% [markdown]
 # ## 6 · Paper versus reproduction
@@ -806,8 +810,14 @@ table.add(obs.filled(OPS["cadence_sweet_spot"], cadences=f"{obs.cadence_label(mi
                      f"{obs.cadence_label(max(cost.cadences_h))}").judge(
     cost.knee_h in (1.0, 2.0, 4.0), shown=f"knee at {obs.cadence_label(cost.knee_h)}; elasticity "
     f"{np.nanmin(cost.elasticity):.2f}-{np.nanmax(cost.elasticity):.2f}; 2 h costs {1 / cost.cost_ratio()[0]:.2f}x "
-    f"the {obs.cadence_label(cost.cadences_h[0])} run for {cost.sigma3_km[list(cost.cadences_h).index(2.0)] / cost.sigma3_km[0]:.2f}x its "
-    "3-sigma" if 2.0 in cost.cadences_h else f"knee at {obs.cadence_label(cost.knee_h)}",
+    f"the {obs.cadence_label(cost.cadences_h[0])} run for "
+    f"{cost.sigma3_km[list(cost.cadences_h).index(2.0)] / cost.sigma3_km[0]:.2f}x its 3-sigma"
+    if 2.0 in cost.cadences_h else f"knee at {obs.cadence_label(cost.knee_h)}",
+    reason=(f"the knee is at {obs.cadence_label(cost.knee_h)}, "
+            + ("the sparsest cadence: no step to a denser one improves the final 3-sigma as fast as it adds run "
+               "time (every elasticity below 1), so the curve has no bend that singles out a cadence"
+               if cost.knee_h == max(cost.cadences_h) else
+               "beyond which a denser cadence adds run time faster than it improves the final 3-sigma")),
     note="CPU time of the single-trial filter per period, best of up to 3 runs"))
 executors.close()  # shuts the worker processes down
 table.display()

@@ -886,7 +886,8 @@ def fig8_report(variants) -> str:
     variants = _check_fig8(variants, "variants")
     lines = []
     for v in variants:
-        state = (f"failed ({v.failure[:60]})" if v.failure else
+        msg = v.failure if len(v.failure) <= 100 else v.failure[:97].rstrip() + "..."  # a cut message says so
+        state = (f"failed ({msg})" if v.failure else
                  f"final NEES {v.final_nees:8.1f} ({'re-converged' if v.reconverged else 'inconsistent'}), "
                  f"final error {v.err_final_km:9.2f} km")
         lines.append(f"{v.measurement_set:>12} {v.rule:>10}: resets at {list(v.epochs)}; {state}")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib import ticker
 from scipy import stats
 
 from cislunar.estimation import adaptive_ocbe as ad
@@ -85,7 +86,8 @@ def metric_law(null: ads.NullMetricStudy):
     ax[0].axvline(lim, color="C3", ls="--", label=f"99 % limit {lim:.2f}")
     ax[0].set(xlabel="OCBE metric $M$ [-]", ylabel="probability density [-]",
               title=f"no maneuver: KS p = {null.ks_p:.2f}")
-    ax[0].legend()
+    # below the panel: in it, the legend would sit on the vertical limit line
+    ax[0].legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3, fontsize=8)
     srt = np.sort(pooled)
     ax[1].plot(law.ppf((np.arange(srt.size) + 0.5) / srt.size), srt, ".", ms=3)
     ax[1].plot([0, 20], [0, 20], "k", lw=0.8)
@@ -562,10 +564,22 @@ def figure_conditioning(case: cu.ConditioningCase):
     a2.axhspan(*case.band, color="0.85", zorder=0, label="99.9 % band (consistent)")
     a1.set(xlabel="epoch index (-)", ylabel="eigenvalue ratio of P (-)")
     a2.set(xlabel="epoch index (-)", ylabel="mean NEES over draws (-)")
+    _plain_log_ticks(a2)
     for a in (a1, a2):
         a.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7)
     fig.suptitle(case.label, fontsize=9)
     return fig
+
+
+def _plain_log_ticks(ax, which: str = "y") -> None:
+    """Label a log axis (``which``: "x" or "y") that spans less than two decades at 1, 2 and 5 times a power of ten,
+    in plain numbers (matplotlib would otherwise label its minor ticks as 2x10^0, 3x10^0, ... and crowd the axis)."""
+    lo, hi = ax.get_xlim() if which == "x" else ax.get_ylim()
+    axis = ax.xaxis if which == "x" else ax.yaxis
+    if lo > 0 and hi / lo < 100:
+        axis.set_major_locator(ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+        axis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+        axis.set_minor_formatter(ticker.NullFormatter())
 
 
 def _cadence_label(hours):
@@ -585,5 +599,7 @@ def figure_cadence_cost(cost: cu.CadenceCost):
     ax.loglog(cost.seconds, cost.sigma3_km[0] * s0 / cost.seconds, ":", color="0.5",
               label="accuracy ~ 1/cost (elasticity 1)")
     ax.set(xlabel="filter CPU time per tracking period (s)", ylabel="final 3-sigma position (km)")
+    _plain_log_ticks(ax, "x")
+    _plain_log_ticks(ax, "y")
     ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7)
     return fig

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib import ticker
 from scipy import stats
 
 from cislunar.cr3bp.dynamics import CR3BP, check_system
@@ -1019,12 +1020,24 @@ def figure_divergence(example: DivergenceExample, what: str):
     axes[2].set(ylabel="NEES [-]", xlabel="time since apoapsis [d]")
     for ax in axes:
         ax.axvline(system.tu_to_days(sc.orbit.period / 2), color="0.5", ls=":", lw=1, label="perilune")
+    for ax in axes:
+        _plain_log_ticks(ax)
     axes[0].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     axes[2].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     fig.suptitle(f"{what}: angles only, {orbit_name}, {cad:g} h, {sig * 1e6:g} urad, hand-off 3-sigma {10 * h:g} km "
                  "(analogue of Fig. 4)", fontsize=10)
     fig.tight_layout()
     return fig
+
+
+def _plain_log_ticks(ax) -> None:
+    """Label a log y axis that spans less than two decades at 1, 2 and 5 times a power of ten, in plain numbers
+    (matplotlib would otherwise label its minor ticks as 2x10^0, 3x10^0, ... and crowd the axis)."""
+    lo, hi = ax.get_ylim()
+    if lo > 0 and hi / lo < 100:
+        ax.yaxis.set_major_locator(ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+        ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(ticker.NullFormatter())
 
 
 # ---------------------------------------------------------------------------------------------------------------
