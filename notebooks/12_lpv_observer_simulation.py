@@ -104,8 +104,9 @@ _ = table.add(*r.judged(CLAIMS))
 # intervals of hours, except with a large disturbance (down to minutes at notebook 11's largest level), and
 # H-infinity 0.08 deg only on orbits whose apogee lies at 0.88-0.99 LU from the Earth (the
 # 2:1 resonance used here); both of the paper's numbers and its ordering hold together on that orbit only for
-# sampling intervals of roughly 100-400 min at disturbance levels up to $10^{-3}$ (81-312 min for accelerations and
-# 7-26 min for state perturbations at level $10^{-2}$; notebook 11's windows). At this notebook's sampling interval:
+# sampling intervals of about 90-400 min at disturbance levels up to $10^{-3}$ (81-312 min for accelerations and
+# 7-26 min for state perturbations at level $10^{-2}$; notebook 11's windows in its full run, which alone tries
+# level $10^{-2}$). At this notebook's sampling interval:
 
 # %%
 al = obs.allowance_at(od, dt)
@@ -262,16 +263,19 @@ _ = table.add(*r.judged(CLAIMS))
 # not the accuracy the LMIs promise.
 #
 # **Why both H-infinity runs print the same RMS from both starts.** The H-infinity gains are large: $\|L\|\,\Delta t$
-# is about forty at 233 min (printed above), so within one interval the estimate is pulled onto the position that
-# the held pair of angles triangulates, and its error at each sample is the error of the angle-only fix of the
-# sample before (`WindowStudy.fix_following`: correlation and RMS ratio printed above, row "Hinf at 233 min" below).
+# is about thirty at 233 min (the row's note below), so within one interval the estimate is pulled onto the
+# position that the held pair of angles triangulates, and its error at each sample is the error of the angle-only
+# fix of the sample before (`WindowStudy.fix_following`: correlation and RMS ratio printed above, row "Hinf at
+# 233 min" below).
 # Neither the gain's details (nominal or robust) nor the initial error matter then: at this interval the
-# H-infinity observer is an angle-only triangulator, and its RMS is the fixes' RMS, not its LMI's. The row
+# H-infinity observer is an angle-only triangulator, and its RMS is close to the fixes' RMS (the RMS ratio above),
+# not its LMI's. The row
 # "Hinf at 233 min" tests exactly that model, $e_{k+1} = f_k + d_k$ (error vector at sample $k+1$ = the fix's error
 # vector at sample $k$ plus an error of the observer's own): it holds when the RMS of $d_k = e_{k+1} - f_k$ is no
 # larger than the nominal H-infinity guarantee, the size the LMI certifies for the observer's own error (a limit
 # fixed from the model, not from a run: `WindowStudy.fix_residual`, printed above next to the same sample's fix for
-# contrast).
+# contrast; in fairness, the residual itself was looked at while choosing what to measure, as the claim's comment in
+# `claims.observer_simulation` records).
 #
 # The error comparison of Fig. 3c at both intervals, with the nominal runs above:
 

@@ -314,6 +314,10 @@ def fig3_window(ws, system):
             a.axhline(ws.guarantee[("robust", n)] * KM, color="C3", ls="--", lw=1.1)
             a.set_title(f"{title}, initial error {ws.e0[start] * KM:,.0f} km", fontsize=10)
             a.axvspan(ws.t[0], 0.1 * (ws.t[-1] - ws.t[0]), color="0.9", lw=0, zorder=0)
+            nom, rob = ws.errors[("nominal", n, start)], ws.errors[("robust", n, start)]
+            if np.nanmedian(np.abs(nom - rob) / rob) < 0.01:  # one trace drawn over the other: say so
+                a.text(0.02, 0.03, "nominal and robust (triangulated) overlap", transform=a.transAxes, ha="left",
+                       va="bottom", fontsize=8, color="0.3")
         ax[i, 0].set_ylabel("position error [km]")
     for a in ax[1]:
         a.set_xlabel("t [TU]")
