@@ -237,13 +237,17 @@ with open_executor(workers, SCHEDULER) as executor:  # seeded runs (section 7), 
 # so the multi-start can only match or beat them. Two converged plans are the *same* local optimum when their costs
 # agree within $10^{-6}(1+|J|)$ and their node positions (or one's and the other's $z$-mirror, which is an optimum
 # with the same cost) never lie more than 100 km apart; otherwise they are *distinct* (tolerances fixed before the
-# runs). Per weight: starts, how many converged, how many distinct optima, and the spread of their costs.
+# runs). Per weight: starts, how many converged, how many distinct optima, and the spread of their costs. Where a
+# sweep's best plan came from a cold start, it was solved from the ballistic guess: it counts as the ballistic start
+# of that weight instead of being solved again (every run is deterministic; same plan, bit for bit).
 
 # %%
 known = global_search.known_from_sweep(runs.sweep, ms_alphas)
 for (a_, z_), r_ in runs.seeded.items():  # section 7's seeded runs are the multi-start's +z / -z starts there
     if a_ in ms_alphas and not isinstance(r_, Exception):
         known.setdefault(a_, []).append(("+z seed" if z_ > 0 else "-z seed", r_))
+for a_, rows_ in global_search.known_from_sweep(runs.sweep, ms_alphas, which="ballistic").items():  # a sweep's
+    known.setdefault(a_, []).extend(rows_)  # best solved from the ballistic guess is the ballistic start there
 with open_executor(workers, SCHEDULER) as executor:
     multi = global_search.multi_start(solver, ms_alphas, rng=rng, n_random=ms_random, seeds_z=ms_seeds_z, known=known,
                                    executor=executor)

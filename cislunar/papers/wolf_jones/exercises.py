@@ -538,6 +538,18 @@ class PenaltyIterationsAnswer:
     answer: str
 
 
+def _prefix_runs(converged: bool, history: list, limits) -> list:
+    """``(converged, history)`` of SCvx runs with each iteration limit of ``limits``, read off one run at the largest.
+
+    SCvx is deterministic and its iteration limit only ends the loop, so a run limited to ``m`` iterations repeats
+    the first ``m`` iterations of the longer run (one history record per iteration): if the long run stopped
+    (converged, or raised) within ``m`` iterations the short one stops the same way with the same history;
+    otherwise it ends unconverged after the first ``m`` records.  Bit-identical to separate runs
+    (tests/papers/wolf_jones/test_exercises_wolf_jones.py).
+    """
+    return [(converged, history) if len(history) <= m else (False, history[:m]) for m in limits]
+
+
 def exercise_05_penalty_iterations(max_iter=(10, 30), *, n_nodes: int = 10, alpha: float = 5e-3,
                                    gamma: float = 1e3) -> PenaltyIterationsAnswer:
     """Notebook 05, exercise 2: raise ``PENALTY_ITER_LONG`` and predict whether the printed method converges.
@@ -556,15 +568,16 @@ def exercise_05_penalty_iterations(max_iter=(10, 30), *, n_nodes: int = 10, alph
     x_ball, u_ball = sc.ballistic_guess(t)
     info_model = sc.information_model()
     u_max = sc.control_bounds(t)
+    st = scvx.SCvxSettings(method="penalty", information_model="linear", defect_weight=float(gamma),
+                           max_iter=limits[-1])
+    try:  # one run at the larger limit: the shorter run is its prefix (_prefix_runs)
+        r = scvx.solve_scvx(sc.system, t, x_ball, u_ball, u_max, x_final=sc.observer_xf, info=info_model,
+                            info_node=k_ws, alpha=float(alpha), settings=st)
+        long_hist, long_ok = r.history, True
+    except scvx.SCvxError as exc:
+        long_hist, long_ok = exc.history, False
     conv, defect, eta, best = [], [], [], []
-    for m in limits:
-        st = scvx.SCvxSettings(method="penalty", information_model="linear", defect_weight=float(gamma), max_iter=m)
-        try:
-            r = scvx.solve_scvx(sc.system, t, x_ball, u_ball, u_max, x_final=sc.observer_xf, info=info_model,
-                                info_node=k_ws, alpha=float(alpha), settings=st)
-            hist, ok = r.history, True
-        except scvx.SCvxError as exc:
-            hist, ok = exc.history, False
+    for ok, hist in _prefix_runs(long_ok, long_hist, limits):
         conv.append(ok)
         defect.append(float(hist[-1]["max_defect"]))
         eta.append(float(hist[-1]["eta"]))
@@ -657,12 +670,19 @@ def exercise_06_free_run_iterations(max_iter=(10, 30), *, n_nodes: int = 12,
     info_model = sc.information_model()
     t, k_ws, _ = sc.node_times(n, 1.0)
     x_ball, u_ball = sc.ballistic_guess(t)
-    runs = [tc_studies.free_run(sc, t, k_ws, info_model, float(alpha), x_ball, u_ball, m) for m in limits]
-    conv = tuple(not f.failed for f in runs)
-    defect = tuple(float(f.outcome.history[-1]["max_defect"]) if f.failed else float(f.outcome.max_defect)
-                   for f in runs)
-    best = tuple(float(f.best_cost) if f.failed else float(f.outcome.cost) for f in runs)
-    last = tuple(float(f.ref_range_km[-1]) for f in runs)
+    # one run at the larger limit: the shorter run is its prefix (_prefix_runs)
+    run = tc_studies.free_run(sc, t, k_ws, info_model, float(alpha), x_ball, u_ball, limits[-1])
+    conv, defect, best, last = [], [], [], []
+    for ok, hist in _prefix_runs(not run.failed, run.outcome.history, limits):
+        conv.append(ok)
+        defect.append(float(run.outcome.max_defect) if ok else float(hist[-1]["max_defect"]))
+        acc = [h["new_cost"] for h in hist if h.get("accepted")]
+        best.append(float(run.outcome.cost) if ok else float(min(acc)) if acc else float("nan"))
+        # the references are the starting guess and the state after each accepted step that did not end the run:
+        # a prefix cut before the end holds 1 + (its accepted steps) of them, the whole run all of them
+        n_refs = run.ref_range_km.size if hist is run.outcome.history else 1 + sum(bool(h["accepted"]) for h in hist)
+        last.append(float(run.ref_range_km[n_refs - 1]))
+    conv, defect, best, last = tuple(conv), tuple(defect), tuple(best), tuple(last)
     answer = (f"Without a keep-out, more iterations do not bring convergence: after {limits[0]} and {limits[1]} "
               f"iterations (alpha_h = {alpha:g}, {n} nodes) the run "
               f"{'has not converged in either' if not any(conv) else 'converged in ' + str(sum(conv))}. The best "

@@ -178,13 +178,31 @@ class MultiStart:
         return "\n".join(lines)
 
 
-def known_from_sweep(sweep, alphas=None) -> dict:
-    """``{alpha: [("sweep (up|down)", plan)]}`` from a :class:`~cislunar.guidance.scvx.SweepResult`'s best plans
-    (only the weights in ``alphas`` if given), for the ``known`` argument of :func:`multi_start`."""
+def known_from_sweep(sweep, alphas=None, *, which: str = "best") -> dict:
+    """Plans of a :class:`~cislunar.guidance.scvx.SweepResult` for the ``known`` argument of :func:`multi_start`
+    (only the weights in ``alphas`` if given).
+
+    ``which="best"``: ``{alpha: [("sweep (up|down)", plan)]}``, the best plan per weight.  ``which="ballistic"``:
+    ``{alpha: [("ballistic", plan)]}`` for the weights whose best plan came from a cold start of a
+    :func:`~cislunar.papers.wolf_jones.scenarios.sweep_both_ways` sweep (its ``attempts`` name each run's
+    ``start``), i.e. from the sweep's own guess: when that guess is the ballistic one (:meth:`Scenario.ballistic_guess`
+    on the solver's grid) these are the multi-start's ballistic starts, already solved; merged into ``known`` after
+    the other rows they are not solved again (SCvx is deterministic: the same outcome, bit for bit).
+    """
     validation.instance(sweep, "sweep", scvx.SweepResult)
     keep = None if alphas is None else {float(a) for a in _checks.vector(alphas, "alphas")}
-    return {float(a): [(f"sweep ({s})", b)] for a, b, s in zip(sweep.alphas, sweep.best, sweep.source)
-            if b is not None and (keep is None or float(a) in keep)}
+    which = validation.choice(which, "which", ("best", "ballistic"))
+    out = {}
+    for a, b, d in zip(sweep.alphas, sweep.best, sweep.source):
+        if b is None or (keep is not None and float(a) not in keep):
+            continue
+        if which == "best":
+            out[float(a)] = [(f"sweep ({d})", b)]
+            continue
+        run = [r for r in sweep.attempts if r["alpha"] == float(a) and r.get("direction") == d and r["converged"]]
+        if len(run) == 1 and run[0].get("start") == "cold":
+            out[float(a)] = [("ballistic", b)]
+    return out
 
 
 def adopt(sweep, ms: MultiStart):

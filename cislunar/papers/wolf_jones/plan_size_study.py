@@ -257,7 +257,7 @@ def _combination(problem: tuple, task: tuple) -> list:
     """Solve one (normalisation, reading) combination at every weight of ``task``, each from the ballistic DRO."""
 
     sc0, t, k_ws, forward_hessian, settings = problem
-    norm, reading, alphas = task
+    norm, reading, alphas, known = task
     sc = dataclasses.replace(sc0, q=_q_nd(reading, sc0.system))
     info = sc.information_model()
     if forward_hessian:
@@ -269,6 +269,9 @@ def _combination(problem: tuple, task: tuple) -> list:
     rows = []
     for a in alphas:
         cpu0 = time.thread_time()
+        if a in known:  # already solved from the ballistic DRO (plan_size_sweep's known)
+            rows.append(_row(sc, solver, norm, reading, a, cpu0, known[a]))
+            continue
         try:
             res = solver(a, x_ball, u_ball)
         except scvx.SCvxError as exc:
@@ -293,7 +296,7 @@ class _Task:
 
 def plan_size_sweep(n_nodes: int, *, normalisations=None, readings=None, alphas=PAPER_ALPHAS, sigma: float = 1.0,
                     forward_hessian: bool = False, settings=None, fraction: float = FIT_FRACTION, executor=None,
-                    progress: bool = False) -> PlanSizeStudy:
+                    progress: bool = False, known=None) -> PlanSizeStudy:
     """Test case 1 at each weight for every control-term normalisation and process-noise reading.
 
     Parameters
@@ -317,6 +320,11 @@ def plan_size_sweep(n_nodes: int, *, normalisations=None, readings=None, alphas=
     executor : concurrent.futures.Executor or dask.distributed.Client, optional
         Runs the combinations side by side (one task each); the result is bit-identical to the serial one.
     progress : bool
+    known : dict, optional
+        ``{alpha: SCvxResult}``: plans of the adopted normalisation and reading already solved from the ballistic
+        DRO on this grid with the same ``forward_hessian`` and ``settings`` (e.g. notebook 05's sweep at
+        alpha_h = 0 and its multi-start's ballistic starts); used instead of solving them again (SCvx is
+        deterministic: the same plans, bit for bit, apart from the run times in the rows).
 
     Returns
     -------
@@ -344,8 +352,17 @@ def plan_size_sweep(n_nodes: int, *, normalisations=None, readings=None, alphas=
 
     sc = wj.test_case_1()
     t, k_ws, _ = sc.node_times(n_nodes, sigma)
+    known = {} if known is None else validation.instance(known, "known", dict, "a dict {alpha: SCvxResult}")
+    for k, r in known.items():
+        validation.instance(r, f"known[{k!r}]", scvx.SCvxResult)
+        if r.alpha != validation.real(k, "known key") or not np.array_equal(r.t, t):
+            raise ValueError(f"known[{k!r}] must be solved at alpha = {k!r} on the {t.size}-node grid; got alpha = "
+                             f"{r.alpha:g} on {np.size(r.t)} nodes")
+    adopted = {float(k): r for k, r in known.items()}
     task = _Task((sc, t, k_ws, forward_hessian, settings))
-    tasks = [(ADOPTED_NORMALISATION, ADOPTED_READING, (0.0,))] + [(n, q, alphas) for n in norms for q in reads]
+    tasks = [(ADOPTED_NORMALISATION, ADOPTED_READING, (0.0,), adopted)] + [
+        (n, q, alphas, adopted if (n, q) == (ADOPTED_NORMALISATION, ADOPTED_READING) else {}) for n in norms
+        for q in reads]
     t0 = time.perf_counter()
     out = montecarlo.map_tasks(task, tasks, executor=executor, progress=progress, desc="plan size")
     seconds = time.perf_counter() - t0

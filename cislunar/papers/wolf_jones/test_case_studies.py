@@ -409,7 +409,7 @@ def _penalty_task(problem: tuple, task: tuple) -> dict:
 
 
 def penalty_study(case: Case1Sweep, gammas, n_iter: int, n_iter_long: int, *, alpha: float = 5e-3,
-                  executor=None) -> PenaltyStudy:
+                  executor=None, cold=None) -> PenaltyStudy:
     """Our solver cold from the ballistic DRO, and the printed exact-penalty SCvx over penalty weights ``gammas``
     (``n_iter`` iterations each), at gamma = 1e3 with ``n_iter_long`` iterations, and the hybrid (exact penalty,
     quadratic MI model) at gamma = 1e3 (notebook 05, section 4).
@@ -417,7 +417,9 @@ def penalty_study(case: Case1Sweep, gammas, n_iter: int, n_iter_long: int, *, al
     The exact-penalty runs are independent: with an ``executor`` (``submit``, e.g. from
     :func:`cislunar.utils.executors.open_executor`) they run side by side through
     :func:`cislunar.utils.montecarlo.map_tasks`, the cold run of our solver here meanwhile; results do not depend
-    on it.
+    on it.  ``cold``, an SCvxResult of ``case.solver(alpha, case.x_ball, case.u_ball)`` already at hand (e.g. the
+    multi-start's ballistic start at ``alpha``, :func:`global_search.multi_start`), is used instead of solving it
+    again (SCvx is deterministic: the same plan, bit for bit).
     """
     validation.instance(case, "case", Case1Sweep)
     n_iter = validation.integer(n_iter, "n_iter", minimum=1)
@@ -427,17 +429,22 @@ def penalty_study(case: Case1Sweep, gammas, n_iter: int, n_iter_long: int, *, al
         raise ValueError(f"gammas must be positive penalty weights; got {gammas}")
     alpha = validation.in_range(alpha, "alpha", 0.0, 1.0)
     _checks.executor(executor)
+    if cold is not None:
+        validation.instance(cold, "cold", scvx.SCvxResult)
+        if cold.alpha != alpha or not np.array_equal(cold.t, case.t):
+            raise ValueError(f"cold must be solved at alpha = {alpha:g} on the case's node grid; got alpha = "
+                             f"{cold.alpha:g} on {np.size(cold.t)} nodes")
     tasks = [(float(g), n_iter, "linear") for g in gammas] + [(1e3, n_iter_long, "linear"), (1e3, n_iter, "quadratic")]
     run = functools.partial(_penalty_task, _penalty_problem(case, alpha))
     if executor is None:
-        cold = case.solver(alpha, case.x_ball, case.u_ball)
+        cold = case.solver(alpha, case.x_ball, case.u_ball) if cold is None else cold
         t0 = time.perf_counter()
         out = montecarlo.map_tasks(run, tasks, progress=False)
     else:
         t0 = time.perf_counter()
         with concurrent.futures.ThreadPoolExecutor(max_workers=1) as waiter:  # a thread only waits on the executor
             fut = waiter.submit(montecarlo.map_tasks, run, tasks, executor=executor, progress=False)
-            cold = case.solver(alpha, case.x_ball, case.u_ball)
+            cold = case.solver(alpha, case.x_ball, case.u_ball) if cold is None else cold
             out = fut.result()
     return PenaltyStudy(alpha, cold, out[:-1], out[-1], n_iter, time.perf_counter() - t0)
 

@@ -7,8 +7,11 @@ import numpy as np
 import pytest
 
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
+from cislunar.guidance import scvx
 from cislunar.papers.wolf_jones import exercises as X
 from cislunar.papers.wolf_jones import reference_tables as wjt
+from cislunar.papers.wolf_jones import scenarios as wj
+from cislunar.papers.wolf_jones import test_case_studies as tc
 
 # ===============================================================================================================
 # Notebook 01 (MU_STEP: how tightly the printed DRO rows pin mu)
@@ -159,6 +162,72 @@ def test_05_more_iterations_do_not_make_the_printed_method_converge():
     assert "do not make the printed method converge" in a.answer
     with pytest.raises(ValueError):
         X.exercise_05_penalty_iterations(max_iter=(30, 10))
+
+
+def _histories_equal(a, b):
+    """Two SCvx histories record the same iterations bit for bit (run times aside)."""
+    timing = {"t_discretize", "t_info", "t_solve", "t_hessian"}
+    def same(u, v):
+        return u == v or (isinstance(u, float) and isinstance(v, float) and np.isnan(u) and np.isnan(v))
+
+    return len(a) == len(b) and all(ra.keys() == rb.keys() and all(same(ra[k], rb[k]) for k in ra if k not in timing)
+                                    for ra, rb in zip(a, b))
+
+
+def _direct(run, m):
+    """(converged, history) of ``run(m)``, a separate SCvx run with iteration limit m."""
+    try:
+        return True, run(m).history
+    except scvx.SCvxError as exc:
+        return False, exc.history
+
+
+def test_prefix_runs_equal_separate_runs_bit_for_bit():
+    # one SCvx run at the largest limit stands for the shorter ones (exercises 05 and 06): a limit that cuts the
+    # run (2, 5) and one beyond its convergence (60), against separate runs; a slice off by one iteration, or a cut
+    # run reported as converged, fails
+    sc = wj.test_case_1()
+    t, k_ws, _ = sc.node_times(8, 1.0)
+    x_ball, u_ball = sc.ballistic_guess(t)
+
+    def run(m):
+        return wj.ScenarioSolver(sc, t, k_ws, information=sc.information_model(),
+                                 settings=scvx.SCvxSettings(max_iter=m))(5e-3, x_ball, u_ball)
+
+    ok, hist = _direct(run, 60)
+    assert ok and 5 < len(hist) < 60, len(hist)  # converges between the limits
+    for m, (ok_m, hist_m) in zip((2, 5, 60), X._prefix_runs(ok, hist, (2, 5, 60))):
+        ok_d, hist_d = _direct(run, m)
+        assert ok_m == ok_d and _histories_equal(hist_m, hist_d), m
+
+
+def test_exercise_iterations_read_off_one_run_equal_separate_runs():
+    # exercise 05 (printed exact penalty) and 06 (no keep-out) at small limits, against separate runs per limit
+    a = X.exercise_05_penalty_iterations(max_iter=(2, 4), n_nodes=8)
+    sc = wj.test_case_1()
+    t, k_ws, _ = sc.node_times(8, 1.0)
+    x_ball, u_ball = sc.ballistic_guess(t)
+
+    def printed(m):
+        st = scvx.SCvxSettings(method="penalty", information_model="linear", defect_weight=1e3, max_iter=m)
+        return scvx.solve_scvx(sc.system, t, x_ball, u_ball, sc.control_bounds(t), x_final=sc.observer_xf,
+                               info=sc.information_model(), info_node=k_ws, alpha=5e-3, settings=st)
+
+    for i, m in enumerate((2, 4)):
+        ok, hist = _direct(printed, m)
+        acc = [h["new_cost"] for h in hist if h["accepted"]]
+        assert (a.converged[i], a.last_defect[i], a.last_eta[i]) == (ok, hist[-1]["max_defect"], hist[-1]["eta"])
+        assert np.array_equal(a.best_cost[i], min(acc) if acc else np.nan, equal_nan=True)
+    b = X.exercise_06_free_run_iterations(max_iter=(2, 4), n_nodes=8)
+    sc2 = wj.test_case_2()
+    t2, k2, _ = sc2.node_times(8, 1.0)
+    x2, u2 = sc2.ballistic_guess(t2)
+    for i, m in enumerate((2, 4)):
+        f = tc.free_run(sc2, t2, k2, sc2.information_model(), 1e-2, x2, u2, m)
+        assert b.converged[i] == (not f.failed)
+        assert b.last_defect[i] == (f.outcome.history[-1]["max_defect"] if f.failed else f.outcome.max_defect)
+        assert np.array_equal(b.best_cost[i], f.best_cost if f.failed else f.outcome.cost, equal_nan=True)
+        assert b.last_range_km[i] == f.ref_range_km[-1]
 
 
 def test_06_each_decade_closer_adds_ln10_nats():

@@ -76,6 +76,29 @@ def test_a_known_better_plan_is_kept_and_a_known_label_is_not_solved_again(setup
     assert out.improvements([fake]) == []
 
 
+def test_known_ballistic_plans_are_the_sweeps_cold_starts_only():
+    # a two-way sweep (scenarios.sweep_both_ways) names each run's start: a best plan whose converged run in its
+    # chain was a cold start was solved from the sweep's guess (the multi-start's ballistic start); a warm one not
+    p = {k: object() for k in "abcd"}
+    att = [dict(alpha=0.0, direction="up", start="cold", converged=True),
+           dict(alpha=0.5, direction="up", start="warm", converged=False),
+           dict(alpha=0.5, direction="up", start="cold", converged=True),  # warm failed, retried cold
+           dict(alpha=0.7, direction="up", start="warm", converged=True),
+           dict(alpha=1.0, direction="up", start="warm", converged=True),
+           dict(alpha=1.0, direction="down", start="cold", converged=True),
+           dict(alpha=0.7, direction="down", start="cold", converged=True),  # cold, but the best came from up
+           dict(alpha=0.5, direction="down", start="warm", converged=True),
+           dict(alpha=0.0, direction="down", start="warm", converged=True)]
+    sweep = scvx.SweepResult(np.array([0.0, 0.5, 0.7, 1.0]), [p["a"], p["b"], p["c"], p["d"]],
+                             ["up", "up", "up", "down"], att)
+    assert gs.known_from_sweep(sweep, which="ballistic") == {0.0: [("ballistic", p["a"])], 0.5: [("ballistic", p["b"])],
+                                                             1.0: [("ballistic", p["d"])]}
+    assert gs.known_from_sweep(sweep, [0.5, 0.7], which="ballistic") == {0.5: [("ballistic", p["b"])]}
+    assert gs.known_from_sweep(sweep, [0.7])[0.7] == [("sweep (up)", p["c"])]
+    with pytest.raises(ValueError, match="which"):
+        gs.known_from_sweep(sweep, which="cold")
+
+
 def test_multi_start_is_the_same_on_an_executor(setup, ms):
     with ThreadPoolExecutor(max_workers=2) as ex:
         other = gs.multi_start(setup[3], [A], rng=np.random.default_rng(7), n_random=1, neighbours=False,

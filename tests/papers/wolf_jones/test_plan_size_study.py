@@ -2,6 +2,7 @@
 "not immediately apparent" test, a small sweep against invariants of the weighted-sum front, executor
 independence and the figure."""
 
+import dataclasses
 from concurrent.futures import ThreadPoolExecutor
 
 import matplotlib.pyplot as plt
@@ -10,6 +11,7 @@ import pytest
 
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.cr3bp.propagation import propagate
+from cislunar.guidance import scvx
 from cislunar.papers.wolf_jones import figures
 from cislunar.papers.wolf_jones import plan_size_study as ps
 from cislunar.papers.wolf_jones import scenarios as wj
@@ -98,6 +100,24 @@ def test_executor_gives_the_same_rows(small):
     with ThreadPoolExecutor(2) as ex:
         threaded = ps.plan_size_sweep(10, executor=ex, **SMALL)
     assert threaded.rows == small.rows and threaded.baseline == small.baseline
+
+
+def test_known_plans_stand_for_the_solves_bit_for_bit(small):
+    # notebook 05 hands the sweep's and the multi-start's plans from the ballistic DRO to the sweep instead of solving
+    # them again: they must be the plans the sweep would solve (same rows, run times aside), and be used
+    sc = wj.test_case_1()
+    t, k_ws, _ = sc.node_times(10, 1.0)
+    solver = wj.ScenarioSolver(sc, t, k_ws, information=sc.information_model(), settings=scvx.SCvxSettings())
+    x_ball, u_ball = sc.ballistic_guess(t)
+    known = {a: solver(a, x_ball, u_ball) for a in (0.0, 5e-3)}
+    reused = ps.plan_size_sweep(10, known=known, **SMALL)
+    assert reused.rows == small.rows and reused.baseline == small.baseline
+    fake = {5e-3: dataclasses.replace(known[5e-3], impulse=2 * known[5e-3].impulse)}  # a known plan is not re-solved
+    doubled = ps.plan_size_sweep(10, known=fake, normalisations=[ADOPTED], readings=[ps.ADOPTED_READING],
+                                 alphas=(5e-3,))
+    assert doubled.rows[0].impulse_mps == pytest.approx(2 * small.rows[0].impulse_mps, rel=1e-12)
+    with pytest.raises(ValueError, match="known"):
+        ps.plan_size_sweep(10, known={2e-2: known[5e-3]}, **SMALL)
 
 
 def test_figure_has_units(small):

@@ -10,6 +10,7 @@ import pytest
 
 from cislunar.guidance import scvx
 from cislunar.guidance.scvx import SCvxError
+from cislunar.papers.wolf_jones import global_search
 from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.papers.wolf_jones import test_case_studies as S
 from cislunar.papers.wolf_jones.case_2_closing import Departures
@@ -147,6 +148,37 @@ def test_departures_count_the_grids_above_the_threshold():
 # ---------------------------------------------------------------------------------------------------------------
 # The executor paths (round 2): queued runs give the serial results, whatever runs them
 # ---------------------------------------------------------------------------------------------------------------
+
+
+def test_penalty_study_reuses_the_multi_start_ballistic_run_bit_for_bit(case1):
+    # notebook 05 hands the multi-start's ballistic start at 5e-3 to the penalty study as its cold run: the same plan
+    # as the study's own solve, bit for bit, and used as given
+    own = S.penalty_study(case1, [1e1], 1, 2)
+    ms = global_search.multi_start(case1.solver, [5e-3], n_random=0, seeds_z=False, neighbours=False)
+    start = next(o.result for o in ms.at(5e-3) if o.label == "ballistic")
+    assert np.array_equal(start.x, own.cold.x) and np.array_equal(start.u, own.cold.u)
+    assert (start.cost, start.information, start.iterations) == (own.cold.cost, own.cold.information,
+                                                                 own.cold.iterations)
+    given = S.penalty_study(case1, [1e1], 1, 2, cold=start)
+    assert given.cold is start and [r["outcome"] for r in given.runs] == [r["outcome"] for r in own.runs]
+    with pytest.raises(ValueError, match="cold"):
+        S.penalty_study(case1, [1e1], 1, 2, alpha=0.0, cold=start)
+
+
+def test_the_upward_sweeps_first_plan_stands_for_the_multi_start_ballistic_start(case1):
+    # notebook 05 hands the upward sweep's first plan (alpha_h = 0 from the ballistic DRO) to the multi-start as its
+    # ballistic start there: the outcomes are those of solving it, bit for bit (labels, order, costs, optima)
+    assert case1.sweep.source[0] == "up"
+    gs_known = global_search.known_from_sweep(case1.sweep, [0.0])
+    solved = global_search.multi_start(case1.solver, [0.0], n_random=0, seeds_z=False, known=gs_known)
+    known = {0.0: gs_known[0.0] + [("ballistic", case1.best[0])]}
+    reused = global_search.multi_start(case1.solver, [0.0], n_random=0, seeds_z=False, known=known)
+    fields = ("alpha", "label", "converged", "cost", "impulse_mps", "mi", "iterations", "optimum")
+    assert [tuple(getattr(o, f) for f in fields) for o in solved.outcomes] == [
+        tuple(getattr(o, f) for f in fields) for o in reused.outcomes]
+    assert [o.label for o in reused.outcomes] == ["sweep (up)", "ballistic"]
+    b_solved, b_reused = solved.outcomes[1].result, reused.outcomes[1].result
+    assert np.array_equal(b_solved.x, b_reused.x) and np.array_equal(b_solved.u, b_reused.u)
 
 
 def test_penalty_study_is_the_same_with_an_executor(case1):
