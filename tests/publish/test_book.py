@@ -115,10 +115,20 @@ def untypeset_tex(path: Path) -> list[str]:
     return [text[max(0, m.start() - 30):m.end() + 30] for m in re.finditer(r"\\[a-zA-Z]{2,}|\$\$?[^$\s]", text)]
 
 
+_PARSED: dict = {}
+
+
 def parse(path: Path) -> _Page:
-    page = _Page()
-    page.feed(path.read_text(encoding="utf-8", errors="replace"))
-    return page
+    """The parsed page, read once per version of the file: four tests read every page of the built book (about 100
+    pages, 10 MB of HTML) and share one parse; the key is path, size and modification time, so a page written again
+    is parsed again (:func:`test_a_page_written_again_is_parsed_again`)."""
+    stat = path.stat()
+    key = (str(path.resolve()), stat.st_size, stat.st_mtime_ns)
+    if key not in _PARSED:
+        page = _Page()
+        page.feed(path.read_text(encoding="utf-8", errors="replace"))
+        _PARSED[key] = page
+    return _PARSED[key]
 
 
 _CSS_URL = re.compile(r"""url\(\s*['"]?([^'")]+)['"]?\s*\)|@import\s+['"]([^'"]+)['"]""")
@@ -406,6 +416,16 @@ def test_browser_probe_sees_network_requests_missing_files_and_untypeset_math(tm
     assert "https://cdn.example.com/mathjax.js" in browser.requests()
     errors = {f.get("errorText") for f in browser.failures()}
     assert "net::ERR_FILE_NOT_FOUND" in errors and "net::ERR_NAME_NOT_RESOLVED" in errors
+
+
+def test_a_page_written_again_is_parsed_again(tmp_path):
+    """The parse kept for the built book's pages (:func:`parse`) is never a stale one."""
+    page = tmp_path / "p.html"
+    page.write_text('<a href="a.html">x</a>')
+    assert parse(page).refs == [("a", "href", "a.html")]
+    page.write_text('<a href="gone.html">x</a><img src="b.png">')
+    assert parse(page).refs == [("a", "href", "gone.html"), ("img", "src", "b.png")]
+    assert check_site(tmp_path)["broken"] == ["p.html: <a href=gone.html> (no file)", "p.html: <img src=b.png> (no file)"]
 
 
 def test_untypeset_tex_checker(tmp_path):

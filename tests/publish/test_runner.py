@@ -109,7 +109,12 @@ def test_sigint_mid_notebook_ends_every_process_and_leaves_the_build(tmp_path):
     previous build untouched, no temporary folder left."""
     target = tmp_path / "build-quick"
     done = source(tmp_path, "93_done")
-    assert notebooks.run_all([done], quick=True, output_dir=target, out=io.StringIO(), heartbeat=0) == 0
+    # the previous build is written by hand (a record is what the runner would replace): running it through
+    # run_all too cost a child process and a kernel, and test_the_build_is_replaced_only_when_everything_ran
+    # already checks what run_all writes
+    earlier = provenance.new_run(quick=True, seed=0, root=tmp_path)
+    provenance.write_record(target, "93_done", earlier, status="ok", seconds=1.0)
+    (target / "report.md").write_text("earlier build\n")
     before = provenance.read_records(target)
     pids = tmp_path / "pids.txt"
     body = (f"import os, subprocess, sys, time\n"
@@ -138,6 +143,7 @@ def test_sigint_mid_notebook_ends_every_process_and_leaves_the_build(tmp_path):
     for pid in (kernel, worker):
         assert not psutil.pid_exists(pid) or psutil.Process(pid).status() == psutil.STATUS_ZOMBIE, pid
     assert provenance.read_records(target) == before
+    assert (target / "report.md").read_text() == "earlier build\n"
     assert list(scratch.iterdir()) == [], list(scratch.iterdir())
     import glob
     left = [d for d in glob.glob('/tmp/cl-*/spec.json') if str(slow) in Path(d).read_text()]
@@ -147,7 +153,8 @@ def test_sigint_mid_notebook_ends_every_process_and_leaves_the_build(tmp_path):
 
 
 def test_status_lines_give_an_estimate_only_from_an_earlier_run(tmp_path):
-    src = source(tmp_path, "97_wait", body="import time\ntime.sleep(2.5)")
+    # 1 s in the cell (the child's start-up alone spans several 0.5 s beats): long enough for status lines
+    src = source(tmp_path, "97_wait", body="import time\ntime.sleep(1.0)")
     target = tmp_path / "build-quick"
     first, second = io.StringIO(), io.StringIO()
     assert notebooks.run_all([src], quick=True, output_dir=target, out=first, heartbeat=0.5) == 0
