@@ -25,27 +25,27 @@
 # informed station keeping of Secs. 4-5 are notebook 08.
 
 # %% tags=["parameters"]
-QUICK = False  # quick mode: coarser sphere of burn directions and fewer coast times (the default sizes below)
+QUICK = False  # quick mode: coarser sphere of burn directions, fewer coast times, arcs and ring angles (sizes below)
 SEED = 0  # seed of the random states of the coordinate checks (section 1)
 OUTPUT_DIR = ""  # folder for the figures (empty: build-scratch/ by hand, the build under the runner)
 N_GRID = None  # burn directions on the Fibonacci sphere (None: 600 quick, 3000 full)
 N_PERP = None  # burn directions on the circle perpendicular to the line of sight (None: 36 quick, 120 full)
-COAST_HOURS = None  # coast times tau_f - tau_0 swept, whole hours in 1-72 (None: 1, 4, 12, 24, 48 quick; 9 in full)
+COAST_HOURS = None  # coast times tau_f - tau_0 swept, whole hours in 1-72 (None: 1, 4, 24, 48 quick; 9 in full)
 DV_M_S = None  # burn magnitudes upsilon, m/s, the last one is "the larger burn" (None: [0.1, 1.0])
 MAP_COAST_H = None  # coast of the surrogate check, the direction map and the timing, whole hours (None: 12)
 LEAD_DAYS = None  # the burn happens this long before the target's apolune, days (None: 1.0)
 APOLUNE_RANGE_KM = None  # agent-target range at the target's apolune, km (None: 215.0, the paper's scale)
 PRE_ARC_H = None  # tracking arc before the burn in section 4, whole hours (None: 24)
-PRE_ARC_SWEEP_H = None  # tracking arcs swept, whole hours (None: 12, 24 quick; 6, 12, 24, 48 full; PRE_ARC_H added)
-RING_ANGLES_DEG = None  # initial ring angles of the agent on the QPO, deg, must include 0 (None: 0, 45, 90, 135)
-TIMING_REPEAT = None  # runs of the true minimiser timed, best kept (None: 2 quick, 1 full)
+PRE_ARC_SWEEP_H = None  # tracking arcs swept, whole hours (None: 24 quick; 6, 12, 24, 48 full; PRE_ARC_H added)
+RING_ANGLES_DEG = None  # agent's initial ring angles on the QPO, deg, with 0 (None: 0, 90 quick; 0, 45, 90, 135 full)
+TIMING_REPEAT = None  # runs of the true minimiser timed, best kept (None: 1)
 WORKERS = 1  # local processes for the sweeps (1: serial)
 SCHEDULER = ""  # address of a Dask scheduler to run the sweeps on ("" = none; then WORKERS applies)
 
 # %% [markdown]
 # **Changing the chapter.** Every size and setting of this chapter is a parameter of the cell above. A parameter
-# left at `None` is chosen in the next cell, from `QUICK` for the sizes (quick mode: a 600-direction sphere, five
-# coast times and two tracking arcs) and from the paper's scale for the scenario (215 km at apolune, burn 1 day before it); a value you
+# left at `None` is chosen in the next cell, from `QUICK` for the sizes (quick mode: a 600-direction sphere, four
+# coast times, one tracking arc and two ring angles on the torus) and from the paper's scale for the scenario (215 km at apolune, burn 1 day before it); a value you
 # give, in Jupyter or with `-p NAME=VALUE` on the command line, is used as given in either mode. The three sweeps
 # of sections 3 and 4 (burn sizes, tracking arcs, ring angles on the torus) run one task per case on the executor
 # that `WORKERS` local processes or a Dask `SCHEDULER` provide; every task is deterministic, so the numbers do not
@@ -56,16 +56,17 @@ SCHEDULER = ""  # address of a Dask scheduler to run the sweeps on ("" = none; t
 N_GRID = N_GRID if N_GRID is not None else (600 if QUICK else 3000)
 N_PERP = N_PERP if N_PERP is not None else (36 if QUICK else 120)
 COAST_HOURS = list(COAST_HOURS if COAST_HOURS is not None else
-                   ([1, 4, 12, 24, 48] if QUICK else [1, 2, 4, 8, 12, 18, 24, 36, 48]))
+                   ([1, 4, 24, 48] if QUICK else [1, 2, 4, 8, 12, 18, 24, 36, 48]))
 DV_M_S = list(DV_M_S if DV_M_S is not None else [0.1, 1.0])  # the paper gives no magnitude for this experiment
 MAP_COAST_H = MAP_COAST_H if MAP_COAST_H is not None else 12
 LEAD_DAYS = LEAD_DAYS if LEAD_DAYS is not None else 1.0
 APOLUNE_RANGE_KM = APOLUNE_RANGE_KM if APOLUNE_RANGE_KM is not None else 215.0
 PRE_ARC_H = PRE_ARC_H if PRE_ARC_H is not None else 24
 PRE_ARC_SWEEP_H = sorted(set(PRE_ARC_SWEEP_H if PRE_ARC_SWEEP_H is not None else
-                             ((12, 24) if QUICK else (6, 12, 24, 48))) | {PRE_ARC_H})
-RING_ANGLES_DEG = tuple(RING_ANGLES_DEG if RING_ANGLES_DEG is not None else (0.0, 45.0, 90.0, 135.0))
-TIMING_REPEAT = TIMING_REPEAT if TIMING_REPEAT is not None else (2 if QUICK else 1)
+                             ((24,) if QUICK else (6, 12, 24, 48))) | {PRE_ARC_H})
+RING_ANGLES_DEG = tuple(RING_ANGLES_DEG if RING_ANGLES_DEG is not None else
+                        ((0.0, 90.0) if QUICK else (0.0, 45.0, 90.0, 135.0)))
+TIMING_REPEAT = TIMING_REPEAT if TIMING_REPEAT is not None else 1
 WORKERS = WORKERS if WORKERS is not None else 1
 
 import numpy as np

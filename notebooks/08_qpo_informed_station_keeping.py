@@ -33,10 +33,10 @@ QUICK = False  # quick mode: coarser surface, fewer sweep points, fewer Monte Ca
 SEED = 0  # root seed: Monte Carlo streams [SEED, k], offset directions [SEED, 8], random picks [SEED, 20] and [SEED, 21]
 OUTPUT_DIR = ""  # folder for the figures (empty: build-scratch/ by hand, the build under the runner)
 N_SURF = None  # ring angles = arrival times of the station-keeping surface (None: 14 quick, 40 full; paper: not given)
-N_SWEEP = None  # arrival times in the sweep over the unstated scenario inputs (None: 5 quick, 16 full)
-N_GRID = None  # ring-angle counts of the resolution study of section 5b (None: 10, 20, 40 quick; 16 ... 640 full)
+N_SWEEP = None  # arrival times in the sweep over the unstated scenario inputs (None: 3 quick, 16 full)
+N_GRID = None  # ring-angle counts of the resolution study of section 5b (None: 10, 20 quick; 16 ... 640 full)
 N_GRID_SLICES = None  # arrival times in the resolution study (None: 3 quick, 5 full)
-N_TRIALS = None  # Monte Carlo trials per policy and execution-error level (None: 4 quick, 40 full)
+N_TRIALS = None  # Monte Carlo trials per policy and execution-error level (None: 2 quick, 40 full)
 N_RANDOM = None  # uninformed picks per arrival slice, ring angles uniform on [0, 2 pi) (None: 16 quick, 64 full)
 MEMBER_CHECK = None  # re-solve the torus for two other readings of "average range" (None: False quick, True full)
 WORKERS = None  # local processes for the sweeps and the Monte Carlo, 1 runs serially (None: 1 quick, 2 full)
@@ -56,7 +56,7 @@ EXEC_REL = None  # execution error, part proportional to the burn, fraction 1 si
 # %% [markdown]
 # **Changing the chapter.** Every size and every scenario choice the paper leaves open is a parameter of the cell
 # above. A parameter left at `None` is chosen in the next cell, from `QUICK` for the sizes (quick mode: a 14 x 14
-# surface, 4 Monte Carlo trials, the two extra torus members of section 6 skipped) and from our stated baseline for the scenario (first burn 24 h before apoapsis,
+# surface, 2 Monte Carlo trials, the two extra torus members of section 6 skipped) and from our stated baseline for the scenario (first burn 24 h before apoapsis,
 # arrivals within 12 h of it, read-out 24 h after it, agent at ring angle 0); a value you give, in Jupyter or with
 # `-p NAME=VALUE` on the command line, is used as given in either mode. The sweeps of sections 5b and 6 (one
 # surface per task) and the Monte Carlo of section 7 (one filter run per trial, trial streams `[SEED, k]`) run on
@@ -66,10 +66,10 @@ EXEC_REL = None  # execution error, part proportional to the burn, fraction 1 si
 # %%
 # Every parameter left at None is picked here (sizes from QUICK); a value the reader gave is used as given.
 N_SURF = N_SURF if N_SURF is not None else (14 if QUICK else 40)
-N_SWEEP = N_SWEEP if N_SWEEP is not None else (5 if QUICK else 16)
-N_GRID = tuple(N_GRID if N_GRID is not None else ((10, 20, 40) if QUICK else (16, 40, 80, 160, 320, 640)))
+N_SWEEP = N_SWEEP if N_SWEEP is not None else (3 if QUICK else 16)
+N_GRID = tuple(N_GRID if N_GRID is not None else ((10, 20) if QUICK else (16, 40, 80, 160, 320, 640)))
 N_GRID_SLICES = N_GRID_SLICES if N_GRID_SLICES is not None else (3 if QUICK else 5)
-N_TRIALS = N_TRIALS if N_TRIALS is not None else (4 if QUICK else 40)
+N_TRIALS = N_TRIALS if N_TRIALS is not None else (2 if QUICK else 40)
 N_RANDOM = N_RANDOM if N_RANDOM is not None else (16 if QUICK else 64)
 MEMBER_CHECK = MEMBER_CHECK if MEMBER_CHECK is not None else not QUICK
 WORKERS = WORKERS if WORKERS is not None else (1 if QUICK else 2)

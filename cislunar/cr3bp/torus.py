@@ -1048,6 +1048,33 @@ def mean_range(torus: InvariantTorus, *, n_theta: int = 48, n_t: int = 1201, per
     periods = validation.integer(periods, "periods", minimum=1)
     validation.work_size(float(n_theta) * periods * n_t, "n_theta * n_t * periods", _MAX_SAMPLES, "torus samples")
     tol = _heyoka_tol(tol)
+    return _range_stats(torus, n_theta, n_t, periods, tol).finish()
+
+
+@dataclass(frozen=True)
+class _RangeSamples:
+    """The sampled ranges of :func:`mean_range` before the (costly) refinement of their extrema."""
+
+    torus: InvariantTorus
+    th: np.ndarray
+    t: np.ndarray
+    rng: np.ndarray
+    tol: float
+    mean_km: float
+    rms_km: float
+    ring_mean_km: float
+
+    def finish(self) -> RangeStats:
+        """Refine the minimum and maximum range (Nelder-Mead from the grid extrema) and return the statistics."""
+        lo = _refine_extremum(self.torus, self.th, self.t, self.rng, +1.0, self.tol)
+        hi = _refine_extremum(self.torus, self.th, self.t, self.rng, -1.0, self.tol)
+        return RangeStats(mean_km=self.mean_km, min_km=lo[0], max_km=hi[0], rms_km=self.rms_km,
+                          ring_mean_km=self.ring_mean_km, theta0=self.th, t=self.t, range_km=self.rng,
+                          min_at=lo[1], max_at=hi[1])
+
+
+def _range_stats(torus, n_theta, n_t, periods, tol) -> _RangeSamples:
+    """Sampled ranges and their averages (the kernel of :func:`mean_range`; arguments already checked)."""
     T = torus.period
     th = 2.0 * np.pi * np.arange(n_theta) / n_theta
     t = np.linspace(0.0, periods * T, periods * (n_t - 1) + 1)
@@ -1058,11 +1085,8 @@ def mean_range(torus: InvariantTorus, *, n_theta: int = 48, n_t: int = 1201, per
     w[0] = w[-1] = 0.5
     w /= w.sum()
     per_theta = rng @ w
-    lo = _refine_extremum(torus, th, t, rng, +1.0, tol)
-    hi = _refine_extremum(torus, th, t, rng, -1.0, tol)
-    return RangeStats(mean_km=float(per_theta.mean()), min_km=lo[0], max_km=hi[0],
-                      rms_km=float(np.sqrt(np.mean((rng**2) @ w))), ring_mean_km=float(rng[:, 0].mean()),
-                      theta0=th, t=t, range_km=rng, min_at=lo[1], max_at=hi[1])
+    return _RangeSamples(torus=torus, th=th, t=t, rng=rng, tol=tol, mean_km=float(per_theta.mean()),
+                         rms_km=float(np.sqrt(np.mean((rng**2) @ w))), ring_mean_km=float(rng[:, 0].mean()))
 
 
 def _range_at(torus: InvariantTorus, theta0: float, t: float, tol: float) -> float:
@@ -1145,7 +1169,9 @@ def qpo_for_mean_range(orbit: PeriodicOrbit, target_km: float = 215.0, N: int = 
     progress = validation.boolean(progress, "progress")
     max_iter = validation.integer(max_iter, "max_iter", minimum=1)
     small = torus_from_orbit(orbit, N, min(5.0, target_km / 10.0), **solve_kw)
-    stats = mean_range(small, n_theta=n_theta, n_t=n_t)
+    # the range extrema (a Nelder-Mead each) are refined for the accepted member only: they do not enter the match
+    tol = _heyoka_tol(DEFAULT_TOL)
+    stats = _range_stats(small, n_theta, n_t, 1, tol)
     sizes, means = [small.size_km], [getattr(stats, statistic)]
     guess_km = small.size_km * target_km / means[0]
     torus = small
@@ -1154,11 +1180,11 @@ def qpo_for_mean_range(orbit: PeriodicOrbit, target_km: float = 215.0, N: int = 
         n_steps = max(1, int(np.ceil(abs(guess_km - torus.size_km) / 25.0)))
         values = np.linspace(torus.size_km, guess_km, n_steps + 1)[1:]
         torus = continue_tori(torus, values, parameter="size_km", progress=progress, **solve_kw)[-1]
-        stats = mean_range(torus, n_theta=n_theta, n_t=n_t)
+        stats = _range_stats(torus, n_theta, n_t, 1, tol)
         value = getattr(stats, statistic)
         history.append(value - target_km)
         if abs(value - target_km) <= rtol * target_km:
-            return torus, stats
+            return torus, stats.finish()
         sizes.append(torus.size_km)
         means.append(value)
         slope = (means[-1] - means[-2]) / (sizes[-1] - sizes[-2])

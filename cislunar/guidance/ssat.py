@@ -55,6 +55,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.linalg import _umath_linalg
 
 from cislunar.cr3bp.dynamics import CR3BP, check_system
 from cislunar.cr3bp.propagation import propagate_stm
@@ -534,6 +535,39 @@ def _check_pair_trajectories(agent, target, n_agent_name="agent", n_target_name=
         raise ValueError(f"{n_agent_name} and {n_target_name} must share the same time grid")
 
 
+_TRIU_12 = np.triu(np.ones((12, 12), dtype=bool))
+
+
+def _sri_range_variance(R, A, stm_a, stm_t, M):
+    """The measurement loop of :func:`ssat_covariance` (arguments checked there): :math:`J_\\rho` at every epoch
+    (n, N) and the final square-root information matrix (n, 12, 12).
+
+    The QR factorisations and triangular-system solves are the very LAPACK calls of ``np.linalg.qr(..., mode="r")``
+    and ``np.linalg.solve`` (numpy's own linalg gufuncs, same inputs, same signature), called once per epoch without
+    the per-call wrapper work of those functions; the results are bit-identical to them
+    (``tests/guidance/test_ssat_kernel.py`` keeps the wrapper form as its oracle).
+    """
+    n, N = A.shape[:2]
+    J = np.empty((n, N))
+    # g_k = Phi_k^T m_k (block diagonal STM), every epoch at once
+    g = np.concatenate([np.einsum("nkji,nkj->nki", stm_a, M[..., :6]),
+                        np.einsum("nkji,nkj->nki", stm_t, M[..., 6:])], axis=-1)[..., None]
+    qr_r_raw, solve = _umath_linalg.qr_r_raw, _umath_linalg.solve
+    stacked = np.empty((n, 12 + A.shape[-2], 12))
+    with np.errstate(invalid="raise", over="ignore", divide="ignore", under="ignore"):
+        try:
+            for k in range(N):
+                stacked[:, :12] = R
+                stacked[:, 12:] = A[:, k]
+                qr_r_raw(stacked, signature="d->d")  # Householder QR in place (LAPACK dgeqrf), R in the upper part
+                R = np.where(_TRIU_12, stacked[:, :12], 0.0)
+                w = solve(np.swapaxes(R, -1, -2), g[:, k], signature="dd->d")[..., 0]
+                J[:, k] = np.sum(w * w, axis=-1)
+        except FloatingPointError as err:  # what np.linalg raises on a failed factorisation or a singular R
+            raise np.linalg.LinAlgError(f"square-root information update failed: {err}") from None
+    return J, R
+
+
 def ssat_covariance(system: CR3BP, agent: ImpulsiveTrajectory, target: ImpulsiveTrajectory, P0, *,
                     sigma_min_rad: float = AMOS_SIGMA_MIN_RAD,
                     resolution_km: float = AMOS_RESOLUTION_KM) -> SSATCovariance:
@@ -576,16 +610,9 @@ def ssat_covariance(system: CR3BP, agent: ImpulsiveTrajectory, target: Impulsive
     # A_k = H_k blockdiag(Phi_a, Phi_t)
     A = np.concatenate([H[..., :6] @ agent.stm, H[..., 6:] @ st], axis=-1)
     R = np.broadcast_to(np.linalg.inv(np.linalg.cholesky(P0)), (n, 12, 12)).copy()  # R^T R = P0^{-1}
-    J = np.empty((n, N))
     X = np.concatenate([agent.x, xt], axis=-1)
     M = range_projection(X, "inertial")  # (n, N, 12)
-    for k in range(N):
-        R = np.linalg.qr(np.concatenate([R, A[:, k]], axis=-2), mode="r")[..., :12, :]
-        # g = Phi_k^T m_k (block diagonal STM)
-        g = np.concatenate([np.einsum("nji,nj->ni", agent.stm[:, k], M[:, k, :6]),
-                            np.einsum("nji,nj->ni", st[:, k], M[:, k, 6:])], axis=-1)
-        w = np.linalg.solve(np.swapaxes(R, -1, -2), g[..., None])[..., 0]
-        J[:, k] = np.sum(w * w, axis=-1)
+    J, R = _sri_range_variance(R, A, agent.stm, st, M)
     Rinv = np.linalg.inv(R)
     Pt0 = Rinv @ np.swapaxes(Rinv, -1, -2)
     Phi = np.zeros((n, 12, 12))

@@ -324,6 +324,10 @@ def test_member_with_215_km_mean_range(orbit):
     assert torus.invariance_error() < 1e-9
     assert 100.0 < torus.size_km < 215.0
     assert stats.min_km < 215.0 < stats.max_km
+    # the extrema are refined for the accepted member only: its statistics are those of mean_range, bit for bit
+    again = tm.mean_range(torus, n_theta=24, n_t=601)
+    for name in ("mean_km", "min_km", "max_km", "rms_km", "ring_mean_km", "min_at", "max_at", "range_km"):
+        assert np.array_equal(getattr(stats, name), getattr(again, name)), name
     # matching the mean over the apolune ring instead selects a larger member (the ring is smallest near apolune)
     ring, ring_stats = tm.qpo_for_mean_range(orbit, 215.0, N=11, n_theta=24, n_t=601, statistic="ring_mean_km")
     assert abs(ring_stats.ring_mean_km - 215.0) < 215.0 * 1e-5
