@@ -20,7 +20,8 @@ minimum-range keep-out) on 30 nodes.
      :class:`~cislunar.guidance.scvx.SCvxWorkspace`: canonicalised once per sweep, stacked FOH Parameters; the
      window's fixed ingredients checked once; no gradient or Hessian on the converged step; the FOH parameters
      set in place; since 2026-11-26d each re-solve hands cvxpy's canonical data straight to Clarabel
-     (``_Subproblem._solve_clarabel``) instead of going through ``Problem.solve``).
+     (``_Subproblem._solve_clarabel``) instead of going through ``Problem.solve``, and the Hessian's second-order
+     propagations run with sorted lanes in wide batches, item 4; the old path keeps the old ones).
 
    Both paths visit the same iterates (the solutions are compared bit for bit and the iteration counts printed);
    one saving is not rebuilt in the old path (the gradient and Hessian it computed on the converged step of every
@@ -32,6 +33,14 @@ minimum-range keep-out) on 30 nodes.
    and re-solved with new values (direct Clarabel path; the per-interval old subproblem through
    ``Problem.solve``), against building and solving a fresh problem each time.
 
+4. **The Hessian's second-order propagations** (:func:`compare_lane_order`, since 2026-11-26d): the 12 perturbed
+   observers x window intervals handed to heyoka's batch integrator (4 SIMD lanes) in the given, observer-major order
+   (``old``: a batch holds 4 consecutive intervals of one observer and steps until its slowest lane has finished)
+   or sorted by an estimate of their step counts (``new``, :func:`cislunar.sensing.covariance._lane_order`: a batch
+   holds the perturbed copies of one interval, lanes = perturbations; and order-2 batches twice heyoka's SIMD size,
+   :func:`cislunar.cr3bp.propagation._batch_plan`); one Hessian refresh and the whole notebook sweeps of both test
+   cases by each, bit for bit the same results.
+
 ``python -m benchmarks scvx`` prints the numbers; ``main()`` returns them.  Ratios are within one run.
 """
 
@@ -41,6 +50,7 @@ import time
 
 import numpy as np
 
+from cislunar.cr3bp import propagation
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.guidance import discretization as D
 from cislunar.guidance import scvx
@@ -198,9 +208,10 @@ def _timed_sweep(solver, alphas, x0, u0, old: bool = False):
     if old:  # the old FOH interval code for this sweep only (module attribute looked up at every call)
         D._foh_interval = _old_foh_interval
     try:
-        p0, t0 = time.process_time(), time.perf_counter()
-        sweep = wolf_jones.sweep_both_ways(solver, alphas, x0, u0)
-        return sweep, time.process_time() - p0, time.perf_counter() - t0
+        with _OldSecondOrder() if old else _New():  # and the old second-order propagations (before 2026-11-26d)
+            p0, t0 = time.process_time(), time.perf_counter()
+            sweep = wolf_jones.sweep_both_ways(solver, alphas, x0, u0)
+            return sweep, time.process_time() - p0, time.perf_counter() - t0
     finally:
         D._foh_interval = fast
 
@@ -219,8 +230,11 @@ def compare_sweeps(case: int) -> dict:
     new = wolf_jones.ScenarioSolver(sc, t, k_ws, information=sc.information_model(), keep_out=keep_out,
                                     settings=settings)
     old = _old_solver(new)
-    old.information(x0[k_ws], 1)  # warm the integrators of both paths
+    with _OldSecondOrder():  # warm the integrators of both paths
+        old.information(x0[k_ws], 1)
+        old.information.hessian(x0[k_ws] + 1e-9)
     new.information(x0[k_ws], 1)
+    new.information.hessian(x0[k_ws] + 1e-9)
     s_old, cpu_old, wall_old = _timed_sweep(old, alphas, x0, u0, old=True)
     s_new, cpu_new, wall_new = _timed_sweep(new, alphas, x0, u0)
     same = all((a is None and b is None) or (a is not None and b is not None and np.array_equal(a.x, b.x)
@@ -240,6 +254,130 @@ def compare_sweeps(case: int) -> dict:
     print(f"  CPU old {cpu_old:.1f} s, new {cpu_new:.1f} s: new / old = {cpu_new / cpu_old:.2f} "
           f"({100 * (1 - cpu_new / cpu_old):.0f} % less); wall old {wall_old:.1f} s, new {wall_new:.1f} s: "
           f"{wall_new / wall_old:.2f}")
+    return out
+
+
+# ------------------------------------------------------------------------------------------------------------------
+# the Hessian's second-order propagations: batch lanes in the given order (before 2026-11-26d) or sorted
+# ------------------------------------------------------------------------------------------------------------------
+def _narrow_plan(n, simd, order):
+    """``propagation._batch_plan`` before 2026-11-26d: chunks of heyoka's SIMD size at every order."""
+    return [(0, 1)] if n == 1 else [(i, simd) for i in range(0, n, simd)]
+
+
+class _OldSecondOrder:
+    """Context: the second-order interval propagations as before 2026-11-26d (lanes in the given order, batches of
+    the SIMD size), by swapping the two module attributes for the duration."""
+
+    def __enter__(self):
+        self.saved = cov._propagate_arcs, propagation._batch_plan
+        cov._propagate_arcs, propagation._batch_plan = _unsorted_arcs, _narrow_plan
+
+    def __exit__(self, *exc):
+        cov._propagate_arcs, propagation._batch_plan = self.saved
+
+
+class _New:
+    def __enter__(self):
+        pass
+
+    def __exit__(self, *exc):
+        pass
+
+
+def _unsorted_arcs(system, x0, t, qq, order, n_nodes):
+    """``covariance._propagate_arcs`` before 2026-11-26d: the batch lanes in the given (observer-major) order."""
+    K, N = x0.shape[0], t.size
+    X = cov.propagate(system, x0, t).x
+    X = X if X.ndim == 3 else X[None]
+    F, Qd, Psi = cov._interval_transitions(system, X[:, :-1].reshape(-1, 6), np.tile(np.diff(t), K), qq,
+                                           int(n_nodes), order, sort_lanes=False)
+    return cov.ObjectArcs(t=t, x=X, F=F.reshape(K, N - 1, 6, 6),
+                          Q=None if Qd is None else Qd.reshape(K, N - 1, 6, 6),
+                          stt=None if Psi is None else Psi.reshape(K, N - 1, 6, 6, 6))
+
+
+def _case(case):
+    if case == 1:
+        sc = wolf_jones.test_case_1()
+        t, k_ws, _ = sc.node_times(N_NODES)
+        return sc, t, k_ws, ALPHAS, False, None
+    sc = wolf_jones.test_case_2()
+    t, k_ws, _ = sc.node_times(N_NODES_CASE_2, 1.0)
+    return sc, t, k_ws, ALPHAS_CASE_2, True, scvx.SCvxSettings(max_iter=150)
+
+
+def compare_lane_order(case: int, sweeps: bool = True, repeat: int = 6) -> dict:
+    """Hessian refresh and whole sweeps of test case ``case`` with the second-order interval propagations as before
+    2026-11-26d (``old``: batch lanes in the given order, batches of heyoka's SIMD size) and now (``new``: lanes
+    sorted by step count, :func:`cislunar.sensing.covariance._lane_order`; order-2 batches twice as wide,
+    :func:`cislunar.cr3bp.propagation._batch_plan`), side by side in one process.
+
+    Prints the Hessian times (CPU, median of ``repeat`` interleaved pairs at fresh points near the ballistic guess),
+    the largest relative difference of the two Hessians, and (``sweeps``) the CPU time of the notebook sweep by each
+    path, the iteration counts, the largest relative cost difference of the best plans and the largest state
+    difference.
+    """
+    sc, t, k_ws, alphas, keep_out, settings = _case(case)
+    x0, u0 = sc.ballistic_guess(t)
+    info = sc.information_model()
+    xw = x0[k_ws]
+    info(xw, 1)
+    with _OldSecondOrder():
+        info.hessian(xw + 1e-9)  # compile the narrow order-2 integrator outside the timings
+    rng = np.random.default_rng(0)
+    t_old, t_new, rel = [], [], 0.0
+    for _ in range(repeat):
+        x = xw + 1e-9 * rng.standard_normal(6)
+        H = {}
+        for name, path, sink in (("old", _OldSecondOrder, t_old), ("new", _New, t_new)):
+            with path():
+                info._hessians.clear()
+                p0 = time.process_time()
+                H[name] = info.hessian(x)
+                sink.append(time.process_time() - p0)
+        rel = max(rel, float(np.max(np.abs(H["new"] - H["old"])) / np.max(np.abs(H["old"]))))
+    p = f"case{case}_"
+    out = {p + "hessian_old_ms": 1e3 * float(np.median(t_old)), p + "hessian_new_ms": 1e3 * float(np.median(t_new)),
+           p + "hessian_ratio_new_over_old": float(np.median(np.array(t_new) / np.array(t_old))),
+           p + "hessian_max_rel_diff": rel}
+    print(f"test case {case}: Hessian refresh old {out[p + 'hessian_old_ms']:.1f} ms, new "
+          f"{out[p + 'hessian_new_ms']:.1f} ms (new / old {out[p + 'hessian_ratio_new_over_old']:.2f}); "
+          f"max relative difference {rel:.1e}")
+    if not sweeps:
+        return out
+    res = {}
+    for name, path in (("old", _OldSecondOrder), ("new", _New)):
+        with path():
+            solver = wolf_jones.ScenarioSolver(sc, t, k_ws, information=sc.information_model(), keep_out=keep_out,
+                                               settings=settings)
+            solver.information(xw, 1)
+            res[name] = _timed_sweep(solver, alphas, x0, u0)
+    so, sn = res["old"][0], res["new"][0]
+    it = {k: [(int(a["iterations"]), bool(a["converged"])) for a in res[k][0].attempts] for k in res}
+    cost = dx = 0.0
+    identical = True
+    for a, b in zip(so.attempts, sn.attempts):
+        ca, cb = float(a.get("cost", np.nan)), float(b.get("cost", np.nan))
+        if np.isfinite(ca) or np.isfinite(cb):
+            cost = max(cost, abs(cb - ca) / max(abs(ca), 1e-300))
+    for a, b in zip(so.best, sn.best):
+        if (a is None) != (b is None):
+            identical, dx = False, np.inf
+        elif a is not None:
+            identical = identical and np.array_equal(a.x, b.x) and np.array_equal(a.u, b.u)
+            dx = max(dx, float(np.max(np.abs(a.x - b.x))))
+    out.update({p + "sweep_cpu_old_s": res["old"][1], p + "sweep_cpu_new_s": res["new"][1],
+                p + "sweep_cpu_ratio_new_over_old": res["new"][1] / res["old"][1],
+                p + "sweep_iterations_equal": it["old"] == it["new"],
+                p + "sweep_iterations": sum(i for i, _ in it["new"]),
+                p + "sweep_max_rel_cost_diff": cost, p + "sweep_max_state_diff_lu": dx,
+                p + "sweep_bit_identical": identical})
+    print(f"  sweep ({len(alphas)} alpha_h up and down): CPU old {res['old'][1]:.1f} s, new {res['new'][1]:.1f} s "
+          f"(new / old {res['new'][1] / res['old'][1]:.2f}); iterations per run equal: {it['old'] == it['new']} "
+          f"({sum(i for i, _ in it['new'])}); max relative cost difference {cost:.1e}; max state difference "
+          f"{dx:.1e} LU; "
+          f"bit-identical: {identical}")
     return out
 
 
@@ -329,6 +467,8 @@ def main() -> dict:
     out = {}
     out.update(compare_sweeps(1))
     out.update(compare_sweeps(2))
+    out.update(compare_lane_order(1))
+    out.update(compare_lane_order(2))
     sc, t, k_ws, x0, u0, u_max, info = _setup()
     xw = x0[k_ws]
     D.foh_discretize(em, t, x0, u0)  # compile / warm the integrators

@@ -323,9 +323,36 @@ def van_loan(A, q: float, dt: float):
     return Phi, symmetrize(Phi @ E[:6, 6:])
 
 
+def _lane_order(system: CR3BP, starts: np.ndarray, ends: np.ndarray | None, dts: np.ndarray) -> np.ndarray:
+    r"""Order in which to hand the intervals ``starts`` (K, 6) to heyoka's batch integrator: by an estimate of their
+    number of Taylor steps, fewest first (stable argsort; a permutation of ``range(K)``).
+
+    A batch of SIMD lanes steps until its slowest lane has finished, so lanes with equal step counts should share a
+    batch.  The estimate is :math:`|\Delta t|\,\max |\mathbf v| / \min(r_1, r_2)` over the interval's start and
+    (when given) end states ``ends`` (K, 6): Taylor step sizes scale with the distance to the nearest primary over
+    the speed.  Intervals of perturbed copies of one arc (the Hessian's 12 observers) get nearly equal estimates and
+    share batches (lanes = perturbations).  Each lane has its own step sizes, so the order changes only the time,
+    not a bit of the results (compared in ``tests/sensing/test_covariance_lanes.py``).  Unchecked (inner kernel).
+    """
+    def rate(x):
+        r1, r2 = system.distances(x)
+        return np.sqrt(np.einsum("ki,ki->k", x[:, 3:], x[:, 3:])) / np.minimum(r1, r2)
+
+    est = rate(starts) if ends is None else np.maximum(rate(starts), rate(ends))
+    return np.argsort(np.abs(dts) * est, kind="stable")
+
+
 def _interval_transitions(system: CR3BP, starts: np.ndarray, dts: np.ndarray, q: float | None, n_nodes: int,
-                          order: int):
-    """Per-interval STM (and STT) over ``dts`` from ``starts`` (K, 6), and the process noise by quadrature."""
+                          order: int, ends: np.ndarray | None = None, sort_lanes: bool = True):
+    """Per-interval STM (and STT) over ``dts`` from ``starts`` (K, 6), and the process noise by quadrature.
+
+    ``sort_lanes=True`` (default since 2026-11-26d) hands the intervals to heyoka's batch integrator in the order
+    of :func:`_lane_order` (``ends`` (K, 6), optional: the states at the ends of the intervals, used only for that
+    order); False keeps the given order (the path before).  Each lane of a heyoka batch has its own steps, so the
+    order moves no result (compared bit for bit in ``tests/sensing/test_covariance_lanes.py``); the group's
+    interval length stays its first interval's in the given order (lengths equal to 12 digits are grouped, and may
+    differ in the last bits).
+    """
 
     K = starts.shape[0]
     F = np.empty((K, 6, 6))
@@ -336,7 +363,9 @@ def _interval_transitions(system: CR3BP, starts: np.ndarray, dts: np.ndarray, q:
     keys = np.round(dts / np.max(np.abs(dts)), 12)
     for key in np.unique(keys):
         idx = np.flatnonzero(keys == key)
-        dt = float(dts[idx[0]])
+        dt = float(dts[idx[0]])  # the group's length: its first interval's in the given order (whatever the lanes')
+        if sort_lanes and idx.size > 1:
+            idx = idx[_lane_order(system, starts[idx], None if ends is None else ends[idx], dts[idx])]
         taus = 0.5 * dt * (nodes + 1.0)
         grid = np.r_[0.0, taus, dt] if q is not None else np.array([0.0, dt])
         prop = propagate_stt if order == 2 else propagate_stm
@@ -390,7 +419,7 @@ def process_noise(system: CR3BP, x, t, q: float, *, n_nodes: int = 12) -> np.nda
     n, m = xs.shape[0], xs.shape[1]
     starts = xs[:, :-1].reshape(-1, 6)
     dts = np.tile(np.diff(t), n)
-    _, Qd, _ = _interval_transitions(system, starts, dts, q, int(n_nodes), 1)
+    _, Qd, _ = _interval_transitions(system, starts, dts, q, int(n_nodes), 1, xs[:, 1:].reshape(-1, 6))
     Qd = Qd.reshape(n, m - 1, 6, 6)
     return Qd[0] if single else Qd
 
@@ -813,7 +842,9 @@ def _propagate_arcs(system, x0, t, qq, order, n_nodes) -> ObjectArcs:
     X = X if X.ndim == 3 else X[None]
     starts = X[:, :-1].reshape(-1, 6)
     dts = np.tile(np.diff(t), K)
-    F, Qd, Psi = _interval_transitions(system, starts, dts, qq, int(n_nodes), order)
+    # batch lanes sorted by step count (the SCvx Hessian's 12 perturbed observers: lanes = perturbations); the
+    # results are bit-identical to the given order's
+    F, Qd, Psi = _interval_transitions(system, starts, dts, qq, int(n_nodes), order, X[:, 1:].reshape(-1, 6))
     return ObjectArcs(t=t, x=X, F=F.reshape(K, N - 1, 6, 6),
                       Q=None if Qd is None else Qd.reshape(K, N - 1, 6, 6),
                       stt=None if Psi is None else Psi.reshape(K, N - 1, 6, 6, 6))

@@ -321,3 +321,27 @@ def test_screen_and_the_16_piece_sum_decide_alike_along_a_near_grazing_family(re
             kept = [tuple(t[k:k + 2]) for k in np.flatnonzero(many <= np.diff(t))]
             assert repropagated[0] == kept[:len(repropagated[0])] and (depth < 0 or repropagated[0])
             assert (outcomes[0] == "clear") == (depth < 0), (depth, n_sub, outcomes)
+
+
+@pytest.mark.parametrize("n", [5, 12, 13])
+def test_wide_order_2_batches_give_the_narrow_batches_bits(n):
+    """Order 2 is integrated in batches of twice heyoka's SIMD size (``_batch_plan``); every state's STM and STT are
+    bit for bit those of the narrow batches (the path before 2026-11-26d) and belong to that state: a chunk plan
+    that drops, repeats or shifts a state (a wrong lane order) fails."""
+    rng = np.random.default_rng(n)
+    x0 = np.array([7.80136159e-1, 0, 0, 0, 5.53104815e-1, 0]) + 1e-3 * rng.standard_normal((n, 6))
+    grid = np.array([0.0, 0.3, 0.7])
+    simd = 4
+    plan = pr._batch_plan(n, simd, 2)
+    assert [i for i, _ in plan] == sorted(i for i, _ in plan) and plan[0][0] == 0
+    assert sum(min(b, n - i) for i, b in plan) == n and all(b in (simd, 2 * simd) for _, b in plan)
+    assert any(b == 2 * simd for _, b in plan)
+    assert pr._batch_plan(n, simd, 1) == [(i, simd) for i in range(0, n, simd)]  # orders 0 and 1 unchanged
+    wide = propagate_stt(em, x0, grid)
+    narrow = np.concatenate([pr._propagate_chunk(em, x0[i:i + simd], grid, 2, pr.DEFAULT_TOL, simd)
+                             for i in range(0, n, simd)])
+    _, stm_index, stt_index = pr._unpack_maps(2)
+    assert np.array_equal(wide.x, narrow[..., :6])
+    assert np.array_equal(wide.stm, narrow[..., stm_index]) and np.array_equal(wide.stt, narrow[..., stt_index])
+    alone = propagate_stt(em, x0[n - 1], grid)  # the last (padded) lane is its own state's
+    np.testing.assert_allclose(wide.stm[n - 1], alone.stm, rtol=0, atol=1e-12 * np.max(np.abs(alone.stm)))
