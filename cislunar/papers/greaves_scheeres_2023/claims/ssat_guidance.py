@@ -51,8 +51,8 @@ CLAIMS = {
         "'nearly optimal'", AtMost(5.0), source="Sec. 4.1",
         reason=f"MMD's excess over the true minimiser (percent, 1 m/s burn, worst coast) exceeds 5 %; {_NOT_GIVEN}"),
     "mmd_near_optimal_qpo": Claim(
-        "MMD near-optimal, burn at the start of tracking, agent on the 215-km QPO (4 ring angles 0, 45, 90, 135 deg, "
-        "1.0 m/s)", "'nearly optimal'", AtMost(5.0), kind="beyond paper", source="Sec. 4.1",
+        "MMD near-optimal, burn at the start of tracking, agent on the 215-km QPO (ring angles and coasts in the "
+        "note; 1.0 m/s)", "'nearly optimal'", AtMost(5.0), kind="beyond paper", source="Sec. 4.1",
         reason="MMD's median excess over the true minimiser (percent, all ring angles and coasts) exceeds 5 %: the "
                "verdict depends on geometry and coast time"),
     "mmd_near_optimal_arc_short": Claim(
