@@ -44,6 +44,7 @@ OUTPUT_DIR = ""
 N_NODES = None  # Sundman nodes over the three periods, window ends moved onto nodes (None: 16 quick, 30 full)
 MAX_ITER = None  # SCvx iteration limit per run (None: 100 quick, 150 full)
 N_NODES_ALT = None  # other node grids on which the whole sweep is solved again (None: [12] quick, [24, 27] full)
+ALT_DIRECTIONS = None  # homotopy chains of the sweep on those grids (None: ["up"] quick, ["up", "down"] full)
 FREE_ITER = None  # iterations granted to the run without keep-out at the Fig. 6 weight (None: 5 quick, 75 full)
 SIGMA = 1.0  # Sundman exponent of the node spacing dt = r_m^sigma dtau (notebook 04)
 ALPHAS = None  # homotopy weights alpha_h, increasing in [0, 1] (None: [0, 5e-3, 1e-2] quick; 8 values full)
@@ -78,6 +79,7 @@ SCHEDULER = ""  # address of a Dask scheduler to run them on, e.g. "tcp://10.0.0
 n_nodes = N_NODES if N_NODES is not None else (16 if QUICK else 30)
 max_iter = MAX_ITER if MAX_ITER is not None else (100 if QUICK else 150)
 n_nodes_alt = N_NODES_ALT if N_NODES_ALT is not None else ([12] if QUICK else [24, 27])
+alt_directions = ALT_DIRECTIONS if ALT_DIRECTIONS is not None else (["up"] if QUICK else ["up", "down"])
 free_iter = FREE_ITER if FREE_ITER is not None else (5 if QUICK else 75)
 alphas = ALPHAS if ALPHAS is not None else ([0.0, 5e-3, 1e-2] if QUICK else [0.0, 5e-4, 1e-3, 2e-3, 5e-3, 7e-3, 1e-2,
                                                                               2e-2])
@@ -219,14 +221,16 @@ for d_show in (1000.0, 424.0, 1.0, 0.1, 1e-3, 1e-6):
 # $\alpha_h = 0$) and downward (from the ballistic guess at the largest $\alpha_h$) and keep the lower cost per
 # $\alpha_h$. The two sweeps are independent: with `WORKERS = 2` they run side by side, together with the
 # seeded runs of section 7 and the sweeps on other node grids of section 6 (`test_case_studies.case2_runs`
-# queues them all on one executor and collects them).
+# queues them all on one executor and collects them). On those other grids `ALT_DIRECTIONS` says which chains run:
+# both in the full run, only the upward one in the quick run (half the solves; that grid then reports the upward
+# chain's optima, not the better of two).
 
 # %%
 solver = wj.ScenarioSolver(sc, t, k_ws, information=info, keep_out=True,
                            settings=scvx.SCvxSettings(max_iter=max_iter))
 with open_executor(workers, SCHEDULER) as executor:  # seeded runs (section 7), this sweep, other grids (section 6)
     runs = studies.case2_runs(sc, solver, alphas, x_ball, u_ball, seed_alphas=seed_alphas, alt_nodes=n_nodes_alt,
-                              sigma=SIGMA, executor=executor)
+                              sigma=SIGMA, executor=executor, alt_directions=alt_directions)
 
 # %% [markdown]
 # **Several starts per weight.** Two sweeps give at most two starts per weight. `global_search.multi_start`

@@ -62,3 +62,11 @@ def plan(value, name: str, *, controls: bool = True, n: int | None = None):
     if controls:
         validation.as_array(value.u, f"{name}.u", shape=(x.shape[0], 3))
     return value
+
+
+def directions(value, name: str) -> tuple:
+    """Homotopy chains to run: a non-empty subset of ("up", "down") without repeats, returned in that order."""
+    given = sequence(value, name)
+    if any(d not in ("up", "down") for d in given) or len(set(given)) != len(given):
+        raise ValueError(f"{name} must be a non-empty subset of ('up', 'down') without repeats; got {given!r}")
+    return tuple(d for d in ("up", "down") if d in given)

@@ -65,6 +65,7 @@ from cislunar.guidance.scvx import (
     impulse,  # noqa: F401 - re-exported: the trapezoid impulse of Eq. 42 has one home (scvx)
     solve_scvx,
 )
+from cislunar.papers.wolf_jones import _checks
 from cislunar.papers.wolf_jones.reference import load_wolf_jones_table, verify_table_row
 from cislunar.sensing import covariance as cov
 from cislunar.sensing import information as info
@@ -807,14 +808,16 @@ def _chain(solver, alphas, x_guess, u_guess, direction):
     return results, attempts
 
 
-def sweep_both_ways(solver: ScenarioSolver, alphas, x_guess, u_guess, *, executor=None):
+def sweep_both_ways(solver: ScenarioSolver, alphas, x_guess, u_guess, *, executor=None,
+                    directions=("up", "down")):
     """Upward and downward homotopy sweeps from the same guess, best cost kept per alpha.
 
     The upward chain starts at the smallest alpha, the downward at the largest, both from ``(x_guess,
     u_guess)``, each warm-started from its previous solution; a warm start that fails (:class:`SCvxError`) is
     retried from ``(x_guess, u_guess)`` (on test case 2 warm starts from a neighbouring optimum with an active
     keep-out sometimes creep where the cold start converges).  The two chains are independent, so an executor
-    (``submit``) can run them side by side.
+    (``submit``) can run them side by side.  ``directions`` (a non-empty subset of ``("up", "down")``, run in
+    that order) runs only some chains: ``("up",)`` is the cheaper one-way sweep of a quick run.
 
     Returns
     -------
@@ -829,16 +832,17 @@ def sweep_both_ways(solver: ScenarioSolver, alphas, x_guess, u_guess, *, executo
         raise ValueError("alphas must be strictly increasing within [0, 1]")
     x_guess = validation.as_array(x_guess, "x_guess", ndim=(2,), last=6)
     u_guess = validation.as_array(u_guess, "u_guess", shape=(x_guess.shape[0], 3))
+    directions = _checks.directions(directions, "directions")
     if executor is None:
-        chains = [_chain(solver, a, x_guess, u_guess, d) for d in ("up", "down")]
+        chains = [_chain(solver, a, x_guess, u_guess, d) for d in directions]
     else:
         if not callable(getattr(executor, "submit", None)):
             raise ValueError(f"executor must have a submit method; got {type(executor).__name__}")
-        futs = [executor.submit(_chain, solver, a, x_guess, u_guess, d) for d in ("up", "down")]
+        futs = [executor.submit(_chain, solver, a, x_guess, u_guess, d) for d in directions]
         chains = [f.result() for f in futs]
     best, source = [], []
     for i in range(a.size):
-        cands = [(res[i], d) for (res, _), d in zip(chains, ("up", "down")) if res[i] is not None]
+        cands = [(res[i], d) for (res, _), d in zip(chains, directions) if res[i] is not None]
         if not cands:
             best.append(None)
             source.append("")
@@ -846,7 +850,7 @@ def sweep_both_ways(solver: ScenarioSolver, alphas, x_guess, u_guess, *, executo
         b, d = min(cands, key=lambda c: c[0].cost)
         best.append(b)
         source.append(d)
-    return SweepResult(a, best, source, chains[0][1] + chains[1][1])
+    return SweepResult(a, best, source, [att for _, atts in chains for att in atts])
 
 
 class ImpulseBudgetError(RuntimeError):

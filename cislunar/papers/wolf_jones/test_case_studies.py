@@ -1142,9 +1142,11 @@ def radius_row(sc: wj.Scenario, k_ws: int, d: float, src: str, res, reference_x)
                      float(np.max(np.linalg.norm((res.x - reference_x)[:, :3], axis=1)) * em.length_unit_km))
 
 
-def alt_grid_sweep(sc: wj.Scenario, info, n_nodes: int, alphas, settings, *, sigma: float = 1.0, executor=None):
+def alt_grid_sweep(sc: wj.Scenario, info, n_nodes: int, alphas, settings, *, sigma: float = 1.0, executor=None,
+                   directions=("up", "down")):
     """The two-way sweep of test case 2 (424 km keep-out) on another Sundman grid: ``(t, k_ws, SweepResult)``;
-    with an executor its two chains run side by side."""
+    with an executor its two chains run side by side; ``directions`` as in
+    :func:`~cislunar.papers.wolf_jones.scenarios.sweep_both_ways` (one chain only, e.g. ``("up",)``)."""
     validation.instance(sc, "sc", wj.Scenario)
     validation.callable_(info, "info")
     n_nodes = validation.integer(n_nodes, "n_nodes", minimum=4)
@@ -1154,7 +1156,8 @@ def alt_grid_sweep(sc: wj.Scenario, info, n_nodes: int, alphas, settings, *, sig
     _checks.executor(executor)
     t, k, _ = sc.node_times(n_nodes, sigma)
     solver = wj.ScenarioSolver(sc, t, k, information=info, keep_out=True, settings=settings)
-    return t, k, wj.sweep_both_ways(solver, alphas, *sc.ballistic_guess(t), executor=executor)
+    return t, k, wj.sweep_both_ways(solver, alphas, *sc.ballistic_guess(t), executor=executor,
+                                    directions=directions)
 
 
 
@@ -1204,12 +1207,13 @@ class Case2Runs:
 
 
 def case2_runs(sc: wj.Scenario, solver, alphas, x_guess, u_guess, *, seed_alphas=(), alt_nodes=(),
-               sigma: float = 1.0, executor=None) -> Case2Runs:
+               sigma: float = 1.0, executor=None, alt_directions=("up", "down")) -> Case2Runs:
     """Queue the independent runs of test case 2 on ``executor`` and collect them.
 
     The +z/-z seeded runs at ``seed_alphas`` (:meth:`Scenario.seeded_guess`), the two-way sweep of ``solver`` over
     ``alphas`` from ``(x_guess, u_guess)`` (:func:`~cislunar.papers.wolf_jones.scenarios.sweep_both_ways`) and the
-    same sweep on each Sundman grid of ``alt_nodes`` nodes (:func:`alt_grid_sweep`, same settings).  With an
+    same sweep on each Sundman grid of ``alt_nodes`` nodes (:func:`alt_grid_sweep`, same settings; only the chains
+    of ``alt_directions`` there, e.g. ``("up",)`` in a quick run).  With an
     executor (``submit``: a process pool or a Dask client from :func:`cislunar.utils.executors.open_executor`)
     every chain and seeded run is one task, queued in that order; without one they run here, one after the other.
     Every run is deterministic, so the results do not depend on the executor.
@@ -1225,12 +1229,14 @@ def case2_runs(sc: wj.Scenario, solver, alphas, x_guess, u_guess, *, seed_alphas
                       for i, n in enumerate(_checks.sequence(alt_nodes, "alt_nodes", allow_empty=True)))
     sigma = validation.real(sigma, "sigma")
     _checks.executor(executor)
+    alt_directions = _checks.directions(alt_directions, "alt_directions")
     seed_jobs = {(a, z): _submit(executor, solver, a, *sc.seeded_guess(solver.t, z))
                  for a in seed_alphas for z in (+1, -1)}
     t0 = time.perf_counter()
 
     def alt(n):
-        return alt_grid_sweep(sc, solver.information, n, alphas, solver.settings, sigma=sigma, executor=executor)
+        return alt_grid_sweep(sc, solver.information, n, alphas, solver.settings, sigma=sigma, executor=executor,
+                              directions=alt_directions)
 
     if executor is None:
         sweep = wj.sweep_both_ways(solver, alphas, x_guess, u_guess)

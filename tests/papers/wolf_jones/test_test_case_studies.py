@@ -228,6 +228,22 @@ def test_case2_runs_serial_and_queued_agree_and_an_alt_grid_equal_to_the_main_on
         assert p.cost == pytest.approx(m.cost, rel=1e-6)
     with pytest.raises(ValueError):
         S.case2_runs(sc, solver, [0.0], x_ball, u_ball, alt_nodes=[2])
+    with pytest.raises(ValueError, match="alt_directions"):
+        S.case2_runs(sc, solver, [0.0], x_ball, u_ball, alt_nodes=[10], alt_directions=["across"])
+
+
+def test_case2_runs_one_way_alt_grid_runs_only_that_chain(case2_small):
+    """``alt_directions`` reaches the other grids only: the main sweep stays two-way, the alt grid runs the
+    downward chain alone, whose plan is that chain's plan of the two-way sweep on the same grid (same cost)."""
+    sc, solver, k_ws, k_we, x_ball, u_ball = case2_small
+    r = S.case2_runs(sc, solver, [0.0, 1e-2], x_ball, u_ball, alt_nodes=[10], alt_directions=("down",))
+    assert {a["direction"] for a in r.sweep.attempts} == {"up", "down"}
+    _, _, sw = r.alt[10]
+    assert {a["direction"] for a in sw.attempts} == {"down"} and set(sw.source) <= {"down", ""}  # "": failed
+    two_way_down = [a for a in r.sweep.attempts if a["direction"] == "down"]
+    assert [(a["alpha"], a["start"], a["converged"]) for a in sw.attempts] == [
+        (a["alpha"], a["start"], a["converged"]) for a in two_way_down]
+    np.testing.assert_array_equal([a["cost"] for a in sw.attempts], [a["cost"] for a in two_way_down])
 
 
 def test_queued_keep_out_runs_respect_their_radius(case2_small):

@@ -311,6 +311,34 @@ def test_sweep_both_ways_merges_retries_and_is_executor_independent():
         W.sweep_both_ways(_ToySolver(), alphas, x, u, executor=object())
 
 
+def test_sweep_one_way_is_that_chain_of_the_two_way_sweep():
+    """``directions`` runs only the named chains: each one-way sweep returns exactly that chain's plans and
+    attempts (same costs, same retries), and the two-way sweep is the per-alpha best of the two."""
+    x, u = np.zeros((4, 6)), np.zeros((4, 3))
+    alphas = [0.0, 0.2, 0.6]
+    both = W.sweep_both_ways(_ToySolver(), alphas, x, u)
+    up = W.sweep_both_ways(_ToySolver(), alphas, x, u, directions=["up"])
+    down = W.sweep_both_ways(_ToySolver(), alphas, x, u, directions=("down",))
+    assert up.source == ["up"] * 3 and down.source == ["down"] * 3
+    np.testing.assert_allclose([r.cost for r in up.best], [0.0, -0.2, -0.58])  # warm start at 0.6: 0.02 worse
+    np.testing.assert_allclose([r.cost for r in down.best], [0.01, -0.19, -0.6])  # the downward basin
+    for one, d in ((up, "up"), (down, "down")):  # the same attempts as that chain of the two-way sweep
+        chain = [a for a in both.attempts if a["direction"] == d]
+        assert [(a["alpha"], a["start"], a["converged"]) for a in one.attempts] == [
+            (a["alpha"], a["start"], a["converged"]) for a in chain]
+        np.testing.assert_allclose([a["cost"] for a in one.attempts], [a["cost"] for a in chain], equal_nan=True)
+    assert [a["start"] for a in up.attempts] == ["cold", "warm", "cold", "warm"]
+    assert [a["direction"] for a in down.attempts] == ["down"] * 3
+    np.testing.assert_allclose([r.cost for r in both.best],
+                               np.minimum([r.cost for r in up.best], [r.cost for r in down.best]))
+    reversed_order = W.sweep_both_ways(_ToySolver(), alphas, x, u, directions=("down", "up"))
+    assert reversed_order.source == both.source  # chains always merged in the order up, down
+    for bad in ([], ["up", "up"], ["sideways"]):
+        with pytest.raises(ValueError, match="directions"):
+            W.sweep_both_ways(_ToySolver(), alphas, x, u, directions=bad)
+    with pytest.raises(TypeError, match="directions"):
+        W.sweep_both_ways(_ToySolver(), alphas, x, u, directions="up")
+
 class _FrontSolver:
     """impulse(alpha) along a toy front; counts solves; a jump makes a budget unreachable."""
 
