@@ -23,6 +23,10 @@ napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 autodoc_member_order = "bysource"
 autodoc_typehints = "none"  # the docstrings state types with units
+# Documented functions and classes are not entries of the table of contents (the API pages list their modules).
+# Sphinx copies every page's table of contents into the navigation of every page; with an entry per object
+# (about 2300) that copying was a third of the build.  Objects keep their anchors, index and search entries.
+toc_object_entries = False
 
 # Notebooks are executed by cislunar.publish.notebooks (papermill); the book only renders them.
 nb_execution_mode = "off"

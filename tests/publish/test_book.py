@@ -480,6 +480,37 @@ def test_status_counts_read_the_last_column():
     assert book._statuses(md) == {"reproduced": 2, "differs": 1, "derived": 1}
 
 
+def _package_modules() -> set:
+    """Every public module of the package, from the files on disk (``cislunar/<wing>/.../<name>.py``)."""
+    root = paths.repo_root() / "cislunar"
+    found = set()
+    for f in root.rglob("*.py"):
+        rel = f.relative_to(root.parent).with_suffix("").parts
+        if len(rel) >= 3 and not any(part.startswith("_") for part in rel[1:]):
+            found.add(".".join(rel))
+    return found
+
+
+def test_api_pages_hold_every_module_once_a_page_per_subpackage(tmp_path):
+    """One page per subpackage (one per paper), each module documented exactly once, on its subpackage's page,
+    and the API index naming every module and every page."""
+    book._write_api_pages(tmp_path)
+    modules = _package_modules()
+    documented = {}
+    for page in sorted(tmp_path.glob("cislunar.*.md")):
+        for mod in re.findall(r"^\.\. automodule:: (\S+)$", page.read_text(), flags=re.MULTILINE):
+            assert mod not in documented, f"{mod} on {page.name} and {documented[mod]}"
+            assert mod.startswith(page.stem + "."), f"{mod} is not in {page.stem}"
+            documented[mod] = page.name
+    assert set(documented) == modules
+    subpackages = {".".join(m.split(".")[:3 if m.split(".")[1] == "papers" else 2]) for m in modules}
+    assert {p.stem for p in tmp_path.glob("cislunar.*.md")} == subpackages
+    index = (tmp_path / "index.md").read_text()
+    assert set(re.findall(r"\{py:mod\}`([^`]+)`", index)) == modules
+    toctree = index.split("```{toctree}")[1]
+    assert {line.strip() for line in toctree.splitlines()} >= subpackages
+
+
 def test_book_needs_executed_notebooks(tmp_path):
     with pytest.raises(book.BookError, match="no executed notebooks"):
         book.stage(tmp_path)
@@ -589,6 +620,24 @@ def test_every_local_link_and_image_resolves_and_nothing_is_external(built):
     assert problems["broken"] == [], "\n".join(problems["broken"][:20])
     images = [v for p in (out / "notebooks").glob("*.html") for tag, _, v in parse(p).refs if tag == "img"]
     assert len(images) >= len(list((out / "notebooks").glob("*.html"))), "figures are missing from the pages"
+
+
+@pytest.mark.notebook
+@pytest.mark.xdist_group("book")
+def test_every_module_has_its_anchor_and_a_link_from_the_api_index(built):
+    """Each module of the package is documented on one API page, under the anchor ``#module-<name>``, and the API
+    index links it there."""
+    _, out, _, _ = built
+    where = {}
+    for page in sorted((out / "api").glob("cislunar.*.html")):
+        for anchor in parse(page).ids:
+            if anchor.startswith("module-"):
+                assert anchor not in where, f"{anchor} on {page.name} and {where[anchor]}"
+                where[anchor] = page.name
+    assert set(where) == {f"module-{m}" for m in _package_modules()}
+    links = {v for _, attr, v in parse(out / "api" / "index.html").refs if attr == "href"}
+    missing = [f"{page}#{anchor}" for anchor, page in where.items() if f"{page}#{anchor}" not in links]
+    assert missing == [], missing
 
 
 @pytest.mark.notebook
