@@ -42,17 +42,18 @@ N_H0 = None  # non-maneuvering training runs per policy and orbit (None: 8 quick
 N_H1 = None  # maneuvering training runs per policy and orbit (None: 8 quick, 3000 full; paper: 3000)
 N_TEST = None  # test runs per hypothesis, policy and orbit (None: 4 quick, 100 full; paper: 100 + 100)
 OUTER_SIZE = None  # share of the training runs the outer-band stable NRHO runs; it gets half the tests (None: 0.2)
-N_MAP = None  # (H0, H1) runs per cell of the tuning map of Section 2 (None: (8, 8) quick, (150, 250) full)
+N_MAP = None  # (H0, H1) runs per cell of the tuning map of Section 2 (None: (6, 6) quick, (150, 250) full)
 F_GRID = None  # window weight factors f of the map, units of the variance-matched weight, increasing
 #                (None: 0.03, 0.1, 0.2, 0.3, 0.5, 1.0)
-F_SIDE = None  # factors of the map's side axes (noise, window length, base weight), 9:2 NRHO (None: 0.1, 0.2, 0.3)
+F_SIDE = None  # factors of the map's side axes (noise, window length, base weight), 9:2 NRHO
+#                (None: 0.1, 0.2 quick; 0.1, 0.2, 0.3 full; must contain 0.1, the threshold reading)
 Q_BASE = None  # control weight outside the apoapsis window, km^2/s^3 (None: 1e-18)
 WINDOW_HOURS = None  # length of the apoapsis window, hours (None: 8, the paper's)
 N_SPIKE = None  # runs per hypothesis of the Figs. 10-11 check (None: 8 quick, 200 full)
 N_POLICY_DRAWS = None  # draws that check the station-keeping distributions (None: 5000 quick, 200000 full)
 PM_J_SEEDS = None  # noise draws per direction in the +-j search of Section 4 (None: 1 quick, 3 full)
-PM_J_F = None  # window weight factors of the +-j search (None: 0.03, 0.1, 0.3, 1.0)
-PM_J_NOISE_URAD = None  # angle noise of the +-j search, micro-rad (None: 10, 100, 300, 1000)
+PM_J_F = None  # window weight factors of the +-j search (None: 0.03, 0.3, 1.0 quick; 0.03, 0.1, 0.3, 1.0 full)
+PM_J_NOISE_URAD = None  # angle noise of the +-j search, micro-rad (None: 10, 1000 quick; 10, 100, 300, 1000 full)
 PM_J_OFFSET_H = None  # burn times after apoapsis in the +-j search, hours, inside the window (None: -3, 0, 3)
 N_PM_J_MC = None  # randomly pointed burns per policy where the +-j pattern appears (None: 8 quick, 600 full)
 N_Z05 = None  # 0.5 m/s burns per tuning factor for the health metric of Section 6 (None: 4 quick, 64 full)
@@ -60,7 +61,7 @@ N_LEAD = None  # (no-burn runs for calibration and validation, runs per burn siz
 #                (None: (10, 2) quick, (200, 48) full)
 LEAD_MAGNITUDES = None  # burn sizes of the control-versus-residual race, m/s (None: 0.05, 0.1, 0.2, 0.5)
 JOINT_WINDOWS = None  # window lengths of the joint search of Section 2b, hours (None: 4, 8 quick; 2, 4, 8 full)
-JOINT_F = None  # window weight factors of the joint search (None: 0.2, 0.3 quick; 0.15, 0.2, 0.3 full)
+JOINT_F = None  # window weight factors of the joint search (None: 0.2 quick; 0.15, 0.2, 0.3 full)
 JOINT_Q_BASE = None  # base weights of the joint search, km^2/s^3 (None: 1e-18 quick; 1e-18, 1e-16 full)
 JOINT_NOISE_URAD = None  # angle noise of the joint search, micro-rad (None: 10 quick; 5, 10, 20 full)
 JOINT_OFFSET_H = None  # burn times after apoapsis in the joint search, hours (None: 0 quick; 0, 1 full)
@@ -68,7 +69,7 @@ N_JOINT_SCREEN = None  # (H0, H1) runs per policy of the joint search's screen (
 N_JOINT_PAPER = None  # (H0, H1) runs per policy where the screen passes (None: (8, 8) quick, (500, 3000) full)
 JOINT_CONFIRM_WINDOWS = None  # windows whose passing settings are rerun at N_JOINT_PAPER (None: all quick; 8 full)
 RACE_F = None  # window weight factors of the Fig. 22 race grid of Section 6 (None: 0.3 quick; 0.1, 0.3, 1 full)
-RACE_NOISE_URAD = None  # angle noise of the race grid, micro-rad (None: 20, 50 quick; 20, 30, 50 full)
+RACE_NOISE_URAD = None  # angle noise of the race grid, micro-rad (None: 20 quick; 20, 30, 50 full)
 N_RACE = None  # (no-burn runs for calibration and validation, runs per burn size) of the race grid
 #                (None: (10, 2) quick, (100, 48) full)
 N_BOOT = None  # bootstrap resamples for the standard errors of z_lim and of FP + MD (None: 4 quick, 40 full)
@@ -90,23 +91,24 @@ N_H0 = N_H0 if N_H0 is not None else (8 if QUICK else 500)
 N_H1 = N_H1 if N_H1 is not None else (8 if QUICK else 3000)
 N_TEST = N_TEST if N_TEST is not None else (4 if QUICK else 100)
 OUTER_SIZE = OUTER_SIZE if OUTER_SIZE is not None else 0.2
-N_MAP = tuple(N_MAP if N_MAP is not None else ((8, 8) if QUICK else (150, 250)))
+N_MAP = tuple(N_MAP if N_MAP is not None else ((6, 6) if QUICK else (150, 250)))
 F_GRID = tuple(F_GRID if F_GRID is not None else (0.03, 0.1, 0.2, 0.3, 0.5, 1.0))
-F_SIDE = tuple(F_SIDE if F_SIDE is not None else (0.1, 0.2, 0.3))
+F_SIDE = tuple(F_SIDE if F_SIDE is not None else ((0.1, 0.2) if QUICK else (0.1, 0.2, 0.3)))
 Q_BASE = Q_BASE if Q_BASE is not None else 1e-18
 WINDOW_HOURS = WINDOW_HOURS if WINDOW_HOURS is not None else 8.0
 N_SPIKE = N_SPIKE if N_SPIKE is not None else (8 if QUICK else 200)
 N_POLICY_DRAWS = N_POLICY_DRAWS if N_POLICY_DRAWS is not None else (5000 if QUICK else 200000)
 PM_J_SEEDS = PM_J_SEEDS if PM_J_SEEDS is not None else (1 if QUICK else 3)
-PM_J_F = tuple(PM_J_F if PM_J_F is not None else (0.03, 0.1, 0.3, 1.0))
-PM_J_NOISE_URAD = tuple(PM_J_NOISE_URAD if PM_J_NOISE_URAD is not None else (10.0, 100.0, 300.0, 1000.0))
+PM_J_F = tuple(PM_J_F if PM_J_F is not None else ((0.03, 0.3, 1.0) if QUICK else (0.03, 0.1, 0.3, 1.0)))
+PM_J_NOISE_URAD = tuple(PM_J_NOISE_URAD if PM_J_NOISE_URAD is not None
+                        else ((10.0, 1000.0) if QUICK else (10.0, 100.0, 300.0, 1000.0)))
 PM_J_OFFSET_H = tuple(PM_J_OFFSET_H if PM_J_OFFSET_H is not None else (-3.0, 0.0, 3.0))
 N_PM_J_MC = N_PM_J_MC if N_PM_J_MC is not None else (8 if QUICK else 600)
 N_Z05 = N_Z05 if N_Z05 is not None else (4 if QUICK else 64)
 N_LEAD = tuple(N_LEAD if N_LEAD is not None else ((10, 2) if QUICK else (200, 48)))
 LEAD_MAGNITUDES = tuple(LEAD_MAGNITUDES if LEAD_MAGNITUDES is not None else (0.05, 0.1, 0.2, 0.5))
 JOINT_WINDOWS = tuple(JOINT_WINDOWS if JOINT_WINDOWS is not None else ((4.0, 8.0) if QUICK else (2.0, 4.0, 8.0)))
-JOINT_F = tuple(JOINT_F if JOINT_F is not None else ((0.2, 0.3) if QUICK else (0.15, 0.2, 0.3)))
+JOINT_F = tuple(JOINT_F if JOINT_F is not None else ((0.2,) if QUICK else (0.15, 0.2, 0.3)))
 JOINT_Q_BASE = tuple(JOINT_Q_BASE if JOINT_Q_BASE is not None else ((1e-18,) if QUICK else (1e-18, 1e-16)))
 JOINT_NOISE_URAD = tuple(JOINT_NOISE_URAD if JOINT_NOISE_URAD is not None else ((10.0,) if QUICK else (5.0, 10.0, 20.0)))
 JOINT_OFFSET_H = tuple(JOINT_OFFSET_H if JOINT_OFFSET_H is not None else ((0.0,) if QUICK else (0.0, 1.0)))
@@ -115,7 +117,7 @@ N_JOINT_PAPER = tuple(N_JOINT_PAPER if N_JOINT_PAPER is not None else ((8, 8) if
 JOINT_CONFIRM_WINDOWS = tuple(JOINT_CONFIRM_WINDOWS if JOINT_CONFIRM_WINDOWS is not None
                               else (JOINT_WINDOWS if QUICK else (8.0,)))
 RACE_F = tuple(RACE_F if RACE_F is not None else ((0.3,) if QUICK else (0.1, 0.3, 1.0)))
-RACE_NOISE_URAD = tuple(RACE_NOISE_URAD if RACE_NOISE_URAD is not None else ((20.0, 50.0) if QUICK else (20.0, 30.0, 50.0)))
+RACE_NOISE_URAD = tuple(RACE_NOISE_URAD if RACE_NOISE_URAD is not None else ((20.0,) if QUICK else (20.0, 30.0, 50.0)))
 N_RACE = tuple(N_RACE if N_RACE is not None else ((10, 2) if QUICK else (100, 48)))
 N_BOOT = N_BOOT if N_BOOT is not None else (4 if QUICK else 40)
 BATCH = BATCH if BATCH is not None else 8
@@ -554,13 +556,12 @@ pmj, ((f_pm, sig_pm, _), _) = pm_j.cells, pm_j.best
 # azimuth $\pm90°$ over that at 0°/180°, elevations below 45°).
 
 # %%
-pm_mc = {}
-for j, (p, pol) in enumerate(POLICIES.items()):
-    s_pm = det.make_setup(em, ORBITS["9:2 NRHO"], f_pm * det.window_control_weight(pol, WINDOW_HOURS), Q_BASE,
-                          window_hours=WINDOW_HOURS, sigma_angle_rad=sig_pm * 1e-6)
-    pm_mc[p] = det.run_detection_monte_carlo(s_pm, pol, N_PM_J_MC, [SEED, 33, j], batch_size=BATCH,
-                                             executor=executor, progress=False)
-    h = pm_mc[p]
+# both policies' Monte Carlos in one pooled sweep (the same trials as one run_detection_monte_carlo per policy)
+pm_jobs = [(det.make_setup(em, ORBITS["9:2 NRHO"], f_pm * det.window_control_weight(pol, WINDOW_HOURS), Q_BASE,
+                           window_hours=WINDOW_HOURS, sigma_angle_rad=sig_pm * 1e-6), pol, N_PM_J_MC, [SEED, 33, j])
+           for j, pol in enumerate(POLICIES.values())]
+pm_mc = dict(zip(POLICIES, det.run_detection_monte_carlos(pm_jobs, batch_size=BATCH, executor=executor)))
+for p, h in pm_mc.items():
     print(f"{p:6s}: {len(h.z)} randomly pointed burns, f = {f_pm:g}, noise {sig_pm:g} urad: Fig. 16 statistic "
           f"{dstudies.ratio_text(det.azimuth_contrast(h))}; mean z/|dv| {np.mean(h.z / h.magnitude):.2f}; corr(z, |dv|) "
           f"{np.corrcoef(h.magnitude, h.z)[0, 1]:.2f}")

@@ -326,9 +326,16 @@ def make_setup(system: CR3BP, orbit: PeriodicOrbit, q_window_km2_s3: float, q_ba
         raise ValueError("the detection scenario uses the single L2 observer")
     if not np.all(getattr(sc, "available", True)):
         raise ValueError("the L2 observer must see the target at every epoch")
-    q = tracking.apoapsis_window_weights(sc.t, sc.t_apoapsis[:1], _km2_s3_to_nd(system, qb),
-                                         _km2_s3_to_nd(system, qw), wh, system)
-    return DetectionSetup(sc, q, float(sc.t_apoapsis[0]), qb, qw, wh, int(n_sub), _check_tol(tol))
+    return _retuned(sc, qw, qb, wh, int(n_sub), tol)
+
+
+def _retuned(sc, qw, qb, wh, n_sub, tol) -> DetectionSetup:
+    """The setup of :func:`make_setup` on an already built (and checked) scenario ``sc``: only the tuning (window
+    and base weights in km^2/s^3, window length in hours) is new; unchecked.  Studies that tune one track many ways
+    (:mod:`cislunar.papers.greaves_scheeres_2021.detection_studies`) build the scenario once through it."""
+    q = tracking.apoapsis_window_weights(sc.t, sc.t_apoapsis[:1], _km2_s3_to_nd(sc.system, qb),
+                                         _km2_s3_to_nd(sc.system, qw), wh, sc.system)
+    return DetectionSetup(sc, q, float(sc.t_apoapsis[0]), qb, qw, wh, n_sub, tol)
 
 
 @dataclass(frozen=True)

@@ -53,6 +53,27 @@ def _check_executor(executor):
                                            f"{type(executor).__name__}")
 
 
+def _setup_maker(system):
+    """:func:`detection.make_setup` (default cadence, period and sub-grid) building one scenario per orbit and angle
+    noise: the tunings of a track share its propagation and event search, and every setup equals the one
+    ``make_setup`` builds call by call."""
+    scenarios = {}  # (id(orbit), noise) -> (orbit, first setup); the orbit is kept so that its id stays its own
+
+    def make(orbit, q_window_km2_s3, q_base_km2_s3, *, window_hours, sigma_angle_rad=tracking.DEFAULT_SIGMA_ANGLE_RAD):
+        key = (id(orbit), float(sigma_angle_rad))
+        if key not in scenarios:
+            st = det.make_setup(system, orbit, q_window_km2_s3, q_base_km2_s3, window_hours=window_hours,
+                                sigma_angle_rad=sigma_angle_rad)
+            scenarios[key] = (orbit, st)
+            return st
+        st = scenarios[key][1]
+        return det._retuned(st.scenario, validation.positive(q_window_km2_s3, "q_window_km2_s3"),
+                            validation.positive(q_base_km2_s3, "q_base_km2_s3"),
+                            validation.positive(window_hours, "window_hours"), st.n_sub, st.tol)
+
+    return make
+
+
 def _positive_values(value, name: str) -> np.ndarray:
     """A non-empty 1-D array of positive finite numbers (a set is taken in sorted order)."""
     if isinstance(value, (set, frozenset)):
@@ -311,12 +332,12 @@ def run_tuning_map(system, orbits: dict, policies: dict, variants: dict, f_grid,
     cells = [(o, p, f, base) for o in orbits for p in policies for f in f_grid]
     cells += [("9:2 NRHO", p, f, v) for v in names[1:] for p in policies for f in f_side]
     jobs = []
+    make_setup = _setup_maker(system)
     for i, (o, p, f, v) in enumerate(cells):
         ov = variants[v]
         wh = ov.get("window_hours", window_hours)
-        setup = det.make_setup(system, orbits[o], f * det.window_control_weight(policies[p], wh),
-                               ov.get("q_base", q_base_km2_s3), window_hours=wh,
-                               sigma_angle_rad=ov.get("sigma_angle_rad", sigma_angle_rad))
+        setup = make_setup(orbits[o], f * det.window_control_weight(policies[p], wh), ov.get("q_base", q_base_km2_s3),
+                           window_hours=wh, sigma_angle_rad=ov.get("sigma_angle_rad", sigma_angle_rad))
         k = 0.5 if o in half_size_orbits else 1.0  # the outer band's period is 10 days: half the runs
         jobs.append((setup, policies[p], max(int(k * n_map[0]), 4), max(int(k * n_map[1]), 4), 0, [*seed, i]))
     # every cell's Monte Carlo in one pooled sweep (the same trials as one run_policy_study per cell)
@@ -825,8 +846,9 @@ def run_pm_j_search(system, orbit, f_values, noise_urad, offsets_h, n_repeats: i
     window_hours = validation.positive(window_hours, "window_hours")
     _check_executor(executor)
     dirs = np.radians(np.array(list(DIRECTIONS.values())))
-    setups = {(f, s): det.make_setup(system, orbit, f * det.window_control_weight(det.ACTIVE_POLICY, window_hours),
-                                     q_base_km2_s3, window_hours=window_hours, sigma_angle_rad=s * 1e-6)
+    make_setup = _setup_maker(system)
+    setups = {(f, s): make_setup(orbit, f * det.window_control_weight(det.ACTIVE_POLICY, window_hours), q_base_km2_s3,
+                                 window_hours=window_hours, sigma_angle_rad=s * 1e-6)
               for f in f_values for s in noise_urad}
     # the trials depend on the noise and the burn time, not on f: drawn once, filtered under every f, all cells
     # pooled in lockstep groups (detection.direction_response per cell gives the same numbers)
@@ -893,8 +915,9 @@ def run_burn_z_study(setup: det.DetectionSetup, orbit, factors, magnitude_m_s: f
     _check_executor(executor)
     runs = det.draw_trials(np.random.default_rng(seed).spawn(n), setup, magnitude_m_s=magnitude_m_s)
     fs = sorted(set(factors))
-    tunings = [det.make_setup(setup.system, orbit, f * det.window_control_weight(det.QUIET_POLICY, window_hours),
-                              q_base_km2_s3, window_hours=window_hours) for f in fs]
+    make_setup = _setup_maker(setup.system)
+    tunings = [make_setup(orbit, f * det.window_control_weight(det.QUIET_POLICY, window_hours), q_base_km2_s3,
+                          window_hours=window_hours) for f in fs]
     results = det.filter_trial_sets([(s, runs) for s in tunings], executor=executor)
     z = {f: r.z_smooth * setup.system.velocity_unit_km_s * 1e3 for f, r in zip(fs, results)}
     return BurnZStudy(z, float(magnitude_m_s))
@@ -1057,12 +1080,12 @@ class JointSearch:
         return "\n".join(lines)
 
 
-def _joint_setups(system, orbit, policies, key):
+def _joint_setups(system, orbit, policies, key, make_setup=None):
     w, f, qb, s, off = key
+    make_setup = make_setup or _setup_maker(system)  # a maker shared across settings builds each track once
     out = {}
     for p, pol in policies.items():
-        st = det.make_setup(system, orbit, f * det.window_control_weight(pol, w), qb, window_hours=w,
-                            sigma_angle_rad=s * 1e-6)
+        st = make_setup(orbit, f * det.window_control_weight(pol, w), qb, window_hours=w, sigma_angle_rad=s * 1e-6)
         if off:  # the burn moves, the window stays centred on the apoapsis
             st = dataclasses.replace(st, t_maneuver=st.t_maneuver + off * 3600.0 / system.time_unit_s)
         out[p] = st
@@ -1157,7 +1180,8 @@ def run_joint_search(system, orbit, policies: dict, windows_hours, factors, q_ba
     if not keys:
         raise ValueError(f"burn_offsets_hours must hold an offset inside some window (|offset| <= window / 2); got "
                          f"{offsets} for windows {windows}")
-    setups = {k: _joint_setups(system, orbit, policies, k) for k in keys}
+    make_setup = _setup_maker(system)
+    setups = {k: _joint_setups(system, orbit, policies, k, make_setup) for k in keys}
     pnames = tuple(policies)
 
     def stage(chosen, n, tag):
@@ -1274,9 +1298,10 @@ def run_lead_grid(system, orbit, factors, noise_urad, magnitudes_m_s, n_h0: int,
     horizon_hours = validation.positive(horizon_hours, "horizon_hours")
     _check_executor(executor)
     cells = {}
+    make_setup = _setup_maker(system)
     for i, (f, s) in enumerate((f, s) for f in factors for s in noises):
-        st = det.make_setup(system, orbit, f * det.window_control_weight(det.QUIET_POLICY, window_hours), q_base_km2_s3,
-                            window_hours=window_hours, sigma_angle_rad=s * 1e-6)
+        st = make_setup(orbit, f * det.window_control_weight(det.QUIET_POLICY, window_hours), q_base_km2_s3,
+                        window_hours=window_hours, sigma_angle_rad=s * 1e-6)
         cells[f, s] = det.health_lead_study(st, mags, n_h0, n_h1, [*seed, i], horizon_hours=horizon_hours,
                                             executor=executor)
     return LeadGrid(cells, float(judged))
@@ -1533,7 +1558,8 @@ def closing_rows(*, ks_text: str, tmap: TuningMap, f_tune: float, q_window_quiet
         sb = lead_grid.summary(best)
         rows["race grid"] = dict(
             measured=bool(hold),
-            shown=f"{len(lead_grid.cells)} cells (f {', '.join(sorted({f'{k[0]:g}' for k in lead_grid.cells}))}; noise "
+            shown=f"{len(lead_grid.cells)} {'cells' if len(lead_grid.cells) > 1 else 'cell'} "
+            f"(f {', '.join(sorted({f'{k[0]:g}' for k in lead_grid.cells}))}; noise "
             f"{', '.join(sorted({f'{k[1]:g}' for k in lead_grid.cells}, key=float))} micro-rad); the combination holds in "
             + (", ".join(f"f = {f:g} / {s_:g} urad" for f, s_ in hold) or "none"),
             note=f"most benign residuals at f = {best[0]:g}, {best[1]:g} micro-rad: residual test silent in "

@@ -9,6 +9,7 @@ from cislunar.cr3bp import orbits
 from cislunar.cr3bp.dynamics import EARTH_MOON as em
 from cislunar.cr3bp.propagation import ImpactError
 from cislunar.papers.greaves_scheeres_2021 import detection as det
+from cislunar.papers.greaves_scheeres_2021 import detection_studies as dstudies
 from cislunar.utils.montecarlo import MonteCarloError
 from tests.papers.greaves_scheeres_2021.reference_detection import (
     reference_detection_batches,
@@ -215,3 +216,31 @@ def test_direction_trials_are_those_of_direction_response(short_setup):
     ref = reference_draw_trial(np.random.default_rng([4, 1]), short_setup, magnitude_m_s=1.0, direction=dirs[2],
                                burn_offset_hours=1.0)
     assert np.array_equal(ref.y, inputs[5].y) or np.allclose(ref.y, inputs[5].y, rtol=1e-12, atol=1e-13)
+
+
+def test_studies_build_one_scenario_per_track_and_the_same_setups_as_make_setup():
+    """The studies' setup maker (one scenario per orbit and angle noise, retuned for each weight and window) gives,
+    field by field and bit for bit, the setup that make_setup builds from scratch; a swap of the window and base
+    weights, or a window length left at the first call's, changes the control weights."""
+    nrho = orbits.nrho_9_2(em)
+    make = dstudies._setup_maker(em)
+    cases = [(3e-15, 1e-18, 8.0, 10e-6), (3e-14, 1e-18, 8.0, 10e-6), (3e-15, 1e-16, 4.0, 10e-6),
+             (1e-13, 1e-18, 12.0, 10e-6), (3e-15, 1e-18, 8.0, 20e-6), (5e-15, 1e-17, 6.0, 20e-6)]
+    got = [make(nrho, qw, qb, window_hours=wh, sigma_angle_rad=s) for qw, qb, wh, s in cases]
+    for (qw, qb, wh, s), a in zip(cases, got):
+        b = det.make_setup(em, nrho, qw, qb, window_hours=wh, sigma_angle_rad=s)
+        assert np.array_equal(a.control_weight, b.control_weight)
+        nd = em.time_unit_s**3 / em.length_unit_km**2  # km^2/s^3 -> LU^2/TU^3, independently of the module
+        assert np.isclose(a.control_weight.max(), qw * nd, rtol=1e-12) and np.isclose(a.control_weight.min(), qb * nd,
+                                                                                        rtol=1e-12)
+        assert (a.q_window_km2_s3, a.q_base_km2_s3, a.window_hours) == (qw, qb, wh)
+        assert (a.t_maneuver, a.q_window_km2_s3, a.q_base_km2_s3, a.window_hours, a.n_sub, a.tol) == (
+            b.t_maneuver, b.q_window_km2_s3, b.q_base_km2_s3, b.window_hours, b.n_sub, b.tol)
+        assert np.array_equal(a.scenario.t, b.scenario.t) and np.array_equal(a.scenario.meas_cov, b.scenario.meas_cov)
+        assert np.array_equal(a.observer_states, b.observer_states) and np.array_equal(a.scenario.x_start,
+                                                                                        b.scenario.x_start)
+    assert got[1].scenario is got[0].scenario and got[3].scenario is got[0].scenario  # one track per noise
+    assert got[5].scenario is got[4].scenario and got[4].scenario is not got[0].scenario
+    assert len({g.control_weight.tobytes() for g in got[:4]}) == 4  # the tunings differ where they should
+    with pytest.raises(ValueError, match="q_window_km2_s3"):
+        make(nrho, -1.0, 1e-18, window_hours=8.0, sigma_angle_rad=10e-6)
