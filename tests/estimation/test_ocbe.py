@@ -183,15 +183,7 @@ def test_block_integrator_equals_the_full_variational_system(two_hours_near_peri
     lay = ocbe.BLOCK_LAYOUT
     starts = np.array([x0, x0 + np.r_[1e-5, -2e-5, 1e-5, 3e-5, 0.0, -1e-5]])
     qs = np.array([Q_WEIGHT, 40 * Q_WEIGHT])
-    tb = ocbe.block_integrator(2)
-    init = np.zeros((lay["phi_pp"].stop, 2))
-    init[lay["x"]] = starts.T
-    init[lay["phi_xx"]] = init[lay["phi_pp"]] = np.eye(6).ravel()[:, None]
-    tb.set_time(np.full(2, grid[0]))
-    tb.state[:] = init
-    tb.pars[0] = em.mu
-    tb.pars[1] = qs
-    out = tb.propagate_grid(np.repeat(grid[:, None], 2, axis=1))[-1]  # (grid, 114, 2)
+    out = _propagate_blocks(ocbe.block_integrator(2), starts, qs, grid, costate_block=True)  # (grid, 114, 2)
     for b in range(2):
         full = ocbe.ocbe_transition(em, starts[b], grid, qs[b])
         assert np.max(np.abs(out[:, lay["x"], b] - full.x)) < 1e-14
@@ -203,6 +195,22 @@ def test_block_integrator_equals_the_full_variational_system(two_hours_near_peri
         ocbe.block_integrator(0)
     with pytest.raises(ValueError, match="tol"):
         ocbe.block_integrator(2, tol=1.0)
+
+
+def _propagate_blocks(tb, starts, qs, grid, *, costate_block: bool):
+    """Run a 2-lane block integrator from identity blocks at ``starts`` (2, 6) with weights ``qs`` over ``grid``;
+    returns its states on the grid, shape (grid, n_states, 2)."""
+    lay = ocbe.BLOCK_LAYOUT
+    init = np.zeros((lay["phi_pp" if costate_block else "phi_xp"].stop, 2))
+    init[lay["x"]] = starts.T
+    init[lay["phi_xx"]] = np.eye(6).ravel()[:, None]
+    if costate_block:
+        init[lay["phi_pp"]] = np.eye(6).ravel()[:, None]
+    tb.set_time(np.full(2, grid[0]))
+    tb.state[:] = init
+    tb.pars[0] = em.mu
+    tb.pars[1] = qs
+    return tb.propagate_grid(np.repeat(grid[:, None], 2, axis=1))[-1]
 
 
 def test_spike_contrast_of_a_known_spike():
@@ -235,14 +243,7 @@ def test_block_integrator_without_the_costate_block_equals_the_full_variational_
     qs = np.array([Q_WEIGHT, 40 * Q_WEIGHT])
     tb = ocbe.block_integrator(2, costate_block=False)
     assert tb.state.shape == (lay["phi_xp"].stop, 2)
-    init = np.zeros((lay["phi_xp"].stop, 2))
-    init[lay["x"]] = starts.T
-    init[lay["phi_xx"]] = np.eye(6).ravel()[:, None]
-    tb.set_time(np.full(2, grid[0]))
-    tb.state[:] = init
-    tb.pars[0] = em.mu
-    tb.pars[1] = qs
-    out = tb.propagate_grid(np.repeat(grid[:, None], 2, axis=1))[-1]  # (grid, 78, 2)
+    out = _propagate_blocks(tb, starts, qs, grid, costate_block=False)  # (grid, 78, 2)
     for b in range(2):
         full = ocbe.ocbe_transition(em, starts[b], grid, qs[b])
         # other states, other step sizes: the two integrations agree to the tolerance's level, not to the last bit
