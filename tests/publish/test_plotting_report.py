@@ -42,6 +42,53 @@ def test_save_figure_rejects_bad_names_and_formats(tmp_path):
     plt.close(fig)
 
 
+def _labelled_figure():
+    plotting.use_style()
+    fig, ax = plt.subplots(figsize=(4.0, 3.0))
+    ax.plot(np.arange(5), np.arange(5) ** 2)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("distance [m]")
+    return fig
+
+
+def test_save_figure_show_displays_the_saved_png_at_the_inline_size_and_closes(tmp_path, monkeypatch):
+    import IPython.display
+    import matplotlib.image
+
+    shown = []
+    monkeypatch.setattr(IPython.display, "display", lambda obj: shown.append(obj))
+    fig = _labelled_figure()
+    (p,) = plotting.save_figure(fig, "shown", output_dir=tmp_path, show=True)
+    assert len(shown) == 1 and shown[0].data == p.read_bytes()  # exactly the saved file
+    height, width = matplotlib.image.imread(p).shape[:2]  # an independent reader of the PNG
+    assert plotting._png_size(p.read_bytes()) == (width, height)
+    # displayed at the inline backend's size: pixels at figure.dpi (110) instead of savefig.dpi (150)
+    assert shown[0].width == round(width * 110 / 150) and shown[0].width < width
+    assert not plt.fignum_exists(fig.number)  # closed: the inline backend does not draw it again
+
+    fig = _labelled_figure()  # Agg (tests): the default neither displays nor closes
+    plotting.save_figure(fig, "kept", output_dir=tmp_path)
+    assert len(shown) == 1 and plt.fignum_exists(fig.number)
+    monkeypatch.setattr(plotting, "_inline_backend", lambda: True)  # a notebook: the default shows
+    plotting.save_figure(fig, "inline", output_dir=tmp_path)
+    assert len(shown) == 2 and not plt.fignum_exists(fig.number)
+    fig = _labelled_figure()
+    plotting.save_figure(fig, "vector_only", output_dir=tmp_path, formats=("svg",))  # no PNG: nothing to show
+    assert len(shown) == 2 and plt.fignum_exists(fig.number)
+    plt.close(fig)
+
+
+def test_save_figure_show_rejects_bad_values(tmp_path):
+    fig = _labelled_figure()
+    with pytest.raises(TypeError, match="show"):
+        plotting.save_figure(fig, "x", output_dir=tmp_path, show="yes")
+    with pytest.raises(ValueError, match="show=True.*png"):
+        plotting.save_figure(fig, "x", output_dir=tmp_path, formats=("pdf",), show=True)
+    with pytest.raises(ValueError, match="PNG"):
+        plotting._png_size(b"GIF89a" + bytes(30))
+    plt.close(fig)
+
+
 def test_comparison_table_rows_come_from_judged_claims():
     t = ComparisonTable("demo")
     period = Claim("period [d]", 6.5624, Within(6.5624, printed_tolerance("6.5624")), source="Table 2")
