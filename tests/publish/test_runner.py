@@ -164,3 +164,25 @@ def test_status_lines_give_an_estimate_only_from_an_earlier_run(tmp_path):
     assert notebooks.run_all([src], quick=True, output_dir=target, out=second, heartbeat=0.5) == 0
     assert f"last run {seconds:.0f} s" in second.getvalue()
     assert f"of ~{seconds:.0f} s (last run)" in second.getvalue()
+
+
+def test_child_skips_the_iri_grammar_and_notebook_validation_still_works():
+    # the runner child marks rfc3987_syntax absent (0.8 s of grammar compilation at import); jsonschema must then
+    # load without it and nbformat must still accept a valid notebook and reject an invalid one
+    code = textwrap.dedent("""
+        import sys
+        from cislunar.publish import notebooks
+        notebooks._skip_iri_grammar()
+        import jsonschema, nbformat, papermill, jupytext
+        assert sys.modules["rfc3987_syntax"] is None
+        nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("1 + 1")])
+        nbformat.validate(nb)
+        nb.cells[0]["cell_type"] = "not a cell type"
+        try:
+            nbformat.validate(nb)
+        except nbformat.ValidationError:
+            print("rejected")
+    """)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "rejected"
