@@ -86,8 +86,9 @@ def specs(Spec, lazy):
                dict(scenario="instance", t_nodes="grid", u_nodes="arr")))
     s.append(S("sweep_both_ways", W.sweep_both_ways,
                dict(solver=fake_solver, alphas=np.array([0.0, 0.01]), x_guess=np.zeros((4, 6)), u_guess=U,
-                    executor=None),
-               dict(solver="callable", alphas="vec", x_guess="arr", u_guess="arr", executor="instance_opt")))
+                    executor=None, directions=("up", "down")),
+               dict(solver="callable", alphas="vec", x_guess="arr", u_guess="arr", executor="instance_opt",
+                    directions="directions")))
     s.append(S("solve_for_impulse", W.solve_for_impulse,
                dict(solver=fake_solver, budget=0.05, lower=(0.0, fake_solver(0.0, X, U[:1])),
                     upper=(0.01, fake_solver(0.01, X, U[:1])), rtol=0.02, max_solves=3),

@@ -403,9 +403,9 @@ def specs(Spec, lazy):
                dict(sc="instance", k_ws="int0", d="pos", src="instance_str", res="instance", reference_x="arr")))
     s.append(S("alt_grid_sweep", tcs.alt_grid_sweep,
                dict(sc=lz(sc2), info=lz(info2), n_nodes=6, alphas=[0.0], settings=scvx.SCvxSettings(max_iter=60),
-                    sigma=1.0, executor=None),
+                    sigma=1.0, executor=None, directions=("up",)),
                dict(sc="instance", info="callable", n_nodes="int1", alphas="vec", settings="instance", sigma="real",
-                    executor="instance_opt"), baseline=False))
+                    executor="instance_opt", directions="directions"), baseline=False))
     s.append(S("mirror_study", tcs.mirror_study,
                dict(case=lz(case2), pair_rows=lz(lambda: (row6(), row6())), mirror_row=lz(row6), seeded={}),
                dict(case="instance", pair_rows="iterable", mirror_row="instance", seeded="instance")))
@@ -427,9 +427,11 @@ def specs(Spec, lazy):
                     amax_results="instance", radius_start="choice")))
     s.append(S("case2_runs", tcs.case2_runs,
                dict(sc=lz(sc2), solver=lz(solver2), alphas=[0.0], x_guess=lz(lambda: g()[3]),
-                    u_guess=lz(lambda: g()[4]), seed_alphas=(), alt_nodes=(), sigma=1.0, executor=None),
+                    u_guess=lz(lambda: g()[4]), seed_alphas=(), alt_nodes=(), sigma=1.0, executor=None,
+                    alt_directions=("up", "down")),
                dict(sc="instance", solver="instance", alphas="vec", x_guess="arr", u_guess="arr",
-                    seed_alphas="iterable", alt_nodes="iterable", sigma="real", executor="instance_opt"),
+                    seed_alphas="iterable", alt_nodes="iterable", sigma="real", executor="instance_opt",
+                    alt_directions="directions"),
                baseline=False))
     s.append(S("queue_keep_out_runs", tcs.queue_keep_out_runs,
                dict(case=lz(case2), row6=lz(row6), d_min_km=[1500.0], warm=True, x_guess=None, u_guess=None,

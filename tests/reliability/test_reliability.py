@@ -148,6 +148,8 @@ def bad_values(kind, valid):
         return [None, 3.0, object(), b"x"]
     if kind == "iterable":
         return [None, 3.0, object(), "abc"]
+    if kind == "directions":  # a non-empty subset of ("up", "down") without repeats
+        return [None, 3.0, object(), "up", [], ["sideways"], ("up", "up")]
     if kind == "path":  # a folder or file path
         return [None, 3.0, object(), "", b"x"]
     if kind == "names":  # an iterable of str
