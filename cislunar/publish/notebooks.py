@@ -541,6 +541,25 @@ class _Interrupted(Exception):
     pass
 
 
+def _run_order(sources, last_seconds: dict, parameters: dict, quick: bool) -> list:
+    """The order the runner starts notebooks in: longest expected run first.
+
+    A notebook's expected run is its time in the last run of this mode into this build (``last_seconds``, name
+    -> seconds or None); without one, :data:`_DEFAULT_SECONDS` times the processes it asks for
+    (:func:`_workers_asked`), so that on a fresh clone the notebooks that take the whole machine come first, back
+    to back, and the one-process notebooks pair up after them (in the alphabetical order a fresh clone used to
+    start everything in, a whole-machine notebook reached the head of the queue while a one-process notebook ran,
+    and waited for it with a core idle).  Ties keep the order of ``sources``.
+    """
+    mode = "quick" if quick else "full"
+
+    def expected(src):
+        last = last_seconds.get(src.stem)
+        return _DEFAULT_SECONDS[mode] * _workers_asked(src, parameters, quick) if last is None else float(last)
+
+    return sorted(sources, key=lambda s: -expected(s))
+
+
 def run_all(sources, *, quick: bool, seed: int = 0, output_dir=None, parameters: dict | None = None,
             timeout: float | None = None, jobs: int = 2, log_output: bool = False, heartbeat: float = 15.0,
             out=None) -> int:
@@ -596,11 +615,7 @@ def run_all(sources, *, quick: bool, seed: int = 0, output_dir=None, parameters:
         rec = previous.get(name)
         return float(rec["seconds"]) if rec and rec.get("mode") == mode else None
 
-    def expected_seconds(name):
-        last = last_seconds(name)
-        return _DEFAULT_SECONDS[mode] if last is None else last
-
-    queue = sorted(sources, key=lambda s: -expected_seconds(s.stem))
+    queue = _run_order(sources, {s.stem: last_seconds(s.stem) for s in sources}, parameters, quick)
     running: list[_Child] = []
     outcome: dict = {}
     stop = {"signal": None}

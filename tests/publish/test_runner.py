@@ -50,6 +50,24 @@ def test_parameters_are_parsed_and_checked(tmp_path):
         notebooks.run_notebook(src, quick=True, output_dir=tmp_path / "b", parameters={"N_NODE": 3})
 
 
+def test_fresh_build_starts_whole_machine_notebooks_first_then_longest_last_run_first(tmp_path):
+    a = source(tmp_path, "01_short")
+    b = source(tmp_path, "02_wide", extra="WORKERS = None")  # QUICK picks: 2 processes in full mode
+    c = source(tmp_path, "03_short")
+    d = source(tmp_path, "04_wide", extra="WORKERS = 2")
+    fresh = {s.stem: None for s in (a, b, c, d)}
+    assert [s.stem for s in notebooks._run_order([a, b, c, d], fresh, {}, quick=False)] == \
+        ["02_wide", "04_wide", "01_short", "03_short"]
+    # quick mode: QUICK's pick is one process, so only the explicit WORKERS = 2 moves; WORKERS=1 given by the
+    # reader keeps the sources' order
+    assert notebooks._run_order([a, b, c, d], fresh, {}, quick=True) == [d, a, b, c]
+    assert notebooks._run_order([a, b, c, d], fresh, {"WORKERS": 1}, quick=False) == [a, b, c, d]
+    # with a last run, its time decides, whatever the processes (03_short, never run here: the 60 s default)
+    last = {"01_short": 300.0, "02_wide": 20.0, "03_short": None, "04_wide": 90.0}
+    assert [s.stem for s in notebooks._run_order([a, b, c, d], last, {}, quick=False)] == \
+        ["01_short", "04_wide", "03_short", "02_wide"]
+
+
 def test_a_parameter_changes_the_output_and_provenance_is_recorded(tmp_path):
     src = source(tmp_path, "90_param", extra="N_NODES = 12", body="print('nodes', N_NODES)",
                  value="N_NODES")
