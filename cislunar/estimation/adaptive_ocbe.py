@@ -708,7 +708,8 @@ def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x
 
     Same rule and reset as :func:`adaptive_ocbe`, trial by trial; each pass re-runs, as one batch, only the trials
     with a new detection (each trial's result does not depend on the other trials of a batch, so the others keep
-    their previous pass).
+    their previous pass).  Parameters not listed below are as in
+    :func:`cislunar.estimation.batched_ocbe.ocbe_batch`.
 
     Parameters
     ----------
@@ -729,7 +730,6 @@ def adaptive_ocbe_batch(system: CR3BP, t, y, observer_states, model, meas_cov, x
         batch (``"raise"``) or is flagged and dropped while the others go on (``"flag"``): its epoch and message are
         in the result's ``failure_epoch`` / ``failure`` (the epoch of the detection for a :class:`ResetError`, as
         :func:`adaptive_ocbe` raises it), its arrays and metric NaN; its detections are those made before the failure.
-    Others as in :func:`cislunar.estimation.batched_ocbe.ocbe_batch`.
 
     Returns
     -------

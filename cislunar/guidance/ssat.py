@@ -695,7 +695,7 @@ def mmd_matrix(agent_stm, H_agent) -> np.ndarray:
 
 
 def mmd_direction(Q) -> np.ndarray:
-    """Unit eigenvector of the largest eigenvalue of ``Q`` (..., 3, 3) (Eq. 23), sign fixed (largest |component| > 0).
+    """Unit eigenvector of the largest eigenvalue of ``Q`` (..., 3, 3) (Eq. 23), sign fixed (its largest component in absolute value is positive).
 
     Eq. 23 as printed, :math:`\\mathbf u_y = \\pm\\upsilon\\max(\\mathrm{eig}(Q))`, names the largest eigenvalue (a
     scalar); the policy is its eigenvector, the maximiser of the Rayleigh quotient :math:`\\mathbf u^TQ\\mathbf u`

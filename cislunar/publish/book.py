@@ -479,18 +479,6 @@ def _mathjax_dir() -> Path:
     raise BookError("sphinx-mathjax-offline is installed but holds no mathjax/tex-chtml.js")
 
 
-def _unlink_docstring_markup_errors(folder: Path) -> None:
-    """On the API pages, drop the links docutils puts around markup it could not parse in a docstring (e.g. the
-    ``|x|`` of a norm read as a substitution): they point at error messages the pages do not show.  The text stays."""
-    for page in folder.glob("*.html") if folder.is_dir() else ():
-        text = page.read_text()
-        ids = set(re.findall(r'id="([^"]+)"', text))
-        fixed = re.sub(r'<a[^>]*href="#(id\d+)"[^>]*>(<span class="problematic"[^>]*>.*?</span>)</a>',
-                       lambda m, ids=ids: m.group(2) if m.group(1) not in ids else m.group(0), text, flags=re.S)
-        if fixed != text:
-            page.write_text(fixed)
-
-
 def build_book(build_dir=None, *, out_dir=None, quiet: bool = True, expected=None) -> Path:
     """Stage and render the book; returns ``<out>/index.html``.
 
@@ -553,7 +541,6 @@ def build_book(build_dir=None, *, out_dir=None, quiet: bool = True, expected=Non
     if out.exists():
         shutil.rmtree(out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    _unlink_docstring_markup_errors(html / "api")
     shutil.move(str(html), str(out))
     return out / "index.html"
 

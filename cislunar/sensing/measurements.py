@@ -20,13 +20,18 @@ s) and a :class:`~cislunar.cr3bp.dynamics.CR3BP` to return covariances in non-di
 
 Models
 ------
-``relative_position``  :math:`h = \boldsymbol\rho` (Wolf & Jones test case 1), 3 components.
-``range_range_rate``   :math:`[\rho,\ \dot\rho] = [\|\boldsymbol\rho\|,\ \boldsymbol\rho\cdot\dot{\boldsymbol\rho}/\rho]`
-                       (Wolf & Jones test case 2).
-``azimuth_elevation``  :math:`[\theta, \psi] = [\operatorname{atan2}(\rho_y, \rho_x),\ \arcsin(\rho_z/\rho)]`
-                       (Greaves & Scheeres 2021 Eqs. 7-8; AMOS 2023 Eqs. 15-17; Jacobian AMOS Eq. 18).
-``angle_rates``        :math:`[\dot\theta, \dot\psi]` of Greaves & Scheeres 2021 Eqs. 10-11.
-``angles_and_rates``   the four of them stacked, as filtered by Greaves & Scheeres 2021.
+``relative_position``
+    :math:`h = \boldsymbol\rho` (Wolf & Jones test case 1), 3 components.
+``range_range_rate``
+    :math:`[\rho,\ \dot\rho] = [\|\boldsymbol\rho\|,\ \boldsymbol\rho\cdot\dot{\boldsymbol\rho}/\rho]`
+    (Wolf & Jones test case 2).
+``azimuth_elevation``
+    :math:`[\theta, \psi] = [\operatorname{atan2}(\rho_y, \rho_x),\ \arcsin(\rho_z/\rho)]`
+    (Greaves & Scheeres 2021 Eqs. 7-8; AMOS 2023 Eqs. 15-17; Jacobian AMOS Eq. 18).
+``angle_rates``
+    :math:`[\dot\theta, \dot\psi]` of Greaves & Scheeres 2021 Eqs. 10-11.
+``angles_and_rates``
+    the four of them stacked, as filtered by Greaves & Scheeres 2021.
 
 Degenerate geometry (documented behaviour, tested)
 --------------------------------------------------

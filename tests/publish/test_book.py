@@ -642,6 +642,23 @@ def test_every_module_has_its_anchor_and_a_link_from_the_api_index(built):
 
 @pytest.mark.notebook
 @pytest.mark.xdist_group("book")
+def test_api_pages_render_every_docstring_without_markup_errors(built):
+    """Docutils renders markup it cannot parse (``|x|`` read as a substitution, a field list ending without a blank
+    line) as a red "problematic" span or a system message, and two module docstrings with the same heading give
+    one page two sections with the same anchor: none of them on any API page."""
+    _, out, _, _ = built
+    problems = []
+    for page in sorted((out / "api").glob("*.html")):
+        text = page.read_text()
+        problems += [f"{page.name}: {n} x {what}" for what in ('class="problematic"', 'class="system-message"')
+                     if (n := text.count(what))]
+        ids = re.findall(r'\sid="([^"]+)"', text)
+        problems += [f"{page.name}: anchor {i!r} {ids.count(i)} times" for i in sorted(set(ids)) if ids.count(i) > 1]
+    assert problems == [], "\n".join(problems[:30])
+
+
+@pytest.mark.notebook
+@pytest.mark.xdist_group("book")
 def test_no_error_or_widget_output_is_rendered(built):
     build, out, ok, _ = built
     problems = []

@@ -248,7 +248,7 @@ def control_integral_pdfs(studies: dict, orbit_names, policy_names):
 
 
 def z_vs_maneuver(studies: dict, orbit_names, policy_names):
-    """Figs. 16-17, 20-21 analogues on the 9:2 NRHO's training runs: z over the pointing, z/|dv| over the azimuth,
+    """Figs. 16-17, 20-21 analogues on the 9:2 NRHO's training runs: z over the pointing, ``z/|dv|`` over the azimuth,
     z against the magnitude (the first two orbits of ``orbit_names`` overlaid)."""
     orbit_names = _names(orbit_names, "orbit_names")
     policy_names = _names(policy_names, "policy_names", at_most=2)
@@ -280,7 +280,7 @@ def z_vs_maneuver(studies: dict, orbit_names, policy_names):
 
 def pm_j_search(pmj: dict, f_values, noise_urad, offsets_h, f_pm: float, sig_pm: float, active_sample):
     """The +-j search: paired contrast against the angle noise per window factor (burn at apoapsis), per burn time
-    at ``f_pm``, and the random-burn runs of the regime ``(f_pm, sig_pm)`` coloured by z/|dv|.
+    at ``f_pm``, and the random-burn runs of the regime ``(f_pm, sig_pm)`` coloured by ``z/|dv|``.
     ``pmj``: (f, noise, offset) -> (z per direction, contrast)."""
     f_values = _values(f_values, "f_values", positive=True)
     noise_urad = _values(noise_urad, "noise_urad", positive=True)

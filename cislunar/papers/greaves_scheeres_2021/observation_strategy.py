@@ -145,7 +145,7 @@ class MeasurementDemo:
 
     @property
     def rates_urad_s(self) -> np.ndarray:
-        """|azimuth rate|, |elevation rate|, micro-rad/s."""
+        """Absolute azimuth and elevation rates, micro-rad/s."""
         return np.abs(self.y[:, 2:]) / self.time_unit_s * 1e6
 
     @property
@@ -650,14 +650,15 @@ def regime_map(system: CR3BP, orbits_: dict, cadences, sigmas, handoffs, rate_mo
                *, n_runs: int, seed: int, executor=None) -> RegimeMap:
     """Diverged fractions of angles-only and angles + rates runs over the map.
 
-    Parameters
-    ----------
-    rate_models : dict of str -> float
-        Name of each rate model and the differencing baseline of Eq. 13 it uses, s.
     Cell indices ``(io, ic, isg, im, ih)`` seed run sets as ``(seed, 77, io, ic, isg, im, ih)`` (run ``i`` draws
     from its child ``i``).  The runs of all hand-offs of an (orbit, cadence, noise, model) share a scenario and run
     in lockstep through the batched OCBE (:func:`tracking.filter_trials`), one executor task per
     :data:`LOCKSTEP_TRIALS` runs.
+
+    Parameters
+    ----------
+    rate_models : dict of str -> float
+        Name of each rate model and the differencing baseline of Eq. 13 it uses, s.
     """
     check_system(system)
     _check_orbits(orbits_)

@@ -631,7 +631,7 @@ class QpoPairStudy:
 
     @property
     def mirror_ratio(self) -> float:
-        """|d_0 + d_180| / |d_0|: 0 when the antipodal relative positions are exact mirror images."""
+        """``|d_0 + d_180| / |d_0|``: 0 when the antipodal relative positions are exact mirror images."""
         return float(np.linalg.norm(self.offset_0 + self.offset_180) / np.linalg.norm(self.offset_0))
 
     def antipode_differences(self) -> tuple:

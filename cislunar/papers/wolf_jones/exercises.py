@@ -176,7 +176,7 @@ class MonteCarloSamplesAnswer:
     """Standard error of the joint Monte Carlo estimate of the scalar example's MI at ``n`` and ``factor * n`` samples.
 
     ``ratio`` is the measured standard-error ratio (small over large sample), ``predicted_ratio`` is
-    ``sqrt(factor)``; ``misses`` are |estimate - closed form| in standard errors, for both runs.
+    ``sqrt(factor)``; ``misses`` are ``|estimate - closed form|`` in standard errors, for both runs.
     """
 
     n_samples: int

@@ -127,7 +127,7 @@ def relative_motion(alphas, rel_km):
 
 
 def thrust(case: studies.Case1Sweep, show):
-    """Fig. 3 analogue: |a| and its components over time for the alpha_h indices ``show`` (window shaded)."""
+    """Fig. 3 analogue: the thrust norm ``|a|`` and its components over time for the alpha_h indices ``show`` (window shaded)."""
     validation.instance(case, "case", studies.Case1Sweep)
     show = _show(show, len(case.alphas))
     sc, em = case.scenario, case.scenario.system

@@ -4,8 +4,8 @@ item 4; notebook 06, section 11).
 Without the 424 km keep-out, SCvx on test case 2 does not converge: its iterates head for a target and a convex
 subproblem fails about half a kilometre from it.  This module says why, and tries a smooth remedy.
 
-What is here
-------------
+What is here:
+
 * :func:`passing_state`: the window-start state whose ballistic arc passes a target at a given distance at one
   measurement time (Newton on the STM).
 * :func:`pass_scan`: along such passes, the MI, the norms of its gradient and Hessian, and the conditioning of the
@@ -149,7 +149,7 @@ def _whitened_jacobian(lin, j: int, k: int) -> np.ndarray:
 @dataclass(frozen=True)
 class PassScan:
     """Along passes of the target nearest the ballistic arc at ``d_km``: MI (nats), its gradient's position and
-    velocity norms (nats/LU, nats/(LU/TU)), the largest |eigenvalue| of its Hessian (nats per unit^2; NaN when not
+    velocity norms (nats/LU, nats/(LU/TU)), the largest absolute eigenvalue of its Hessian (nats per unit^2; NaN when not
     computed), and at the pass the whitened Jacobian's row norms (range, range-rate; per LU of relative position)
     and condition number (largest over smallest singular value)."""
 
@@ -187,7 +187,7 @@ def pass_scan(sc: wj.Scenario, info, x_ws, d_km, *, hessian: bool = False) -> Pa
     d_km : array_like
         Pass distances, km (> 0).
     hessian : bool
-        Also the largest |eigenvalue| of the MI Hessian (12 gradients per distance).
+        Also the largest absolute eigenvalue of the MI Hessian (12 gradients per distance).
     """
     validation.instance(sc, "sc", wj.Scenario)
     validation.callable_(info, "info")
@@ -237,7 +237,7 @@ class FreeRunDiagnosis:
     grad_position : ndarray
         Position part of the MI gradient per reference, nats/LU.
     hessian_norm : ndarray
-        Largest |eigenvalue| of the MI Hessian per reference (the last ``n_hessian`` references; NaN before),
+        Largest absolute eigenvalue of the MI Hessian per reference (the last ``n_hessian`` references; NaN before),
         nats per unit^2.
     information_scale : ndarray
         Ratio of the information term's largest subproblem coefficient, :math:`\alpha_h\max(|g|, \|H\|)`, to the

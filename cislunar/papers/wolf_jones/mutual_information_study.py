@@ -1,7 +1,7 @@
 r"""The studies of the mutual-information chapter (notebook 02): Wolf & Jones Eqs. 9-23 and 44-52 on test case 2.
 
-What is here
-------------
+What is here:
+
 * :func:`scalar_worked_example`: the mutual information of a scalar linear-Gaussian measurement three ways
   (closed form, expected KL divergence of Eq. 11, joint Monte Carlo of the log ratio).
 * :func:`constant_velocity_toy`: a 1-D constant-velocity window whose stacked matrices (Eqs. 19-23) are small
@@ -248,11 +248,11 @@ class WindowCRLB:
     gains: np.ndarray
     mi_dense: float
     mi_chain: float
-    largest_z_jacobian: float  #: largest |dH/dz|, |dH/dvz| entry over the window
+    largest_z_jacobian: float  #: largest ``|dH/dz|``, ``|dH/dvz|`` entry over the window
 
     @property
     def relative_difference(self) -> float:
-        """|dense - chain rule| / dense for Eq. 18."""
+        """``|dense - chain rule| / dense`` for Eq. 18."""
         return abs(self.mi_dense - self.mi_chain) / self.mi_dense
 
     @property
@@ -314,12 +314,12 @@ class GradientCheck:
 
     @property
     def error(self) -> float:
-        """max |structured - FD| / max |FD|."""
+        """``max |structured - FD| / max |FD|``."""
         return float(np.max(np.abs(self.structured - self.finite_difference)) / np.max(np.abs(self.finite_difference)))
 
     @property
     def dense_error(self) -> float:
-        """max |structured - dense| / max |dense|."""
+        """``max |structured - dense| / max |dense|``."""
         return float(np.max(np.abs(self.structured - self.dense)) / np.max(np.abs(self.dense)))
 
 

@@ -1,8 +1,8 @@
 r"""The studies of the node-placement chapter (notebook 04): Sundman-spaced nodes (Wolf & Jones Eqs. 37-39), the
 accuracy of the first-order-hold affine model between them (Eqs. 27-33), and the node thrust bounds (Eqs. 40-41).
 
-What is here
-------------
+What is here:
+
 * :func:`reference_arcs`: the two references, the test-case-1 observer DRO (corrected Table 2 row) over two periods
   and, beyond the paper, the 9:2 NRHO over one period.
 * :func:`node_sweep`: Sundman nodes for every arc and exponent, with the longest/shortest interval ratio.

@@ -20,7 +20,7 @@ DRO (km) and the largest distance from the Moon (km); the minimum-impulse plan (
 every combination) is solved once for comparison.
 
 "Not immediately apparent", fixed before any sweep was run
----------------------------------------------------------
+----------------------------------------------------------
 Fig. 1 draws the whole reference DRO in the rotating frame, so its scale is the DRO's size: we take the DRO's
 largest distance from the Moon, :math:`R_{DRO}` (117,553 km for test case 1's corrected observer DRO).  A
 departure is "not immediately apparent" on such a panel when it is a small fraction of that scale: we fix

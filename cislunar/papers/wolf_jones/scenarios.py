@@ -1,7 +1,7 @@
 r"""Wolf & Jones test cases 1 and 2 as data, and the information model that SCvx maximises.
 
-What is here
-------------
+What is here:
+
 * :func:`test_case_1`, :func:`test_case_2` build a :class:`Scenario` from the paper's Tables 2-5: the observer and
   target DROs (printed rows from ``data/wolf_jones_dros.csv``, each corrected into an exactly periodic orbit by
   :func:`cislunar.papers.wolf_jones.reference.verify_table_row`), the scenario length (two or three periods of the observer's initial

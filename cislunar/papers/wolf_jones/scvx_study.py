@@ -1,8 +1,8 @@
 r"""The studies of the SCvx chapter (notebook 03): a minimum-impulse transfer on Wolf & Jones test case 1's boundary
 conditions, solved by successive convexification with first-order hold (Eqs. 24-36, 42-43, Table 1).
 
-What is here
-------------
+What is here:
+
 * :func:`transfer_problem`: the problem (corrected Table 2 observer DRO to the printed :math:`x_{\mathcal S}(t_f)`,
   Sundman nodes with the window ends on nodes, zero thrust bound inside the observation window).
 * :func:`solve` : one SCvx run of the problem from the ballistic guess.
@@ -96,7 +96,7 @@ class TransferProblem:
 
     @property
     def ballistic_miss(self) -> float:
-        """|x_f - x(T)| of the ballistic arc over the transfer time, non-dimensional 6-vector norm."""
+        """``|x_f - x(T)|`` of the ballistic arc over the transfer time, non-dimensional 6-vector norm."""
         return float(np.linalg.norm(propagate(self.system, self.x0, self.scenario.duration).x[-1] - self.x_final))
 
 

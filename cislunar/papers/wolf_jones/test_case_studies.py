@@ -454,8 +454,8 @@ def penalty_study(case: Case1Sweep, gammas, n_iter: int, n_iter_long: int, *, al
 # --------------------------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Reflight:
-    """Single-shooting re-flight of every best plan: terminal miss (km, mm/s), largest |u|/a_max outside the
-    window, largest |u| inside it (LU/TU^2); one entry per alpha_h."""
+    """Single-shooting re-flight of every best plan: terminal miss (km, mm/s), largest ``|u|/a_max`` outside the
+    window, largest ``|u|`` inside it (LU/TU^2); one entry per alpha_h."""
 
     miss_km: tuple
     miss_mm_s: tuple
@@ -766,7 +766,7 @@ def keep_out_scan(sc: wj.Scenario, info, x_ws, n_points: int, *, d_range_km=(1e-
 @dataclass(frozen=True)
 class PlanRow:
     """One converged plan of test case 2 and its figures of merit (impulse m/s, MI nats, terminal miss km,
-    closest approach to a target at a measurement km, largest |z| km, largest |u|/a_max, largest |u| in the
+    closest approach to a target at a measurement km, largest ``|z|`` km, largest ``|u|/a_max``, largest ``|u|`` in the
     window LU/TU^2)."""
 
     alpha: float
@@ -1108,7 +1108,7 @@ def free_run(sc: wj.Scenario, t, k_ws: int, info, alpha: float, x_guess, u_guess
 @dataclass(frozen=True)
 class RadiusRow:
     """A plan at the Fig. 6 weight under one keep-out radius ``d`` (km): start, impulse (m/s), MI (nats),
-    terminal RMS (km), closest approach (km), node states, largest |z| (km), keep-out active, largest node
+    terminal RMS (km), closest approach (km), node states, largest ``|z|`` (km), keep-out active, largest node
     distance to the adopted plan (km)."""
 
     d: float

@@ -12,8 +12,8 @@ The printed method, fairly (section 6 of notebook 03, issue 22 item 4): test cas
 alpha_h = 5e-3, from the ballistic DRO, by each combination of the paper's ingredients (L1 exact penalty, linear MI
 model of Eq. 44) and ours (augmented Lagrangian, concave-quadratic MI model).  The practical stopping rule
 (``scvx_study.PRACTICAL_STOP``: five consecutive accepted steps with the largest defect <= 1e-8 and a relative
-cost change <= 1e-8) was fixed before any run.  The cost tolerance of "reaches the optimum", |cost - reference| <=
-1e-6 (non-dimensional cost of about 0.54, so ~2e-6 relative), was fixed after a first exploratory run on 40 nodes
+cost change <= 1e-8) was fixed before any run.  The cost tolerance of "reaches the optimum", ``|cost - reference| <=
+1e-6`` (non-dimensional cost of about 0.54, so ~2e-6 relative), was fixed after a first exploratory run on 40 nodes
 (printed method 3.7e-5 away, augmented Lagrangian with the linear model 1.5e-9 away): every tolerance between 1e-8
 and 3e-5 gives the same verdicts.
 """
@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from cislunar.publish.claims import AtMost, Claim, Equals, Holds
 
-#: |cost - reference optimum| (non-dimensional) within which a run "reaches the optimum" (module docstring).
+#: ``|cost - reference optimum|`` (non-dimensional) within which a run "reaches the optimum" (module docstring).
 OPTIMUM_TOL = 1e-6
 
 CLAIMS = {
