@@ -554,6 +554,10 @@ class MeshStudy:
     rtol : float
         Convergence tolerance: impulse, MI and RMS change by at most ``rtol`` (relative) between the two finest
         grids.
+    attempts : tuple of tuple
+        Every solve of the study, ``(n_nodes, alpha, start, cost, impulse m/s)`` with ``start`` ``"warm"`` or
+        ``"cold"``; cost and impulse NaN when the solve did not converge.  Where both starts converge with different
+        costs, the two are different local optima and the row keeps the lower.
     """
 
     alphas: tuple
@@ -561,6 +565,12 @@ class MeshStudy:
     figure_nodes: int
     rows: tuple
     rtol: float
+    attempts: tuple = ()
+
+    def starts(self, alpha: float, n_nodes: int) -> dict:
+        """``{start: (cost, impulse m/s)}`` of the solves at ``alpha`` on the ``n_nodes`` grid (NaN: not
+        converged)."""
+        return {s: (c, dv) for n, a, s, c, dv in self.attempts if n == n_nodes and a == alpha}
 
     def table(self, alpha: float) -> list:
         return sorted((r for r in self.rows if r.alpha == alpha), key=lambda r: r.n_nodes)
@@ -594,6 +604,11 @@ class MeshStudy:
             lines += [f"{a:8.4g} {r.n_nodes:5d} {r.start:>7} {r.impulse_mps:9.3f} {r.mi:8.3f} {r.rms_km:10.2f} "
                       f"{r.cost:12.7f}" if r.converged else f"{a:8.4g} {r.n_nodes:5d}  no start converged"
                       for r in self.table(a)]
+            both = [(n, st) for n in self.n_nodes if len(st := self.starts(a, n)) > 1]
+            if both:
+                lines.append(f"{'':8} both starts (cost, dV m/s): " + "; ".join(
+                    f"{n} nodes " + ", ".join(f"{k} {c:.7f} / {dv:.1f}" if np.isfinite(c) else f"{k} failed"
+                                              for k, (c, dv) in st.items()) for n, st in both))
             ch = self.changes(a)
             lines.append(f"{'':8} changes between consecutive converged grids: " + "; ".join(
                 f"{q} " + ", ".join(f"{100 * v:.1f} %" for v in c) for q, c in ch.items())
@@ -680,4 +695,7 @@ def mesh_study(solver, plans: dict, n_nodes, *, sigma: float = 1.0, rtol: float 
                 rows.append(row(n, a, s, o, k_n))
             else:
                 rows.append(MeshRow(n, a, "-", False, np.nan, np.nan, np.nan, np.nan, None))
-    return MeshStudy(tuple(plans), tuple(sorted(set(n_nodes) | {fig_n})), fig_n, tuple(rows), rtol)
+    attempts = tuple((n_, a_, s, *((np.nan, np.nan) if isinstance(o, scvx.SCvxError) else
+                                   (float(o.cost), float(o.impulse * mps))))
+                     for (n_, a_, s), o in zip(where, outs))
+    return MeshStudy(tuple(plans), tuple(sorted(set(n_nodes) | {fig_n})), fig_n, tuple(rows), rtol, attempts)

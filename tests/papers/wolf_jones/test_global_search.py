@@ -228,6 +228,11 @@ def test_mesh_study_re_converges_on_other_sundman_grids(setup, ms):
     assert rows[1].start == "figures" and rows[1].result is ms.best[0]
     for r in (rows[0], rows[2]):  # impulse within 10 % of the figures' plan on a grid one node apart
         assert r.start == "warm" and abs(r.impulse_mps / rows[1].impulse_mps - 1) <= 0.10
+    # every solve is recorded, and each row is the best converged start of its grid
+    assert sorted((n, s) for n, a, s, *_ in m.attempts) == [(9, "warm"), (11, "warm")]
+    for r in (rows[0], rows[2]):
+        st = m.starts(A, r.n_nodes)
+        assert st["warm"] == (r.cost, r.impulse_mps)
     ch = m.changes(A)
     assert ch["impulse_mps"][1] == pytest.approx(abs(rows[2].impulse_mps - rows[1].impulse_mps) / rows[1].impulse_mps)
     assert m.converged(A) == all(c[-1] <= m.rtol for c in ch.values())

@@ -124,7 +124,7 @@ CLAIMS = {
     "envelope": Claim("Fig. 10 front as the lower envelope over every optimum found", "one curve (Fig. 10)",
                       kind="beyond paper"),
     "mesh_study": Claim(
-        "plans converged in the node grid at the headline weight (mesh study up to 60 nodes)", "N, sigma not given",
+        "plans converged in the node grid at the headline weights (mesh study up to 60 nodes)", "N, sigma not given",
         Holds("impulse, MI and observer terminal RMS change by at most 5 % between the two finest grids at every "
               "headline weight"), kind="beyond paper",
         reason="the plans move with the grid by more than the 5 % tolerance"),
