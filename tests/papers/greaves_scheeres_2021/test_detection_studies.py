@@ -250,6 +250,13 @@ def small_studies():
 
     s_tune, s_c = setups(0.1), setups(tmap.f_c)
     train = ds.run_training_studies(s_tune, s_c, policies, {o: (8, 8, 2) for o in orbit_set}, 0, 3, batch_size=4)
+    # each threshold's bootstrap draws from its own seed [seed, 90, n, w] (n: the case, w: the tuning), whatever
+    # runs it (the bootstraps go to the executor side by side)
+    for w, tag in enumerate(ds.TAGS):
+        for n, key in enumerate(train.studies[tag]):
+            st = train.studies[tag][key]
+            ref = det.threshold_bootstrap(st.h0.z, st.h1.z, 3, np.random.default_rng([0, 90, n, w]))
+            np.testing.assert_array_equal(train.boot[key, tag], ref)
     s_q = s_tune["9:2 NRHO", "quiet"]
     spike = ds.run_spike_study(det.make_setup(em, orbit_set["9:2 NRHO"], s_q.q_window_km2_s3, s_q.q_window_km2_s3),
                                s_q, 2, [0, 41])
