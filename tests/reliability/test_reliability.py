@@ -520,8 +520,8 @@ def _specs():
                dict(verdict=Claim("q", 1.0, Within(1.0, 0.1)).judge(1.0)), dict(verdict="instance")))
     s.append(S("fmt", report.fmt, dict(value=1.0, digits=6), dict(digits="int1")))
     s.append(S("save_figure", plotting.save_figure, dict(fig=lazy(lambda: _fig()[0]), name="x", output_dir="/tmp",
-                                                         formats=("png",)),
-               dict(fig="instance", name="instance_str", formats="instance"), baseline=False))
+                                                         formats=("png",), show=False),
+               dict(fig="instance", name="instance_str", formats="instance", show="bool_opt"), baseline=False))
     s.append(S("plot_primaries", plotting.plot_primaries, dict(ax=lazy(_ax_kw), system=em, plane="xy",
                                                                units="LU"),
                dict(ax="instance", system="system", plane="choice", units="choice")))
