@@ -2,8 +2,8 @@
 tests/reliability/test_reliability.py; issue 22, item 1).
 
 Valid baselines run on test case 1 planned on 6 Sundman nodes at alpha_h = 0: a multi-start of two starts (the
-ballistic guess and one random perturbation), a mesh study on one other grid (warm start only), and the envelope
-of a few points.  The same valid calls are the Dask cases of tests/utils/test_every_executor_on_dask.py.
+ballistic guess and one random perturbation), a mesh study on one other grid (warm start only) and its plan moved
+back, and the envelope of a few points.  The same valid calls are the Dask cases of tests/utils/test_every_executor_on_dask.py.
 """
 
 from __future__ import annotations
@@ -37,6 +37,11 @@ def ms1():
                           neighbours=False)
 
 
+@functools.lru_cache(maxsize=None)
+def mesh1():
+    return gs.mesh_study(solver1(), {0.0: ms1().best[0]}, [7], cold=False)
+
+
 def sweep1():
     return scvx.SweepResult(np.array([0.0]), [ms1().best[0]], ["up"], [])
 
@@ -67,4 +72,6 @@ def specs(S, lazy):
                     cold=False, executor=None),
                dict(solver="instance", plans="instance", n_nodes="iterable", sigma="real", rtol="range:0:1",
                     cold="bool", executor="instance_opt")))
+    s.append(S("back_to_grid", gs.back_to_grid, dict(solver=lz(solver1), study=lz(mesh1), executor=None),
+               dict(solver="instance", study="instance", executor="instance_opt")))
     return s

@@ -40,7 +40,7 @@ from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.utils import montecarlo, validation
 
 __all__ = ["StartOutcome", "MultiStart", "multi_start", "known_from_sweep", "adopt", "Envelope", "lower_envelope",
-           "FrontPoints", "front_points", "MeshRow", "MeshStudy", "mesh_study"]
+           "FrontPoints", "front_points", "MeshRow", "MeshStudy", "mesh_study", "back_to_grid"]
 
 _MIRROR = np.diag([1, 1, -1, 1, 1, -1.0])
 
@@ -558,6 +558,8 @@ class MeshStudy:
         Every solve of the study, ``(n_nodes, alpha, start, cost, impulse m/s)`` with ``start`` ``"warm"`` or
         ``"cold"``; cost and impulse NaN when the solve did not converge.  Where both starts converge with different
         costs, the two are different local optima and the row keeps the lower.
+    sigma : float
+        Sundman exponent of the grids.
     """
 
     alphas: tuple
@@ -566,6 +568,7 @@ class MeshStudy:
     rows: tuple
     rtol: float
     attempts: tuple = ()
+    sigma: float = 1.0
 
     def starts(self, alpha: float, n_nodes: int) -> dict:
         """``{start: (cost, impulse m/s)}`` of the solves at ``alpha`` on the ``n_nodes`` grid (NaN: not
@@ -698,4 +701,48 @@ def mesh_study(solver, plans: dict, n_nodes, *, sigma: float = 1.0, rtol: float 
     attempts = tuple((n_, a_, s, *((np.nan, np.nan) if isinstance(o, scvx.SCvxError) else
                                    (float(o.cost), float(o.impulse * mps))))
                      for (n_, a_, s), o in zip(where, outs))
-    return MeshStudy(tuple(plans), tuple(sorted(set(n_nodes) | {fig_n})), fig_n, tuple(rows), rtol, attempts)
+    return MeshStudy(tuple(plans), tuple(sorted(set(n_nodes) | {fig_n})), fig_n, tuple(rows), rtol, attempts, sigma)
+
+
+def back_to_grid(solver, study: MeshStudy, *, executor=None) -> dict:
+    """Each weight's best plan on the finest converged grid of ``study`` (finer than the figures'), moved back onto
+    ``solver``'s grid (states and first-order-hold controls interpolated in time) and solved there.
+
+    The mesh study's grids are other starts for the figures' grid: a result with a lower cost than the figures'
+    plan (``study``'s row on ``solver``'s grid) is an optimum the multi-start did not find there.  Only finer grids
+    are moved back: interpolating a coarser grid's states in time can cut through a close flyby (on test case 2 a
+    12-node plan moved onto 16 nodes starts inside the Moon).
+
+    Parameters
+    ----------
+    solver : ScenarioSolver
+        The figures' solver (the one :func:`mesh_study` was given).
+    study : MeshStudy
+        Its mesh study.
+    executor : optional
+        ``submit``-style executor (results do not depend on it).
+
+    Returns
+    -------
+    dict
+        ``{alpha: (n_nodes, start, result)}``: the grid and start the plan came from, and the
+        :class:`~cislunar.guidance.scvx.SCvxResult` on ``solver``'s grid (or the :class:`SCvxError` of a solve that
+        did not converge); weights without another converged grid are left out.
+    """
+    validation.instance(solver, "solver", wj.ScenarioSolver)
+    validation.instance(study, "study", MeshStudy)
+    if study.figure_nodes != solver.t.size:
+        raise ValueError(f"study must be the mesh study of solver's grid ({solver.t.size} nodes); it was made on "
+                         f"{study.figure_nodes}")
+    _checks.executor(executor)
+    picks = {}
+    for a in study.alphas:
+        others = [r for r in study.table(a) if r.converged and r.n_nodes > study.figure_nodes]
+        if others:
+            picks[a] = others[-1]
+    tasks = []
+    for a, r in picks.items():
+        t_n = solver.scenario.node_times(r.n_nodes, study.sigma)[0]
+        tasks.append((solver, a, *_interpolate_plan(t_n, r.result.x, r.result.u, solver.t)))
+    outs = montecarlo.map_tasks(_mesh_task, tasks, executor=executor, progress=False)
+    return {a: (r.n_nodes, r.start, o) for (a, r), o in zip(picks.items(), outs)}
