@@ -357,17 +357,14 @@ print(mstudy.summary())
 # %%
 with open_executor(workers, SCHEDULER) as executor:
     back = global_search.back_to_grid(solver, mstudy, executor=executor)
-back_gain = {}
+back_gain = {a_: g_ for a_, (*_, g_) in back.items() if np.isfinite(g_)}
 if not back:
     print("no mesh grid finer than the figures' converged in this run: nothing to move back")
-for a_, (n_, start_, r_) in back.items():
+for a_, (n_, start_, r_, g_) in back.items():
     fig_ = by_alpha[a_].res
-    if isinstance(r_, Exception):
-        print(f"alpha_h {a_:g}: the {n_}-node plan moved back did not converge ({r_})")
-        continue
-    back_gain[a_] = (fig_.cost - r_.cost) / (1 + abs(fig_.cost))
-    print(f"alpha_h {a_:g}: the {n_}-node plan ({start_} start) moved back to {n_nodes} nodes: cost {r_.cost:.7f} "
-          f"against the figures' {fig_.cost:.7f} (gain {back_gain[a_]:+.2e}); {r_.impulse * mps:.1f} against "
+    print(f"alpha_h {a_:g}: the {n_}-node plan moved back did not converge ({r_})" if isinstance(r_, Exception) else
+          f"alpha_h {a_:g}: the {n_}-node plan ({start_} start) moved back to {n_nodes} nodes: cost {r_.cost:.7f} "
+          f"against the figures' {fig_.cost:.7f} (gain {g_:+.2e}); {r_.impulse * mps:.1f} against "
           f"{fig_.impulse * mps:.1f} m/s")
 
 # %% [markdown]

@@ -725,9 +725,10 @@ def back_to_grid(solver, study: MeshStudy, *, executor=None) -> dict:
     Returns
     -------
     dict
-        ``{alpha: (n_nodes, start, result)}``: the grid and start the plan came from, and the
+        ``{alpha: (n_nodes, start, result, gain)}``: the grid and start the plan came from, the
         :class:`~cislunar.guidance.scvx.SCvxResult` on ``solver``'s grid (or the :class:`SCvxError` of a solve that
-        did not converge); weights without another converged grid are left out.
+        did not converge, gain NaN), and the gain :math:`(J_{fig} - J)/(1 + |J_{fig}|)` over the figures' plan (the
+        measure of :class:`MultiStart`'s ``cost_tol``); weights without a finer converged grid are left out.
     """
     validation.instance(solver, "solver", wj.ScenarioSolver)
     validation.instance(study, "study", MeshStudy)
@@ -745,4 +746,7 @@ def back_to_grid(solver, study: MeshStudy, *, executor=None) -> dict:
         t_n = solver.scenario.node_times(r.n_nodes, study.sigma)[0]
         tasks.append((solver, a, *_interpolate_plan(t_n, r.result.x, r.result.u, solver.t)))
     outs = montecarlo.map_tasks(_mesh_task, tasks, executor=executor, progress=False)
-    return {a: (r.n_nodes, r.start, o) for (a, r), o in zip(picks.items(), outs)}
+    fig = {a: next(r.cost for r in study.table(a) if r.n_nodes == study.figure_nodes) for a in picks}
+    return {a: (r.n_nodes, r.start, o, np.nan if isinstance(o, scvx.SCvxError) else
+                (fig[a] - float(o.cost)) / (1 + abs(fig[a])))
+            for (a, r), o in zip(picks.items(), outs)}

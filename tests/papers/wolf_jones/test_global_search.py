@@ -235,9 +235,10 @@ def test_mesh_study_re_converges_on_other_sundman_grids(setup, ms):
         assert st["warm"] == (r.cost, r.impulse_mps)
     # the finest other grid's plan moved back onto the figures' grid re-converges to the figures' optimum
     back = gs.back_to_grid(solver, m)
-    n_back, start, res = back[A]
+    n_back, start, res, gain = back[A]
     assert (n_back, start) == (11, "warm") and not isinstance(res, Exception)
     assert abs(res.cost - rows[1].cost) <= 1e-6 * (1 + abs(rows[1].cost))
+    assert gain == (rows[1].cost - res.cost) / (1 + abs(rows[1].cost))
     assert res.cost <= rows[2].cost + 0.05 * abs(rows[2].cost)
     with pytest.raises(ValueError, match="mesh study of solver's grid"):
         gs.back_to_grid(wj.ScenarioSolver(sc, *sc.node_times(9)[:2], information=solver.information,
