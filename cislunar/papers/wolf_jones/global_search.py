@@ -8,7 +8,9 @@ is non-convex, so one SCvx run per weight returns *a* local optimum.  This modul
   known such as the homotopy sweep's), keeps the lowest cost and counts the distinct local optima;
 * draws the Pareto front as the lower envelope of every optimum found (:func:`lower_envelope`, monotone by
   construction; :func:`front_points` evaluates the CRLB of each distinct optimum);
-* solves the headline weights again on several Sundman grids (:func:`mesh_study`).
+* solves the headline weights again on several Sundman grids (:func:`mesh_study`) and moves the finer grids'
+  plans back onto the figures' grid as further starts there (:func:`back_to_grid`, :func:`with_starts`,
+  :func:`with_moved_back`).
 
 **Same or distinct optimum** (fixed before any run).  Two converged plans at one weight are *the same local optimum*
 when their costs agree within ``cost_tol (1 + max |J|)`` (default ``cost_tol`` = 1e-6, a hundred times the solver's
@@ -26,6 +28,7 @@ states are rotating-frame barycentric CR3BP states in LU and LU/TU, controls in 
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import time
 from dataclasses import dataclass
@@ -39,8 +42,9 @@ from cislunar.papers.wolf_jones import _checks
 from cislunar.papers.wolf_jones import scenarios as wj
 from cislunar.utils import montecarlo, validation
 
-__all__ = ["StartOutcome", "MultiStart", "multi_start", "known_from_sweep", "adopt", "Envelope", "lower_envelope",
-           "FrontPoints", "front_points", "MeshRow", "MeshStudy", "mesh_study", "back_to_grid"]
+__all__ = ["StartOutcome", "MultiStart", "multi_start", "with_starts", "known_from_sweep", "adopt", "Envelope",
+           "lower_envelope", "FrontPoints", "front_points", "MeshRow", "MeshStudy", "mesh_study", "back_to_grid",
+           "with_moved_back"]
 
 _MIRROR = np.diag([1, 1, -1, 1, 1, -1.0])
 
@@ -339,7 +343,6 @@ def multi_start(solver, alphas, *, rng=None, n_random: int = 1, random_scale: fl
             _checks.plan(r[1], f"known[{k!r}][{i}][1]", n=t.size)
         known_rows[kf] = list(rows)
     t0 = time.perf_counter()
-    L = sc.system.length_unit_km
     # round one: every generated start, guesses built (and random numbers drawn) here in a fixed order
     guesses = {}
     if ballistic:
@@ -378,10 +381,16 @@ def multi_start(solver, alphas, *, rng=None, n_random: int = 1, random_scale: fl
                     where.append((al, f"neighbour {alphas[j]:g}"))
         for (al, lab), out in zip(where, montecarlo.map_tasks(run, tasks, executor=executor, progress=False)):
             entries[al].append((lab, None, out.reason) if isinstance(out, scvx.SCvxError) else (lab, out, ""))
-    mps, outcomes, best, best_label = _mps(sc.system), [], [], []
+    return _assemble(alphas, entries, sc.system, cost_tol, plan_km, time.perf_counter() - t0)
+
+
+def _assemble(alphas, entries, system, cost_tol, plan_km, seconds) -> MultiStart:
+    """The :class:`MultiStart` of ``entries`` (``{alpha: [(label, plan or None, error), ...]}``, in start order):
+    distinct optima clustered per weight, the lowest cost kept (ties: the earliest start)."""
+    mps, outcomes, best, best_label = _mps(system), [], [], []
     for al in alphas:
         rows = entries[al]
-        opt = _cluster([r for _, r, _ in rows], cost_tol, plan_km / L)
+        opt = _cluster([r for _, r, _ in rows], cost_tol, plan_km / system.length_unit_km)
         for (lab, r, err), k in zip(rows, opt):
             outcomes.append(StartOutcome(al, lab, r is not None, np.nan if r is None else float(r.cost),
                                          np.nan if r is None else float(r.impulse * mps),
@@ -395,8 +404,47 @@ def multi_start(solver, alphas, *, rng=None, n_random: int = 1, random_scale: fl
         else:
             best.append(None)
             best_label.append("")
-    return MultiStart(alphas, tuple(outcomes), tuple(best), tuple(best_label), cost_tol, plan_km,
-                      time.perf_counter() - t0)
+    return MultiStart(alphas, tuple(outcomes), tuple(best), tuple(best_label), cost_tol, plan_km, seconds)
+
+
+def with_starts(solver, ms: MultiStart, extra: dict) -> MultiStart:
+    """``ms`` with more starts per weight, solved elsewhere on the same grid (e.g. the mesh study's plans moved
+    back by :func:`back_to_grid`): their outcomes are appended after ``ms``'s own, the distinct optima clustered
+    again with ``ms``'s tolerances and the best plan per weight chosen again (ties: the earlier start, so an extra
+    start replaces a plan only with a strictly lower cost).
+
+    Parameters
+    ----------
+    solver : ScenarioSolver
+        The solver ``ms`` was run with (its grid and system).
+    ms : MultiStart
+    extra : dict
+        ``{alpha: [(label, outcome), ...]}`` with ``alpha`` among ``ms.alphas``; ``outcome`` a converged
+        :class:`~cislunar.guidance.scvx.SCvxResult` on ``ms``'s grid or the :class:`~cislunar.guidance.scvx.SCvxError`
+        of a start that failed.
+
+    Returns
+    -------
+    MultiStart
+        Same weights, tolerances and wall time (``seconds``: the extra starts were timed where they ran).
+    """
+    validation.instance(solver, "solver", wj.ScenarioSolver)
+    validation.instance(ms, "ms", MultiStart)
+    extra = validation.instance(extra, "extra", dict, "a dict {alpha: [(label, outcome)]}")
+    entries = {al: [(o.label, o.result if o.converged else None, o.error) for o in ms.at(al)] for al in ms.alphas}
+    for k, rows in extra.items():
+        kf = validation.real(k, "extra key")
+        if kf not in ms.alphas:
+            raise ValueError(f"extra holds a weight {k!r} outside ms.alphas {ms.alphas}")
+        for i, r in enumerate(_checks.sequence(rows, f"extra[{k!r}]", allow_empty=True)):
+            if not isinstance(r, tuple) or len(r) != 2 or not isinstance(r[0], str):
+                raise validation.ArgumentTypeError(f"extra[{k!r}][{i}] must be a (label, outcome) tuple")
+            lab, out = r
+            if isinstance(out, scvx.SCvxError):
+                entries[kf].append((lab, None, out.reason))
+            else:
+                entries[kf].append((lab, _checks.plan(out, f"extra[{k!r}][{i}][1]", n=solver.t.size), ""))
+    return _assemble(ms.alphas, entries, solver.scenario.system, ms.cost_tol, ms.plan_km, ms.seconds)
 
 
 # --------------------------------------------------------------------------------------------------------------
@@ -617,6 +665,47 @@ class MeshStudy:
                 f"{q} " + ", ".join(f"{100 * v:.1f} %" for v in c) for q, c in ch.items())
                 + f" -> converged: {self.converged(a)}")
         return "\n".join(lines)
+
+
+def with_moved_back(solver, study: MeshStudy, back: dict) -> MeshStudy:
+    """``study`` after the moved-back plans of :func:`back_to_grid` have been adopted: on the figures' grid each
+    weight's row becomes its moved-back plan where that plan's cost is strictly lower (start ``"back <n>"``, ``n``
+    the grid it came from), so that the table holds, per grid, the best plan known there; every moved-back solve is
+    recorded in ``attempts`` (start ``"back <n>"``, NaN where it failed).
+
+    Parameters
+    ----------
+    solver : ScenarioSolver
+        The figures' solver (the one the study and ``back`` were made with).
+    study : MeshStudy
+    back : dict
+        The result of :func:`back_to_grid` for ``solver`` and ``study``.
+    """
+    validation.instance(solver, "solver", wj.ScenarioSolver)
+    validation.instance(study, "study", MeshStudy)
+    back = validation.instance(back, "back", dict, "the dict of back_to_grid")
+    if study.figure_nodes != solver.t.size:
+        raise ValueError(f"study must be the mesh study of solver's grid ({solver.t.size} nodes); it was made on "
+                         f"{study.figure_nodes}")
+    sc, mps = solver.scenario, _mps(solver.scenario.system)
+    rows, attempts = list(study.rows), list(study.attempts)
+    for a, entry in back.items():
+        if not isinstance(entry, tuple) or len(entry) != 4:
+            raise validation.ArgumentTypeError(f"back[{a!r}] must be an (n_nodes, start, result, gain) tuple")
+        n, _, r, _ = entry
+        i = next((i for i, row in enumerate(rows) if row.alpha == a and row.n_nodes == study.figure_nodes), None)
+        if i is None:
+            raise ValueError(f"back holds a weight {a!r} outside the study's {study.alphas}")
+        if isinstance(r, scvx.SCvxError):
+            attempts.append((study.figure_nodes, a, f"back {n}", np.nan, np.nan))
+            continue
+        _checks.plan(r, f"back[{a!r}][2]", n=solver.t.size)
+        attempts.append((study.figure_nodes, a, f"back {n}", float(r.cost), float(r.impulse * mps)))
+        if r.cost < rows[i].cost:
+            rows[i] = MeshRow(study.figure_nodes, a, f"back {n}", True, float(r.cost), float(r.impulse * mps),
+                              float(r.information),
+                              float(wj.evaluate_crlb(sc, r.x[solver.k_window]).terminal_rms_km[0]), r)
+    return dataclasses.replace(study, rows=tuple(rows), attempts=tuple(attempts))
 
 
 def _interpolate_plan(t_from, x, u, t_to):

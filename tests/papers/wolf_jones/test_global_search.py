@@ -145,6 +145,34 @@ def test_adopt_takes_the_lower_cost_plan_per_weight_and_keeps_the_sweeps_attempt
     assert list(gs.known_from_sweep(kept)) == [A] and gs.known_from_sweep(kept, [0.0]) == {}
 
 
+def test_extra_starts_join_the_multi_start_and_replace_its_best_only_when_strictly_lower(setup, ms):
+    """with_starts: the extra outcomes follow ms's own, are clustered with its tolerances, and become the best only
+    with a strictly lower cost; a failed extra start is recorded as failed; the old outcomes are unchanged."""
+    solver = setup[3]
+    (b,) = ms.best
+    lower, tie = _fake(b, b.cost - 1e-3), _fake(b, b.cost)
+    err = scvx.SCvxError("diverged")
+    out = gs.with_starts(solver, ms, {A: [("mesh 11 (warm)", lower), ("mesh 12 (cold)", err)]})
+    assert out.best == (lower,) and out.best_label == ("mesh 11 (warm)",)
+    assert [o.label for o in out.outcomes] == [o.label for o in ms.outcomes] + ["mesh 11 (warm)", "mesh 12 (cold)"]
+    assert [o.cost for o in out.outcomes[:len(ms.outcomes)]] == [o.cost for o in ms.outcomes]
+    failed = out.outcomes[-1]
+    assert not failed.converged and failed.error == "diverged" and failed.optimum == -1
+    assert out.n_distinct[0] == ms.n_distinct[0] + 1  # 1e-3 lower: another optimum, and the lowest (index 0)
+    assert next(o for o in out.outcomes if o.result is lower).optimum == 0
+    assert out.improvements([b]) == [(A, b.cost, lower.cost, "mesh 11 (warm)")]
+    same = gs.with_starts(solver, ms, {A: [("mesh 11 (warm)", tie)]})
+    assert same.best == ms.best and same.best_label == ms.best_label  # a tie keeps the earlier start
+    assert same.n_distinct == ms.n_distinct  # the same optimum: no new one counted
+    assert gs.with_starts(solver, ms, {}).outcomes == ms.outcomes
+    with pytest.raises(ValueError, match="outside ms.alphas"):
+        gs.with_starts(solver, ms, {1e-2: []})
+    with pytest.raises(TypeError, match=r"extra\[0.005\]\[0\]"):
+        gs.with_starts(solver, ms, {A: [lower]})
+    with pytest.raises(ValueError, match="node states"):
+        gs.with_starts(solver, ms, {A: [("short", _fake(b, b.cost, b.x[:-1]))]})
+
+
 def test_multi_start_refuses_bad_arguments(setup):
     solver = setup[3]
     with pytest.raises(ValueError, match="alphas"):
@@ -246,3 +274,21 @@ def test_mesh_study_re_converges_on_other_sundman_grids(setup, ms):
     ch = m.changes(A)
     assert ch["impulse_mps"][1] == pytest.approx(abs(rows[2].impulse_mps - rows[1].impulse_mps) / rows[1].impulse_mps)
     assert m.converged(A) == all(c[-1] <= m.rtol for c in ch.values())
+    # adopting the moved-back plans: the figures' row is replaced only by a strictly lower cost, every moved-back
+    # solve is recorded, the other grids are untouched
+    kept = gs.with_moved_back(solver, m, back)
+    assert kept.attempts[:-1] == m.attempts and kept.attempts[-1][:3] == (N, A, "back 11")
+    assert kept.attempts[-1][3] == res.cost
+    assert kept.table(A)[1].start == ("back 11" if res.cost < rows[1].cost else "figures")
+    lower = _fake(res, rows[1].cost - 1e-3)
+    swapped = gs.with_moved_back(solver, m, {A: (11, "warm", lower, 1e-3)})
+    new_row = swapped.table(A)[1]
+    assert (new_row.start, new_row.cost, new_row.result) == ("back 11", lower.cost, lower)
+    assert new_row.rms_km == pytest.approx(wj.evaluate_crlb(sc, lower.x[k]).terminal_rms_km[0])
+    assert swapped.table(A)[0] == rows[0] and swapped.table(A)[2] == rows[2]
+    failed = gs.with_moved_back(solver, m, {A: (11, "warm", scvx.SCvxError("x"), np.nan)})
+    assert failed.rows == m.rows and np.isnan(failed.attempts[-1][3])
+    with pytest.raises(ValueError, match="outside the study"):
+        gs.with_moved_back(solver, m, {1e-2: (11, "warm", lower, 0.0)})
+    with pytest.raises(TypeError, match="back"):
+        gs.with_moved_back(solver, m, {A: lower})
