@@ -3,7 +3,8 @@ tests/reliability/test_reliability.py; issue 22, item 1).
 
 Valid baselines run on test case 1 planned on 6 Sundman nodes at alpha_h = 0: a multi-start of two starts (the
 ballistic guess and one random perturbation), a mesh study on one other grid (warm start only) and its plan moved
-back, and the envelope of a few points.  The same valid calls are the Dask cases of tests/utils/test_every_executor_on_dask.py.
+back (and adopted: with_starts, with_moved_back), and the envelope of a few points.  The same valid calls are the
+Dask cases of tests/utils/test_every_executor_on_dask.py.
 """
 
 from __future__ import annotations
@@ -42,6 +43,10 @@ def mesh1():
     return gs.mesh_study(solver1(), {0.0: ms1().best[0]}, [7], cold=False)
 
 
+def back1():  # a back_to_grid result holding the multi-start's own plan (as if moved back from the 7-node grid)
+    return {0.0: (7, "warm", ms1().best[0], 0.0)}
+
+
 def sweep1():
     return scvx.SweepResult(np.array([0.0]), [ms1().best[0]], ["up"], [])
 
@@ -74,4 +79,9 @@ def specs(S, lazy):
                     cold="bool", executor="instance_opt")))
     s.append(S("back_to_grid", gs.back_to_grid, dict(solver=lz(solver1), study=lz(mesh1), executor=None),
                dict(solver="instance", study="instance", executor="instance_opt")))
+    s.append(S("with_starts", gs.with_starts,
+               dict(solver=lz(solver1), ms=lz(ms1), extra=lz(lambda: {0.0: [("mesh 7", ms1().best[0])]})),
+               dict(solver="instance", ms="instance", extra="instance")))
+    s.append(S("with_moved_back", gs.with_moved_back, dict(solver=lz(solver1), study=lz(mesh1), back=lz(back1)),
+               dict(solver="instance", study="instance", back="instance")))
     return s
