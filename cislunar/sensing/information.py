@@ -93,6 +93,7 @@ __all__ = [
     "InformationKernel",
     "window_information",
     "range_noise_scale",
+    "regularised_range_rate_jacobian",
     "gaussian_kl",
     "monte_carlo_mutual_information",
     "TimingResult",
@@ -842,6 +843,56 @@ def range_noise_scale(lin: AugmentedLinearization, range_scale: float, *, deriva
     drho = np.einsum("jka,kab->jkb", rel / rho[..., None], lin.observer_stm[:, :3, :])  # (N_T, N, 6)
     dscale = np.repeat(np.moveaxis(dsdr[..., None] * drho, 0, 1), m, axis=1)  # (N, M, 6)
     return scale, dscale
+
+
+def regularised_range_rate_jacobian(lin: AugmentedLinearization, range_scale: float, *, derivatives: bool = False):
+    r"""The window's measurement Jacobians with the range-rate row regularised at short range: its position part
+    :math:`(\Delta\dot{\mathbf r}-\dot\rho\hat\rho)^T/\rho` becomes
+    :math:`(\Delta\dot{\mathbf r}-\dot\rho\hat\rho)^T/\sqrt{\rho^2+\rho_c^2}` (bounded as :math:`\rho\to0`
+    instead of growing like :math:`1/\rho`); the range row and the velocity part of the range-rate row are kept.
+
+    The position columns of each target's range-rate row (the observer's and that target's) are multiplied by
+    :math:`\rho/\sqrt{\rho^2+\rho_c^2}`, the factor of :func:`range_noise_scale`; the measurement noise is left
+    as it is.  Far from the targets (:math:`\rho \gg \rho_c`) the Jacobians are the model's.
+
+    Parameters
+    ----------
+    lin : AugmentedLinearization
+        A range and range-rate window (two rows per target, range first, as
+        :data:`cislunar.sensing.measurements.RANGE_RANGE_RATE` gives them); ``derivatives`` needs ``lin.dH``.
+    range_scale : float
+        :math:`\rho_c` (> 0), LU.
+    derivatives : bool
+        Also return the derivative of the Jacobians with respect to the observer state at ``t[0]`` (product rule:
+        ``lin.dH`` times the factor plus the Jacobian times the factor's derivative).
+
+    Returns
+    -------
+    ndarray (N, M, n), or (ndarray (N, M, n), ndarray (N, M, n, 6))
+        ``H`` (and ``dH``) in the units of ``lin.H`` (``lin.dH``): for :meth:`InformationKernel.value` and
+        :meth:`InformationKernel.value_gradient` in place of ``lin.H`` and ``lin.dH``.
+    """
+    validation.instance(lin, "lin", AugmentedLinearization)
+    rc = validation.positive(range_scale, "range_scale")
+    derivatives = validation.boolean(derivatives, "derivatives")
+    n_t = lin.targets.shape[0]
+    M, n = lin.H.shape[1], lin.H.shape[2]
+    if M != 2 * n_t:
+        raise ValueError(f"lin must be a range and range-rate window (2 rows per target, {2 * n_t} rows); got "
+                         f"{M} rows for {n_t} targets")
+    if derivatives and lin.dH is None:
+        raise ValueError("lin has no dH: linearise with derivatives=True for derivatives=True")
+    mask = np.zeros((M, n), dtype=bool)  # the position columns of each target's range-rate row
+    for j in range(n_t):
+        mask[2 * j + 1, 0:3] = True
+        mask[2 * j + 1, 6 * (j + 1):6 * (j + 1) + 3] = True
+    if not derivatives:
+        s = range_noise_scale(lin, rc)
+        return np.where(mask, s[..., None] * lin.H, lin.H)
+    s, ds = range_noise_scale(lin, rc, derivatives=True)
+    H = np.where(mask, s[..., None] * lin.H, lin.H)
+    dH = np.where(mask[..., None], s[..., None, None] * lin.dH + lin.H[..., None] * ds[:, :, None, :], lin.dH)
+    return H, dH
 
 
 def window_information(lin: AugmentedLinearization, *, method: str = "structured", gradient: bool = False,

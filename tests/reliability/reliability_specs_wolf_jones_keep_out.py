@@ -84,6 +84,9 @@ def specs(S, lazy):
     s.append(S("range_noise_scale", information.range_noise_scale,
                dict(lin=lz(lin2), range_scale=0.01, derivatives=True),
                dict(lin="instance", range_scale="pos", derivatives="bool")))
+    s.append(S("regularised_range_rate_jacobian", information.regularised_range_rate_jacobian,
+               dict(lin=lz(lin2), range_scale=0.01, derivatives=False),
+               dict(lin="instance", range_scale="pos", derivatives="bool")))
     s.append(S("printed_method_study", scvx_study.printed_method_study,
                dict(n_nodes=6, alpha=5e-3, max_iter=2, sigma=1.0, labels=[], executor=None),
                dict(n_nodes="int1", alpha="range:0:1", max_iter="int1", sigma="nonneg")))
@@ -105,11 +108,14 @@ def specs(S, lazy):
     s.append(S("remedy_runs", kd.remedy_runs,
                dict(sc=lz(sc2), t=lazy(lambda: grid2()[0]), k_ws=lazy(lambda: grid2()[1]), info=lz(info2),
                     range_scale_km=141.0, alphas=[1e-2], x_guess=lazy(lambda: grid2()[2]),
-                    u_guess=lazy(lambda: grid2()[3]), max_iter=1, keep_out=False),
+                    u_guess=lazy(lambda: grid2()[3]), max_iter=1, keep_out=False,
+                    remedies=("range noise", "regularised J")),
                dict(sc="instance", k_ws="int1", info="instance", range_scale_km="pos", alphas="vec", max_iter="int1",
                     keep_out="bool")))
     s.append(S("remedy_table", kd.remedy_table, dict(runs=lz(remedy2)), dict(runs="instance")))
     s.append(S("figure_keep_out_diagnosis", closed(figures.figure_keep_out_diagnosis),
-               dict(diagnosis=lz(diag2), plain=lz(scan2), remedy=lz(scan2), range_scale_km=141.0),
-               dict(diagnosis="instance", plain="instance", remedy="instance", range_scale_km="pos")))
+               dict(diagnosis=lz(diag2), plain=lz(scan2), remedy=lz(scan2), range_scale_km=141.0,
+                    regularised=lz(scan2)),
+               dict(diagnosis="instance", plain="instance", remedy="instance", range_scale_km="pos",
+                    regularised="instance_opt")))
     return s

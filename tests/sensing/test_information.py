@@ -34,6 +34,70 @@ def random_system(seed, N=5, M=3, n=4, p=3, cond=1.0):
     return P0, F, Q, H, R, dF, dH
 
 
+def test_regularised_range_rate_jacobian_is_the_model_jacobian_with_rho_replaced_in_the_position_part(window):
+    """Independent of the mask bookkeeping: rebuilt from the relative states, the range-rate row's position part
+    is (dv - rdot u) / sqrt(rho^2 + rho_c^2) (observer +, target -); every other entry is lin.H's."""
+    lin, _ = window
+    rc = float(np.median(_window_ranges(lin)))
+    H = I.regularised_range_rate_jacobian(lin, rc)
+    assert H.shape == lin.H.shape
+    for j in range(lin.targets.shape[0]):
+        rel = lin.observer - lin.targets[j]  # (N, 6), observer minus target
+        rho = np.linalg.norm(rel[:, :3], axis=1)
+        u = rel[:, :3] / rho[:, None]
+        rdot = np.sum(u * rel[:, 3:], axis=1)
+        pos = (rel[:, 3:] - rdot[:, None] * u) / np.sqrt(rho**2 + rc**2)[:, None]
+        c = 6 * (j + 1)
+        np.testing.assert_allclose(H[:, 2 * j + 1, 0:3], pos, rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(H[:, 2 * j + 1, c:c + 3], -pos, rtol=1e-12, atol=1e-15)
+        # unregularised, the same rebuild with rho gives the model's row (the reference is right)
+        np.testing.assert_allclose(lin.H[:, 2 * j + 1, 0:3], (rel[:, 3:] - rdot[:, None] * u) / rho[:, None],
+                                   rtol=1e-12, atol=1e-15)
+    changed = H != lin.H
+    assert not changed[:, 0::2].any()  # range rows untouched
+    assert not changed[:, 1::2, 3:6].any()  # velocity part untouched
+    # a scale far below the ranges gives the model's Jacobians (to round-off), so the MI is the paper's
+    tiny = I.regularised_range_rate_jacobian(lin, 1e-9 * float(_window_ranges(lin).min()))
+    np.testing.assert_allclose(tiny, lin.H, rtol=1e-12, atol=0)
+
+
+def test_regularised_range_rate_jacobian_derivative_matches_finite_differences(window):
+    """dH of the regularised Jacobians against central differences of H (re-linearised), and the MI gradient
+    through it against differences of the MI; dropping the factor's derivative is visibly wrong."""
+    lin, R = window
+    rc = float(np.median(_window_ranges(lin)))
+    H, dH = I.regularised_range_rate_jacobian(lin, rc, derivatives=True)
+    np.testing.assert_array_equal(H, I.regularised_range_rate_jacobian(lin, rc))
+    kernel = I.InformationKernel(lin.P0, lin.Q, lin.R, lin.t.size)
+
+    def lin_at(x):
+        return C.linearize_augmented(EARTH_MOON, x, TARGETS, lin.t, M.RANGE_RANGE_RATE, R, lin.P0, Q=lin.Q)
+
+    h = 1e-6
+    fd_H = np.zeros_like(dH)
+    fd_I = np.zeros(6)
+    for j in range(6):
+        e = np.zeros(6)
+        e[j] = h
+        lp, lm = lin_at(OBSERVER + e), lin_at(OBSERVER - e)
+        fd_H[..., j] = (I.regularised_range_rate_jacobian(lp, rc)
+                        - I.regularised_range_rate_jacobian(lm, rc)) / (2 * h)
+        fd_I[j] = (kernel.value(lp.F, I.regularised_range_rate_jacobian(lp, rc))
+                   - kernel.value(lm.F, I.regularised_range_rate_jacobian(lm, rc))) / (2 * h)
+    np.testing.assert_allclose(dH, fd_H, rtol=1e-5, atol=1e-6 * np.abs(dH).max())
+    val, grad = kernel.value_gradient(lin.F, H, lin.dF, dH)
+    assert val == pytest.approx(kernel.value(lin.F, H), rel=1e-12)
+    scale = np.max(np.abs(fd_I))
+    np.testing.assert_allclose(grad, fd_I, rtol=1e-4, atol=1e-5 * scale)
+    frozen = np.where(dH != lin.dH, lin.dH * I.range_noise_scale(lin, rc)[..., None, None], lin.dH)
+    _, g_frozen = kernel.value_gradient(lin.F, H, lin.dF, frozen)
+    assert np.max(np.abs(g_frozen - fd_I)) > 1e-3 * scale
+    with pytest.raises(ValueError, match="range_scale"):
+        I.regularised_range_rate_jacobian(lin, 0.0)
+    with pytest.raises(TypeError, match="lin"):
+        I.regularised_range_rate_jacobian(lin.H, rc)
+
+
 @given(seed=st.integers(0, 2**32 - 1), N=st.integers(1, 7), M=st.integers(1, 4), n=st.integers(1, 6),
        logcond=st.floats(-3, 6))
 def test_structured_equals_dense(seed, N, M, n, logcond):

@@ -606,14 +606,17 @@ def departure_figure(study: plan_size_study.PlanSizeStudy):
 # ------------------------------------------------------------------------------------------------------------
 # keep-out diagnosis and remedy (notebook 06 section 11; keep_out_diagnosis)
 def figure_keep_out_diagnosis(diagnosis: kod.FreeRunDiagnosis, plain: kod.PassScan, remedy: kod.PassScan,
-                              range_scale_km: float):
+                              range_scale_km: float, regularised: kod.PassScan | None = None):
     """Left: closest approach of each SCvx reference to a target without a keep-out (km, log), the failure marked.
     Right: along passes at a chosen distance, the position part of the MI gradient (nats/LU) with the paper's
-    noise and with the range-dependent noise, and the whitened range-rate row (per LU)."""
+    noise, with the range-dependent noise and (if ``regularised`` is given) with the regularised range-rate
+    Jacobian, and the whitened range-rate row (per LU)."""
     validation.instance(diagnosis, "diagnosis", kod.FreeRunDiagnosis)
     validation.instance(plain, "plain", kod.PassScan)
     validation.instance(remedy, "remedy", kod.PassScan)
     rc = validation.positive(range_scale_km, "range_scale_km")
+    if regularised is not None:
+        validation.instance(regularised, "regularised", kod.PassScan)
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 4.6), layout="constrained")
     ref = np.arange(diagnosis.ref_range_km.size)
     ax1.semilogy(ref, diagnosis.ref_range_km, ".-", color="C0", label="closest approach of the reference")
@@ -626,9 +629,13 @@ def figure_keep_out_diagnosis(diagnosis: kod.FreeRunDiagnosis, plain: kod.PassSc
     ax2.loglog(plain.d_km, plain.grad_position, "o-", color="C3", label=r"$|\partial I/\partial r|$, paper's noise")
     ax2.loglog(remedy.d_km, remedy.grad_position, "s-", color="C2",
                label=rf"$|\partial I/\partial r|$, range noise ($\rho_c$ = {rc:g} km)")
+    if regularised is not None:
+        ax2.loglog(regularised.d_km, regularised.grad_position, "^--", color="C1", mfc="none",
+                   label=rf"$|\partial I/\partial r|$, regularised range-rate Jacobian ($\rho_c$ = {rc:g} km)")
     ax2.loglog(plain.d_km, plain.range_rate_row, ":", color="0.3", label="whitened range-rate row [1/LU]")
     ax2.set(xlabel="pass distance [km]", ylabel="norm [nats/LU or 1/LU]", title="the reward's slope near a target")
     for ax in (ax1, ax2):
-        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
-    fig.suptitle("Test case 2 without a keep-out: what the convex subproblem hits, and the range-dependent noise")
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2 if ax is ax1 else 1,
+                  frameon=False)
+    fig.suptitle("Test case 2 without a keep-out: what the convex subproblem hits, and two remedies")
     return fig

@@ -1,8 +1,8 @@
-r"""Test case 2 without a keep-out: what the convex subproblem hits, and a remedy that is not a keep-out (issue 22
-item 4; notebook 06, section 11).
+r"""Test case 2 without a keep-out: what the convex subproblem hits, and two remedies that are not a keep-out (issue
+22 item 4; notebook 06, section 11).
 
 Without the 424 km keep-out, SCvx on test case 2 does not converge: its iterates head for a target and a convex
-subproblem fails about half a kilometre from it.  This module says why, and tries a smooth remedy.
+subproblem fails about half a kilometre from it.  This module says why, and tries two smooth remedies.
 
 What is here:
 
@@ -15,13 +15,17 @@ What is here:
 * :func:`free_run_diagnosis`: the run without keep-out, recording every reference; the solver's status at the
   failure, the closest approach and the MI gradient and curvature at each reference, and the scale of the
   information term of the convex subproblem against its other terms (what Clarabel must resolve).
-* :class:`RangeNoiseInformation`: the remedy, a range-dependent measurement noise :math:`\sigma(\rho) =
+* :class:`RangeNoiseInformation`: a remedy, a range-dependent measurement noise :math:`\sigma(\rho) =
   \sigma\sqrt{1 + (\rho_c/\rho)^2}` (:func:`cislunar.sensing.information.range_noise_scale`) in the window's MI,
   with its exact gradient (product rule through the noise), in the information-model protocol of
   :func:`cislunar.guidance.scvx.solve_scvx`.  Far from the targets (:math:`\rho \gg \rho_c`) it is the paper's
   model; near one, the information of that target vanishes like :math:`\rho/\rho_c` instead of diverging.
-* :func:`remedy_sweep`: test case 2 over a grid of weights with the remedy and without any keep-out, compared with
-  the keep-out plans.
+* :class:`RegularisedJacobianInformation`: the other remedy, narrower: only the :math:`1/\rho` of the range-rate
+  row's position part becomes :math:`1/\sqrt{\rho^2+\rho_c^2}`
+  (:func:`cislunar.sensing.information.regularised_range_rate_jacobian`), the noise and every other entry the
+  paper's.  It tests the diagnosis itself: if removing that one term lets SCvx converge, that term is what fails.
+* :func:`remedy_runs`: test case 2 over a grid of weights with the remedies and without any keep-out, compared with
+  the keep-out plans (:func:`remedy_table`).
 
 Units: non-dimensional (LU, TU) unless a name says ``_km``; Earth-Moon rotating frame.
 """
@@ -43,7 +47,9 @@ from cislunar.utils import validation
 __all__ = [
     "FreeRunDiagnosis",
     "PassScan",
+    "REMEDIES",
     "RangeNoiseInformation",
+    "RegularisedJacobianInformation",
     "RemedyRun",
     "free_run_diagnosis",
     "pass_scan",
@@ -56,22 +62,12 @@ __all__ = [
 # --------------------------------------------------------------------------------------------------------------
 # the remedy: range-dependent noise in the window's MI
 # --------------------------------------------------------------------------------------------------------------
-class RangeNoiseInformation:
-    r"""The MI of a :class:`~cislunar.papers.wolf_jones.scenarios.WindowInformation` window with a range-dependent
-    measurement noise :math:`\sigma(\rho) = \sigma\sqrt{1 + (\rho_c/\rho)^2}` on every row of each target.
-
-    Implements the protocol of :func:`cislunar.guidance.scvx.solve_scvx`: ``model(x, 0) -> I`` (nats),
-    ``model(x, 1) -> (I, dI/dx)`` and ``model.hessian(x)`` (central differences of the gradient).  The fixed
-    ingredients (P0, the fixed Q, R) are the inner model's; only the row scale of :math:`H` depends on the range.
-
-    Parameters
-    ----------
-    inner : WindowInformation
-    range_scale_km : float
-        :math:`\rho_c`, km (> 0).
-    hessian_step : float
-        Central-difference step of :meth:`hessian` (non-dimensional, all six components; default the inner's).
-    """
+class _RemedyInformation:
+    """What the two remedies share: the window of an inner
+    :class:`~cislunar.papers.wolf_jones.scenarios.WindowInformation` (P0, the fixed Q, R and its linearisations),
+    the protocol of :func:`cislunar.guidance.scvx.solve_scvx`
+    (``model(x, 0) -> I`` in nats, ``model(x, 1) -> (I, dI/dx)``, ``model.hessian(x)`` by central differences of the
+    gradient) and the range scale :math:`\\rho_c`; a subclass says how the window's rows change near a target."""
 
     def __init__(self, inner: wj.WindowInformation, range_scale_km: float, *, hessian_step: float | None = None):
         self.inner = validation.instance(inner, "inner", wj.WindowInformation)
@@ -90,6 +86,34 @@ class RangeNoiseInformation:
     def system(self):
         return self.inner.system
 
+    def hessian(self, x) -> np.ndarray:
+        """Symmetrised central differences of the gradient, (6, 6), nats per unit^2."""
+        x = validation.as_state(x, "x", batch=False)
+        h = self.hessian_step
+        G = np.array([self(x + h * e, 1)[1] - self(x - h * e, 1)[1] for e in np.eye(6)]) / (2.0 * h)
+        return 0.5 * (G + G.T)
+
+
+class RangeNoiseInformation(_RemedyInformation):
+    r"""The MI of a :class:`~cislunar.papers.wolf_jones.scenarios.WindowInformation` window with a range-dependent
+    measurement noise :math:`\sigma(\rho) = \sigma\sqrt{1 + (\rho_c/\rho)^2}` on every row of each target.
+
+    Implements the protocol of :func:`cislunar.guidance.scvx.solve_scvx`: ``model(x, 0) -> I`` (nats),
+    ``model(x, 1) -> (I, dI/dx)`` and ``model.hessian(x)`` (central differences of the gradient).  The fixed
+    ingredients (P0, the fixed Q, R) are the inner model's; only the row scale of :math:`H` depends on the range.
+
+    Parameters
+    ----------
+    inner : WindowInformation
+    range_scale_km : float
+        :math:`\rho_c`, km (> 0).
+    hessian_step : float
+        Central-difference step of :meth:`hessian` (non-dimensional, all six components; default the inner's).
+    """
+
+    #: The remedy's name in :func:`remedy_runs` and its tables.
+    name = "range noise"
+
     def __call__(self, x, order: int = 0):
         """``order=0``: MI (nats); ``order=1``: (MI, gradient (6,)) in nats per LU and per LU/TU."""
         order = validation.integer(order, "order", minimum=0, maximum=1)
@@ -101,12 +125,38 @@ class RangeNoiseInformation:
         value, grad = self._kernel.value_gradient(lin.F, lin.H, lin.dF, lin.dH, row_scale=s, d_row_scale=ds)
         return float(value), grad
 
-    def hessian(self, x) -> np.ndarray:
-        """Symmetrised central differences of the gradient, (6, 6), nats per unit^2."""
-        x = validation.as_state(x, "x", batch=False)
-        h = self.hessian_step
-        G = np.array([self(x + h * e, 1)[1] - self(x - h * e, 1)[1] for e in np.eye(6)]) / (2.0 * h)
-        return 0.5 * (G + G.T)
+
+class RegularisedJacobianInformation(_RemedyInformation):
+    r"""The MI of a :class:`~cislunar.papers.wolf_jones.scenarios.WindowInformation` window whose range-rate
+    Jacobians are regularised at short range (:func:`cislunar.sensing.information.regularised_range_rate_jacobian`):
+    the position part :math:`(\Delta\dot{\mathbf r}-\dot\rho\hat\rho)^T/\rho` becomes
+    :math:`(\Delta\dot{\mathbf r}-\dot\rho\hat\rho)^T/\sqrt{\rho^2+\rho_c^2}`; the noise, the range row and the
+    velocity part are the paper's.
+
+    Unlike :class:`RangeNoiseInformation`, which makes every measurement of a close target worth less, this remedy
+    removes only the :math:`1/\rho` growth of the range-rate row, the one term the diagnosis blames: if it alone
+    lets SCvx converge without a keep-out, that term is what fails.  Same protocol and parameters as
+    :class:`RangeNoiseInformation` (``range_scale_km`` is :math:`\rho_c`, km); exact gradient (the product rule
+    through the regularising factor).
+    """
+
+    #: The remedy's name in :func:`remedy_runs` and its tables.
+    name = "regularised J"
+
+    def __call__(self, x, order: int = 0):
+        """``order=0``: MI (nats); ``order=1``: (MI, gradient (6,)) in nats per LU and per LU/TU."""
+        order = validation.integer(order, "order", minimum=0, maximum=1)
+        if order == 0:
+            lin = self.inner.linearization(x)
+            return self._kernel.value(lin.F, info_mod.regularised_range_rate_jacobian(lin, self.range_scale))
+        lin = self.inner.linearization(x, derivatives=True)
+        H, dH = info_mod.regularised_range_rate_jacobian(lin, self.range_scale, derivatives=True)
+        value, grad = self._kernel.value_gradient(lin.F, H, lin.dF, dH)
+        return float(value), grad
+
+
+#: The remedies :func:`remedy_runs` can solve with, by name.
+REMEDIES = {c.name: c for c in (RangeNoiseInformation, RegularisedJacobianInformation)}
 
 
 # --------------------------------------------------------------------------------------------------------------
@@ -180,7 +230,7 @@ def pass_scan(sc: wj.Scenario, info, x_ws, d_km, *, hessian: bool = False) -> Pa
     ----------
     sc : Scenario
         Test case 2.
-    info : WindowInformation or RangeNoiseInformation
+    info : WindowInformation, RangeNoiseInformation or RegularisedJacobianInformation
         The MI (value, gradient, and with ``hessian`` its Hessian).
     x_ws : array_like (6,)
         Ballistic window-start state.
@@ -196,7 +246,7 @@ def pass_scan(sc: wj.Scenario, info, x_ws, d_km, *, hessian: bool = False) -> Pa
     if np.any(d <= 0):
         raise ValueError(f"d_km must be positive distances; got {d}")
     hessian = validation.boolean(hessian, "hessian")
-    base = info.inner if isinstance(info, RangeNoiseInformation) else info
+    base = info.inner if isinstance(info, _RemedyInformation) else info
     lin0 = base.linearization(x_ws)
     j, k, _ = _closest(lin0)
     em = sc.system
@@ -298,7 +348,7 @@ def free_run_diagnosis(sc: wj.Scenario, t, k_ws: int, info, alpha: float, x_gues
         m = _STATUS.search(exc.reason)
         status = m.group(1) if m else ("solver error" if "failed" in exc.reason else "")
     refs = list(rec.refs)
-    base = info.inner if isinstance(info, RangeNoiseInformation) else info
+    base = info.inner if isinstance(info, _RemedyInformation) else info
     em = sc.system
     ko = sc.keep_out(k_ws)
     ranges = np.array([ko.ranges(x).min() for x in refs]) * em.length_unit_km
@@ -320,11 +370,12 @@ def free_run_diagnosis(sc: wj.Scenario, t, k_ws: int, info, alpha: float, x_gues
 # --------------------------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class RemedyRun:
-    r"""Test case 2 at one weight with the range-dependent noise and no keep-out.
+    r"""Test case 2 at one weight with a remedy and no keep-out (or with the keep-out and the paper's model).
 
-    ``model``: "range noise" (the remedy, no keep-out) or "keep-out" (the paper's noise with the scenario's
-    keep-out); ``converged``, ``outcome``; ``dv_mps`` impulse (m/s); ``mi`` the plan's MI under the paper's model
-    (the plain window MI, nats) and ``mi_remedy`` under the remedy's; ``closest_km`` its closest approach to a
+    ``model``: "range noise" or "regularised J" (a remedy of :data:`REMEDIES`, no keep-out) or "keep-out" (the
+    paper's model with the scenario's keep-out); ``converged``, ``outcome``; ``dv_mps`` impulse (m/s); ``mi`` the
+    plan's MI under the paper's model (the plain window MI, nats) and ``mi_remedy`` under the run's remedy (the
+    keep-out run: the first remedy solved); ``closest_km`` its closest approach to a
     target at a measurement; ``rms_km`` the observer's CRLB position RMS at the window end (km); ``cost`` the
     paper's objective :math:`(1-\alpha_h)\,\mathrm{impulse} - \alpha_h\mathcal I` with the paper's MI
     (non-dimensional: the plans of both models judged by one yardstick); ``result`` the
@@ -346,10 +397,13 @@ class RemedyRun:
 
 
 def remedy_runs(sc: wj.Scenario, t, k_ws: int, info, range_scale_km: float, alphas, x_guess, u_guess, *,
-                max_iter: int = 150, keep_out: bool = True) -> list:
-    """Solve each weight of ``alphas`` from the ballistic guess with :class:`RangeNoiseInformation` and no keep-out
-    (default SCvx settings with ``max_iter``) and, with ``keep_out``, with the paper's noise and the scenario's
-    keep-out from the same guess (cold starts both: a like-for-like comparison); a list of :class:`RemedyRun`."""
+                max_iter: int = 150, keep_out: bool = True, remedies=("range noise",)) -> list:
+    """Solve each weight of ``alphas`` from the ballistic guess with each remedy of ``remedies`` (names of
+    :data:`REMEDIES`: ``"range noise"``, :class:`RangeNoiseInformation`; ``"regularised J"``,
+    :class:`RegularisedJacobianInformation`; both with :math:`\\rho_c` = ``range_scale_km``) and no keep-out
+    (default SCvx settings with ``max_iter``) and, with ``keep_out``, with the paper's model and the scenario's
+    keep-out from the same guess (cold starts all: a like-for-like comparison); a list of :class:`RemedyRun`, per
+    weight in the order of ``remedies`` (then the keep-out run)."""
     validation.instance(sc, "sc", wj.Scenario)
     t = validation.time_grid(t, "t", increasing=True)
     k_ws = validation.integer(k_ws, "k_ws", minimum=1, maximum=t.size - 2)
@@ -357,17 +411,23 @@ def remedy_runs(sc: wj.Scenario, t, k_ws: int, info, range_scale_km: float, alph
     a = validation.as_array(alphas, "alphas", ndim=(1,), min_size=1)
     max_iter = validation.integer(max_iter, "max_iter", minimum=1)
     keep_out = validation.boolean(keep_out, "keep_out")
-    remedy = RangeNoiseInformation(info, range_scale_km)
+    names = remedies if isinstance(remedies, (list, tuple)) else None
+    if not names or any(n not in REMEDIES for n in names) or len(set(names)) != len(names):
+        raise ValueError(f"remedies must be a non-empty sequence of distinct names from {tuple(REMEDIES)}; got "
+                         f"{remedies!r}")
+    models = {n: REMEDIES[n](info, range_scale_km) for n in names}
     st = scvx.SCvxSettings(max_iter=max_iter)
-    solvers = [("range noise", wj.ScenarioSolver(sc, t, k_ws, information=remedy, keep_out=False, settings=st))]
-    if keep_out:
-        solvers.append(("keep-out", wj.ScenarioSolver(sc, t, k_ws, information=info, keep_out=True, settings=st)))
+    solvers = [(n, m, wj.ScenarioSolver(sc, t, k_ws, information=m, keep_out=False, settings=st))
+               for n, m in models.items()]
+    if keep_out:  # its mi_remedy: under the first remedy
+        solvers.append(("keep-out", models[names[0]],
+                        wj.ScenarioSolver(sc, t, k_ws, information=info, keep_out=True, settings=st)))
     ko = sc.keep_out(k_ws)
     em = sc.system
     mps = em.velocity_unit_km_s * 1e3
     out = []
     for alpha in a:
-        for model, solver in solvers:
+        for model, remedy, solver in solvers:
             try:
                 r = solver(float(alpha), x_guess, u_guess)
             except scvx.SCvxError as exc:

@@ -1,4 +1,4 @@
-"""Test case 2 without a keep-out: the range-noise remedy's MI and gradient, and the close-pass growth it removes."""
+"""Test case 2 without a keep-out: the two remedies' MI and gradients, and the close-pass growth each removes."""
 
 from __future__ import annotations
 
@@ -62,6 +62,77 @@ def test_close_pass_growth_and_its_removal(case2):
     remedy = K.pass_scan(sc, K.RangeNoiseInformation(info, 141.0), x_ws, d)
     assert remedy.slope("grad_position") > -0.2
     assert remedy.grad_position[0] < 0.05 * plain.grad_position[0]
+
+
+def test_regularised_jacobian_remedy_gradient_matches_finite_differences_near_a_target(case2):
+    """At a 50 km pass, the regularised-Jacobian MI's gradient (product rule through the regularising factor)
+    against fourth-order central differences of its value; with rho_c far below every range it is the paper's MI."""
+    sc, info, x_ws = case2
+    remedy = K.RegularisedJacobianInformation(info, 141.0)
+    tiny = K.RegularisedJacobianInformation(info, 1e-6)
+    v0, g0 = info(x_ws, 1)
+    v1, g1 = tiny(x_ws, 1)
+    assert v1 == pytest.approx(v0, rel=1e-9) and np.allclose(g1, g0, rtol=1e-7, atol=1e-9 * np.abs(g0).max())
+    lin0 = info.linearization(x_ws)
+    j, k, _ = K._closest(lin0)
+    x = K.passing_state(sc.system, [lin0.t[0], lin0.t[k]], lin0.targets[j, k, :3], 50.0, x_ws)
+    _, g = remedy(x, 1)
+    h = 1e-7
+    fd = np.zeros(6)
+    for i in range(6):
+        e = np.zeros(6)
+        e[i] = h
+        fd[i] = (8 * (remedy(x + e) - remedy(x - e)) - (remedy(x + 2 * e) - remedy(x - 2 * e))) / (12 * h)
+    scale = np.abs(fd).max()
+    np.testing.assert_allclose(g, fd, rtol=2e-4, atol=2e-4 * scale)
+    # it removes information only (a smaller range-rate row): below the paper's MI, above the range-noise one's
+    assert K.RangeNoiseInformation(info, 141.0)(x) < remedy(x) < info(x)
+
+
+def test_the_regularised_jacobian_bounds_the_reward_but_not_its_gradient(case2):
+    """The range-rate row's 1/rho is what makes the reward grow without bound (the paper's MI gains nats below
+    ~100 m; with that row regularised the MI stays flat to a micrometre), but not what makes the MI gradient grow:
+    that still grows like 1/rho (log-log slope -1 within 0.2 below 10 km), because the line of sight, shared by
+    both rows, turns like 1/rho as the observer nears the target.  Only a model that discounts the whole target
+    near the observer (the range-dependent noise) bounds the gradient."""
+    sc, info, x_ws = case2
+    d = np.array([1e-6, 1e-3, 0.3, 1.0, 3.0, 9.0])
+    plain = K.pass_scan(sc, info, x_ws, d)
+    reg = K.pass_scan(sc, K.RegularisedJacobianInformation(info, 141.0), x_ws, d)
+    noise = K.pass_scan(sc, K.RangeNoiseInformation(info, 141.0), x_ws, d)
+    assert plain.mi[0] - plain.mi[2] > 5.0  # the paper's reward: +10 nats at a micrometre
+    assert abs(reg.mi[0] - reg.mi[2]) < 1e-2  # regularised: flat
+    assert reg.slope("grad_position") == pytest.approx(-1.0, abs=0.2)
+    assert plain.slope("grad_position") == pytest.approx(-1.0, abs=0.2)
+    assert reg.grad_position[1] > 1e3 * noise.grad_position[1]  # at 1 m: still huge, unlike the range noise's
+
+
+def test_remedy_runs_solve_each_named_remedy(case2, monkeypatch):
+    """remedy_runs builds one solver per remedy name, in order, each with its own information model; bad names
+    are refused by name (the solves themselves are the notebook's, and are stubbed here)."""
+    sc, info, _ = case2
+    t, k_ws, _ = sc.node_times(10)
+    seen = []
+
+    class Stub:
+        def __init__(self, sc_, t_, k_, information=None, keep_out=None, settings=None):
+            self.information, self.keep_out = information, keep_out
+
+        def __call__(self, alpha, x, u):
+            seen.append((type(self.information).__name__, self.keep_out, alpha))
+            raise K.scvx.SCvxError("stub")
+
+    monkeypatch.setattr(K.wj, "ScenarioSolver", Stub)
+    x, u = sc.ballistic_guess(t)
+    runs = K.remedy_runs(sc, t, k_ws, info, 141.0, [1e-2], x, u, keep_out=True,
+                         remedies=("regularised J", "range noise"))
+    assert [r.model for r in runs] == ["regularised J", "range noise", "keep-out"]
+    assert seen == [("RegularisedJacobianInformation", False, 1e-2), ("RangeNoiseInformation", False, 1e-2),
+                    ("WindowInformation", True, 1e-2)]
+    assert not any(r.converged for r in runs)
+    for bad in ((), ("range noise", "range noise"), ("keep-out",), "range noise"):
+        with pytest.raises(ValueError, match="remedies"):
+            K.remedy_runs(sc, t, k_ws, info, 141.0, [1e-2], x, u, remedies=bad)
 
 
 def test_bad_arguments_name_the_argument(case2):
