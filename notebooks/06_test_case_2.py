@@ -643,8 +643,9 @@ print(f"MI gradient (position) on the ballistic guess: {g_ball:.3g} nats/LU; at 
 # **What grows as the observer nears a target.** We pass the target nearest the ballistic arc at chosen distances
 # (Newton on the STM, `keep_out_diagnosis.pass_scan`) and read the whitened Jacobian of that target's range and
 # range-rate at the pass, and the MI gradient. The range row is flat; the range-rate row grows like $1/\rho$ (its
-# position part is $(\Delta\dot{\mathbf r}-\dot\rho\hat\rho)^T/\rho$), and the MI gradient with it: the log-log
-# slopes below 10 km are printed. The whitened Jacobian is *not* ill-conditioned there (its two rows are orthogonal,
+# position part is $(\Delta\dot{\mathbf r}-\dot\rho\hat\rho)^T/\rho$), and so does the MI gradient: the log-log
+# slopes below 10 km are printed (whether the first causes the second is tested below, with a remedy that
+# regularises that row alone: it does not). The whitened Jacobian is *not* ill-conditioned there (its two rows are orthogonal,
 # and the range row, whitened by its 0.1 km noise, stays the larger of the two down to 0.1 km): its condition number
 # falls. What the convex solver meets is the size of the information term: a gradient of 1e5-1e6 nats/LU and a
 # curvature of 1e12 nats/LU$^2$ against impulse weights of order 0.1, eleven orders of magnitude apart.
