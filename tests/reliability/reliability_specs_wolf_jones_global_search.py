@@ -84,4 +84,9 @@ def specs(S, lazy):
                dict(solver="instance", ms="instance", extra="instance")))
     s.append(S("with_moved_back", gs.with_moved_back, dict(solver=lz(solver1), study=lz(mesh1), back=lz(back1)),
                dict(solver="instance", study="instance", back="instance")))
+    s.append(S("mesh_starts", gs.mesh_starts,
+               dict(solver=lz(solver1), sweep=lz(sweep1), ms=lz(ms1), alphas=[0.0], n_nodes=[7], sigma=1.0,
+                    rtol=0.05, cold=False, executor=None),
+               dict(solver="instance", sweep="instance", ms="instance", alphas="vec", n_nodes="iterable",
+                    sigma="real", rtol="range:0:1", cold="bool", executor="instance_opt")))
     return s

@@ -44,7 +44,7 @@ from cislunar.utils import montecarlo, validation
 
 __all__ = ["StartOutcome", "MultiStart", "multi_start", "with_starts", "known_from_sweep", "adopt", "Envelope",
            "lower_envelope", "FrontPoints", "front_points", "MeshRow", "MeshStudy", "mesh_study", "back_to_grid",
-           "with_moved_back"]
+           "with_moved_back", "MeshStarts", "mesh_starts"]
 
 _MIRROR = np.diag([1, 1, -1, 1, 1, -1.0])
 
@@ -706,6 +706,105 @@ def with_moved_back(solver, study: MeshStudy, back: dict) -> MeshStudy:
                               float(r.information),
                               float(wj.evaluate_crlb(sc, r.x[solver.k_window]).terminal_rms_km[0]), r)
     return dataclasses.replace(study, rows=tuple(rows), attempts=tuple(attempts))
+
+
+@dataclass(frozen=True)
+class MeshStarts:
+    """The mesh study as further starts of a multi-start (:func:`mesh_starts`).
+
+    Attributes
+    ----------
+    study : MeshStudy
+        The mesh study run from the multi-start's best plans, with the moved-back plans adopted on the figures' grid
+        (:func:`with_moved_back`).
+    back : dict
+        The result of :func:`back_to_grid` (``{alpha: (n_nodes, start, result, gain)}``).
+    multi : MultiStart
+        The multi-start with each moved-back plan as one more start, labelled ``"mesh <n>"`` (:func:`with_starts`).
+    before : dict
+        ``{alpha: SCvxResult}``: the plan each weight's study started from (the best of the sweep and the generic
+        starts, :func:`adopt`), against which the gains are measured.
+    """
+
+    study: MeshStudy
+    back: dict
+    multi: MultiStart
+    before: dict
+
+    @property
+    def gains(self) -> dict:
+        """``{alpha: gain}`` of every moved-back plan that converged: :math:`(J_{before} - J_{back})/(1 + |J_{before}|)`,
+        positive where the mesh found a lower optimum of the figures' grid than the other starts."""
+        return {a: g for a, (*_, g) in self.back.items() if np.isfinite(g)}
+
+    @property
+    def changed(self) -> list:
+        """The weights whose best plan now comes from a mesh start."""
+        return [a for a, lab in zip(self.multi.alphas, self.multi.best_label) if lab.startswith("mesh ")]
+
+    def summary(self, mps: float) -> str:
+        """The moved-back solves, the mesh table and the weights whose best plan changed (``mps``: m/s per
+        velocity unit of the plans' system)."""
+        mps = validation.positive(mps, "mps")
+        n_fig = self.study.figure_nodes
+        lines = [] if self.back else ["no mesh grid finer than the figures' converged in this run: nothing to move "
+                                      "back"]
+        for a, (n, start, r, g) in self.back.items():
+            b = self.before[a]
+            lines.append(f"alpha_h {a:g}: the {n}-node plan moved back did not converge ({r})"
+                         if isinstance(r, scvx.SCvxError) else
+                         f"alpha_h {a:g}: the {n}-node plan ({start} start) moved back to {n_fig} nodes: cost "
+                         f"{r.cost:.8f} against the multi-start's {b.cost:.8f} (gain {g:+.2e}); "
+                         f"{r.impulse * mps:.2f} against {b.impulse * mps:.2f} m/s")
+        lines.append(self.study.summary())
+        opts = {a: next(o for o in self.multi.at(a) if o.result is b)
+                for a, b in zip(self.multi.alphas, self.multi.best) if a in self.changed}
+        lines.append("best plan per weight with the mesh starts, where it changed: " + ("; ".join(
+            f"alpha_h {a:g}: {o.label} ({o.impulse_mps:.2f} m/s, {o.mi:.3f} nats, cost {o.cost:.8f})"
+            for a, o in opts.items()) or "nowhere"))
+        return "\n".join(lines)
+
+
+def mesh_starts(solver, sweep, ms: MultiStart, alphas, n_nodes, *, sigma: float = 1.0, rtol: float = 0.05,
+                cold: bool = True, executor=None) -> MeshStarts:
+    """The mesh study of ``alphas`` run from the best plan of ``sweep`` and ``ms`` per weight, its finest plans moved
+    back onto ``solver``'s grid, and those plans added to ``ms`` as starts: :func:`adopt`, :func:`mesh_study`,
+    :func:`back_to_grid`, :func:`with_starts` and :func:`with_moved_back` in that order.
+
+    Parameters
+    ----------
+    solver : ScenarioSolver
+        The figures' solver (the multi-start's).
+    sweep : SweepResult
+        The homotopy sweep on ``solver``'s grid (its weights include ``ms``'s).
+    ms : MultiStart
+        The multi-start of ``solver`` (generic starts).
+    alphas : sequence of float
+        Headline weights of the mesh study, weights of ``sweep`` with a converged plan.
+    n_nodes : sequence of int
+        The study's other node counts (>= 6).
+    sigma, rtol, cold, executor
+        As in :func:`mesh_study` (results do not depend on ``executor``).
+
+    Returns
+    -------
+    MeshStarts
+    """
+    validation.instance(solver, "solver", wj.ScenarioSolver)
+    validation.instance(sweep, "sweep", scvx.SweepResult)
+    validation.instance(ms, "ms", MultiStart)
+    a = validation.as_array(alphas, "alphas", ndim=(1,), min_size=1)
+    provisional = adopt(sweep, ms)
+    weights = [float(w) for w in sweep.alphas]
+    before = {}
+    for al in (float(v) for v in a):
+        if al not in weights or provisional.best[weights.index(al)] is None:
+            raise ValueError(f"alphas must be weights of sweep {tuple(weights)} with a converged plan; got {al!r}")
+        before[al] = provisional.best[weights.index(al)]
+    study = mesh_study(solver, before, n_nodes, sigma=sigma, rtol=rtol, cold=cold, executor=executor)
+    back = back_to_grid(solver, study, executor=executor)
+    multi = with_starts(solver, ms, {al: [(f"mesh {n}", r)] for al, (n, _, r, _) in back.items() if al in ms.alphas})
+    return MeshStarts(with_moved_back(solver, study, back), back, multi, before)
 
 
 def _interpolate_plan(t_from, x, u, t_to):

@@ -292,3 +292,26 @@ def test_mesh_study_re_converges_on_other_sundman_grids(setup, ms):
         gs.with_moved_back(solver, m, {1e-2: (11, "warm", lower, 0.0)})
     with pytest.raises(TypeError, match="back"):
         gs.with_moved_back(solver, m, {A: lower})
+
+
+def test_mesh_starts_is_the_composition_of_its_steps(setup, ms):
+    """mesh_starts = adopt -> mesh_study -> back_to_grid -> with_starts / with_moved_back, the same numbers as the
+    steps called by hand; its summary names every moved-back solve; bad weights are refused by name."""
+    sc, t, k, solver = setup
+    (b,) = ms.best
+    sweep = scvx.SweepResult(np.array([A]), [_fake(b, b.cost + 1.0)], ["up"], [])  # the multi-start's plan wins
+    out = gs.mesh_starts(solver, sweep, ms, [A], [11], cold=False)
+    assert out.before == {A: b}
+    m = gs.mesh_study(solver, {A: b}, [11], cold=False)
+    back = gs.back_to_grid(solver, m)
+    assert [(r.n_nodes, r.start, r.cost) for r in out.study.rows] == [
+        (r.n_nodes, r.start, r.cost) for r in gs.with_moved_back(solver, m, back).rows]
+    assert out.back[A][:2] == back[A][:2] and out.back[A][3] == back[A][3]
+    hand = gs.with_starts(solver, ms, {A: [("mesh 11", back[A][2])]})
+    assert [(o.label, o.cost, o.optimum) for o in out.multi.outcomes] == [(o.label, o.cost, o.optimum)
+                                                                          for o in hand.outcomes]
+    assert out.gains == {A: back[A][3]} and out.changed == ([A] if back[A][3] > 0 else [])
+    text = out.summary(sc.system.velocity_unit_km_s * 1e3)
+    assert "the 11-node plan (warm start) moved back to 10 nodes" in text and "mesh study:" in text
+    with pytest.raises(ValueError, match="alphas"):
+        gs.mesh_starts(solver, sweep, ms, [0.5], [11], cold=False)
