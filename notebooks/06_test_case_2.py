@@ -400,7 +400,10 @@ print(f"Spearman(alpha_h, departure) above 0.8 on {dep_pass} of {len(rho_grids)}
 # therefore judged by the rank correlation (closing table, threshold 0.8), on this node grid and on the other node
 # grids of the robustness check (whole sweep re-solved there; printed above, so the row does not rest on one grid's
 # choice of local optima). More weight on information also shows
-# in larger out-of-plane excursions and more impulse (table of section 4).
+# in larger out-of-plane excursions and more impulse (table of section 4). In the full run the $2\times10^{-2}$
+# plan (the one adopted from the mesh study, section 4) departs about 30,200 km from the reference, more than three
+# times any other weight, and is the only plan with $\alpha_h > 0$ whose keep-out is inactive (open marker; closest
+# approach 1050 km): its curve dwarfs the others in the three left panels.
 
 # %% [markdown]
 # ## 7 · The z-mirror question of Fig. 7
@@ -552,7 +555,7 @@ _ = plotting.save_figure(figures.figure_readings(rd2, em), "06_fig9_10_readings"
 # coefficient. In the full run the three small readings move the RMS of the information plans by the spread printed
 # last, but keep both statements (the quick run's three plans are too few for a rank correlation to reach $-0.8$
 # under any reading); under the literal $10^{-11}$ km²/s³ the process noise swamps what the window's measurements
-# teach: every plan, $\alpha_h = 0$ included, ends with a few thousand km, and more MI no longer means a smaller
+# teach: every plan, $\alpha_h = 0$ included, ends with 3,000-9,200 km (full run), and more MI no longer means a smaller
 # RMS. A statement that holds under every reading is "reproduced"; one that holds only under some rests on the
 # reading we chose while looking at the paper's figures and is "consistent (tuned)", its note naming the readings it
 # fails under (the rule of `claims.process_noise_readings`).
@@ -580,9 +583,11 @@ _ = plotting.save_figure(figures.figure_readings(rd2, em), "06_fig9_10_readings"
 # fixed in advance) mean another local optimum; a radius whose solve fails
 # leaves the question open there.
 # Without any keep-out the run at the Fig. 6 weight is on a knife edge (on the last full run it converged in 73 of
-# its 75 iterations, passing 13 km from a target on the way; earlier runs ended with defects still open), and at
-# 2e-2 it fails (the diagnosis below); the closest approach to a target of its successive references (recorded along the run, printed below) shows whether
-# they head for the close-approach singularity. Which local optimum a solve finds is fragile: the planar guess is a saddle
+# its 75 iterations, its references passing 13 km from a target on the way, numbers not printed here because the
+# notebook prints a converged run's plan only; earlier runs ended with defects still open), and at 2e-2 it fails
+# (the diagnosis below); when the run fails, the closest approach to a target of its successive references
+# (recorded along the run, printed below) shows whether they head for the close-approach singularity. Which local
+# optimum a solve finds is fragile: the planar guess is a saddle
 # (section 2) and round-off picks the way out of it, so a change as small as another evaluation order of the MI
 # gradient can move a run of this section, or of the sweep, to a neighbouring optimum. In the figure each radius is
 # a separate solve, so its points are not joined (neighbouring radii can land in different local optima); the dashed
@@ -718,16 +723,19 @@ print(f"notebook compute time {time.perf_counter() - t_start:.0f} s")
 # compare impulse, MI, closest approach and RMS row by row; the paper's cost says which of the two is the better
 # plan under the paper's own objective.
 #
-# The narrower remedy says which ingredient fails. Regularising the range-rate row's $1/\rho$ alone removes the
-# *reward's* divergence (a pass at a micrometre gains 10 nats under the paper's model and nothing with the
+# The narrower remedy tests which ingredient matters. Regularising the range-rate row's $1/\rho$ alone removes the
+# *reward's* divergence (a pass at a millimetre (1e-6 km) gains 10 nats under the paper's model and nothing with the
 # regularised row, printed above) but not the *gradient's*: $|\partial\mathcal I/\partial\mathbf r|$ still grows
 # like $1/\rho$ (log-log slope -1.00 below 10 km), because the line of sight, the direction both rows share,
 # turns at a rate $\propto 1/\rho$ as the observer nears a target. In the full run SCvx with it converges at
-# $5\times10^{-3}$ (its iterates pass 15 km from a target on the way) and $10^{-2}$, and does not converge at
-# $2\times10^{-2}$ within the iteration limit (closing row "differs"). So what fails is not the size of the
-# range-rate Jacobian but the linear-Gaussian model of a target's measurements trusted at any range, whose
-# geometry reaches the gradient through the line of sight; only a model that discounts the whole target near the
-# observer, the range-dependent noise, bounds the gradient, and with it SCvx converges at every weight tried.
+# $5\times10^{-3}$ (its plan passes 15 km from a target at a measurement) and $10^{-2}$, and does not converge at
+# $2\times10^{-2}$ within the iteration limit (closing row "differs"). That failure is an iteration-limit stop (largest
+# defect 2e-7 when it stopped), not a failed subproblem at a close pass, so this run alone does not show where its
+# iterates went. What the scans do show: bounding the range-rate Jacobian's size does not bound the
+# gradient, which the linear-Gaussian model of a target's measurements, trusted at any range, feeds through the line
+# of sight; only a model that discounts the whole target near the observer, the range-dependent noise, bounds the
+# gradient, and with it SCvx converges at every weight tried. Under the paper's own cost every remedy plan of the
+# full run is worse than the keep-out plan at the same weight (printed above: "higher").
 
 # %% [markdown]
 # ## 12 · Paper versus reproduction

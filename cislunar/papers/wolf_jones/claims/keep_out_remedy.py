@@ -38,6 +38,7 @@ CLAIMS = {
         f"test case 2 without a keep-out, regularised range-rate Jacobian (1/rho -> 1/sqrt(rho^2 + "
         f"{RANGE_SCALE_KM:g}^2 km^2)), noise as in the paper", "no keep-out in the paper",
         Holds("every weight solved converges (strict stop) with no keep-out"), kind="beyond paper",
-        reason="a weight fails with the regularised range-rate Jacobian: the MI gradient still grows like 1/rho "
-               "(the line of sight turns like 1/rho near a target), so regularising that row is not enough"),
+        reason="a weight does not converge with the regularised range-rate Jacobian (outcome in the row); it "
+               "bounds the reward but not the MI gradient, which still grows like 1/rho near a target (the line "
+               "of sight turns like 1/rho), so regularising that row alone is not enough to bound it"),
 }

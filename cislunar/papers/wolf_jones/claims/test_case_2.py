@@ -127,7 +127,9 @@ CLAIMS = {
         "plans converged in the node grid at the headline weights (mesh study up to 60 nodes)", "N, sigma not given",
         Holds("impulse, MI and observer terminal RMS change by at most 5 % between the two finest grids at every "
               "headline weight"), kind="beyond paper",
-        reason="the plans move with the grid by more than the 5 % tolerance"),
+        reason="at a headline weight the best plan found changes by more than the 5 % tolerance between the two "
+               "finest grids (the plan moves with the grid, or the starts reach another local optimum on one of "
+               "them: the note names the start of the finest grid's best plan)"),
     # AtMost(1e-6): the multi-start's own "same optimum" tolerance on the cost, 1e-6 (1 + |J|) (global_search)
     "mesh_back": Claim(
         "multi-start's generic starts find the best known plan of their grid (each weight's finest mesh-study plan "
