@@ -239,32 +239,15 @@ print("better than the sweep's best: " + ("; ".join(
 # ($10^{-6}$): a positive gain is an optimum the generic starts did not find on their own grid. The moved-back plans
 # then join the multi-start as starts named `mesh <n>` (`global_search.with_starts`), so the plan adopted below is
 # the best known on the figures' grid, and the mesh table's row for that grid shows it
-# (`global_search.with_moved_back`, start `back <n>`).
+# (`global_search.with_moved_back`, start `back <n>`). `global_search.mesh_starts` does all of this in one call.
 
 # %%
-provisional = global_search.adopt(case.sweep, ms)  # the best per weight of the generic starts
-ms_best = {a_: provisional.best[alphas.index(a_)] for a_ in mesh_alphas if a_ in alphas}
 with open_executor(workers, SCHEDULER) as executor:
-    mstudy = global_search.mesh_study(case.solver, {a_: p_ for a_, p_ in ms_best.items() if p_ is not None},
-                                      mesh_nodes, sigma=SIGMA, rtol=MESH_RTOL, cold=mesh_cold, executor=executor)
-    back = global_search.back_to_grid(case.solver, mstudy, executor=executor)
-back_gain = {a_: g_ for a_, (*_, g_) in back.items() if np.isfinite(g_)}
-if not back:
-    print("no mesh grid finer than the figures' converged in this run: nothing to move back")
-for a_, (n_, start_, r_, g_) in back.items():
-    print(f"alpha_h {a_:g}: the {n_}-node plan moved back did not converge ({r_})" if isinstance(r_, Exception) else
-          f"alpha_h {a_:g}: the {n_}-node plan ({start_} start) moved back to {n_nodes} nodes: cost {r_.cost:.8f} "
-          f"against the multi-start's {ms_best[a_].cost:.8f} (gain {g_:+.2e}); {r_.impulse * MPS:.2f} against "
-          f"{ms_best[a_].impulse * MPS:.2f} m/s")
-ms = global_search.with_starts(case.solver, ms, {a_: [(f"mesh {n_}", r_)] for a_, (n_, _, r_, _) in back.items()
-                                                 if a_ in ms.alphas})
-mstudy = global_search.with_moved_back(case.solver, mstudy, back)
-print(mstudy.summary())
+    mesh = global_search.mesh_starts(case.solver, case.sweep, ms, mesh_alphas, mesh_nodes, sigma=SIGMA,
+                                     rtol=MESH_RTOL, cold=mesh_cold, executor=executor)
+print(mesh.summary(MPS))
+ms, mstudy, back_gain = mesh.multi, mesh.study, mesh.gains  # the multi-start with the mesh starts, from here on
 ms_better = ms.improvements([sweep_best[alphas.index(a)] for a in ms_alphas])
-print("best plan per weight with the mesh starts, where it changed: " + ("; ".join(
-    f"alpha_h {a_:g}: {lab_} ({o_.impulse_mps:.2f} m/s, {o_.mi:.3f} nats, cost {o_.cost:.8f})"
-    for a_, lab_, b_ in zip(ms.alphas, ms.best_label, ms.best) if lab_.startswith("mesh")
-    for o_ in ms.at(a_) if o_.result is b_) or "nowhere"))
 
 # %% [markdown]
 # **Reading (mesh).** Impulse is the quantity that moves most with the grid: the plans are a few near-impulsive
@@ -579,7 +562,8 @@ table.add(CLAIMS["window"].judge(max(abs(w_start - 12.0), abs(w_end - 23.0)), sh
                                  f"{em.tu_to_days(sc.measurement_times[-1]):.2f} d"))
 table.add(CLAIMS["fig3_alpha"].judge(alphas[show[0]], shown="5e-3 shown"))
 table.add(CLAIMS["process_noise"].judge(cr.bounded, shown=f"q = {sc.q:g} LU^2/TU^3 (acceleration PSD)", note=(
-    "notebook 06, section 9; the SI reading 1e-11 m^2/s^3 would pass the same test")))
+    "notebook 06, section 9; the SI reading 1e-11 m^2/s^3 and the square-root-PSD reading (1e-11)^2 km^2/s^3 "
+    "would pass the same test")))
 table.add(CLAIMS["literal_q_bounded"].judge(
     not any(g_ > 1.0 for g_ in cr.literal_growth), shown=lit_text + f" (adopted q: {crlb[0].rms_km[0, 1]:.0f} -> "
     f"{term_obs[0]:.0f} km and {crlb[-1].rms_km[0, 1]:.0f} -> {term_obs[-1]:.1f} km)", note=(
@@ -711,8 +695,8 @@ off_env = [a for i_, a in enumerate(fp.alpha) if fp.optimum[i_] == 0 and i_ not 
 table.add(CLAIMS["envelope"].judge(len(env.index), shown=f"{len(env.index)} of {len(fp.alpha)} distinct optima "
                                    f"on the envelope; {impulse_mps[0]:.2f} -> {env.x[-1]:.1f} m/s, observer RMS "
                                    f"{env.y[0]:.1f} -> {env.y[-1]:.2f} km", note=(
-    "best-cost plans off the envelope (a costlier optimum ends with a lower RMS) at alpha_h " + (
-        ", ".join(f"{a:g}" for a in off_env) or "none"))))
+    "best-cost plans off the envelope (a costlier optimum ends with a lower RMS): " + ("at alpha_h "
+        + ", ".join(f"{a:g}" for a in off_env) if off_env else "none"))))
 table.add(CLAIMS["mesh_study"].judge(all(mstudy.converged(a) for a in mstudy.alphas), shown="; ".join(
     f"alpha_h {a:g}: " + ", ".join(f"{r.n_nodes} nodes {r.impulse_mps:.2f} m/s / {r.rms_km:.1f} km"
                                    for r in mstudy.table(a) if r.converged) for a in mstudy.alphas),

@@ -113,6 +113,8 @@ def specs(S, lazy):
                dict(sc="instance", k_ws="int1", info="instance", range_scale_km="pos", alphas="vec", max_iter="int1",
                     keep_out="bool")))
     s.append(S("remedy_table", kd.remedy_table, dict(runs=lz(remedy2)), dict(runs="instance")))
+    s.append(S("brief_outcome", kd.brief_outcome, dict(outcome="no convergence in 3 iterations"),
+               dict(outcome="instance_str")))
     s.append(S("figure_keep_out_diagnosis", closed(figures.figure_keep_out_diagnosis),
                dict(diagnosis=lz(diag2), plain=lz(scan2), remedy=lz(scan2), range_scale_km=141.0,
                     regularised=lz(scan2)),

@@ -443,11 +443,11 @@ def specs(Spec, lazy):
     s.append(S("measurements", case_2_closing.measurements,
                dict(case=lz(case2_graded), row6=lz(row6), n_nodes=6, sigma=1.0, gc=lz(gradient2), ms=lz(mirror2),
                     ko=lz(keep_out_study), nr=lz(readings), fr=lz(front2), departures=lz(departures2), obs_mean={},
-                    tgt_mean={}, common={}, budget_row=None, extra_mps=2.0, rtol=0.02),
+                    tgt_mean={}, common={}, budget_row=None, extra_mps=2.0, rtol=0.02, diagnosed=None),
                dict(case="instance", row6="instance", n_nodes="int1", sigma="real", gc="instance", ms="instance",
                     ko="instance", nr="instance", fr="instance", departures="instance", obs_mean="instance",
                     tgt_mean="instance", common="instance", budget_row="instance_opt", extra_mps="real",
-                    rtol="range:0:1")))
+                    rtol="range:0:1", diagnosed="instance_opt")))
     # ------------------------------------------------------------------------------ exercises
     mark("exercises")
     s.append(S("exercise_01_mu_step", exercises.exercise_01_mu_step,

@@ -51,6 +51,7 @@ __all__ = [
     "RangeNoiseInformation",
     "RegularisedJacobianInformation",
     "RemedyRun",
+    "brief_outcome",
     "free_run_diagnosis",
     "pass_scan",
     "passing_state",
@@ -268,6 +269,13 @@ def pass_scan(sc: wj.Scenario, info, x_ws, d_km, *, hessian: bool = False) -> Pa
     return PassScan(d, *(np.array(cols[n]) for n in ("mi", "gp", "gv", "hn", "rr", "rrr", "cond")))
 
 
+def brief_outcome(outcome: str) -> str:
+    """An SCvx outcome without the solver's advice: cvxpy's "Try another solver, or solve with verbose=True ..."
+    dropped, whole numbers kept (a failure reason cut at a fixed width could end inside a number)."""
+    outcome = validation.instance(outcome, "outcome", str)
+    return re.sub(r"\s*Try another solver[^.]*\.", "", outcome).strip()
+
+
 # --------------------------------------------------------------------------------------------------------------
 # the free run, diagnosed
 # --------------------------------------------------------------------------------------------------------------
@@ -454,5 +462,5 @@ def remedy_table(runs) -> str:
         validation.instance(r, "runs[i]", RemedyRun)
         lines.append(f"{r.alpha:8.4f} {r.model:>12} {'y' if r.converged else 'n':>3} {r.iterations:5d} "
                      f"{r.dv_mps:8.2f} {r.mi:8.3f} {r.mi_remedy:10.3f} {r.closest_km:11.1f} {r.rms_km:8.2f} {r.cost:11.6f}"
-                     + ("" if r.converged else f"  ({r.outcome[:60]})"))
+                     + ("" if r.converged else f"  ({brief_outcome(r.outcome)})"))
     return "\n".join(lines)

@@ -143,3 +143,12 @@ def test_bad_arguments_name_the_argument(case2):
         K.RangeNoiseInformation(lambda x, o=0: 0.0, 1.0)
     with pytest.raises(ValueError, match="d_km"):
         K.pass_scan(sc, info, x_ws, [1.0, -1.0])
+
+
+def test_brief_outcome_drops_the_solver_advice_and_keeps_whole_numbers():
+    advice = "Try another solver, or solve with verbose=True for more information."
+    assert K.brief_outcome(f"convex subproblem failed at iteration 3: Solver 'CLARABEL' failed. {advice}") == (
+        "convex subproblem failed at iteration 3: Solver 'CLARABEL' failed.")
+    assert K.brief_outcome(f"x failed. {advice} (solver status: failed)") == "x failed. (solver status: failed)"
+    kept = "no convergence in 150 iterations (largest defect 2.23e-07)"
+    assert K.brief_outcome(kept) == kept

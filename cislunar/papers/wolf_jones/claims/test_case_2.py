@@ -22,7 +22,7 @@ _SLIP_TUNED = ("the x0-held reading of the Table 2/4 slip, which sets P, was fir
 _Q_READING_TUNED = ("holds under the adopted process-noise reading q = 1e-11 LU^2/TU^3, chosen among the readings of "
                     "Table 5's '1e-11 km/s^3' by looking at the paper's figures (test case 1's bounded CRLB, Fig. 4); "
                     "under the literal 1e-11 km^2/s^3 it fails: the alpha_h = 0 plan ends no worse than the "
-                    "information plans and MI and CRLB rank-correlate positively (Spearman about +0.6 on a full run); "
+                    "information plans and MI and CRLB rank-correlate positively (the readings row prints the value); "
                     "section 9 compares the readings")
 #: Why "impulse and MI grow with alpha_h" is no evidence for the paper: for global optima x_1, x_2 of the weighted
 #: sum J = (1 - a) impulse - a MI at a_1 < a_2 over the same feasible set, the two optimality inequalities, each
@@ -30,8 +30,8 @@ _Q_READING_TUNED = ("holds under the adopted process-noise reading q = 1e-11 LU^
 #: plans behave like global optima, not the paper.
 _OPTIMALITY_FAILS = ("the plans are not all global optima: for global optima of the weighted sum (1 - alpha_h) "
                      "impulse - alpha_h MI, impulse and MI cannot decrease as alpha_h grows")
-_NO_KEEP_OUT = ("without a keep-out even our modified solver does not converge (convex subproblem fails or the "
-                "iteration limit is hit)")
+_NO_KEEP_OUT = ("at a weight run without a keep-out even our modified solver does not converge (convex subproblem "
+                "fails or the iteration limit is hit)")
 
 CLAIMS = {
     "observer_t0_periodic": Claim(
@@ -51,10 +51,12 @@ CLAIMS = {
     "window": Claim(
         "Observation window", "roughly 17-32 days", AtMost(1.0), tuned=_SLIP_TUNED, source="Test Case #2 text",
         reason="a window end misses the text's day count by more than 1 day (largest miss, days)"),
+    # widened 2026-11-26 (a referee): the paper implies convergence at every weight; the row used to judge the Fig. 6
+    # weight alone although the diagnosis of section 11 runs another weight without a keep-out
     "no_keep_out": Claim(
-        "SCvx converges without a keep-out at the Fig. 6 weight (our modified solver; 2e-2: diagnosis row below)",
-        "implied (Figs. 7, 10)",
-        Holds("the Fig. 6 weight converges without a keep-out"), source="Figs. 7, 10", reason=_NO_KEEP_OUT),
+        "SCvx converges without a keep-out at every weight run so (our modified solver: the Fig. 6 weight and the "
+        "diagnosed weight)", "implied (Figs. 7, 10)",
+        Holds("every weight run without a keep-out converges"), source="Figs. 7, 10", reason=_NO_KEEP_OUT),
     "keep_out_converges": Claim(
         "modified SCvx with a 424 km keep-out converges for every alpha_h", "-",
         Holds("every alpha_h of the grid has a converged plan"), kind="beyond paper",
