@@ -364,6 +364,14 @@ print(f"chain rule faster than dense from {timing.crossover_value} for the MI, f
 # targets' mean (notebook 06's criterion for the same sentence). The process-noise reading was chosen while
 # looking at the paper's result, so its row says so; so was the in-plane measure of the baseline rows (the total
 # RMS, which includes the unobservable z, failed first), so they are at best consistent (tuned).
+#
+# Two rows deserve a caution when you read their verdicts. The two baseline rows show the *same* shape in section
+# 6: the MI and the in-plane CRLB improve up to about 150 000 km and then both turn at the half-period baseline.
+# Their verdicts differ by the size of that turn, not by its presence: in the full run the relative-position rebound
+# is 1.199x against the 1.2x threshold (0.1 % inside), the range/range-rate rebound 3.1x. And the in-plane growth row
+# tests a symptom that Table 5's prior makes nearly certain: a velocity error of 10 m/s per axis moves a position by
+# about 860 km in one day, against the ~110 km the first update leaves, so the row cannot tell whether the paper's
+# cause (a diagonal $P_0$) is the right one.
 
 # %%
 table.add(claims.CLAIMS["eq11_scalar"].judge(

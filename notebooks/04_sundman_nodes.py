@@ -153,7 +153,11 @@ for seed, errs in lin.extra.items():
 # the affine model then degrades, so an intermediate exponent is best and a large one can be worse than uniform
 # nodes (ratios printed above). On the NRHO the right spacing changes the error by a large factor; on the quiescent
 # DRO of the paper's test cases the gain at $\sigma = 1$ is modest and depends on the random control draws (the
-# other seeds are printed above; the table reports the range and judges it against the 1.1x threshold).
+# other seeds are printed above; the table reports the range and judges it against the 1.1x threshold). The
+# regime in which the paper's "effective" holds on the DRO is a milder dilation: in the full run $\sigma = 0.5$
+# reduces the error 1.21-1.47x for every draw seed (printed above), while $\sigma = 1$ ranges over 1.04-1.21x and
+# $\sigma \ge 1.5$ is worse than uniform nodes for every seed. That $\sigma = 0.5$ was picked out after the sweep,
+# so it is shown here and not judged.
 #
 # ## 3 · Thrust bounds on unequal intervals (Eqs. 40-41)
 #

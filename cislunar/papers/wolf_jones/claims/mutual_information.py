@@ -63,7 +63,7 @@ CLAIMS = {
         reason="our choice; the optimised trajectory is not given, so the observer coasts on its initial reference "
                "DRO (the printed observer_t0 row, not periodic, with vy0 corrected holding x0)"),
     "in_plane_growth": Claim(
-        "In-plane RMS growth after the first update (test case 2 analogue of the Fig. 4 remark)",
+        "In-plane RMS growth after the first update (test case 2 analogue of the Fig. 4 remark; symptom only)",
         "noticeable growth at the window start (attributed to a diagonal P0)",
         Holds("in-plane RMS after the 2nd update above that after the 1st for at least one object"),
         source="Test Case #1 text on Fig. 4", reason="no initial growth in this geometry"),

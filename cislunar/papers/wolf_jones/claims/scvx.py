@@ -27,7 +27,8 @@ OPTIMUM_TOL = 1e-6
 
 CLAIMS = {
     "defects": Claim(
-        "SCvx converges with defects driven to zero (Eqs. 30, 42), at alpha_h = 0 (no information reward)",
+        "SCvx converges with defects driven to zero (Eqs. 30, 42), at alpha_h = 0 (no information reward), package "
+        "default (augmented Lagrangian)",
         "yes (method)", AtMost(1e-9),
         source="Eqs. 30, 42", reason="defects remain (largest node defect, LU)"),
     "superlinear": Claim(
@@ -39,7 +40,8 @@ CLAIMS = {
                "superlinearly; the cited theorem is for Mao's penalty SCvx, whose printed form does not converge on "
                "test case 1 (notebook 05)"),
     "single_shooting": Claim(
-        "converged FOH control flies the nonlinear dynamics to x_f", "implied", AtMost(1.0),
+        "converged FOH control flies the nonlinear dynamics to x_f (alpha_h = 0, package default)", "implied",
+        AtMost(1.0),
         source="Eqs. 27-33", reason="the single-shooting miss is too large (km)"),
     "trust_region_parameters": Claim(
         "trust-region parameters (Table 1)", "user-defined, not given", kind="not in paper", source="Table 1",
