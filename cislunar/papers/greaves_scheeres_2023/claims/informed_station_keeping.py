@@ -50,7 +50,9 @@ CLAIMS = {
     "valley_projection": Claim(
         "Fig. 4: u* in the valley, Eq. 25 read as the projection of the burn on u_y, agent starting at ring phase 0 "
         "or 1/2 only (worst of the baseline and the sweep settings at those phases)", "in the valley",
-        AtMost(25.0), source="Sec. 5, Fig. 4", tuned=_TUNED_PROJECTION,
+        AtMost(25.0), source="Sec. 5, Fig. 4",
+        tuned=f"{_TUNED_PROJECTION}; the split by agent phase (0 or 1/2 here, 1/4 or 3/4 in the next row) was also "
+              "made after the sweep of section 6 showed where the reading holds",
         reason="the projection reading's u* is outside the best quartile of its slices at agent phase 0 or 1/2"),
     "valley_projection_quarter": Claim(
         "Fig. 4: u* in the valley, projection reading, agent a quarter turn away (ring phase 1/4 or 3/4; best sweep "
@@ -78,7 +80,8 @@ CLAIMS = {
                "in a tracked arc) is where the range information comes from, so it lowers sqrt(J_rho) everywhere"),
     "raised_point_projection": Claim(
         "Fig. 4: a single point of the u* line raised by a small local peak, projection reading (slices whose "
-        "sqrt(J_rho) of u* exceeds both neighbours' by more than 10 %)", "one point", Equals(1), source="Sec. 5",
+        "sqrt(J_rho) of u* exceeds both neighbours' by more than 10 %; the arrival slices of section 3 only)",
+        "one point", Equals(1), source="Sec. 5",
         tuned=_TUNED_PROJECTION,
         reason="the projection reading's u* line does not have exactly one slice raised above both neighbours"),
     "vs_best_angle": Claim(
