@@ -332,7 +332,7 @@ print(f"u*: median percentile in its slice {st_pre.median_percentile:.1f} %, bes
 fig = figures.map_with_percentiles(S_pre, f"tracking from {PRE_ARC_H:.0f} h before the first burn",
                                    [("tracking from the first burn (baseline)", S, "o-"),
                                     (f"tracking from {PRE_ARC_H:.0f} h before it", S_pre, "s--")],
-                                   "where u* ranks, both readings")
+                                   "where u* ranks, both tracking starts (angle reading)")
 _ = plotting.save_figure(fig, "08_map_range_sigma_with_tracking_arc", output_dir=out)
 
 # %%
@@ -403,7 +403,7 @@ print(f"second burn: sqrt(J_rho) of u* with both burns / first burn only {second
       f"{second_effect_proj.max():.3f}")
 fig = figures.map_with_percentiles(S_proj, "projection reading: u* on the range map",
                                    [("angle reading", S, "o-"), ("projection reading", S_proj, "s--")],
-                                   "where u* ranks, both readings")
+                                   "where u* ranks, both readings", reading="projection")
 _ = plotting.save_figure(fig, "08_projection_reading", output_dir=out)
 
 # %% [markdown]
@@ -765,7 +765,8 @@ table.add(
              f"(next to the agent's own phase 0, the smallest burns); rank correlation of fuel and sqrt(J_rho) within "
              f"slices {st.rank_correlation:.2f}. MMD coast to t_f instead of the arrival: {pct_horizon:.0f} %. Agent "
              f"drifted 1-50 km off the torus (3 directions each): {pct_offset_all.min():.0f}-{pct_offset_all.max():.0f} %. "
-             f"Tolerance met in {n_valley_angle} of {len(sweep)} sweep settings. {member_note('angle')[0].upper() + member_note('angle')[1:]}. "
+             f"Tolerance met in {n_valley_angle} of {len(sweep)} sweep settings (read at t_f; "
+             f"{sum(r.pct_arr < 25 for r in sweep)} read at arrival). {member_note('angle')[0].upper() + member_note('angle')[1:]}. "
              f"Grid-dependent: with {grids} ring angles (section 5b) {series('angle', 'percentile', '{:.1f}')} %, "
              "tending to 100 % (u* tends to no maneuver)"),
     CLAIMS["valley_projection"].judge(valley_proj_worst,
@@ -781,7 +782,8 @@ table.add(
               f"({'/'.join(f'{v:.0f}' for v in fuel_ok['angle'][1])} % with {grids} ring angles); its median fuel "
               f"{'/'.join(f'{v:.2f}' for v in fuel_ok['angle'][2])} m/s",
         note="Below the median at every grid, but only because Eq. 25 read as an angle picks a burn next to the "
-             "agent's own phase, whose fuel falls with the grid spacing (u* tends to no maneuver): a grid artefact; median {np.median(st.fuel_percentile):.0f} % of maneuvers cost more on the "
+             f"agent's own phase, whose fuel falls with the grid spacing (u* tends to no maneuver): a grid artefact; "
+             f"median {np.median(st.fuel_percentile):.0f} % of maneuvers cost more on the "
              f"{N_SURF}-angle surface"),
     CLAIMS["fuel_projection"].judge(fuel_ok["projection"][0],
         shown=f"u* at or below the slice median fuel in {st_proj.below_median_fuel * 100:.0f} % of slices "

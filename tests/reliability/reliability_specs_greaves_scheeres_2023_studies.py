@@ -239,8 +239,9 @@ def specs(S, lazy):
     s.append(S("map_with_percentiles", _drawn(fg.map_with_percentiles),
                dict(S_map=surface, map_title="map",
                     panels=lazy(lambda: [("angle", _surface(), "o-"), ("projection", _surface_projection(), "s--")]),
-                    panel_title="ranks"),
-               dict(S_map="instance", map_title="instance_str", panels="iterable", panel_title="instance_str")))
+                    panel_title="ranks", reading="projection"),
+               dict(S_map="instance", map_title="instance_str", panels="iterable", panel_title="instance_str",
+                    reading="choice")))
     s.append(S("grid_resolution", _drawn(fg.grid_resolution),
                dict(grid=lazy(_grid), no_maneuver_m=lazy(lambda: float(_surface().range_sigma_km[0, 0] * 1e3))),
                dict(grid="instance", no_maneuver_m="pos")))

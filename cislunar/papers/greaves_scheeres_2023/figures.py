@@ -265,10 +265,14 @@ def surfaces(S, which="burns", projection=None):
     return fig
 
 
-def _informed_markers(ax, surf, projection=None):
-    """u* (magenta open circles; the projection reading as red crosses when given) and the best maneuver of each
-    slice (orange open squares) on a map."""
-    for n_seg, seg in enumerate(_informed_segments(surf)):
+def _informed_markers(ax, surf, projection=None, reading="angle"):
+    """u* (magenta open circles, or red crosses if ``surf`` itself is the projection reading's surface; the
+    projection reading as red crosses when given) and the best maneuver of each slice (orange open squares) on a
+    map."""
+    if reading == "projection":  # the colour and marker of the projection reading on every figure
+        ax.plot(surf.phase[surf.informed], surf.t_arrival_hours, "x", color="tab:red", ms=6, mew=1.5,
+                label="u*, projection reading")
+    for n_seg, seg in enumerate(_informed_segments(surf) if reading == "angle" else ()):
         ax.plot(surf.phase[surf.informed][seg], surf.t_arrival_hours[seg], "o", color="magenta", mfc="none", ms=5,
                 mew=1.2, label=("u* (informed)" if projection is None else "u*, angle reading") if n_seg == 0
                 else None)
@@ -279,7 +283,7 @@ def _informed_markers(ax, surf, projection=None):
             label="best of each slice")
 
 
-def _range_map(ax, surf, fig, projection=None):
+def _range_map(ax, surf, fig, projection=None, reading="angle"):
     """Map of sqrt(J_rho): colours from the maneuvers only, no-maneuver cells hatched, u* and the slice best."""
     none = surf.fuel_m_s < 1e-9
     sig_m = surf.range_sigma_km * 1e3
@@ -295,7 +299,7 @@ def _range_map(ax, surf, fig, projection=None):
         ax.add_patch(Rectangle((surf.phase[i] - dp / 2, surf.t_arrival_hours[0] - dt / 2), dp,
                                np.ptp(surf.t_arrival_hours) + dt, facecolor="0.85", edgecolor="0.3", hatch="////",
                                lw=0.5, label=f"no maneuver: {sig_m[none].min() / 1e3:.1f} km"))
-    _informed_markers(ax, surf, projection)
+    _informed_markers(ax, surf, projection, reading)
     ax.set_xlabel(r"normalised phase $\theta_0/2\pi$ [-]")
     ax.set_ylabel("time from apoapsis (h)")
 
@@ -370,9 +374,12 @@ def informed_within_slices(S):
     return fig
 
 
-def map_with_percentiles(S_map, map_title, panels, panel_title):
-    """A range map of ``S_map`` next to the percentile of u* for each ``(label, surface, style)`` of ``panels``."""
+def map_with_percentiles(S_map, map_title, panels, panel_title, *, reading: str = "angle"):
+    """A range map of ``S_map`` next to the percentile of u* for each ``(label, surface, style)`` of ``panels``;
+    ``reading`` ("angle" or "projection"): which reading of Eq. 25 chose ``S_map``'s u* (its markers on the map:
+    magenta circles or red crosses, as on every other figure)."""
     _surface(S_map, "S_map")
+    validation.choice(reading, "reading", ("angle", "projection"))
     validation.instance(map_title, "map_title", str, "a str")
     validation.instance(panel_title, "panel_title", str, "a str")
     if isinstance(panels, (str, bytes, dict)) or not hasattr(panels, "__iter__"):
@@ -389,7 +396,7 @@ def map_with_percentiles(S_map, map_title, panels, panel_title):
         _surface(panel[1], f"panels[{n}] surface")
         validation.instance(panel[2], f"panels[{n}] style", str, "a str")
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
-    _range_map(axes[0], S_map, fig)
+    _range_map(axes[0], S_map, fig, reading=reading)
     axes[0].set_title(map_title)
     axes[0].legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=8)
     _percentile_panel(axes[1], panels)
