@@ -57,7 +57,7 @@ CLAIMS = {
         source=f"{_SOURCE} (fraction of runs inconsistent after the burn, paper's reset rule; notebook 09's flag)",
         reason="the paper's reset rule leaves some runs inconsistent"),
     "small late": Claim(
-        "50 mm/s burn: detection late (Figs. 8-9)", "late", Holds("most runs not prompt (prompt fraction < 0.5)"),
+        "50 mm/s burn: not detected promptly (late, or not within the period; Figs. 8-9)", "late", Holds("most runs not prompt (prompt fraction < 0.5)"),
         source="Figs. 8-9", reason="most runs detected promptly"),
     "small nearly periapsis": Claim(
         "50 mm/s burn: detected 'nearly periapsis' (Fig. 8 caption)", "nearly periapsis (one run)",

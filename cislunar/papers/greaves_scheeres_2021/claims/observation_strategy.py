@@ -58,7 +58,7 @@ CLAIMS = {
         source=f"{_SECTION} (mechanism: rates stabilise the updates against nonlinearity near periapsis)",
         reason="no filter tried shows the contrast at every cadence"),
     "outer_better": Claim(
-        "stable NRHO (outer stable band) better determined than the 9:2", "qualitatively similar, quantitatively better",
+        "stable NRHO (outer band) better determined than the 9:2", "qualitatively similar, quantitatively better",
         AtLeast(0.5), tuned=_OUTER_TUNED, source=_SECTION,
         reason="the 9:2 NRHO is better determined here too (fraction of cadences with a smaller final sigma)"),
     "inner_consistent_long": Claim(
