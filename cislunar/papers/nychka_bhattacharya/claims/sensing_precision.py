@@ -79,7 +79,9 @@ CLAIMS = {
     "hinf_noise": Claim(
         "allowable theta1 noise, Hinf, gamma = 0.0013", "0.08 deg", Within(0.08, printed_tolerance("0.08")),
         source="§IV-B, Eq. 24",
-        tuned="the 2:1 orbit, whose max r13 sets the number, is a choice not independent of the paper's number",
+        tuned="the 2:1 orbit, whose max r13 sets the number, is a choice not independent of the paper's number; the "
+              "number also depends on the bandwidth bound R = 1000/TU (beyond the paper): Section 5 puts the "
+              "smallest R tried below the band",
         reason="depends on max r13"),
     "ordering": Claim(
         "ordering H2 > Hinf", "H2 0.1 > Hinf 0.08 deg",
