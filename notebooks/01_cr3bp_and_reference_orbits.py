@@ -248,8 +248,10 @@ _ = plotting.save_figure(ro.figure_halo_stability(em, halo), "01_halo_stability_
 #   test runs to separate, and the window-tuned filter is most consistent on the outer-band member.
 #
 # So the outer band's most stable member (`orbits.stable_nrho_outer`) is the reading we favour; the name
-# `orbits.stable_nrho` keeps denoting the inner band's edge, and the closing tables of 09 and 10 carry both rows
-# (the outer band's agreement with the paper's remark is marked "consistent (tuned)", since it was chosen for it).
+# `orbits.stable_nrho` keeps denoting the inner band's edge, and the closing tables of 09 and 10 carry both rows.
+# In notebook 09 the outer band's agreement with the paper's "quantitatively better" remark is marked "consistent
+# (tuned)", since the band was chosen for it; in notebook 10 neither candidate's detection results differ from the
+# 9:2 NRHO's by more than two standard errors.
 #
 # The analogue of Greaves & Scheeres' Fig. 2: NRHO members about the Moon with the 9:2 NRHO and both stable
 # candidates highlighted (Moon-centred axes, as in the paper).

@@ -25,10 +25,10 @@ CLAIMS = {
         source="Dynamics ('approximate 9:2 resonance orbit')", reason="period constraint not met"),
     "nrho_perilune": Claim(
         "9:2 NRHO perilune radius [km]", _NO_TABLE1, Between(3200.0, 3300.0), kind="not in paper",
-        reason="the paper prints no radius (its Table 1 is missing); the public value is 3200-3300 km (book: Sources)"),
+        reason="the paper prints no radius (its Table 1 is missing): compared with the public value instead"),
     "nrho_apolune": Claim(
         "9:2 NRHO apolune radius [km]", _NO_TABLE1, Within(71000.0, 1000.0), kind="not in paper",
-        reason="the paper prints no radius (its Table 1 is missing); the public value is about 71000 km (book: Sources)"),
+        reason="the paper prints no radius (its Table 1 is missing): compared with the public value instead"),
     "nrho_state": Claim("9:2 NRHO apolune state [x0, z0, vy0]", _NO_TABLE1, kind="derived"),
     "nrho_stability": Claim(
         "9:2 NRHO stability index", "Table 1 missing", kind="not in paper",
