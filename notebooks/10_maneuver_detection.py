@@ -413,8 +413,10 @@ print(demo.fig13_report())
 # spike's size, $z$, against its distribution without a burn (Section 3). The same holds for the measure of the
 # closing table's Fig. 13 row (smoothed $z$ above twice the forward $z$): in 16 quiet-tuned runs without a burn on
 # the 9:2 NRHO, run outside the notebook on 2026-11-26 (`detection.run_detection_monte_carlo`, seed 12345), the
-# ratio was at least 6.3 at $f = 0.1$ and at least 2.8 at $f_c$, so that row says that the forward control stays
-# below the smoothed one, not that the spike reveals the burn; the detection rows (Tables 5-8) say that.
+# ratio was at least 6.3 at $f = 0.1$ and at least 2.8 at $f_c$. So the row judges the burn runs and the no-burn
+# runs of Section 3's training together, as the Fig. 11 row does ("indicative of a maneuver" needs both): a spike
+# that appears without a burn as well makes it differ, and the detection rows (Tables 5-8) say what does reveal
+# the burn. (Until a referee's pass on 2026-11-26 this row judged the burn runs alone and said "reproduced".)
 #
 # The forward control rises inside the window too (the estimated control is $-\tilde Q B^\top\mathbf p$, so it
 # scales with $q_w$ whether or not there is a burn);

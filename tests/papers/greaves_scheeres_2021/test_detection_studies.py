@@ -319,6 +319,12 @@ def test_closing_rows_carry_the_studies_numbers(small_studies):
     # the Fig. 10 row is the spike study's verdict; fractions stay fractions
     assert rows["fig10"]["measured"] == small_studies["spike"].fig10_ok
     assert 0.0 <= rows["fig11"]["measured"] <= 1.0 and 0.0 <= rows["fig13"]["measured"] <= 1.0
+    # Fig. 13: the burn runs' spike share and the no-burn runs' no-spike share, the smaller over both tunings
+    shares = []
+    for st in (train.tuned["9:2 NRHO", "quiet"], train.predicted["9:2 NRHO", "quiet"]):
+        shares += [np.mean(st.h1.z / st.h1.z_step > 2), np.mean(st.h0.z / st.h0.z_step <= 2)]
+    assert rows["fig13"]["measured"] == pytest.approx(min(shares))
+    assert "H0 runs without such a spike" in rows["fig13"]["shown"]
     for o in tmap.orbits:
         assert 0.0 <= rows[f"window consistent f=0.1, {o}"]["measured"] <= 1.0
     assert rows["window consistent"]["measured"] == train.worst_predicted
