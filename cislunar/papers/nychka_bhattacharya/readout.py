@@ -256,14 +256,16 @@ def allowances(al: sp.Allowances, D: sp.Designs, bw: sp.BandwidthStudy, orbit: s
         "ordering": Measurement(bool(al.h2_deg > al.hinf_deg), f"intensity reading: H2 {al.h2_deg:.3f} "
                                 f"{'>' if al.h2_deg > al.hinf_deg else '<'} Hinf {al.hinf_deg:.3f}; per sample: H2 > "
                                 f"Hinf iff dt < {al.dt_eq * tu_min:.0f} min"),
-        "hinf_formula": Measurement("kappa = sqrt(beta)", note="verified norm equals gamma with sqrt(beta); the "
+        "hinf_formula": Measurement("kappa = sqrt(beta)", note="with sqrt(beta) the verified Hinf norm stays just "
+                                    "below gamma (Section 6 prints it); the "
                                     f"printed formula would give {al.hinf_literal_deg:.4f} deg, not 0.08"),
         "kappa_implied": Measurement(
             al.kappa_h2, f"H2 {al.kappa_h2:.0f}, Hinf {al.kappa_hinf:.0f}",
             f"judged on the H2 kappa (382-1146 = 1/sin of 0.15-0.05 deg, the band of the H2 rows); H2 "
             f"{al.kappa_h2 / kp['h2']:.1f}x the implied value; Hinf "
             f"{'inside' if kb[0] < al.kappa_hinf <= kb[1] else 'outside'} the band ({kb[0]:.0f}, {kb[1]:.0f}] of the "
-            "printed digits of 0.08 deg; the paper prints no kappa: 1/sin(0.1 deg), 1/sin(0.08 deg)"),
+            "printed digits of 0.08 deg; the paper's Fig. 2 plots kappa but its text gives no value, so the implied "
+            "ones are 1/sin(0.1 deg), 1/sin(0.08 deg)"),
     }
     return Readout(text, rows)
 
