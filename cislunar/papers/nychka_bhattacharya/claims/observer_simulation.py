@@ -2,7 +2,7 @@
 Criteria fixed before the runs: "converges rapidly" = first below the LMI's guaranteed RMS within 5 % of a period,
 "stays accurate" = RMS after that below the guarantee; the error comparison uses medians after 10 % of the run."""
 
-from cislunar.publish.claims import AtMost, Claim, Holds, Within, printed_tolerance
+from cislunar.publish.claims import AtMost, Claim, Holds
 
 _CONVERGES = ("first below the guaranteed RMS within 5 % of a period and the RMS after it (from 2 % of a period "
               "later) below the guarantee")
@@ -36,10 +36,12 @@ CLAIMS = {
         "hinf gain: solve status and verification", None,
         Holds("solve optimal, A + LC Hurwitz and norm < gamma at every checked point"), kind="beyond paper",
         reason="verification failed"),
+    # "beyond paper" since 2026-11-26 (a referee): the simulated dt is this notebook's choice and the paper states no
+    # dt, so comparing its 0.1 deg with the allowance at our dt judged our choice, not the paper; notebook 11 finds
+    # the dt at which 0.1 deg holds (233 min) and Section 6 simulates it
     "ordering_dt": Claim(
-        "H2 per-sample allowance at the simulated dt (this notebook's choice; and the ordering)", "H2 0.1 > Hinf 0.08 deg",
-        Within(0.1, printed_tolerance("0.1")),
-        source="§IV-B", reason="the H2 per-sample allowance at this dt is not the paper's 0.1 deg"),
+        "H2 per-sample allowance at the simulated dt (this notebook's choice; and the ordering)",
+        "dt not stated (H2 0.1 > Hinf 0.08 deg at the paper's unstated dt)", kind="beyond paper", source="§IV-B"),
     "h2_converges": Claim(
         "H2: converges rapidly and stays accurate", "yes (Fig. 3)", Holds(_CONVERGES), source="Fig. 3, §IV-B"),
     "hinf_converges": Claim(
