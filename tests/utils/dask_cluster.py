@@ -29,7 +29,7 @@ def local_client(module_name: str, *, silence_logs: int = 40, config: dict | Non
 
     cloudpickle.register_pickle_by_value(sys.modules[module_name])
     with dask.config.set(config or {}):
-        cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+        cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
                                            silence_logs=silence_logs)
         client = distributed.Client(cluster)
     try:

@@ -29,7 +29,7 @@ def test_serial_and_processes_give_the_same_results():
 def test_a_dask_scheduler_address_gives_a_client():
     distributed = pytest.importorskip("dask.distributed")
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster:
+                                  dashboard_address=":0") as cluster:
         with open_executor(1, cluster.scheduler_address) as ex:
             assert describe_executor(ex).startswith("Dask ")
             got = montecarlo.run_monte_carlo(_trial, 6, seed=3, executor=ex, progress=False)
