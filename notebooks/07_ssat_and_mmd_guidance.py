@@ -430,10 +430,10 @@ print(f"over all QPO pairs and coasts: median percentile {np.median(pct_all):.0f
 #   what is compared). Four settings: the burn at the start of tracking (the first pair), the same on the torus
 #   (the *median* over ring angles and coasts, a milder statistic than the worst coast, in a *beyond paper* check
 #   that turns to *differs* when it fails), and the mid-arc burn split into the leading run of coasts within the
-#   tolerance and the rest. The mid-arc setting was adopted after the first comparison missed, so its agreeing row
-#   is *tuned*, not reproduced; and since its coasts are, by construction, those within the tolerance, that row
-#   cannot fail: it records *where* MMD is near-optimal, and the test is the row after it (the longer coasts),
-#   which fails.
+#   tolerance and the rest. Since the first part's coasts are, by construction, those within the tolerance, that
+#   row could not fail as a verdict: it is a *beyond paper* record of *where* MMD is near-optimal (the mid-arc
+#   setting was, besides, adopted after the first comparison missed), and the test is the row after it (the longer
+#   coasts), which fails.
 # - **Where MMD is near-optimal.** The paper's "nearly optimal" carries no condition, so one summary row counts,
 #   over every case swept with the larger burn (the burn at the start of tracking at each coast, the burn after
 #   each tracking arc at each coast, the agent on the torus at each ring angle and coast), the share in which MMD
