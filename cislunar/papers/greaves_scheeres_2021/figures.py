@@ -268,7 +268,8 @@ def z_vs_maneuver(studies: dict, orbit_names, policy_names):
         ax[row, 1].set(xlabel="azimuth [deg]", ylabel="z / impulse magnitude [-]", title=f"9:2 NRHO, {p}")
         for o, mk in zip(orbit_names, ("o", "x")):
             s1 = studies[o, p].h1
-            ax[row, 2].scatter(s1.magnitude * unit, s1.z * unit, s=4, alpha=0.4, marker=mk, label=o)
+            ax[row, 2].scatter(s1.magnitude * unit, s1.z * unit, s=4 if mk == "o" else 14, alpha=0.4, marker=mk,
+                               linewidths=0.8, label=o)  # crosses larger: at dot size they read as dots
         mm = np.array([0, h1.magnitude.max() * unit])
         ax[row, 2].plot(mm, mm, "k--", lw=1, label="z = magnitude")
         ax[row, 2].set(xlabel=f"impulse magnitude [{ulab}]", ylabel=f"z [{ulab}]",
@@ -326,7 +327,7 @@ def health_lead(lead: dict):
         fr = h.outcome_fractions()
         x = np.arange(h.magnitudes_m_s.size)
         bottom = np.zeros(x.size)
-        for (name, v), col in zip(fr.items(), ("C2", "0.6", "C1", "0.85")):
+        for (name, v), col in zip(fr.items(), ("C2", "C0", "C1", "0.85")):  # neither: the light grey
             a.bar(x, 100 * v, bottom=bottom, color=col, label=name, width=0.7)
             bottom += 100 * v
         a.set(xticks=x, xticklabels=[f"{m:g}" for m in h.magnitudes_m_s], xlabel="burn size [m/s]", title=tag)
@@ -534,17 +535,20 @@ def figure_custody(studies):
     for i, st in enumerate(studies):
         validation.instance(st, f"studies[{i}]", cu.CustodyStudy, "a CustodyStudy (custody_study)")
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True)
-    for s, mk in zip(studies, "os^v"):
+    for i, (s, mk) in enumerate(zip(studies, "os^v")):
         k = np.arange(1, s.periods + 1)
-        a1.plot(k, 100 * s.custody_fraction, marker=mk, label=f"custody kept, {s.policy_name}")
-        a1.plot(k, 100 * s.inconsistent_fraction, marker=mk, ls="--", label=f"inconsistent, {s.policy_name}")
+        # later studies with larger open markers drawn on top: where two policies coincide (e.g. both at 100 %)
+        # both stay visible
+        st = dict(marker=mk, ms=5 + 4 * i, mfc=None if i == 0 else "none", zorder=2 + i)
+        a1.plot(k, 100 * s.custody_fraction, label=f"custody kept, {s.policy_name}", **st)
+        a1.plot(k, 100 * s.inconsistent_fraction, ls="--", label=f"inconsistent, {s.policy_name}", **st)
         pe = np.rad2deg(np.where(np.isfinite(s.max_pointing_rad), s.max_pointing_rad, np.nan))
-        a2.semilogy(k, np.nanmax(pe, axis=0), marker=mk, label=f"worst run, {s.policy_name}")
-        a2.semilogy(k, np.nanmedian(pe, axis=0), marker=mk, ls="--", label=f"median run, {s.policy_name}")
+        a2.semilogy(k, np.nanmax(pe, axis=0), label=f"worst run, {s.policy_name}", **st)
+        a2.semilogy(k, np.nanmedian(pe, axis=0), ls="--", label=f"median run, {s.policy_name}", **st)
     a1.axhspan(0, 10, color="0.9", zorder=0)
-    a1.set(xlabel="period since hand-off (-)", ylabel="runs (%)", ylim=(-5, 105))
+    a1.set(xlabel="period since hand-off [-]", ylabel="runs [%]", ylim=(-5, 105))
     a2.axhline(np.rad2deg(studies[0].half_angle_rad), color="k", ls=":", label="custody bound")
-    a2.set(xlabel="period since hand-off (-)", ylabel="max pointing error (deg)")
+    a2.set(xlabel="period since hand-off [-]", ylabel="max pointing error [deg]")
     for a in (a1, a2):
         a.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7)
     return fig
