@@ -26,6 +26,10 @@ CLAIMS = {
     "angles_only_noise": Claim(
         "angles only, 9:2 NRHO, 12 h, {noise} urad", "diverges at every cadence (at its unstated noise)",
         Holds(_DIVERGES), source=f"{_SECTION}; Table 3 missing", reason="consistent in our runs"),
+    # added 2026-11-26 (a referee: the paper's statement at its own noise was never run), criterion as the others
+    "five_observers_stated": Claim(
+        "angles only, five observers hourly, the stated noise and hand-off", "'nearly always fail'", Holds(_DIVERGES),
+        source=_SECTION, reason="consistent in our runs"),
     "five_observers": Claim(
         "angles only, five observers hourly, noise and hand-off / 10 (Fig. 4)", "diverges", Holds(_DIVERGES),
         source="Fig. 4", reason="consistent in our runs"),
