@@ -301,7 +301,8 @@ def plot_primaries(ax, system: CR3BP, plane: str = "xy", *, moon_centred: bool =
         bodies.append((system.secondary_position, system.secondary_radius, "#8c8c8c", "Moon"))
     for pos, radius, colour, label in bodies:
         p = (pos - shift) * scale
-        ax.add_patch(Circle((p[i], p[j]), radius * scale, color=colour, zorder=3, label=label))
+        ax.add_patch(Circle((p[i], p[j]), radius * scale, color=colour, zorder=3))
+        ax.plot([], [], "o", color=colour, label=label)  # the legend's key: a disc, as drawn (a patch shows a square)
 
 
 def plot_rotating(ax, states, system: CR3BP | None = None, plane: str = "xy", *, moon_centred: bool = False,

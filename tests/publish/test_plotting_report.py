@@ -318,3 +318,23 @@ def test_the_legend_defines_exactly_the_status_words_a_table_uses():
     assert [ln.split("**")[1] for ln in lines] == ["reproduced", "differs", "derived"]
     assert "fixed before comparing" in lines[0]
     assert ComparisonTable("empty").legend() == ""
+
+
+def test_primaries_are_drawn_to_scale_and_keyed_as_discs():
+    """One circle per body, of the body's radius at its position (km here), and a legend key that is a disc marker
+    (a patch's key is a square, which a reader takes for another object)."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Circle
+
+    from cislunar.cr3bp.dynamics import EARTH_MOON as em
+
+    fig, ax = plt.subplots()
+    plotting.plot_primaries(ax, em, units="km")
+    circles = [p for p in ax.patches if isinstance(p, Circle)]
+    assert [c.get_radius() for c in circles] == pytest.approx(
+        [em.primary_radius * em.length_unit_km, em.secondary_radius * em.length_unit_km])
+    assert circles[1].center == pytest.approx((em.secondary_position[0] * em.length_unit_km, 0.0))
+    handles, labels = ax.get_legend_handles_labels()
+    assert labels == ["Earth", "Moon"]
+    assert all(isinstance(h, Line2D) and h.get_marker() == "o" for h in handles)
+    plt.close(fig)

@@ -240,7 +240,7 @@ def figure_control_metric(panels: PanelSeries, title: str, *, burn_days=None, de
         ax[0, j].set(ylabel=r"control norm $\|\hat{\mathbf{u}}\|$ [m/s$^2$]", title=f"{title}: {name}")
         if j == 0 and fp is not None:
             ax[1, j].semilogy(panels.t_days[:until + 1], fp[:until + 1] / panels.limit[:until + 1], "x",
-                              color="0.4", ms=5, label="before the reset")
+                              color="0.4", ms=5, label="first pass (up to the first reset)")
         ax[1, j].semilogy(panels.t_days, norm[j], "C0.-", ms=3, lw=0.8, label="metric / limit")
         ax[1, j].plot(panels.t_days, panels.mean_line, "C1", lw=1.2, label="mean / limit")
         ax[1, j].axhline(1.0, color="k", ls="--", lw=0.8, label="99 % limit")
