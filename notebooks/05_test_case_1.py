@@ -243,10 +243,10 @@ print("better than the sweep's best: " + ("; ".join(
 
 # %%
 with open_executor(workers, SCHEDULER) as executor:
-    mesh = global_search.mesh_starts(case.solver, case.sweep, ms, mesh_alphas, mesh_nodes, sigma=SIGMA,
-                                     rtol=MESH_RTOL, cold=mesh_cold, executor=executor)
-print(mesh.summary(MPS))
-ms, mstudy, back_gain = mesh.multi, mesh.study, mesh.gains  # the multi-start with the mesh starts, from here on
+    mesh_st = global_search.mesh_starts(case.solver, case.sweep, ms, mesh_alphas, mesh_nodes, sigma=SIGMA,
+                                        rtol=MESH_RTOL, cold=mesh_cold, executor=executor)
+print(mesh_st.summary(MPS))
+ms, mstudy = mesh_st.multi, mesh_st.study  # the multi-start with the mesh starts, from here on
 ms_better = ms.improvements([sweep_best[alphas.index(a)] for a in ms_alphas])
 
 # %% [markdown]
@@ -702,11 +702,8 @@ table.add(CLAIMS["mesh_study"].judge(all(mstudy.converged(a) for a in mstudy.alp
                                    for r in mstudy.table(a) if r.converged) for a in mstudy.alphas),
     note=f"figures use {mstudy.figure_nodes} nodes; largest change between the two finest grids: " + ", ".join(
         f"{a:g}: {100 * mstudy.finest_change(a):.1f} %" for a in mstudy.alphas)))
-if back_gain:  # a finer grid converged (the full run's 60 nodes; the quick run's mesh grid is coarser)
-    table.add(CLAIMS["mesh_back"].judge(max(back_gain.values()), shown="; ".join(
-        f"alpha_h {a:g}: gain {g:+.1e}" for a, g in back_gain.items()), note=(
-        "moved back from the finest grid of the mesh study, against the best of the multi-start's generic starts; "
-        "where the gain is positive the moved-back plan is adopted: the figures and the rows above use it")))
+if (back_row := mesh_st.back_measurement()) is not None:  # a finer grid converged (not in the quick run)
+    table.add(CLAIMS["mesh_back"].judge(**back_row))
 else:
     print("not judged in this run: no mesh grid finer than the figures' converged, so no plan was moved back")
 size_failed = [r for r in size.rows if not r.converged]

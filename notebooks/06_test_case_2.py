@@ -283,10 +283,10 @@ print("better than the sweeps' best: " + ("; ".join(
 
 # %%
 with open_executor(workers, SCHEDULER) as executor:
-    mesh = global_search.mesh_starts(solver, runs.sweep, multi, mesh_alphas, mesh_nodes, sigma=SIGMA, rtol=MESH_RTOL,
-                                     cold=mesh_cold, executor=executor)
-print(mesh.summary(mps))
-multi, mstudy, back_gain = mesh.multi, mesh.study, mesh.gains  # the multi-start with the mesh starts, from here on
+    mesh_st = global_search.mesh_starts(solver, runs.sweep, multi, mesh_alphas, mesh_nodes, sigma=SIGMA,
+                                        rtol=MESH_RTOL, cold=mesh_cold, executor=executor)
+print(mesh_st.summary(mps))
+multi, mstudy = mesh_st.multi, mesh_st.study  # the multi-start with the mesh starts, from here on
 ms_better = multi.improvements([sweep_best[a] for a in ms_alphas])
 
 # %% [markdown]
@@ -658,14 +658,14 @@ d_scan = np.array(d_scan_km, dtype=float)
 remedy_info = kod.RangeNoiseInformation(info, REMEDY_RANGE_KM)
 scan_plain = kod.pass_scan(sc, info, x_ws_ball, d_scan)
 scan_remedy = kod.pass_scan(sc, remedy_info, x_ws_ball, d_scan)
-scan_reg = kod.pass_scan(sc, kod.RegularisedJacobianInformation(info, REMEDY_RANGE_KM), x_ws_ball, d_scan)
+reg_info = kod.RegularisedJacobianInformation(info, REMEDY_RANGE_KM)
+scan_reg = kod.pass_scan(sc, reg_info, x_ws_ball, d_scan)
 for name, s_ in (("paper's model", scan_plain), (f"range noise, rho_c = {REMEDY_RANGE_KM:g} km", scan_remedy),
                  (f"regularised range-rate Jacobian, rho_c = {REMEDY_RANGE_KM:g} km", scan_reg)):
     print(f"{name}: |dI/dr| [nats/LU] " + ", ".join(f"{d_:g} km: {g_:.3g}" for d_, g_ in zip(d_scan, s_.grad_position))
           + f"; log-log slope below 10 km {s_.slope('grad_position'):+.2f}; MI at {d_scan[0]:g} km "
           f"{s_.mi[0] - s_.mi[-1]:+.3f} nats against the {d_scan[-1]:g} km pass")
-reg_reward = studies.keep_out_scan(sc, kod.RegularisedJacobianInformation(info, REMEDY_RANGE_KM), x_ws_ball,
-                                   scan_points, d_range_km=SCAN_RANGE_KM)  # section 3's reward scan, regularised
+reg_reward = studies.keep_out_scan(sc, reg_info, x_ws_ball, scan_points, d_range_km=SCAN_RANGE_KM)  # section 3's reward scan, regularised
 print("reward of a close pass (section 3's scan), paper's model -> regularised range-rate Jacobian: " + ", ".join(
     f"{d_:g} km {scan.gain_at(d_):+.2f} -> {reg_reward.gain_at(d_):+.2f} nats" for d_ in (1.0, 1e-3, 1e-6)
     if SCAN_RANGE_KM[0] <= d_ <= SCAN_RANGE_KM[1]))
@@ -874,11 +874,8 @@ table.add(CLAIMS["mesh_study"].judge(all(mstudy.converged(a) for a in mstudy.alp
     note=f"figures use {mstudy.figure_nodes} nodes; largest change between the two finest grids (and the start of "
          "the finest grid's best plan): " + ", ".join(
         f"{a:g}: {100 * mstudy.finest_change(a):.1f} % ({mstudy.table(a)[-1].start})" for a in mstudy.alphas)))
-if back_gain:  # a finer grid converged (the full run's 20-60 nodes; the quick run's mesh grid is coarser)
-    table.add(CLAIMS["mesh_back"].judge(max(back_gain.values()), shown="; ".join(
-        f"alpha_h {a:g}: gain {g:+.1e}" for a, g in back_gain.items()), note=(
-        "moved back from the finest grid of the mesh study, against the best of the multi-start's generic starts; "
-        "where the gain is positive the moved-back plan is adopted: the figures and the rows above use it")))
+if (back_row := mesh_st.back_measurement()) is not None:  # a finer grid converged (not in the quick run)
+    table.add(CLAIMS["mesh_back"].judge(**back_row))
 else:
     print("not judged in this run: no mesh grid finer than the figures' converged, so no plan was moved back")
 table.display()

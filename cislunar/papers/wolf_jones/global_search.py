@@ -742,6 +742,19 @@ class MeshStarts:
         """The weights whose best plan now comes from a mesh start."""
         return [a for a, lab in zip(self.multi.alphas, self.multi.best_label) if lab.startswith("mesh ")]
 
+    def back_measurement(self) -> dict | None:
+        """The measured value, shown text and note of the "generic starts find the best known plan" row (claim
+        ``mesh_back`` of notebooks 05 and 06): the largest gain of a moved-back plan; None when no finer grid
+        converged (nothing was moved back, the row is not judged)."""
+        gains = self.gains
+        if not gains:
+            return None
+        return dict(measured=max(gains.values()),
+                    shown="; ".join(f"alpha_h {a:g}: gain {g:+.1e}" for a, g in gains.items()),
+                    note="moved back from the finest grid of the mesh study, against the best of the multi-start's "
+                         "generic starts; where the gain is positive the moved-back plan is adopted: the figures and "
+                         "the rows above use it")
+
     def summary(self, mps: float) -> str:
         """The moved-back solves, the mesh table and the weights whose best plan changed (``mps``: m/s per
         velocity unit of the plans' system)."""

@@ -311,6 +311,10 @@ def test_mesh_starts_is_the_composition_of_its_steps(setup, ms):
     assert [(o.label, o.cost, o.optimum) for o in out.multi.outcomes] == [(o.label, o.cost, o.optimum)
                                                                           for o in hand.outcomes]
     assert out.gains == {A: back[A][3]} and out.changed == ([A] if back[A][3] > 0 else [])
+    row = out.back_measurement()  # the closing row of notebooks 05/06: the largest gain, each weight's shown
+    assert row["measured"] == back[A][3] and row["shown"] == f"alpha_h {A:g}: gain {back[A][3]:+.1e}"
+    assert "adopted" in row["note"]
+    assert dataclasses.replace(out, back={}).back_measurement() is None  # nothing moved back: not judged
     text = out.summary(sc.system.velocity_unit_km_s * 1e3)
     assert "the 11-node plan (warm start) moved back to 10 nodes" in text and "mesh study:" in text
     with pytest.raises(ValueError, match="alphas"):

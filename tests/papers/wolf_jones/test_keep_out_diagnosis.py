@@ -18,6 +18,16 @@ def case2():
     return sc, info, x_ws
 
 
+def _gradient_fd4(f, x, h):
+    """Fourth-order central differences of the scalar ``f`` at ``x`` (6,), step ``h`` on every component."""
+    fd = np.zeros(6)
+    for i in range(6):
+        e = np.zeros(6)
+        e[i] = h
+        fd[i] = (8 * (f(x + e) - f(x - e)) - (f(x + 2 * e) - f(x - 2 * e))) / (12 * h)
+    return fd
+
+
 def test_remedy_is_the_paper_mi_far_from_the_targets(case2):
     """rho_c far below every range: the row scale is 1 to ~1e-18, so value and gradient are the paper's."""
     sc, info, x_ws = case2
@@ -38,12 +48,7 @@ def test_remedy_gradient_matches_finite_differences_near_a_target(case2):
     j, k, _ = K._closest(lin0)
     x = K.passing_state(sc.system, [lin0.t[0], lin0.t[k]], lin0.targets[j, k, :3], 50.0, x_ws)
     _, g = remedy(x, 1)
-    h = np.array([1e-7] * 3 + [1e-7] * 3)
-    fd = np.zeros(6)
-    for i in range(6):
-        e = np.zeros(6)
-        e[i] = h[i]
-        fd[i] = (8 * (remedy(x + e) - remedy(x - e)) - (remedy(x + 2 * e) - remedy(x - 2 * e))) / (12 * h[i])
+    fd = _gradient_fd4(remedy, x, 1e-7)
     scale = np.abs(fd).max()
     np.testing.assert_allclose(g, fd, rtol=2e-4, atol=2e-4 * scale)
     # the same pass with the paper's noise: a different gradient (the remedy is not a no-op there)
@@ -77,12 +82,7 @@ def test_regularised_jacobian_remedy_gradient_matches_finite_differences_near_a_
     j, k, _ = K._closest(lin0)
     x = K.passing_state(sc.system, [lin0.t[0], lin0.t[k]], lin0.targets[j, k, :3], 50.0, x_ws)
     _, g = remedy(x, 1)
-    h = 1e-7
-    fd = np.zeros(6)
-    for i in range(6):
-        e = np.zeros(6)
-        e[i] = h
-        fd[i] = (8 * (remedy(x + e) - remedy(x - e)) - (remedy(x + 2 * e) - remedy(x - 2 * e))) / (12 * h)
+    fd = _gradient_fd4(remedy, x, 1e-7)
     scale = np.abs(fd).max()
     np.testing.assert_allclose(g, fd, rtol=2e-4, atol=2e-4 * scale)
     # it removes information only (a smaller range-rate row): below the paper's MI, above the range-noise one's
