@@ -17,7 +17,8 @@
 # instead near the Earth-Moon line ($|\sin\theta_3|<0.04$); what accuracy the LMIs actually *guarantee* for this
 # noise, and whether the simulated observers meet it; why they miss it even at the sampling interval where the H2
 # design allows exactly the paper's 0.1 deg (the error of the triangulated $\rho$, which the LMIs do not see), and
-# what a robust design that treats that error as an input certifies (Section 6, beyond the paper); and how an
+# what a robust design that treats that error as an input certifies (Section 6, beyond the paper); whether, with no
+# range information anywhere in the loop, the observers converge and stay converged (Section 7); and how an
 # extended Kalman filter on the same measurements compares (beyond the paper).
 #
 # **Paper sections followed.** Nychka & Bhattacharya (arXiv 2410.02013) §IV-B, Fig. 3 (a-c) and the text around
@@ -251,7 +252,7 @@ print(readout.robust_designs(rd, sc.model.system))
 
 # %%
 ws = rb.simulate_window(sc, od, rd, periods, np.random.default_rng(SEED + 1))
-r = readout.window(ws, rd, cv, od, sc.model.system)
+r = readout.window(ws, rd, od, sc.model.system)
 print(r)
 _ = plotting.save_figure(figures.fig3_window(ws, sc.model.system), "12_fig3_233min", output_dir=out)
 _ = table.add(*r.judged(CLAIMS))
@@ -263,9 +264,7 @@ _ = table.add(*r.judged(CLAIMS))
 # about ten times the paper's 500 km: with $\theta_1$ and $\theta_2$ at 0.1 deg every 233 min, accounting for the
 # error of the scheduling parameters, the LMIs certify several thousand kilometres, and the simulated error lies
 # well inside that (the bound is loose: one quadratic Lyapunov function over the widened box, and an RMS gravity
-# error dominated by the few samples near perigee). Whether "the observers function without range sensors" is
-# judged below by each observer's own guarantee; falling well below the initial error (the earlier criterion) is
-# not the accuracy the LMIs promise.
+# error dominated by the few samples near perigee).
 #
 # **Why both H-infinity runs print the same RMS from both starts.** The H-infinity gains are large: $\|L\|\,\Delta t$
 # is about thirty at 233 min (the row's note below), so within one interval the estimate is pulled onto the
@@ -282,6 +281,58 @@ _ = table.add(*r.judged(CLAIMS))
 # contrast; in fairness, the residual itself was looked at while choosing what to measure, as the claim's comment in
 # `claims.observer_simulation` records).
 #
+# ## 7 · "The observers can function without range sensors"
+#
+# The paper's sentence after Fig. 3 makes two claims: "The results in Fig.3 confirm that the H2 and H-infinity
+# observers can function without range sensors. *Additionally*, despite large initial state estimation errors, the
+# observers rapidly converge and maintain accurate estimates". The second, accuracy, is judged by the rows above
+# against each design's guarantee. The first is what is specific to dropping the range sensors: with no range
+# information anywhere in the loop (the gains' columns for $r_{13}^2$, $r_{23}^2$ are zero, and $\rho$ is
+# triangulated from $\theta_1$, $\theta_2$ alone) does the observer still *work*, i.e. converge from the large
+# initial error and stay there rather than lose the spacecraft? The criterion, fixed before this statistic was
+# looked at (`claims.observer_simulation` records what had been seen): for both observers at both sampling
+# intervals, the largest position error after the first 10 % of the run stays below the initial position error. It
+# is judged on the worst sample, not an average, so a single excursion back to the starting error (near the
+# Earth-Moon line, where $\rho$ comes from the estimate) fails it. For contrast, the same observers scheduled on
+# the true $\rho$ (what a range sensor would add to the scheduling) are printed beside them.
+
+# %%
+tu_min = sc.model.system.time_unit_s / 60.0
+at_dt, at_233 = f"{sim.dt * tu_min:.1f} min", f"{ws.dt * tu_min:.0f} min"
+err = {at_dt: (sim.t, {n: sim.runs[n].position_error for n in od.designs}),
+       at_233: (ws.t, {n: ws.errors[("nominal", n, "large")] for n in od.designs})}
+ref = {at_dt: (sim.t, {n: sim.exact[n].position_error for n in od.designs}),
+       at_233: (ws.t, {n: ws.errors[("nominal, exact rho", n, "large")] for n in od.designs})}
+rf = obs.RangeFree.measure(od, err, reference=ref)
+km = sc.model.system.length_unit_km
+print(rf.text(km))
+print("Earth-Moon line crossings (rho from the estimate) begin at t =", ", ".join(f"{t0:.3f}" for t0 in lc.starts), "TU")
+held = [lab for lab in err if all(rf.bounded(lab, n) for n in od.designs)]
+where = (f"; holds at {', '.join(held)}" if held else "") + (
+    f"; the bound is our initial error: a start above {max(rf.peak.values()) * km:,.0f} km would lift it over the "
+    "excursions, which come long after the start's transient; the paper states neither the interval nor the initial "
+    "error")
+_ = table.add(CLAIMS["no_range"].judge(
+    rf.holds, shown=rf.shown(),
+    note=f"only theta1, theta2 measured; initial error {sim.initial_error * km:,.0f} km; accuracy against the LMI "
+         "guarantees is the separate claim of the rows above (Fig. 3's 'Additionally'); the gain columns are zero by "
+         "construction here (notebook 11's free optimum drops the range sensors)",
+    reason=(rf.why(km) + ": rho triangulated from the angles near the Earth-Moon line" + where) if not rf.holds else ""))
+
+# %% [markdown]
+# **Reading the result** (full run; the quick run's half orbit ends at the first line crossing after settling and
+# prints different numbers). The H2 observer stays far below its starting error at both intervals (at most 0.15 and
+# 0.26 of it). The H-infinity observer at 12.5 min does not: where the spacecraft crosses the Earth-Moon line (the
+# crossings printed above; its largest error comes at the one at the end of the run, and it also passes its initial
+# error at the one half-way) its error comes back to about 22,900 km, twice the initial 10,900 km, while the same
+# gain scheduled on the true $\rho$ (what a range sensor would supply) stays within about 1,400 km. Its large gain
+# follows the noisy angles closely, and just outside $|\sin\theta_3| < 0.04$ the triangulation is still poorly
+# conditioned: 0.1 deg on each angle moves $\theta_3 \approx 2.3°$ by about 0.14 deg, a range error of about 6 %.
+# So without range sensors both observers converge, but one of them loses the spacecraft again at the line
+# crossings of this run, and the row differs. It would pass at 233 min, or with a starting error larger than the
+# excursion (our 10,900 km is a choice: the paper says only "large initial state estimation errors").
+
+# %% [markdown]
 # The error comparison of Fig. 3c at both intervals, with the nominal runs above:
 
 # %%

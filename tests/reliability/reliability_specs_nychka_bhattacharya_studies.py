@@ -306,8 +306,8 @@ def specs(Spec, lazy):
         dict(sim=I, ww=I, od=I, al=I, sigma_deg="pos", system="system"))
     add(ro, "scheduling_error", dict(se=lazy(_serr), system=em), dict(se=I, system="system"))
     add(ro, "robust_designs", dict(rd=lazy(_robust), system=em), dict(rd=I, system="system"))
-    add(ro, "window", dict(ws=lazy(_window), rd=lazy(_robust), cv=lazy(_conv), od=od, system=em),
-        dict(ws=I, rd=I, cv=I, od=I, system="system"))
+    add(ro, "window", dict(ws=lazy(_window), rd=lazy(_robust), od=od, system=em),
+        dict(ws=I, rd=I, od=I, system="system"))
     method("Readout.judged", lambda: ro.Readout("").judged, dict(claims={}), dict(claims=I))
 
     # ---------------------------------------------------------------------------------------------- figures

@@ -31,13 +31,15 @@ from cislunar.utils.montecarlo import map_tasks
 __all__ = ["INITIAL_ERROR", "E0_SCALES", "observer_designs", "ObserverDesigns", "AllowanceAtDt", "allowance_at",
            "Fig3Runs", "simulate_fig3",
            "first_and_rms", "Convergence", "convergence_study", "LineCrossings", "line_crossings", "WindowRerun",
-           "window_rerun"]
+           "window_rerun", "RANGE_CHANNELS", "RangeFree"]
 
 #: Initial estimate error (LU, LU/TU): 0.02 LU in x and -0.02 LU in y (about 10,900 km), 0.01 LU/TU (10 m/s) in
 #: each velocity.  The paper says only "large initial errors".
 INITIAL_ERROR = np.array([0.02, -0.02, 0.01, 0.01])
 #: Scales of the initial error swept by :func:`convergence_study`.
 E0_SCALES = (0.003, 0.01, 0.03, 0.1, 0.3, 1.0)
+#: Indices of the range-squared channels r13^2, r23^2 in the sensor model of Eq. 22 (``lpv.SENSOR_NAMES``).
+RANGE_CHANNELS = (4, 5)
 
 
 @dataclass(frozen=True)
@@ -338,3 +340,138 @@ def window_rerun(scenario: Scenario, designs: ObserverDesigns, sim: Fig3Runs, dt
     med = {n: float(np.median(simulate_lpv_observer(m, d.gain(), meas, x0, truth).position_error[settle]))
            for n, d in designs.designs.items()}
     return WindowRerun(float(dt), int(t.size), med)
+
+
+def _peak_after_settling(t: np.ndarray, position_error: np.ndarray) -> tuple:
+    """Largest position error after the first 10 % of the run (the chapter's settling window) and its time; ``inf``
+    if there is no sample after it or the error is not finite there (a run that blew up)."""
+    keep = t > t[0] + 0.1 * (t[-1] - t[0])
+    after, t_after = position_error[keep], t[keep]
+    if not after.size:
+        return np.inf, float("nan")
+    if not np.all(np.isfinite(after)):
+        return np.inf, float(t_after[np.argmin(np.isfinite(after))])
+    i = int(np.argmax(after))
+    return float(after[i]), float(t_after[i])
+
+
+@dataclass(frozen=True)
+class RangeFree:
+    r"""The row "observers function without range sensors" (§IV-B, after Fig. 3): no range information in the
+    loop, and the error converges from the initial error and never comes back to it.
+
+    Build it with :meth:`measure`.  The claim and why this is its reading: ``claims.observer_simulation``.
+
+    Attributes
+    ----------
+    range_gain : dict of str to float
+        Largest absolute entry of each design's gain columns for r13^2, r23^2 (:data:`RANGE_CHANNELS`), LU/TU per
+        unit of measurement; 0 when the design drops them.
+    range_used : dict of str to bool
+        Whether each design keeps a range channel (``design.used``).
+    initial_error : dict of (str, str) to float
+        Initial position error of each run, LU, keyed ``(interval label, observer)``.
+    peak : dict of (str, str) to float
+        Largest position error after the first 10 % of the run, LU, same keys.
+    peak_time : dict of (str, str) to float
+        When it happens, TU (``nan`` if there is no sample after the first 10 % of the run).
+    reference_peak : dict of (str, str) to float
+        The same for the observer scheduled on the true rho (what range sensors would add), LU; empty if not given.
+    """
+
+    range_gain: dict
+    range_used: dict
+    initial_error: dict
+    peak: dict
+    peak_time: dict
+    reference_peak: dict
+
+    @classmethod
+    def measure(cls, designs: ObserverDesigns, runs: dict, reference: dict | None = None) -> RangeFree:
+        """Measure the row from ``designs`` and ``runs``: a dict of interval label (str) to ``(t, errors)``, ``t``
+        the times (TU, increasing) and ``errors`` a dict of observer name to its position error (LU, one per time);
+        ``reference`` the same for the observers given the true rho (optional).  A run whose error is not finite
+        after the start is measured as unbounded."""
+        designs = validation.instance(designs, "designs", ObserverDesigns)
+        validation.instance(runs, "runs", dict)
+        if not runs:
+            raise ValueError("runs must hold at least one interval")
+
+        def arrays(group, name):
+            out = {}
+            for label, pair in validation.instance(group, name, dict).items():
+                if not isinstance(pair, tuple) or len(pair) != 2:
+                    raise TypeError(f"{name}[{label!r}] must be a (t, errors) pair")
+                t = validation.time_grid(pair[0], f"{name}[{label!r}] t", increasing=True)
+                for obs_name, e in validation.instance(pair[1], f"{name}[{label!r}] errors", dict).items():
+                    # not finite is allowed after the start: a diverged run is measured (as unbounded), not refused
+                    e = validation.as_array(e, f"{name}[{label!r}][{obs_name!r}]", shape=t.shape, finite=False)
+                    if not (np.isfinite(e[0]) and e[0] > 0) or np.any(e[np.isfinite(e)] < 0):
+                        raise ValueError(f"{name}[{label!r}][{obs_name!r}] must be position errors (>= 0) with a "
+                                         "finite, positive initial error")
+                    out[(label, obs_name)] = (t, e)
+            return out
+
+        main = arrays(runs, "runs")
+        ref = arrays(reference, "reference") if reference is not None else {}
+        ch = list(RANGE_CHANNELS)
+        gain = {n: float(np.max(np.abs(d.gain()[:, ch]))) for n, d in designs.designs.items()}
+        used = {n: bool(np.asarray(d.used)[ch].any()) for n, d in designs.designs.items()}
+        peaks = {k: _peak_after_settling(t, e) for k, (t, e) in main.items()}
+        return cls(gain, used, {k: float(e[0]) for k, (t, e) in main.items()}, {k: p for k, (p, _) in peaks.items()},
+                   {k: w for k, (_, w) in peaks.items()},
+                   {k: _peak_after_settling(t, e)[0] for k, (t, e) in ref.items()})
+
+    @property
+    def no_range_channel(self) -> bool:
+        """No design keeps a range channel and every range column of every gain is zero."""
+        return not any(self.range_used.values()) and not any(self.range_gain.values())
+
+    def bounded(self, label: str, name: str) -> bool:
+        """The run's largest error after settling is below its initial error (converged, no divergence)."""
+        key = (label, name)
+        if key not in self.peak:
+            raise ValueError(f"(label, name) must be one of {sorted(self.peak)}; got {key}")
+        return bool(self.peak[key] < self.initial_error[key])
+
+    @property
+    def holds(self) -> bool:
+        """The row's criterion: no range channel and every run bounded."""
+        return self.no_range_channel and all(self.bounded(*k) for k in self.peak)
+
+    def text(self, length_unit_km: float) -> str:
+        """One line per run: initial error, largest error after settling (and with the true rho), km."""
+        km = validation.positive(length_unit_km, "length_unit_km")
+        lines = ["range channels r13^2, r23^2: " + ", ".join(
+            f"{n} used {self.range_used[n]}, largest gain entry {self.range_gain[n]:.1e}" for n in self.range_gain)]
+        for (label, n), p in self.peak.items():
+            ref = self.reference_peak.get((label, n))
+            lines.append(f"{n:4s} at {label:>9s}: initial {self.initial_error[(label, n)] * km:7.0f} km, largest after "
+                         f"10 % of the run {p * km:7.0f} km ({p / self.initial_error[(label, n)]:.2f} of it) at t = "
+                         f"{self.peak_time[(label, n)]:.3f} TU"
+                         + (f"; with the true rho {ref * km:.0f} km" if ref is not None else "")
+                         + f"; bounded: {self.bounded(label, n)}")
+        return "\n".join(lines)
+
+    def why(self, length_unit_km: float) -> str:
+        """Why the row differs: the runs that came back to their initial error, with the same observer on the true
+        rho beside them ("" when none did and no range channel is used)."""
+        km = validation.positive(length_unit_km, "length_unit_km")
+        parts = [] if self.no_range_channel else ["a range channel is used"]
+        for (label, n), p in self.peak.items():
+            if not self.bounded(label, n):
+                ref = self.reference_peak.get((label, n))
+                parts.append(f"{n} at {label} back to {p * km:,.0f} km = {p / self.initial_error[(label, n)]:.2f}x its "
+                             f"initial error (t = {self.peak_time[(label, n)]:.2f} TU)"
+                             + (f"; on the true rho {ref * km:,.0f} km" if ref is not None else ""))
+        return "; ".join(parts)
+
+    def shown(self) -> str:
+        """The row's reproduced value: range columns, and each run's largest error after settling over its initial
+        error."""
+        labels = list(dict.fromkeys(k[0] for k in self.peak))
+        return (f"gain columns of r13^2, r23^2 {'zero' if self.no_range_channel else 'non-zero'}; largest error after "
+                "10 % of the run / initial: " + "; ".join(
+                    ", ".join(f"{'H2' if n == 'h2' else 'Hinf' if n == 'hinf' else n} "
+                              f"{self.peak[(lab, n)] / self.initial_error[(lab, n)]:.2f}"
+                              for (lab_, n) in self.peak if lab_ == lab) + f" ({lab})" for lab in labels))

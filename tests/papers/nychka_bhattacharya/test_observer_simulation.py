@@ -63,6 +63,7 @@ def test_claims_of_the_chapter():
     assert CLAIMS["hinf_larger"].judge(True).status == "consistent (tuned)"  # one orbit, two intervals
     assert CLAIMS["fig3_233"].judge(True).status == "consistent (tuned)"
     assert CLAIMS["no_range"].judge(False, reason="x").status == "differs"
+    assert CLAIMS["no_range"].judge(True).status == "reproduced"  # bound from the paper's words, not tuned
     assert CLAIMS["ordering_dt"].judge(0.36).status == "beyond paper"  # our dt: a record, not a comparison
     assert CLAIMS["dt"].judge(0.004).status == "not in paper"
 
@@ -96,3 +97,79 @@ def test_allowance_at_follows_eq24_per_sample(setup):
     assert a1.hinf_deg == a4.hinf_deg and a1.dt_01 == a4.dt_01
     # at dt_01 the H2 design allows exactly 0.1 deg per sample
     assert obs.allowance_at(od, a1.dt_01).h2_per_sample_deg == pytest.approx(0.1, rel=1e-9)
+
+
+# ------------------------------------------------------------------ the range-free row (obs.RangeFree)
+def _designs(range_gain=0.0, range_used=False):
+    """Two stand-in designs with the interface RangeFree reads (gain(), used), range columns set as asked."""
+    from types import SimpleNamespace
+
+    g = np.zeros((4, 6))
+    g[2:, :2] = -3.0  # theta1 channels
+    g[3, 5] = range_gain
+    used = np.array([True, True, False, False, False, range_used])
+    d = SimpleNamespace(gain=lambda: g, used=used)
+    return obs.ObserverDesigns({"h2": d, "hinf": d}, {})
+
+
+T21 = np.linspace(0.0, 2.0, 21)  # settling window: t > 0.2
+
+
+def _history(**spikes):
+    e = np.full(T21.size, 1.0)
+    e[0] = 10.0
+    for i, v in spikes.items():
+        e[int(i[1:])] = v
+    return e
+
+
+def test_range_free_bounded_run_passes_and_an_excursion_fails():
+    ok = obs.RangeFree.measure(_designs(), {"a": (T21, {"h2": _history(), "hinf": _history(i1=30.0)})})
+    # the early transient (t = 0.1, inside the first 10 % of the run) is not judged
+    assert ok.peak[("a", "hinf")] == 1.0 and ok.initial_error[("a", "hinf")] == 10.0
+    assert ok.no_range_channel and ok.holds
+    late = obs.RangeFree.measure(_designs(), {"a": (T21, {"h2": _history(), "hinf": _history(i15=10.5)})})
+    assert late.bounded("a", "h2") and not late.bounded("a", "hinf") and not late.holds
+    assert late.peak_time[("a", "hinf")] == pytest.approx(1.5)
+    assert late.why(1.0).startswith("hinf at a back to 10 km = 1.05x") and ok.why(1.0) == ""
+    at_start = obs.RangeFree.measure(_designs(), {"a": (T21, {"h2": _history(i20=10.0)})})
+    assert not at_start.holds  # back to the initial error exactly: not below it
+    blown = obs.RangeFree.measure(_designs(), {"a": (T21, {"h2": _history(i18=np.inf)})})
+    assert blown.peak[("a", "h2")] == np.inf and not blown.holds
+    lost = obs.RangeFree.measure(_designs(), {"a": (T21, {"h2": _history(i18=np.nan)})})
+    assert lost.peak[("a", "h2")] == np.inf and not lost.holds  # a NaN estimate is unbounded, not a NaN peak
+
+
+def test_range_free_every_interval_is_judged_and_the_reference_is_context():
+    two = {"a": (T21, {"h2": _history()}), "b": (T21[:11], {"h2": _history(i3=11.0)[:11]})}
+    rf = obs.RangeFree.measure(_designs(), two, reference={"a": (T21, {"h2": _history(i5=50.0)})})
+    assert rf.bounded("a", "h2") and not rf.bounded("b", "h2") and not rf.holds
+    assert rf.reference_peak == {("a", "h2"): 50.0}
+    assert "H2 0.10 (a)" in rf.shown() and "H2 1.10 (b)" in rf.shown()
+    with pytest.raises(ValueError):
+        rf.bounded("c", "h2")
+
+
+def test_range_free_a_range_channel_fails_by_gain_or_by_use():
+    runs = {"a": (T21, {"h2": _history()})}
+    assert obs.RangeFree.measure(_designs(), runs).holds
+    assert not obs.RangeFree.measure(_designs(range_gain=1e-3), runs).holds  # a non-zero r23^2 column
+    assert not obs.RangeFree.measure(_designs(range_used=True), runs).holds  # a range sensor kept
+
+
+def test_range_free_refuses_malformed_runs():
+    with pytest.raises(ValueError):
+        obs.RangeFree.measure(_designs(), {})
+    with pytest.raises(TypeError):
+        obs.RangeFree.measure(_designs(), {"a": T21})
+    with pytest.raises(ValueError):
+        obs.RangeFree.measure(_designs(), {"a": (T21, {"h2": _history()[:5]})})
+    with pytest.raises(ValueError):
+        obs.RangeFree.measure(_designs(), {"a": (T21, {"h2": -_history()})})
+
+
+def test_range_free_on_the_paper_designs(setup):
+    _, od, sim = setup
+    rf = obs.RangeFree.measure(od, {"x": (sim.t, {n: sim.runs[n].position_error for n in od.designs})})
+    assert rf.no_range_channel  # theta1-only designs: r13^2, r23^2 columns exactly zero
+    assert rf.initial_error[("x", "h2")] == pytest.approx(sim.initial_error)

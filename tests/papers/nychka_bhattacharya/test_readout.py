@@ -50,15 +50,13 @@ def test_notebook_12_rows_cover_every_claim():
     se = rbm.scheduling_error(sc, 0.1, 2, np.random.default_rng(3))
     rd = rbm.robust_designs(sc, se, 0.0373, 2, np.random.default_rng(4), iters=2)
     ws = rbm.simulate_window(sc, od, rd, 0.1, np.random.default_rng(5))
-    win = readout.window(ws, rd, cv, od)
+    win = readout.window(ws, rd, od)
     parts = [readout.observer_gains(od, 0.0013), readout.allowance_at_dt(al, 0.1), readout.converges(cv, sim),
              readout.comparison(sim, ww, od, al, 0.1), win]
     assert readout.scheduling_error(se).text and readout.robust_designs(rd).text.count("\n") == 2
-    # the range-free row is judged by each observer's own guarantee, not by a fraction of the initial error
-    own = all(cv.stays(n) for n in ("h2", "hinf")) and all(ws.holds("nominal", n) for n in ("h2", "hinf"))
-    assert win.rows["no_range"].value == own
+    assert "no_range" not in win.rows  # measured by obs.RangeFree (tests/.../test_observer_simulation.py)
     assert win.rows["fig3_233"].value == all(ws.holds("nominal", n, "large") for n in ("h2", "hinf"))
-    keys = [k for p in parts for k in p.rows]
+    keys = [k for p in parts for k in p.rows] + ["no_range"]  # the range-free row comes from obs.RangeFree
     assert sorted(keys) == sorted(CLAIMS_12)  # every declared row, once
     assert all(v.status for p in parts for v in p.judged(CLAIMS_12))
     # the shown comparison follows the numbers: per-sample H2 allowance against H-infinity

@@ -53,11 +53,34 @@ CLAIMS = {
               "(the notebook's and the one where H2 allows 0.1 deg per sample), not under every reading",
         reason="H2 error not smaller at one of the two dt"),
     "rho_from_estimate": Claim("rho from estimate where |sin th3| < 0.04", "used", kind="derived"),
+    # Revised 2026-11-26 (a referee: the row repeated the accuracy rows' criterion, so one shortfall counted twice).
+    # The paper's words (§IV-B, after Fig. 3): "The results in Fig.3 confirm that the H2 and Hinf observers can
+    # function without range sensors. Additionally, despite large initial state estimation errors, the observers
+    # rapidly converge and maintain accurate estimates".  "Additionally" makes accuracy a second claim (judged by
+    # h2_converges / hinf_converges / fig3_233 / small_e0); this row tests the first: with no range information
+    # anywhere in the loop (gain columns of r13^2, r23^2 zero; rho triangulated from the two angles) the observer
+    # still works, i.e. its error converges from the large start and stays bounded.  The divergence bound is the
+    # initial position error itself (an error that never comes back to where it started has not diverged), fixed
+    # from the word "function"/"converge", not from a measured value; scope: both observers, both intervals, the
+    # large start (the paper's "large initial state estimation errors"), settling window = the chapter's 10 % of the
+    # run.  In fairness: this LOOSENS the previous criterion (own LMI guarantee), and the runs' medians and RMS
+    # (126-1499 km against the 10,872 km start) had been seen; the largest error after settling, the statistic
+    # judged here, had not been looked at when this was written, so the row can fail only through excursions
+    # (e.g. near the Earth-Moon line, where rho is taken from the estimate).  Not tuned: the bound and the scope
+    # come from the paper's words, not from our numbers.  The gain columns are zero by construction in this
+    # notebook (theta1-only designs); notebook 11's free 6-sensor optimum is what drops them ("sensors needed").
+    # Outcome of the first full run after this was written (for the record): differs, the Hinf observer at 12.5 min
+    # comes back to 2.1x its initial error at the Earth-Moon line crossings (1,406 km on the true rho).  A check
+    # made afterwards, outside the notebook, with five other noise draws: Hinf 1.2-2.8x, H2 0.14-0.54x, true rho
+    # 0.10-0.12x (so the failure is not one unlucky draw).  Where it holds: at 233 min, or from any start larger
+    # than the excursion (the paper states neither).
     "no_range": Claim(
         "observers function without range sensors", "yes (Fig. 3)",
-        Holds("no range channel in the gains and each observer's RMS error after convergence within its own LMI "
-              "guarantee, at both sampling intervals"), source="Fig. 3",
-        reason="range channels used, or an observer's error above its own guarantee"),
+        Holds("no range information in the loop (gain columns of r13^2, r23^2 zero; rho from theta1, theta2) and "
+              "both observers, at both sampling intervals, from the large initial error: largest position error "
+              "after the first 10 % of the run below the initial position error (converged, no divergence)"),
+        source="Fig. 3, §IV-B",
+        reason="a range channel is used, or an observer's error came back to its initial size"),
     "fig3_233": Claim(
         "Fig. 3 accuracy at the interval where H2 allows 0.1 deg per sample", "accurate (Fig. 3)",
         Holds("both observers, rho triangulated from the noisy angles, from the large initial error: RMS error after "
