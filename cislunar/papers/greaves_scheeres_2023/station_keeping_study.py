@@ -41,6 +41,7 @@ from cislunar.utils.montecarlo import map_tasks, run_monte_carlo
 
 __all__ = [
     "POLICIES",
+    "FUEL_PEAK_QUARTER",
     "RAISED_FRACTION",
     "GridRow",
     "GridStudy",
@@ -111,6 +112,9 @@ class SliceStatistics:
         Smallest :math:`\\sqrt{J_\\rho}` among the maneuvers using at most the fuel of :math:`\\mathbf u^*`, km.
     below_median_fuel : float
         Fraction of slices where :math:`\\mathbf u^*` uses at most the slice's median fuel.
+    outside_fuel_peak_share : float (property)
+        Percent of slices where :math:`\\mathbf u^*` is outside the slice's most expensive quarter of maneuvers (at
+        least :data:`FUEL_PEAK_QUARTER` percent of them use more fuel): the Fig. 5 test "avoids the peak fuel cost".
     valley_phase, informed_phase, fuel_peak_phase : float
         Median normalised phase of the best maneuver, of :math:`\\mathbf u^*` and of the most expensive maneuver.
     rank_correlation : float
@@ -135,6 +139,12 @@ class SliceStatistics:
         return float(np.median(self.percentile))
 
     @property
+    def outside_fuel_peak_share(self) -> float:
+        """Percent of slices where :math:`\\mathbf u^*` is not among the most expensive quarter of the slice's
+        maneuvers (at least :data:`FUEL_PEAK_QUARTER` percent of them use more fuel than it)."""
+        return _outside_peak_share(self.fuel_percentile)
+
+    @property
     def best_quartile_share(self) -> float:
         """Percent of slices with :math:`\\mathbf u^*` in the best quartile."""
         return float(np.mean(self.percentile < 25) * 100)
@@ -151,6 +161,17 @@ class SliceStatistics:
                          f"{self.cheaper_best_km[j] * 1e3:19.2f} | {self.percentile[j]:10.1f} | "
                          f"{S.informed_fuel_m_s[j]:8.3f} | {self.fuel_percentile[j]:6.1f}")
         return "\n".join(lines)
+
+
+#: Fig. 5's "peak fuel cost": the most expensive quarter of a slice's maneuvers.  u* avoids it when at least this
+#: percent of the slice's maneuvers use more fuel than u* (the mirror of the valley rows' best quartile).
+FUEL_PEAK_QUARTER = 25.0
+
+
+def _outside_peak_share(more_fuel_percent) -> float:
+    """Percent of slices whose ``more_fuel_percent`` (percent of the slice's maneuvers using more fuel than u*) is at
+    least :data:`FUEL_PEAK_QUARTER`: u* outside the most expensive quarter of its slice."""
+    return float(np.mean(np.asarray(more_fuel_percent, dtype=float) >= FUEL_PEAK_QUARTER) * 100)
 
 
 #: A slice of the u* line is "raised" when its sqrt(J_rho) exceeds both neighbours' by more than this fraction.
@@ -191,7 +212,9 @@ class GridRow:
     :math:`\\sqrt{J_\\rho}` at :math:`t_f` (m) and total fuel (m/s); ``more_fuel_percent``: share of maneuvers using
     more fuel; ``best_m``: the slice's best :math:`\\sqrt{J_\\rho}` (m); ``ratio_best``: median over slices of
     :math:`\\sqrt{J_\\rho}` of :math:`\\mathbf u^*` over the slice's best; ``below_median_share``: percent of slices
-    where :math:`\\mathbf u^*` uses at most the slice's median fuel; ``beats_random``: percent of random picks
+    where :math:`\\mathbf u^*` uses at most the slice's median fuel; ``outside_peak_share``: percent of slices where
+    :math:`\\mathbf u^*` is outside the most expensive quarter of the slice's maneuvers
+    (:attr:`SliceStatistics.outside_fuel_peak_share`); ``beats_random``: percent of random picks
     (:func:`random_pick_study` on the same slices) with a larger :math:`\\sqrt{J_\\rho}` than :math:`\\mathbf u^*`
     (NaN when the study drew none).
     """
@@ -207,10 +230,11 @@ class GridRow:
     ratio_best: float = float("nan")
     below_median_share: float = float("nan")
     beats_random: float = float("nan")
+    outside_peak_share: float = float("nan")
 
 
 _GRID_KEYS = ("percentile", "sigma_m", "fuel_m_s", "more_fuel_percent", "best_m", "ratio_best", "below_median_share",
-              "beats_random")
+              "beats_random", "outside_peak_share")
 
 
 @dataclass(frozen=True)
@@ -225,10 +249,11 @@ class GridStudy:
     def format(self) -> str:
         """The study as a text table, one line per row."""
         lines = [("agent phase | ring angles | reading    | percentile of u* % | sqrt(J) of u* m | fuel of u* m/s | "
-                 "more fuel % | best of slice m | u*/best | <= median fuel % | beats random %")]
+                 "more fuel % | best of slice m | u*/best | <= median fuel % | beats random % | off fuel peak %")]
         lines += [f" {g.agent_phase:10.2f} | {g.n:11d} | {g.reading:10s} | {g.percentile:18.1f} | {g.sigma_m:15.1f} | "
                   f"{g.fuel_m_s:14.3f} | {g.more_fuel_percent:11.1f} | {g.best_m:15.1f} | {g.ratio_best:7.2f} | "
-                  f"{g.below_median_share:16.0f} | {g.beats_random:14.0f}" for g in self.rows]
+                  f"{g.below_median_share:16.0f} | {g.beats_random:14.0f} | {g.outside_peak_share:15.0f}"
+                  for g in self.rows]
         return "\n".join(lines)
 
     def series(self, agent_phase: float, reading: str, key: str) -> np.ndarray:
@@ -264,7 +289,8 @@ def _grid_task(task):
                              float(np.median(r.informed_fuel_percentile)),
                              float(np.median(r.best_range_sigma_km) * 1e3),
                              float(np.median(r.informed_range_sigma_km / r.best_range_sigma_km)),
-                             float(np.mean(r.informed_fuel_m_s <= np.median(r.fuel_m_s, axis=1)) * 100)),
+                             float(np.mean(r.informed_fuel_m_s <= np.median(r.fuel_m_s, axis=1)) * 100),
+                             outside_peak_share=_outside_peak_share(r.informed_fuel_percentile)),
                      r.informed_range_sigma_km))
     return rows
 

@@ -212,6 +212,8 @@ def test_grid_study_columns_against_their_definitions(torus):
             100 * np.mean(r.informed_fuel_m_s <= np.median(r.fuel_m_s, axis=1)))
         assert g.series(0.0, reading, "beats_random")[0] == pytest.approx(
             100 * np.mean(rnd.range_sigma_km > u[:, None]))
+        more = 100 * np.mean(r.fuel_m_s > r.informed_fuel_m_s[:, None], axis=1)  # percent of maneuvers costing more
+        assert g.series(0.0, reading, "outside_peak_share")[0] == pytest.approx(100 * np.mean(more >= 25))
     assert np.all(g.series(0.0, "angle", "ratio_best") >= 1.0)  # nothing beats the best of a slice
     # without random picks the column is NaN
     g0 = study.grid_resolution_study(em, torus, (6,), t_grid, -18 * HR, 12 * HR, agent_phases=(0.0,))
@@ -251,3 +253,28 @@ def test_surface_figures_draw_both_readings(surface):
     plt.close(fig)
     with pytest.raises(ValueError, match="projection"):
         figures.surfaces(surface, "burns", projection=replace(proj, dv1=proj.dv1 * 2))
+
+
+def test_fuel_peak_share_counts_slices_outside_the_most_expensive_quarter(surface):
+    """Fig. 5's measure: percent of slices where at least a quarter of the maneuvers cost more than u*."""
+    st = study.slice_statistics(surface)
+    assert st.outside_fuel_peak_share == pytest.approx(100 * np.mean(st.fuel_percentile >= 25))
+    # the edge: exactly 25 % costing more is outside the peak, just below is inside it
+    edge = replace(st, fuel_percentile=np.array([25.0, 24.9, 80.0, 0.0]))
+    assert edge.outside_fuel_peak_share == 50.0
+    # u* at the most expensive maneuver of every slice fails; at the cheapest (no maneuver) passes
+    S = surface
+    dearest = replace(S, informed=np.argmax(S.fuel_m_s, axis=1))
+    cheapest = replace(S, informed=np.argmin(S.fuel_m_s, axis=1))
+    assert study.slice_statistics(dearest).outside_fuel_peak_share == 0.0
+    assert study.slice_statistics(cheapest).outside_fuel_peak_share == 100.0
+
+
+def test_raised_point_claim_needs_one_point_at_every_sampling():
+    """The raised-point row is judged on the counts at all arrival samplings: every count must be 1."""
+    from cislunar.papers.greaves_scheeres_2023.claims.informed_station_keeping import CLAIMS
+
+    claim = CLAIMS["raised_point_projection"]
+    assert claim.judge(np.array([1, 1, 1]), reason="r").status == "consistent (tuned)"
+    for counts in ([0, 1, 1], [1, 2, 1], [0, 0, 0]):
+        assert claim.judge(np.array(counts), reason="r").status == "differs"
