@@ -112,21 +112,43 @@ def test_custody_is_cumulative_and_seeded(nrho):
     assert np.array_equal(a.custody, np.cumprod(held, axis=1).astype(bool))
 
 
-def test_knee_of_the_cadence_cost():
-    def cost(sig, sec):
-        c = np.array([12.0, 6.0, 2.0, 1.0])
-        return cu.CadenceCost(c, np.array([13, 26, 78, 157]), np.array(sec), np.array(sig), np.ones(4), np.ones(4) * 6)
+def _cost(sig, sec):
+    c = np.array([12.0, 6.0, 2.0, 1.0])
+    return cu.CadenceCost(c, np.array([13, 26, 78, 157]), np.array(sec), np.array(sig), np.ones(4), np.ones(4) * 6)
 
+
+def test_elasticity_knee_of_the_cadence_cost():
+    """The first definition (kept for comparison): steps with elasticity >= 1 from 12 h on."""
     # accuracy x 1/4 for cost x 2 (elasticity 2), then x 1/2 for x 1.5 (1.7), then x 0.9 for x 3 (0.1): knee 2 h
-    c = cost([8.0, 2.0, 1.0, 0.9], [1.0, 2.0, 3.0, 9.0])
+    c = _cost([8.0, 2.0, 1.0, 0.9], [1.0, 2.0, 3.0, 9.0])
     assert np.allclose(c.elasticity, [2.0, np.log(2) / np.log(1.5), -np.log(0.9) / np.log(3)])
-    assert c.knee_h == 2.0
-    assert cost([8.0, 7.0, 1.0, 0.9], [1.0, 2.0, 3.0, 9.0]).knee_h == 12.0  # first step already too dear
-    assert cost([8.0, 4.0, 2.0, 1.0], [1.0, 1.5, 2.0, 2.5]).knee_h == 1.0  # every step pays
-    assert cost([8.0, 4.0, 2.0, 1.0], [1.0, 1.0, 2.0, 2.5]).knee_h == 1.0  # accuracy for free is a good step
-    assert cost([8.0, 4.0, 2.0, 1.0], [1.0, 0.9, 1.5, 1.8]).knee_h == 1.0  # cheaper and better (timing noise) too
-    assert cost([8.0, 8.0, 2.0, 1.0], [1.0, 1.0, 2.0, 2.5]).knee_h == 12.0  # no gain, no cost: not a gain
+    assert c.elasticity_knee_h == 2.0
+    assert _cost([8.0, 7.0, 1.0, 0.9], [1.0, 2.0, 3.0, 9.0]).elasticity_knee_h == 12.0  # first step already too dear
+    assert _cost([8.0, 4.0, 2.0, 1.0], [1.0, 1.5, 2.0, 2.5]).elasticity_knee_h == 1.0  # every step pays
+    assert _cost([8.0, 4.0, 2.0, 1.0], [1.0, 1.0, 2.0, 2.5]).elasticity_knee_h == 1.0  # accuracy for free pays
+    assert _cost([8.0, 4.0, 2.0, 1.0], [1.0, 0.9, 1.5, 1.8]).elasticity_knee_h == 1.0  # cheaper and better too
+    assert _cost([8.0, 8.0, 2.0, 1.0], [1.0, 1.0, 2.0, 2.5]).elasticity_knee_h == 12.0  # no gain, no cost: no gain
     assert np.allclose(c.cost_ratio(), [1 / 3, 2 / 3, 1.0, 3.0])
+
+
+def test_chord_knee_of_the_cadence_cost():
+    """The row's knee: the cadence deepest below the chord of log(3-sigma) against log(run time)."""
+    # log C = 0, 1, 2, 3 and log A = 0, -1, -2.2, -2.5: chord log A = -2.5/3 log C, depths 0, 1/6, 2.2 - 5/3, 0
+    e = np.exp
+    c = _cost(e([0.0, -1.0, -2.2, -2.5]), e([0.0, 1.0, 2.0, 3.0]))
+    assert np.allclose(c.chord_depth, [0.0, 1 - 2.5 / 3, 2.2 - 5 / 3, 0.0])
+    assert c.has_knee and c.knee_h == 2.0  # a sweet spot at 2 h
+    # the same run times with most of the gain in the first step: the bend moves to 6 h (outside the 1-4 h band)
+    b = _cost(e([0.0, -1.5, -2.0, -2.5]), e([0.0, 1.0, 2.0, 3.0]))
+    assert np.allclose(b.chord_depth, [0.0, 1.5 - 2.5 / 3, 2.0 - 5 / 3, 0.0]) and b.knee_h == 6.0
+    # gains accelerating at the dense end (the curve above its chord): no knee, reported at the sparsest cadence
+    u = _cost(e([0.0, -0.2, -0.5, -2.5]), e([0.0, 1.0, 2.0, 3.0]))
+    assert np.all(u.chord_depth <= 0) and not u.has_knee and u.knee_h == 12.0
+    # a knee is a property of the curve, not of its units: scaling the seconds or the kilometres does not move it
+    assert _cost(7 * e([0.0, -1.0, -2.2, -2.5]), 0.01 * e([0.0, 1.0, 2.0, 3.0])).knee_h == 2.0
+    two = cu.CadenceCost(np.array([12.0, 6.0]), np.array([13, 26]), np.array([1.0, 2.0]), np.array([2.0, 1.5]),
+                         np.ones(2), np.ones(2) * 6)
+    assert not two.has_knee and two.knee_h == 12.0  # two cadences have no interior point
 
 
 def test_cadence_cost_study_small(nrho):
