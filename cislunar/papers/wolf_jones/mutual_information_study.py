@@ -438,9 +438,26 @@ class BaselineCurve:
         """Baselines (km, as text) where the observer's total RMS exceeds the target's by more than 5 %."""
         return [f"{b:.0f}" for b, o, g in zip(self.baseline_km, self.obs, self.tgt) if o > 1.05 * g]
 
-    def improves(self, min_drop: float = 1.5, max_rebound: float = 1.2) -> bool:
-        """MI gain > 0, in-plane RMS drop > ``min_drop`` and rebound < ``max_rebound``."""
-        return self.gain > 0 and self.rms_drop > min_drop and self.rebound < max_rebound
+    @property
+    def step_improves(self) -> np.ndarray:
+        """Per step to the next longer baseline: the MI rises and the observer's in-plane RMS falls (both strictly)."""
+        return (np.diff(self.mi) > 0) & (np.diff(self.obs_xy) < 0)
+
+    @property
+    def improving_until(self) -> int:
+        """Index of the longest baseline reached from the shortest with every step improving (last index: all do)."""
+        bad = np.flatnonzero(~self.step_improves)
+        return int(bad[0]) if bad.size else self.mi.size - 1
+
+    @property
+    def end_to_end_drop(self) -> float:
+        """In-plane observer RMS at the shortest baseline over that at the longest."""
+        return float(self.obs_xy[0] / self.obs_xy[-1])
+
+    def improves_throughout(self, min_drop: float = 1.5) -> bool:
+        """Every step to a longer baseline raises the MI and lowers the in-plane observer RMS, and that RMS falls by
+        more than ``min_drop`` from the shortest to the longest baseline."""
+        return bool(np.all(self.step_improves) and self.end_to_end_drop > min_drop)
 
 
 def _baseline_row(task) -> tuple:

@@ -7,7 +7,7 @@ What is here:
   Sundman nodes with the window ends on nodes, zero thrust bound inside the observation window).
 * :func:`solve` : one SCvx run of the problem from the ballistic guess.
 * :func:`iteration_summary`: what the iteration history says (accepted steps, the noise rule, multiplier updates,
-  the largest-defect ratios that a superlinear rate would drive to zero).
+  the largest-defect ratios that a superlinear rate would drive to zero, above the solver's round-off floor).
 * :func:`single_shooting`: the converged first-order-hold control re-flown from the initial state alone.
 * :func:`blended_guess`, :func:`guess_study`: the same problem from random initial guesses.
 * :func:`printed_method_study`: the printed SCvx, fairly (issue 22 item 4): test case 1 with the information reward
@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import functools
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -142,7 +142,9 @@ class IterationSummary:
     ``forced``: iterations whose predicted decrease was at the noise level, ``|J - L| <= noise_tol (1 + |J|)``, so
     that rho was set to 1; ``forced_negative``: how many of them had a negative prediction; ``rho_range``: (min,
     max) of rho over the other steps; ``updates``: iterations after which the multipliers were updated;
-    ``defect_ratio``: largest defect after each step over that after the previous step.
+    ``defect_ratio``: largest defect after each step over that after the previous step.  ``defects``: largest defect
+    (LU) after each accepted step, in order; ``rate_floor``: the round-off floor (LU) of the rate test, the solver's
+    own defect tolerance ``settings.defect_tol`` (below it the solver counts the defects as closed).
     """
 
     n_steps: int
@@ -156,6 +158,26 @@ class IterationSummary:
     eta_start: float
     eta_end: float
     defect_ratio: np.ndarray
+    defects: np.ndarray
+    rate_floor: float
+
+    @property
+    def rate_ratios(self) -> np.ndarray:
+        """Ratios of successive largest defects over the accepted steps that start and end above ``rate_floor``
+        (a defect below the floor is round-off, so a ratio with an end there measures nothing), in order."""
+        d = self.defects
+        above = (d[:-1] > self.rate_floor) & (d[1:] > self.rate_floor)
+        return d[1:][above] / d[:-1][above]
+
+    def superlinear(self, n_tail: int = 3, factor: float = 0.5) -> bool:
+        """Whether the defect ratios tend to zero: the last ``n_tail`` of :attr:`rate_ratios` are contractions (< 1)
+        and each is at most ``factor`` times the one before (a linear rate, whose ratios settle at a constant, fails;
+        so does a run with fewer than ``n_tail`` steps above the floor, which cannot show a rate)."""
+        r = self.rate_ratios
+        if r.size < n_tail:
+            return False
+        tail = r[-n_tail:]
+        return bool(np.all(tail < 1.0) and np.all(tail[1:] <= factor * tail[:-1]))
 
 
 def iteration_summary(result, settings: scvx.SCvxSettings) -> IterationSummary:
@@ -169,12 +191,13 @@ def iteration_summary(result, settings: scvx.SCvxSettings) -> IterationSummary:
     forced = tuple(h["iteration"] for h, nl in zip(hist, noise) if nl)
     real = [h["rho"] for h, nl in zip(hist, noise) if not nl]
     defects = np.array([h["max_defect"] for h in hist])
+    accepted = np.array([h["max_defect"] for h in hist if h["accepted"]], dtype=float)
     return IterationSummary(
         len(hist), int(sum(h["accepted"] for h in hist)), forced, tuple(hist[i]["predicted"] for i in forced),
         int(sum(hist[i]["predicted"] < 0 for i in forced)), len(real),
         (min(real), max(real)) if real else (float("nan"), float("nan")),
         tuple(h["iteration"] for h in hist if h["multiplier_update"]), float(hist[0]["eta"]), float(hist[-1]["eta"]),
-        defects[1:] / defects[:-1])
+        defects[1:] / defects[:-1], accepted, float(settings.defect_tol))
 
 
 @dataclass(frozen=True)
@@ -295,14 +318,18 @@ class VariantRun:
 class PrintedMethodStudy:
     """Test case 1 at one weight solved by every combination of the paper's SCvx ingredients and ours.
 
-    ``runs``: label -> :class:`VariantRun` (labels of :data:`VARIANTS`); ``reference``: the cost of the package's
-    default run (augmented Lagrangian, quadratic MI model, strict stop), non-dimensional.
+    ``runs``: label -> :class:`VariantRun` (labels of :data:`VARIANTS`, every L1 run at the package's penalty weight
+    gamma = ``SCvxSettings.defect_weight``, 1e3); ``gamma_runs``: penalty weight gamma -> :class:`VariantRun` of
+    the printed method (L1 exact penalty, linear MI model, practical rule) at the other weights asked for;
+    ``reference``: the cost of the package's default run (augmented Lagrangian, quadratic MI model, strict stop),
+    non-dimensional.
     """
 
     alpha: float
     n_nodes: int
     max_iter: int
     runs: dict
+    gamma_runs: dict = field(default_factory=dict)
 
     @property
     def reference(self) -> float:
@@ -324,14 +351,25 @@ class PrintedMethodStudy:
             lines.append(f"{r.label:<27} {(r.stopped_by or 'no'):>10} {r.iterations:5d} {r.cost:14.10f} "
                          f"{r.cost - self.reference:12.2e} {r.max_defect:8.1e} {r.eta:8.1e} {r.tr_active:6.0%}"
                          + ("" if r.converged else f"  ({r.outcome})"))
+        if self.gamma_runs:
+            lines.append("the printed method (L1 + linear, practical) at other penalty weights gamma:")
+        for r in self.gamma_runs.values():
+            lines.append(f"{r.label:<27} {(r.stopped_by or 'no'):>10} {r.iterations:5d} {r.cost:14.10f} "
+                         f"{r.cost - self.reference:12.2e} {r.max_defect:8.1e} {r.eta:8.1e} {r.tr_active:6.0%}"
+                         + ("" if r.converged else f"  ({r.outcome})"))
         return "\n".join(lines)
 
 
-def _variant_task(problem: tuple, label: str) -> VariantRun:
-    """One run of :func:`printed_method_study` (module level: picklable for an executor)."""
+def _variant_task(problem: tuple, task) -> VariantRun:
+    """One run of :func:`printed_method_study` (module level: picklable for an executor): ``task`` is a label of
+    :data:`VARIANTS` (package penalty weight) or a penalty weight gamma for the printed method."""
     system, t, x_ball, u_ball, u_max, x_final, info, k_ws, alpha, max_iter = problem
-    method, model, practical = VARIANTS[label]
-    st = scvx.SCvxSettings(method=method, information_model=model, max_iter=max_iter)
+    if isinstance(task, str):
+        label, extra = task, {}
+    else:
+        label, extra = f"L1 + linear, gamma {task:.0e}", {"defect_weight": float(task)}
+    method, model, practical = VARIANTS[task if isinstance(task, str) else "L1 + linear, practical"]
+    st = scvx.SCvxSettings(method=method, information_model=model, max_iter=max_iter, **extra)
     try:
         r = scvx.solve_scvx(system, t, x_ball, u_ball, u_max, x_final=x_final, info=info, info_node=k_ws, alpha=alpha,
                             settings=st, practical_stop=PRACTICAL_STOP if practical else None)
@@ -347,7 +385,7 @@ def _variant_task(problem: tuple, label: str) -> VariantRun:
 
 
 def printed_method_study(n_nodes: int, *, alpha: float = 5e-3, max_iter: int = 300, sigma: float = 1.0,
-                         labels=None, executor=None) -> PrintedMethodStudy:
+                         labels=None, gammas=(), executor=None) -> PrintedMethodStudy:
     """Test case 1 (information reward at weight ``alpha``) from the ballistic DRO by each variant of :data:`VARIANTS`.
 
     Parameters
@@ -362,6 +400,9 @@ def printed_method_study(n_nodes: int, *, alpha: float = 5e-3, max_iter: int = 3
         Sundman exponent.
     labels : sequence of str, optional
         Subset of :data:`VARIANTS` (default all); the reference run is always included.
+    gammas : sequence of float, optional
+        Further penalty weights gamma (> 0) at which the printed method (L1 exact penalty, linear MI model, practical
+        rule) is run, into ``gamma_runs`` (the paper does not print gamma; the variants use 1e3).
     executor : optional
         Runs the variants side by side (:func:`cislunar.utils.montecarlo.map_tasks`); results do not depend on it.
     """
@@ -375,15 +416,19 @@ def printed_method_study(n_nodes: int, *, alpha: float = 5e-3, max_iter: int = 3
     for lab in chosen:
         validation.choice(lab, "labels", tuple(VARIANTS))
     chosen = ["AL + quadratic, strict"] + [lab for lab in chosen if lab != "AL + quadratic, strict"]
+    if not isinstance(gammas, (list, tuple, np.ndarray)):
+        raise validation.ArgumentTypeError(f"gammas must be a sequence of penalty weights; got {type(gammas).__name__}")
+    gammas = [float(validation.positive(g, "gammas")) for g in np.ravel(gammas)]
     _checks.executor(executor)
     sc = scenarios.test_case_1()
     t, k_ws, _ = sc.node_times(n, sigma)
     x_ball, u_ball = sc.ballistic_guess(t)
     problem = (sc.system, t, x_ball, u_ball, sc.control_bounds(t), np.asarray(sc.observer_xf), sc.information_model(),
                int(k_ws), float(alpha), max_iter)
-    runs = map_tasks(functools.partial(_variant_task, problem), chosen, executor=executor, progress=False,
+    runs = map_tasks(functools.partial(_variant_task, problem), chosen + gammas, executor=executor, progress=False,
                      desc="SCvx variants")
-    return PrintedMethodStudy(float(alpha), n, max_iter, {r.label: r for r in runs})
+    return PrintedMethodStudy(float(alpha), n, max_iter, {r.label: r for r in runs[:len(chosen)]},
+                              dict(zip(gammas, runs[len(chosen):])))
 
 
 # ---------------------------------------------------------------------------------------------------------------

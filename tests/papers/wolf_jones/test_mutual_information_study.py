@@ -83,7 +83,30 @@ def test_baseline_curve_summaries():
     assert c.gain == 2.0 and c.peak_km == 20.0 and c.best == 1 and c.same_peak
     assert c.rms_drop == 4.0 and c.rebound == 3.0 and c.mi_drop == 1.0
     assert c.observer_above_target_km == ["30"]
-    assert not c.improves(1.5, 1.2) and c.improves(1.5, 3.5) and not c.improves(5.0, 3.5)
+    # the MI rises then falls, the RMS falls then rises: the first step improves, the second does not
+    assert c.step_improves.tolist() == [True, False] and c.improving_until == 1 and c.end_to_end_drop == pytest.approx(4 / 3)
+    assert not c.improves_throughout(1.5)
+
+
+def _curve(mi, obs_xy):
+    n = len(mi)
+    ones = np.ones(n)
+    return S.BaselineCurve("x", np.arange(1.0, n + 1), np.array(mi, float), ones, ones, ones,
+                           np.array(obs_xy, float), ones, 1.0)
+
+
+def test_baseline_judged_over_the_whole_range():
+    """Every step must raise the MI and lower the in-plane RMS; a turn at the longest baseline fails however small
+    (the old test judged the MI up to its peak and allowed a rebound), and the end-to-end drop must exceed min_drop."""
+    up = _curve([1.0, 2.0, 3.0, 4.0], [8.0, 4.0, 2.0, 1.0])
+    assert up.improves_throughout(1.5) and up.improving_until == 3 and up.end_to_end_drop == 8.0
+    assert not up.improves_throughout(10.0)  # improves at every step, but by less than asked end to end
+    mi_turns = _curve([1.0, 2.0, 3.0, 2.99], [8.0, 4.0, 2.0, 1.0])  # the MI alone falls at the last step
+    assert not mi_turns.improves_throughout(1.5) and mi_turns.improving_until == 2
+    rms_turns = _curve([1.0, 2.0, 3.0, 4.0], [8.0, 4.0, 2.0, 2.1])  # the RMS alone rises (1.05x) at the last step
+    assert not rms_turns.improves_throughout(1.5) and rms_turns.improving_until == 2
+    flat = _curve([1.0, 2.0, 2.0, 4.0], [8.0, 4.0, 2.0, 1.0])  # no gain in one step is no improvement
+    assert not flat.improves_throughout(1.5) and flat.improving_until == 1
 
 
 def test_crossover_interpolates_on_log_axes():

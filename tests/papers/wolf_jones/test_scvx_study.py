@@ -57,6 +57,31 @@ def test_iteration_summary_applies_the_noise_rule():
         S.iteration_summary(SimpleNamespace(history=[]), settings)
 
 
+def _summary(defects, accepted=None):
+    base = {"multiplier_update": False, "eta": 0.05, "cost": 1.0, "predicted": 0.1, "rho": 0.9}
+    accepted = [True] * len(defects) if accepted is None else accepted
+    hist = [dict(base, iteration=i, max_defect=d, accepted=a) for i, (d, a) in enumerate(zip(defects, accepted))]
+    return S.iteration_summary(SimpleNamespace(history=hist), scvx.SCvxSettings())
+
+
+def test_superlinear_rate_is_judged_above_the_round_off_floor():
+    """Ratios tending to zero pass; a linear rate fails; a step with an end below the floor (defect_tol, 5e-10) is
+    left out; rejected steps do not count; fewer than three ratios above the floor cannot show a rate."""
+    fast = _summary([1e-2, 1e-3, 1e-5, 1e-9])  # ratios 0.1, 0.01, 1e-4
+    assert fast.rate_floor == scvx.SCvxSettings().defect_tol and np.allclose(fast.rate_ratios, [0.1, 0.01, 1e-4])
+    assert fast.superlinear(3, 0.5)
+    assert not _summary([1e-2, 1e-3, 1e-4, 1e-5]).superlinear(3, 0.5)  # linear: every ratio 0.1
+    assert not _summary([1e-2, 1e-3, 1e-4, 4e-5]).superlinear(3, 0.5)  # the last ratio grows
+    # a round-off step (1e-11 -> 3e-10, ratio 30, both ends below the floor) and one that ends below it are left out
+    noisy = _summary([1e-2, 1e-3, 1e-5, 1e-9, 1e-11, 3e-10])
+    assert np.allclose(noisy.rate_ratios, [0.1, 0.01, 1e-4]) and noisy.superlinear(3, 0.5)
+    assert noisy.defect_ratio.max() == pytest.approx(30.0)  # the raw ratios keep it
+    # a rejected step (its defect is the trial's, not an iterate's) is not part of the sequence
+    rejected = _summary([1e-2, 1e-3, 5e-2, 1e-5, 1e-9], accepted=[True, True, False, True, True])
+    assert np.allclose(rejected.rate_ratios, [0.1, 0.01, 1e-4]) and rejected.superlinear(3, 0.5)
+    assert not _summary([1e-2, 1e-4, 1e-12]).superlinear(3, 0.5)  # one ratio above the floor: no rate shown
+
+
 def test_guess_study_draws_first_and_matches_through_an_executor(problem):
     from concurrent.futures import ThreadPoolExecutor
 
@@ -104,3 +129,16 @@ def test_printed_method_study_costs_are_the_objective_of_independent_runs():
         S.printed_method_study(10, labels=["L2 + cubic"])
     with pytest.raises(ValueError, match="alpha"):
         S.printed_method_study(10, alpha=0.0)
+
+
+def test_printed_method_runs_at_other_penalty_weights():
+    """A gamma run at the package's weight (1e3) is the printed-method variant itself; another weight changes it."""
+    study = S.printed_method_study(6, alpha=5e-3, max_iter=3, labels=["L1 + linear, practical"], gammas=[1e3, 1e1])
+    same, other, pen = study.gamma_runs[1e3], study.gamma_runs[1e1], study.runs["L1 + linear, practical"]
+    assert list(study.gamma_runs) == [1e3, 1e1] and same.method == "penalty" and same.information_model == "linear"
+    assert same.practical and [h["cost"] for h in same.history] == [h["cost"] for h in pen.history]
+    assert [h["cost"] for h in other.history] != [h["cost"] for h in pen.history]
+    assert "gamma 1e+01" in study.summary()
+    for bad in ([0.0], 5.0):
+        with pytest.raises(ValueError, match="gammas"):
+            S.printed_method_study(6, max_iter=1, labels=[], gammas=bad)

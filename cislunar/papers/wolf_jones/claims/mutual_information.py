@@ -3,12 +3,25 @@ judged in notebook 02.
 
 Declarations only.  Tolerances fixed before comparing: the scalar Monte Carlo within 3 standard errors of the
 closed form; the structured gradient within 1e-5 (max relative) of central differences; each end of the
-observation window within 1 day of the text's "roughly 17 and 32 days"; the baseline argument holds when the MI
-gains, the observer's in-plane terminal RMS drops by more than 1.5x and does not rebound by 1.2x or more at the
-longest baseline (in-plane: a choice made after the total-RMS test failed, so these rows are tuned).  The observer
+observation window within 1 day of the text's "roughly 17 and 32 days"; the baseline argument as below.  The observer
 "on average" below the targets (Fig. 9) means a window-mean RMS at least 10 % below the targets' mean, the criterion
 notebook 06 fixed for the same sentence (2026-11-26: before, any margin counted; the shared window of notebooks 02
 and 06 turned this row from "differs", -0.2 %, into a pass by 1.3 %, and one sentence of the paper gets one test).
+
+The baseline argument (revised 2026-11-26g, after the full run had been seen; the revision tightens, and both rows
+now differ).  The paper's words (Introduction, after Markley and Psiaki): "Generally, increasing the baseline of the
+test masses provides a higher degree of differentiation, and therefore, increases the navigation accuracy"; and on
+test case 1 (Fig. 2 text): "increasing the baseline generally provides a greater degree of dynamical
+differentiation, and thus, observability".  Read as a statement about the baselines our sweep spans (an observer
+ahead of the target on the same DRO, up to half a period, the longest baseline a DRO offers): every step to a longer
+baseline raises the MI and lowers the observer's in-plane terminal CRLB, and that RMS falls by more than 1.5x from
+the shortest to the longest baseline (the 1.5x materiality floor was fixed before the first run).  No tolerance on
+the steps: the covariance analysis is deterministic (round-off ~1e-9 relative, neighbouring baselines differ by
+percent).  "Generally" is read as the paper's hedge that the rule has exceptions, which the sweep can locate (the row
+says up to which baseline it holds), not as leave to ignore a turn at the end of the range.  The old test judged the
+MI only up to its peak and allowed the in-plane RMS to rebound by up to 1.2x at the longest baseline, so a curve that
+improves and then turns passed on how far it turned.  The in-plane measure is still a choice made after the total-RMS
+test failed (coplanar measurements do not observe z), so the rows stay declared tuned.
 """
 
 from __future__ import annotations
@@ -20,17 +33,16 @@ from cislunar.publish.claims import AtLeast, AtMost, Claim, Holds, Within, print
 #: Closed-form MI of the scalar worked example (p = 4, h = r = 1): 0.5 ln(1 + h^2 p / r), nats.
 SCALAR_CLOSED_FORM = 0.5 * math.log(1 + 4.0)
 
-#: Baseline argument: the observer's in-plane terminal RMS must drop by more than this factor from the shortest
-#: baseline to its minimum ...
+#: Baseline argument: the observer's in-plane terminal RMS must fall by more than this factor from the shortest to
+#: the longest baseline (besides improving, with the MI, at every step).
 BASELINE_MIN_DROP = 1.5
-#: ... and rebound by less than this factor from its minimum to the longest baseline.
-BASELINE_MAX_REBOUND = 1.2
-_BASELINE_TEST = (f"MI gain > 0, observer in-plane terminal RMS drop > {BASELINE_MIN_DROP:g}x and rebound at the "
-                  f"longest baseline < {BASELINE_MAX_REBOUND:g}x (observer phase-shifted on the target's DRO)")
+_BASELINE_TEST = (f"over the whole range swept, every step to a longer baseline raises the MI and lowers the observer's "
+                  f"in-plane terminal RMS, which falls by more than {BASELINE_MIN_DROP:g}x from the shortest to the "
+                  f"longest baseline (observer phase-shifted on the target's DRO)")
 
 #: Why the baseline rows are tuned: the measure was switched from the total to the in-plane terminal RMS (2026-11-24)
 #: after the total-RMS test failed; the reason is physical (coplanar measurements cannot observe z), but the choice
-#: was made while looking at the result, and the full run's rebound sits 0.1 % below the 1.2x threshold.
+#: was made while looking at the result.
 _BASELINE_TUNED = ("in-plane instead of total terminal RMS, chosen after the total-RMS test failed (coplanar "
                    "measurements do not observe z)")
 
@@ -74,11 +86,11 @@ CLAIMS = {
     "baseline_relative_position": Claim(
         "MI and CRLB improve with baseline (relative position (100 m))", "yes (Markley/Psiaki argument, qualitative)",
         Holds(_BASELINE_TEST), source="Introduction (Markley, Psiaki)", tuned=_BASELINE_TUNED,
-        reason="the in-plane CRLB gains little from the baseline"),
+        reason="the MI or the in-plane CRLB does not improve at every step of the baseline range"),
     "baseline_range_rate": Claim(
         "MI and CRLB improve with baseline (range + range rate)", "yes (Markley/Psiaki argument, qualitative)",
         Holds(_BASELINE_TEST), source="Introduction (Markley, Psiaki)", tuned=_BASELINE_TUNED,
-        reason="the in-plane CRLB gains little from the baseline"),
+        reason="the MI or the in-plane CRLB does not improve at every step of the baseline range"),
     "timing": Claim(
         "Structured vs dense speed at test-case-2 size (N = 17)", "not in paper", kind="beyond paper"),
 }

@@ -2,9 +2,21 @@
 42-43, Table 1), judged in notebook 03 on a minimum-impulse transfer with test case 1's boundary conditions.
 
 Declarations only.  Tolerances fixed before the run: converged node defects at most 1e-9 LU; the converged control,
-re-flown by single shooting, within 1 km of x_f; a superlinear rate needs at least that every step shrink the
-largest defect by half (a ratio of successive largest defects at most 0.5); zero thrust in the window exactly (an
-imposed input, so a derived row, not evidence for the paper).  The rows of sections 2-4 are at alpha_h = 0 (no
+re-flown by single shooting, within 1 km of x_f; zero thrust in the window exactly (an imposed input, so a derived
+row, not evidence for the paper).
+
+The superlinear rate (revised 2026-11-26g, after the run's ratios had been seen; the row failed before and fails
+after, so nothing is tuned).  The paper's words (Sequential Convex Programming section): SCvx is "an SCP approach with
+global convergence and superlinear convergence rate" (citing Mao et al. 2018).  A superlinear rate means that the
+ratio of successive errors tends to zero, ``q_k = d_{k+1} / d_k -> 0``, with ``d_k`` the largest node defect after
+the k-th accepted step (our proxy for the distance to the solution).  A finite run can show this only above its
+round-off floor, fixed from the solver's own tolerance, not from the data: ``SCvxSettings.defect_tol`` (5e-10 LU),
+below which the solver counts the defects as closed; a ratio with an end below the floor measures nothing and is
+left out.  The test: over the last ``SUPERLINEAR_TAIL`` = 3 steps above the floor every ratio is a contraction
+(< 1) and at most ``SUPERLINEAR_FACTOR`` = 0.5 times the one before (ratios that fall towards zero; a linear rate,
+whose ratios settle at a constant, fails; a run with fewer steps above the floor cannot show a rate and fails).
+The old test, "every ratio at most 0.5", also demanded a fast contraction at the first steps (which a superlinear
+rate, a local property, does not promise) and counted a step between two round-off-level defects.  The rows of sections 2-4 are at alpha_h = 0 (no
 information reward); section 5's rows (below) are at alpha_h = 5e-3.  The two documented departures from the printed method (augmented
 Lagrangian; noise rule and cap of the trust region) are rows that differ by construction.
 
@@ -24,6 +36,10 @@ from cislunar.publish.claims import AtMost, Claim, Equals, Holds
 
 #: ``|cost - reference optimum|`` (non-dimensional) within which a run "reaches the optimum" (module docstring).
 OPTIMUM_TOL = 1e-6
+#: Superlinear-rate test (module docstring): the last this many largest-defect ratios above the round-off floor ...
+SUPERLINEAR_TAIL = 3
+#: ... are contractions, each at most this factor times the one before.
+SUPERLINEAR_FACTOR = 0.5
 
 CLAIMS = {
     "defects": Claim(
@@ -32,13 +48,17 @@ CLAIMS = {
         "yes (method)", AtMost(1e-9),
         source="Eqs. 30, 42", reason="defects remain (largest node defect, LU)"),
     "superlinear": Claim(
-        "global convergence and superlinear rate (Mao et al. 2018, cited)", "stated, not shown", AtMost(0.5),
+        "global convergence and superlinear rate (Mao et al. 2018, cited)", "stated, not shown",
+        Holds(f"the ratios of successive largest defects tend to zero: over the last {SUPERLINEAR_TAIL} accepted "
+              f"steps above the round-off floor (the solver's defect tolerance) each ratio is < 1 and at most "
+              f"{SUPERLINEAR_FACTOR:g} times the one before"),
         source="Sequential Convex Programming section (citing Mao et al. 2018)",
         reason="no superlinear rate seen: global convergence is consistent with this run (the ballistic guess and the "
-               "random guesses of section 4 all converge), but the largest defect falls irregularly (ratios near 1 "
-               "for several steps), paced by the multiplier and weight updates of our SCvx* variant, not "
-               "superlinearly; the cited theorem is for Mao's penalty SCvx, whose printed form does not converge on "
-               "test case 1 (notebook 05)"),
+               "random guesses of section 4 all converge), but above the round-off floor the largest defect does not "
+               "contract at every step (ratios near 1 between updates), paced by the multiplier and weight updates "
+               "of our SCvx* variant, not superlinearly; the cited theorem is for Mao's penalty SCvx, which on this "
+               "problem reaches the floor in one step (too few to show a rate) and with the information reward "
+               "stops only at some penalty weights (section 5)"),
     "single_shooting": Claim(
         "converged FOH control flies the nonlinear dynamics to x_f (alpha_h = 0, package default)", "implied",
         AtMost(1.0),
@@ -67,14 +87,15 @@ CLAIMS = {
         reason="documented choice: a noise rule sets rho = 1 when the predicted decrease is at the subproblem's noise "
                "level, and eta is capped at eta_max"),
     "printed_stops": Claim(
-        "printed SCvx (L1 exact penalty, linear MI model of Eq. 44) stops, test case 1 at alpha_h = 5e-3, under the "
-        "practical rule", "converges (implied: Figs. 2 and 5 show converged plans)",
+        "printed SCvx (L1 exact penalty, linear MI model of Eq. 44) stops, test case 1 at alpha_h = 5e-3, one penalty "
+        "weight gamma = 1e3, under the practical rule", "converges (implied: Figs. 2 and 5 show converged plans)",
         Holds("the run meets the practical stopping rule within its iteration limit"),
         source="Eqs. 42-44; Figs. 2, 5",
         reason="the L1 exact penalty creeps: with the defects down to ~1e-8 every step still sits on the trust-region "
                "boundary, the second-order defects of a step of size eta cost gamma O(eta^2) against a predicted gain "
                "O(eta), so rho stays at 0.1-0.2 and eta at 1e-4 to 4e-4, and the cost still falls by a few 1e-6 "
-               "(relative) per step when the limit is reached"),
+               "(relative) per step when the limit is reached; one gamma only (the paper does not print it): the "
+               "note lists the printed method at the other weights of section 5's sweep, under the same rule"),
     "printed_gap": Claim(
         "printed SCvx: last iterate's cost against the optimum (our solver)", "-",
         AtMost(OPTIMUM_TOL), kind="beyond paper",
