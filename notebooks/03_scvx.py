@@ -367,7 +367,10 @@ table.add(CLAIMS["failing_ingredient"].judge(
     bool(not pp.converged and not pr["L1 + quadratic, practical"].converged and al_lin.converged),
     shown="L1 exact penalty" if not pp.converged and al_lin.converged else "not the L1 penalty alone",
     note=(f"L1 + quadratic: {pr['L1 + quadratic, practical'].outcome}, cost "
-          f"{printed.gap('L1 + quadratic, practical'):+.1e} from the optimum")))
+          f"{printed.gap('L1 + quadratic, practical'):+.1e} from the optimum; the printed method (L1 + linear) stops "
+          "under the same rule at gamma = " + (", ".join(f"{g:.0e}" for g, r in printed.gamma_runs.items()
+                                                        if r.converged) or "none of the other weights run")
+          + ": the unstated penalty weight decides whether the L1 penalty fails")))
 table.display()
 
 # %% [markdown]

@@ -296,17 +296,21 @@ print(pen.summary(best[i5].cost))
 _ = plotting.save_figure(figures.convergence(pen), "05_convergence", output_dir=out)
 
 # %% [markdown]
-# **Reading.** Whether the printed method converges is read from the printed outcomes: none of the exact-penalty
-# runs, at any $\gamma$ of the sweep or with the larger iteration limit, meets the stopping test; the trust region
+# **Reading.** None of the exact-penalty runs, at any $\gamma$ of the sweep or with the larger iteration limit,
+# meets our strict stopping test; the trust region
 # shrinks (last $\eta$ printed) while the cost creeps towards our solver's optimum. In the full run no best accepted
 # cost reaches the adopted optimum (-0.543793, found by a random start of the multi-start); at $\gamma = 10^2$ it
 # comes within $10^{-5}$ of it and lies *below* our solver's own cold-start plan from the same ballistic guess
 # (-0.543784 against -0.543750), but with defects still open, so it is not a feasible improvement. The hybrid with
 # our quadratic
-# information model does not converge within its limit either: the quadratic model alone does not make the printed
-# method converge (whether the augmented Lagrangian alone would, with Eq. 44's linear model, is not checked here).
-# The closing table therefore separates the printed method (which does
-# not converge here) from our modified solver (which converges on the whole grid).
+# information model does not converge within its limit either. The strict test, though, cannot stop *any* method
+# with Eq. 44's linear information model: it asks for an inactive trust region, and a linear model's step always
+# ends on the trust-region boundary. Notebook 03 (section 5) therefore judges the paper's method on this same
+# problem (test case 1, $\alpha_h = 5\times10^{-3}$, 40 nodes) under a practical stopping rule fixed before its runs:
+# at $\gamma = 10^3$ the L1 penalty still creeps, but at $\gamma = 10^2$ the printed method stops (113 iterations in
+# the full run, at the optimum this notebook's multi-start adopts), and the augmented Lagrangian with the linear
+# model stops too. The closing table here keeps the strict-test sweep as a record and judges our modified solver
+# (which converges on the whole grid); the verdict on the printed method is 03's.
 
 # %% [markdown]
 # ## 5 · Does every plan fly, and does it depend on the node grid? (beyond the paper)
@@ -588,11 +592,11 @@ table.add(CLAIMS["window_thrust"].judge(max(fl.window_thrust), shown=f"max |u| i
 pen_summary = "; ".join(f"gamma {r['gamma']:.0e}, {r['max_iter']} it: " + (
     "converged" if r["converged"] else f"not converged, last defect {r['history'][-1]['max_defect']:.0e}, eta "
     f"{r['eta']:.0e}") for r in pen.runs)
-table.add(CLAIMS["printed_scvx"].judge(pen.any_converged, shown=pen_summary, note=(
+table.add(CLAIMS["printed_scvx"].judge(pen_summary, note=(
     "gamma and the iteration limit are unstated: swept (section 4); best accepted cost at gamma 1e3: "
-    f"{pen.printed['best']:.5f} vs {best[i5].cost:.5f} of our solver" + ("" if pen.any_converged else
-    "; what converges: augmented Lagrangian on the defects, convex quadratic MI model, round-off-level predicted "
-    "decrease counted as rho = 1 (row 'modified SCvx')"))))
+    f"{pen.printed['best']:.5f} vs {best[i5].cost:.5f} of our solver; the strict test asks for an inactive trust "
+    "region, which a linear MI model's step never has (notebook 03, section 5, where the printed method stops at "
+    "gamma = 1e2 under the practical rule)")))
 table.add(CLAIMS["printed_scvx_long"].judge(pen.long_run["outcome"], note=(
     f"gamma 1e3, {pen.long_run['max_iter']} iterations; best accepted cost {pen.long_run['best']:.5f}; last trust "
     f"radius {pen.long_run['eta']:.1e}; hybrid (L1 penalty, quadratic MI, {pen.hybrid['max_iter']} it): "

@@ -97,7 +97,7 @@ CLAIMS = {
                "(relative) per step when the limit is reached; one gamma only (the paper does not print it): the "
                "note lists the printed method at the other weights of section 5's sweep, under the same rule"),
     "printed_gap": Claim(
-        "printed SCvx: last iterate's cost against the optimum (our solver)", "-",
+        "printed SCvx at gamma = 1e3: last iterate's cost against the optimum (our solver)", "-",
         AtMost(OPTIMUM_TOL), kind="beyond paper",
         reason="the printed method is still creeping towards the optimum when the iteration limit is reached"),
     "al_linear": Claim(
@@ -110,7 +110,7 @@ CLAIMS = {
                "region) by default; the practical rule (the same without the trust-region condition, held for five "
                "accepted steps) as an option"),
     "failing_ingredient": Claim(
-        "which printed ingredient fails", "-",
+        "which printed ingredient fails at gamma = 1e3 (the note: the weights at which the printed method stops)", "-",
         Holds("the L1 exact-penalty runs (linear and quadratic MI model) do not stop within the limit while the "
               "augmented Lagrangian with the linear MI model stops under the practical rule"),
         kind="beyond paper",

@@ -52,10 +52,15 @@ CLAIMS = {
     "window_thrust": Claim(
         "zero thrust in the observation window", "a_max = 0 in the window", AtMost(1e-12), kind="derived",
         source="Table 3", reason="thrust inside the window (an imposed input)"),
+    # Revised 2026-11-26g (a referee of notebook 03): this row judged the paper's implied convergence with our
+    # strict stopping test, which asks for an inactive trust region that a linear MI model's step never has, so it
+    # could not pass whatever the printed method does.  The paper's claim is judged once, in notebook 03, under the
+    # practical rule fixed there before any run (its gamma sweep: the printed method stops at gamma = 1e2); this
+    # row keeps the strict-test sweep as a record.
     "printed_scvx": Claim(
-        "printed SCvx (L1 exact penalty, linear MI of Eq. 44) converges, alpha_h = 5e-3", "implied (Figs. 2, 5)",
-        Holds("an exact-penalty run of the gamma sweep meets the stopping test"), source="Eqs. 24-36, 43-44",
-        reason="the printed formulation does not converge here"),
+        "printed SCvx (L1 exact penalty, linear MI of Eq. 44) under our strict stopping test, alpha_h = 5e-3, gamma "
+        "sweep (the paper's claim is judged in notebook 03 under the practical rule)", "implied (Figs. 2, 5)",
+        kind="beyond paper", source="Eqs. 24-36, 43-44"),
     "printed_scvx_long": Claim("printed SCvx at gamma 1e3 with a larger iteration limit", "-", kind="beyond paper"),
     "modified_scvx": Claim(
         "modified SCvx converges for every alpha_h of the grid", "-",
