@@ -591,7 +591,8 @@ def _cadence_label(hours):
 
 
 def figure_cadence_cost(cost: cu.CadenceCost):
-    """Final 3-sigma position against run time per period, one point per cadence (log-log)."""
+    """Final 3-sigma position against run time per period, one point per cadence (log-log), with the chord between
+    the sparsest and densest cadence whose deepest point below it is the knee (:attr:`CadenceCost.knee_h`)."""
     validation.instance(cost, "cost", cu.CadenceCost, "a CadenceCost (cadence_cost_study)")
     fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
     ax.loglog(cost.seconds, cost.sigma3_km, "o-", label="OCBE filter, one period")
@@ -599,11 +600,11 @@ def figure_cadence_cost(cost: cu.CadenceCost):
         ax.annotate(_cadence_label(c), (s, a), textcoords="offset points", xytext=(8, 6), fontsize=7)  # clear of the knee box
     i = int(np.argmin(np.abs(cost.cadences_h - cost.knee_h)))
     ax.loglog(cost.seconds[i], cost.sigma3_km[i], "s", ms=10, mfc="none", label=f"knee ({_cadence_label(cost.knee_h)})")
-    s0 = cost.seconds[0]
-    ax.loglog(cost.seconds, cost.sigma3_km[0] * s0 / cost.seconds, ":", color="0.5",
-              label="accuracy ~ 1/cost (elasticity 1)")
+    ends = [0, -1]  # the chord of CadenceCost.chord_depth: first to last cadence of the study (its two ends)
+    ax.loglog(cost.seconds[ends], cost.sigma3_km[ends], ":", color="0.5",
+              label="chord of the end cadences\n(the knee lies deepest below it)")
     ax.set(xlabel="filter CPU time per tracking period (s)", ylabel="final 3-sigma position (km)")
     _plain_log_ticks(ax, "x")
     _plain_log_ticks(ax, "y")
-    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7)
+    ax.legend(loc="upper right", fontsize=7)  # the curve falls from upper left to lower right: that corner is free
     return fig
