@@ -87,11 +87,12 @@ CLAIMS = {
               "10 % of the run within the LMI's guarantee"), source="Fig. 3, §IV-B", tuned=_TUNED_233,
         reason="the nominal guarantee assumes exact rho; the triangulated rho leaves the polytope and adds "
                "gravity and sensor errors the LMIs do not see"),
+    # kind "beyond paper" since 2026-11-26g (a referee): the paper makes no claim about a small start; the run is a
+    # diagnostic (is the large start's transient to blame for the fig3_233 shortfall?), and judged as a paper claim
+    # it counted the scheduling error's one shortfall a second time.
     "small_e0": Claim(
-        "Fig. 3 accuracy from a small initial error (1 % of the large one)", "accurate (Fig. 3)",
-        Holds("both observers, triangulated rho, from the small start: RMS error after 10 % of the run within the "
-              "LMI's guarantee (the transient cannot be blamed)"), source="Fig. 3, §IV-B", tuned=_TUNED_233,
-        reason="above the guarantee from the small start too: the scheduling error, not the transient"),
+        "diagnostic: Fig. 3 accuracy from a small initial error (1 % of the large one), triangulated rho",
+        None, kind="beyond paper", source="Fig. 3, §IV-B"),
     "fig3_233_exact": Claim(
         "the same with rho from the truth (what the LMIs certify)", None,
         Holds("both observers within the nominal guarantee from both initial errors"), kind="beyond paper",
