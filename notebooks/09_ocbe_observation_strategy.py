@@ -694,7 +694,8 @@ _ = plotting.save_figure(figures.figure_cadence_cost(cost), "09_cadence_run_time
 # * *"consistent"* (angles + rates, the stable NRHOs at the long cadences) as *at most 10 % of the runs
 #   inconsistent*: for 20 runs of a consistent filter, one or two flagged runs are chance (at 1 minute, 4 runs per
 #   cell in the full run, a single flagged run already exceeds it);
-# * the typical run must have at most 5 % of its epochs above the quantile, forward and smoothed;
+# * the typical run must have at most 5 % of its epochs above the quantile, forward and smoothed, and, since the
+#   paper calls it typical, its Monte Carlo cell (9:2 NRHO, 2 h) must be consistent by the rule above;
 # * the regime row asks for the paper's contrast (most angles-only runs diverge, at most 10 % with the paper's
 #   1-s rates) in every cell of the map;
 # * the filter-axes row asks for the same contrast at every cadence tried, for at least one of the filters of
@@ -746,13 +747,14 @@ table.add(obs.filled(CLAIMS["angles_rates_l2"], span=span).judge(
     note="cells above 10% inconsistent runs: " + ("; ".join(f"{n} {c:g} h: {100 * d:.0f}%" for n, c, d in flag_r)
                                                   or "none")))
 tf, ts = typical.forward, typical.smoothed
+cell_runs = with_rates.runs.get(("9:2 NRHO", TYPICAL_CADENCE_H), [])  # its Monte Carlo cell (Section 5)
+cell_bad = float(np.mean([r.diverged for r in cell_runs])) if cell_runs else 1.0
 table.add(CLAIMS["typical_run"].judge(
-    not (tf.diverged or ts.diverged), shown=f"mean NEES forward {tf.nees_mean:.1f}, smoothed {ts.nees_mean:.1f}; "
-    f"epochs over 99.9 %: {100 * tf.inconsistent_fraction:.1f} % / {100 * ts.inconsistent_fraction:.1f} %",
-    note="one run (Section 3)" + (
-        f"; {100 * np.mean([r.diverged for r in with_rates.runs['9:2 NRHO', TYPICAL_CADENCE_H]]):.0f} % of the "
-        f"{len(with_rates.runs['9:2 NRHO', TYPICAL_CADENCE_H])} Monte Carlo runs of this cell (Section 5) are "
-        "inconsistent" if ("9:2 NRHO", TYPICAL_CADENCE_H) in with_rates.runs else "")))
+    not (tf.diverged or ts.diverged) and cell_bad <= 0.10,
+    shown=f"mean NEES forward {tf.nees_mean:.1f}, smoothed {ts.nees_mean:.1f}; epochs over 99.9 %: "
+    f"{100 * tf.inconsistent_fraction:.1f} % / {100 * ts.inconsistent_fraction:.1f} %; its cell: "
+    + (f"{100 * cell_bad:.0f} % of {len(cell_runs)} runs inconsistent" if cell_runs else "not run (CADENCES)"),
+    note="one run (Section 3) and the Monte Carlo cell of its set-up (Section 5)"))
 r92, rst, rso = (with_rates.by_cadence(n) for n in ORBITS)
 for cad in sorted(r92):
     table.add(obs.filled(CLAIMS["table4"], cadence=obs.cadence_label(cad)).judge(

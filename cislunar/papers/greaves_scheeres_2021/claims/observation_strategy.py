@@ -36,10 +36,16 @@ CLAIMS = {
     "angles_rates_l2": Claim(
         "angles and rates, L2, {span} cadence", "consistent at every cadence, both orbits",
         Holds("no (orbit, cadence) cell has more than 10 % inconsistent runs"), source=f"{_SECTION}, Table 4"),
+    # Widened 2026-11-26g (a referee): the paper calls Fig. 5's run "typical", a statement about the runs of its
+    # set-up, not about one draw; the row also asks that the Monte Carlo cell of the same set-up (9:2 NRHO, 2 h,
+    # angles + rates, Section 5) be consistent by the chapter's rule for "consistent" (at most 10 % of its runs
+    # inconsistent).  Widening the scope can only make the row fail.
     "typical_run": Claim(
-        "typical 2-hour run (Fig. 5)", "errors within 3 sigma, forward and smoothed",
-        Holds("at most 5 % of epochs above the NEES 99.9 % quantile in both passes"), source="Fig. 5",
-        reason="the typical run is inconsistent"),
+        "typical 2-hour run (Fig. 5): the run shown and the runs of its Monte Carlo cell",
+        "errors within 3 sigma, forward and smoothed",
+        Holds("the run: at most 5 % of epochs above the NEES 99.9 % quantile in both passes; its cell (9:2 NRHO, "
+              "2 h, angles + rates): at most 10 % of the runs inconsistent"), source="Fig. 5",
+        reason="the run shown, or too many runs of its cell, inconsistent: the run is not typical"),
     "table4": Claim(
         "Table 4: final 3-sigma position / velocity, {cadence}", "Table 4 missing", kind="not in paper",
         source="Table 4 (missing from the text)"),
