@@ -138,6 +138,7 @@ from cislunar.papers.greaves_scheeres_2021 import figures, tracking
 from cislunar.papers.greaves_scheeres_2021 import panels as ocbe_panels
 from cislunar.papers.greaves_scheeres_2021.claims.maneuver_detection import (
     CLAIMS,
+    HEALTH_PLAUSIBLE_FLOOR,
     PAPER_ZLIM,
 )
 from cislunar.publish import plotting
@@ -617,8 +618,12 @@ print(train.accuracy_report(F_C))
 # approximation behind a binomial standard error is poor next to 100 %, so each accuracy row also carries two exact
 # tests in its note: the binomial probability of at least our number of errors if the true accuracy sat at the
 # edge of the paper's printed interval, and Fisher's exact test of our counts against the paper's own 100 + 100 test
-# runs. For 196 of 200 against 100 % the first is 1.9 % (the row differs) and the second p = 0.12: the paper's own
-# 200 runs could not tell 98 % from 100 % either. The status is the declared rule's; the note says how close it is.
+# runs. For 196 of 200 against 100 % (full run, $f_c$, active) the row misses by 0.5 points: $-2.0$ points against a
+# 1.5-point tolerance. The exact binomial probability is 1.9 %, below the 2.3 % one-sided level of two standard
+# errors, so the exact test agrees with the row; and even with the paper's own binomial error added to ours (a
+# tolerance of 0.5 + 2 x 0.71 = 1.9 points) 98.0 % would still differ, by 0.1 point. Fisher's test gives p = 0.12: the
+# paper's own 200 runs could not tell 98 % from 100 % either. The status is the declared rule's; the row says by how
+# much it misses.
 #
 # **The two stable candidates, side by side** (both tunings): detection accuracy, the expected error of the test
 # with its bootstrap standard error (a finer measure than 200 test runs) and the worst consistency cell.
@@ -632,10 +637,17 @@ print(train.stable_difference_report(STABLE, POLICIES))
 # %% [markdown]
 # At either tuning the accuracies of the three orbits lie within a few test runs of each other, and the expected
 # errors, a finer measure than 200 test runs, differ from the 9:2 NRHO's by less than two combined standard errors
-# (printed above): "marginally better" can be neither confirmed nor refuted with the paper's sample sizes. At
-# $f = 0.1$ the window-tuned filter is least consistent on the inner-band orbit; at $f_c$ all three are
-# consistent. Detection therefore does not decide between the candidates; notebook 09's determination and
-# consistency results do (the outer band), and both stay in the table.
+# (printed above). At $f_c$ the test runs even repeat the paper's pattern (full run: quiet 99.0 % on the inner-band
+# stable NRHO against 96.0 % on the 9:2, the paper's 200/200 against 194/200; active 98.0 % on both), but the expected
+# errors show that gap to be the noise of 200 test runs. What "marginally better" can be tested for at these sizes:
+# that the stable orbit is not worse (the 9:2 NRHO is not resolved better) and not better by more than the paper's own
+# largest gap, 3 accuracy points, i.e. 0.06 in FP + MD. What it cannot: the sign of a difference smaller than two
+# combined standard errors, about 0.013 in FP + MD (0.65 accuracy points) on the inner band and 0.018 on the outer
+# band's reduced Monte Carlo; "better" itself is not confirmed. The closing table judges the two-sided reading and
+# marks it tuned (it was written after the values were seen, and an unresolved difference passes it). At
+# $f = 0.1$ the window-tuned filter is least consistent on the inner-band orbit; at $f_c$ all three are consistent.
+# Detection therefore does not decide between the candidates; notebook 09's determination and consistency results do
+# (the outer band), and both stay in the table.
 
 # %% [markdown]
 # ## 6 · Control as a health metric (Fig. 22)
@@ -666,8 +678,8 @@ print(f"smoothed NEES mean {nees_h.mean():.0f} (6 if consistent); residual norms
 # median is 1.83 and 1 % of the epochs lie above the dotted 99 % level, 3.64. In this run the median over the track
 # is 3.25 and 47 % of the epochs lie above that level, every one of them after the burn, starting at the first
 # epoch after it (middle panel). At our noise the left half of Fig. 22 (the estimate diverges, $z$ catches the
-# burn) holds and the right half (residuals that miss the burn) does not. The race below measures this on many
-# runs.
+# burn) holds and the right half (residuals that miss the burn) does not. Whether this run is typical is measured
+# below on all the 0.5 m/s runs of this section, and the race measures when each test reacts.
 #
 # **Is $z$ of a given burn independent of the tuning?** One would expect $z$ of a 0.5 m/s burn to be about 0.5 m/s
 # whatever the window weight. We fly the same $N$ randomly pointed 0.5 m/s burns (sizes printed) through the quiet
@@ -695,6 +707,41 @@ for tag, f_, group in (("f = 0.1", F_TUNE, studies), ("f_c", F_C, studies_c)):
 # 0.49 at $f = 1$, with a single-run spread that shrinks as $f$ grows (printed above). The paper's 0.4761 m/s lies
 # within two single-run standard deviations at $f = 0.1$ and at $f_c$, and the 0.5 m/s burns sit at 29 and 31
 # sigma of the quiet training runs. At $f_c$, which no number of the paper chose, both are predictions.
+#
+# **Fig. 22 over many runs.** The paper shows one run, but reads it as the typical behaviour ("most common filters
+# ... would miss this filter divergence"). So we ask whether the paper's run is a plausible draw at our noise: the
+# $N$ 0.5 m/s burns above, at both readings of $f$, are refiltered to keep what the figure plots, and each run is
+# checked for the combination: the estimate diverges (mean smoothed NEES above 20) while the residuals stay benign.
+# Benign means that the residual monitor of the race below (a squared whitened residual above the 3-sigma tail of
+# its $\chi^2_4$ law) stays silent for the 24 hours after the burn. A lenient reading, the median residual norm over
+# the whole track below 3 (the test first applied to the single run), is printed too: half of the track's epochs
+# precede the burn, so that median hardly sees it. The paper's run is a plausible draw when the share of runs with
+# the combination is not resolved below 5 %, i.e. is at least 5 % less two binomial standard errors of a 5 % share
+# over our runs (fixed before the share was computed; the claims module records that the benign test was tightened
+# from the lenient one after the lenient share had been seen).
+
+# %%
+# the same 0.5 m/s burns as the z study above (seed [SEED, 8]), refiltered at both readings to keep NEES and residuals
+runs05 = det.draw_trials(np.random.default_rng([SEED, 8]).spawn(N_Z05), s_q, magnitude_m_s=0.5)
+s_cq = setups_c["9:2 NRHO", "quiet"]
+res05 = det.filter_trial_sets([(s_q, runs05), (s_cq, runs05)], executor=executor)
+health_runs = {}
+for tag, f_, s_, r in zip(dstudies.TAGS, (F_TUNE, F_C), (s_q, s_cq), res05):
+    np.testing.assert_allclose(r.z_smooth * em.velocity_unit_km_s * 1e3, z05[f_], rtol=1e-9)  # the z study's runs
+    health_runs[tag] = dstudies.HealthRuns.from_filter(s_, runs05, r)
+    print(f"{tag}: combination in {health_runs[tag].text()}")
+hr_all = dstudies.HealthRuns.pooled(health_runs.values())
+print(f"pooled: {100 * hr_all.share:.1f} % of {len(hr_all)} runs; the floor less two standard errors: "
+      f"{100 * (HEALTH_PLAUSIBLE_FLOOR - 2 * hr_all.floor_standard_error):.2f} %")
+
+# %% [markdown]
+# **The paper's run is not a typical draw at our noise** (full run, 64 + 64 runs; the lines above are this run's).
+# The estimate diverges in every run, but the residual monitor fires within 24 hours of the burn in all 64 runs at
+# $f = 0.1$ and 63 of 64 at $f_c$: 1 run of 128 (0.8 %) shows the paper's combination, below the floor (1.1 %; the
+# exact binomial probability of so few if the true share were 5 % is 1 %). The lenient whole-track median stays
+# below 3 in 91 % and 100 % of the runs, which is why one run near its limit looked like a borderline case: the
+# figure's run (median 3.25, drawn apart from these) falls among the 9 % at $f = 0.1$ where even the lenient reading
+# sees the burn.
 #
 # **Does the control react before the residuals? (Fig. 22's claim, measured.)** The paper's statistic is the
 # smoothed control integral; an analyst can recompute it at every epoch on the data received so far. After an
@@ -797,7 +844,7 @@ J = dstudies.closing_rows(  # claim key -> the keyword arguments of Claim.judge 
     q_window_quiet=(setups["9:2 NRHO", "quiet"].q_window_km2_s3, setups_c["9:2 NRHO", "quiet"].q_window_km2_s3),
     spike=spike_study, train=train, pm_j=pm_j, pm_mc=pm_mc, burn_z=z05_study, sig_level=sig_level, lead=lead,
     health_nees_mean=float(nees_h.mean()), health_residual_norms=rh.residual_norms, sigma_angle_rad=SIGMA_ANGLE,
-    joint=joint, lead_grid=race)
+    joint=joint, lead_grid=race, health_runs=health_runs)
 assert set(J) == set(CLAIMS), set(J) ^ set(CLAIMS)  # every declared claim is judged, none is typed
 for key, row in J.items():
     table.add(CLAIMS[key].judge(**row))

@@ -22,6 +22,44 @@ Two limits were changed after their runs had been seen, and how each is then jud
   gives p = 0.12: the paper's sample cannot separate 98 % from 100 %.  The status stays the declared rule's.
 
 The joint search and the race grid (issue 23) had their criteria declared 2026-11-26 before they ran.
+
+Two criteria were revised on 2026-11-26 (session g, a referee's findings), after the values they judge had been seen:
+
+* Table 8, "the stable NRHO had a marginally better performance" (Maneuver Detection; the conclusion gives the
+  counts: quiet 194/200 on the 9:2 NRHO, 200/200 on the stable one; active 100 % on both, Table 7 and "marginally
+  better").  The rows asked for a *resolved* improvement (the stable NRHO's expected error FP + MD at least two
+  combined bootstrap standard errors below the 9:2 NRHO's) and said "differs" whenever the difference was within
+  noise, which asserts a contradiction that an unresolved difference is not.  "Marginally better" says two things:
+  not worse, and better by a small amount.  The rows now test exactly that, two-sided: the improvement
+  ``FP + MD (9:2) - FP + MD (stable)`` must not be resolved below zero (9:2 resolved better: differs) nor resolved
+  above :data:`STABLE_MARGIN` (the stable orbit better by more than "marginally": differs).  The margin is the
+  paper's own largest gap between Tables 7 and 8, 3 accuracy points (194/200 against 200/200; counts, so no rounding),
+  which is 0.06 in FP + MD (the accuracy over 100 + 100 tests is ``1 - (FP + MD)/2``); "resolved" is two combined
+  bootstrap standard errors, as everywhere in this chapter.  The edges come from the paper's words and counts alone,
+  not from our numbers; the rows are nevertheless declared tuned (the lead's call): the revision loosened a criterion
+  after the values had been seen, and a two-sided band passes an unresolved difference, so a pass is not an
+  independent confirmation of "better".  What cannot be tested at our sizes: the sign
+  of an improvement smaller than two standard errors (about 0.013 in FP + MD, 0.65 accuracy points, on the inner
+  band; 0.018 on the reduced outer-band runs): "better" itself is not confirmed, only "not worse, not more than
+  marginally better".
+* Fig. 22, "the filter estimate diverges (left) but the measurement residuals appear benign (right) missing the
+  maneuver"; "this divergence does not appear evident in the measurement residuals.  Most common filters rely on
+  measurement residuals to indicate filter deterioration, and therefore would miss this filter divergence".  The row
+  judged the one run the notebook draws for the figure (smoothed NEES mean above 20 and whitened residual median
+  below 3) and said "differs" on a run near both limits.  The paper shows one run too, but presents it as the typical
+  behaviour; one run of ours cannot say whether the paper's run is a typical draw or a rare one.  The row now applies
+  a per-run test to every 0.5 m/s run the notebook already has at our noise (the 64 + 64 burns of Section 6 at both
+  readings of f, refiltered to keep their NEES and residuals) and asks for the paper's run to be a plausible draw:
+  the share of runs showing the combination must not be resolved below :data:`HEALTH_PLAUSIBLE_FLOOR` (5 %, the usual
+  level for "a draw this rare happens by chance"), i.e. it must be at least 5 % minus two binomial standard errors of
+  a 5 % share over our runs.  The floor and the runs were fixed (2026-11-26, 16:40 UTC) before the share was computed.
+  The per-run test was first fixed as the single run's (whole-track residual median below 3); that share came out
+  95 %, and on inspection the test cannot see the burn: the median runs over 79 epochs of which 39 follow the burn, so
+  it stays below 3 in runs whose residuals exceed their 99 % level at most epochs after the burn (median 80 % of them
+  at f = 0.1, 51 % at f_c) and whose residual monitor fires within hours.  It measured less than the paper's words
+  ("missing the maneuver", "would miss this filter divergence"), so the per-run test of benign residuals was
+  tightened (minutes later, after that share was seen) to the race's residual monitor: no squared whitened residual above
+  its 3-sigma chi-square tail in the 24 hours after the burn.  The lenient share stays in the row's note.
 """
 
 from __future__ import annotations
@@ -52,6 +90,18 @@ _OUTER = "; outer-band candidate (notebook 09), reduced Monte Carlo"
 #: Fixed on 2026-11-26 in place of a rule with a one-point floor per standard error (a 2-point tolerance at 100 %
 #: that the printed digits and 200 test runs do not support).
 _ACC_DIGITS = 0.005
+#: "Marginally better" (Table 8): the paper's largest accuracy gap between Tables 7 and 8 (quiet, 194/200 against
+#: 200/200), as a fraction, and the same gap in the expected error FP + MD (accuracy over 100 + 100 tests is
+#: 1 - (FP + MD)/2).  Fixed from the paper's counts (2026-11-26); see the module docstring.
+STABLE_MARGIN_POINTS = 0.03
+STABLE_MARGIN = 2 * STABLE_MARGIN_POINTS
+#: Fig. 22 over many runs: the paper's one run is a plausible draw when the share of our 0.5 m/s runs showing a
+#: diverging estimate (smoothed NEES mean above HEALTH_NEES_DIVERGED) with benign residuals (the race's residual test
+#: silent for 24 h after the burn) is not resolved below this floor.  Fixed 2026-11-26 before the share was seen.
+#: HEALTH_RESIDUAL_BENIGN: the lenient reading (whole-track median whitened residual norm), kept for the row's note.
+HEALTH_PLAUSIBLE_FLOOR = 0.05
+HEALTH_NEES_DIVERGED = 20.0
+HEALTH_RESIDUAL_BENIGN = 3.0
 _ACC_SOURCE = ("Table 7 (tolerance: half a printed point plus two binomial standard errors over our test runs at "
                "the end of the paper's printed interval)")
 
@@ -129,10 +179,18 @@ CLAIMS = {
         reason="beyond the tolerance") for p in _POLICIES},
     **{f"stable better, {o}, {p}": Claim(
         f"Stable NRHO marginally better than the 9:2, {o}, {p}, f_c (Table 8)",
-        "marginally better" + (" (quiet: 200/200)" if p == "quiet" else ""), AtLeast(2.0),
-        source="Table 8 (measured: how far the expected error FP + MD lies below the 9:2 NRHO's, in combined "
-        "bootstrap standard errors; the paper's own basis is its test accuracies, Tables 7-8)"
-        + (_OUTER if o == _ORBITS[2] else "")) for o in _STABLE for p in _POLICIES},
+        "marginally better" + (" (quiet: 200/200 vs 194/200)" if p == "quiet" else " (9:2: 100 %, Table 7)"),
+        Within(STABLE_MARGIN / 2, STABLE_MARGIN / 2, n_sigma=2),
+        source="Maneuver Detection text and conclusion (Tables 7-8 missing; measured: how far the stable NRHO's "
+        "expected error FP + MD lies below the 9:2 NRHO's, combined bootstrap standard errors; 'marginally better' "
+        "read two-sided: not resolved worse, and not resolved better by more than the paper's own largest gap, 3 "
+        "accuracy points = 0.06 in FP + MD; criterion revised 2026-11-26 after the values were seen, from "
+        "'resolved better', its edges fixed by the paper's words and counts alone)"
+        + (_OUTER if o == _ORBITS[2] else ""),
+        tuned="criterion loosened on 2026-11-26 after the values were seen (from 'resolved better' to the two-sided "
+              "band); an unresolved difference passes it, so 'better' itself is not confirmed",
+        reason="resolved outside the band: the 9:2 NRHO better, or the stable NRHO better by more than marginally")
+       for o in _STABLE for p in _POLICIES},
     **{f"linear, {p}": Claim(
         f"z nearly linear in the magnitude, {p} (Figs. 17, 21)", "apparently linear", AtLeast(0.8),
         source="Figs. 17, 21 (correlation of z and the magnitude at f_c)", reason="weak correlation")
@@ -188,7 +246,13 @@ CLAIMS = {
         tuned="the noise and f are searched for the paper's combination", source="Fig. 22 text",
         reason="no cell of the grid shows the combination"),
     "residuals benign": Claim(
-        "Health metric: residuals benign while the estimate diverges (Fig. 22)", "yes",
-        Holds("one run at our noise: smoothed NEES mean above 20 and residual median below 3"), source="Fig. 22",
+        "Health metric: residuals benign while the estimate diverges (Fig. 22)", "yes (one run)",
+        AtLeast(HEALTH_PLAUSIBLE_FLOOR, n_sigma=2),
+        source="Fig. 22 (measured: share of the 0.5 m/s runs at our noise, quiet tuning at f = 0.1 and f_c, whose "
+        "smoothed NEES mean exceeds 20 while the residual test of the race, a squared whitened residual above its "
+        "3-sigma tail, stays silent for 24 h after the burn; the paper's one run is a plausible draw when that share "
+        "is at least 5 %, less two binomial standard errors of a 5 % share over our runs; floor and runs fixed "
+        "2026-11-26 before the share was computed, the residual test tightened after a whole-track median had been "
+        "seen to miss the burn, see the claims module)",
         reason="at our noise the residuals show the burn at once"),
 }
