@@ -112,9 +112,6 @@ class SliceStatistics:
         Smallest :math:`\\sqrt{J_\\rho}` among the maneuvers using at most the fuel of :math:`\\mathbf u^*`, km.
     below_median_fuel : float
         Fraction of slices where :math:`\\mathbf u^*` uses at most the slice's median fuel.
-    outside_fuel_peak_share : float (property)
-        Percent of slices where :math:`\\mathbf u^*` is outside the slice's most expensive quarter of maneuvers (at
-        least :data:`FUEL_PEAK_QUARTER` percent of them use more fuel): the Fig. 5 test "avoids the peak fuel cost".
     valley_phase, informed_phase, fuel_peak_phase : float
         Median normalised phase of the best maneuver, of :math:`\\mathbf u^*` and of the most expensive maneuver.
     rank_correlation : float
