@@ -10,6 +10,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib import ticker
+from matplotlib.lines import Line2D
 from scipy import stats
 
 from cislunar.estimation import adaptive_ocbe as ad
@@ -451,7 +452,12 @@ def joint_search(joint: dstudies.JointSearch):
         ax[0].plot([0, 100 * tol, 100 * tol], [100 * lim, 100 * lim, 0], color="0.4", ls=ls, lw=1)
     ax[0].set(xlabel="larger |z_lim / paper - 1| of the two policies [%]", ylabel="worst cell: inconsistent runs [%]",
               title=f"screen: {len(joint.screen)} settings ({joint.n_screen[0]} + {joint.n_screen[1]} runs)")
-    ax[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
+    handles, _ = ax[0].get_legend_handles_labels()
+    handles += [Line2D([], [], ls="none", marker="o", ms=4, color="0.3", label="filled: rerun at paper size"),
+                Line2D([], [], ls="none", marker="o", ms=4, mfc="none", color="0.3", label="open: screened only"),
+                Line2D([], [], color="0.4", ls=":", lw=1, label="screen's box"),
+                Line2D([], [], color="0.4", ls="--", lw=1, label="both criteria's box")]
+    ax[0].legend(handles=handles, loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
     keys = list(joint.confirm)
     for j, p in enumerate(joint.policies):
         r = [joint.confirm[k][p]["z_lim"] / joint.paper_zlim[p] for k in keys]
