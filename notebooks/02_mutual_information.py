@@ -164,8 +164,8 @@ print(f"sigma_theta at 215 km: "
 # Process noise: Table 5 prints "$Q$ [km/s³] = $10^{-11}$"; the PSD of an acceleration has units km²/s³. Read as
 # $10^{-11}$ km²/s³ the CRLB of test case 1 grows without bound, against the paper's text, so we adopt the same
 # number in normalised units — a reading chosen by looking at the paper's result, hence "consistent (tuned)" in
-# the table (notebook 06 sweeps the readings) — $q = 10^{-11}$ LU²/TU³ $= 2.80\times10^{-17}$ km²/s³ (the evidence and the other
-# readings are in notebook 06), and discretise it *exactly* along each reference trajectory,
+# the table; the check itself runs at the end of this section, and notebook 06 sweeps the readings through its
+# plans — $q = 10^{-11}$ LU²/TU³ $= 2.80\times10^{-17}$ km²/s³, and discretise it *exactly* along each reference trajectory,
 # $Q_k = \int\Phi(t_{k+1},\tau)GqG^T\Phi(t_{k+1},\tau)^Td\tau$ (time-varying Van Loan; Gauss-Legendre quadrature of
 # heyoka STMs, checked against the Lyapunov ODE in the tests).
 #
@@ -187,6 +187,55 @@ print(f"q = {win.q:.4e} LU^2/TU^3; one-day Q_S velocity sigma = "
 crlb = study.window_crlb(win)
 print(f"I(X;Y): dense Eq. 18 = {crlb.mi_dense:.9f} nats, chain rule = {crlb.mi_chain:.9f} nats "
       f"(rel. diff {crlb.relative_difference:.1e})")
+
+# %% [markdown]
+# **Is the chain rule right, or only close?** The two values printed above differ in the sixth digit. Both are
+# float64 evaluations of one formula, so which is off, and is the gap round-off? `Eq18Precision` evaluates Eq. 18
+# densely once more, forming $\tilde S$ and its Cholesky factor in extended precision (`np.longdouble`, machine
+# epsilon about $10^{-19}$ on this machine) from the same float64 matrices: a reference that shares nothing with the
+# Kalman recursion but its inputs. It also states how much round-off the float64 dense form can carry: a
+# backward-stable formation and factorisation perturb $\tilde S$ by about $u\|\tilde S\|$ ($u = 2^{-53}$), which
+# moves $\ln|\tilde S|$ by up to $n\,u\,\kappa_2(\tilde S)$ ($n$ the dimension of $\tilde S$), so the MI by half
+# that. The window's $\tilde S$ is badly conditioned (measurements of 100 m against a prior of 100 km), so this scale
+# is far from negligible. The table's row asks that the chain rule agree with the reference within it: a recursion
+# that agrees to that level is as good a value of Eq. 18 as the dense form can be, and a wrong recursion (a dropped
+# process noise is worth about 15 nats here) fails by orders of magnitude.
+
+# %%
+eq18 = study.Eq18Precision.of(*lin.arrays)
+print(f"Eq. 18 in extended precision: {eq18.reference:.9f} nats (n = {eq18.size}, kappa_2(S~) = {eq18.condition:.2e}, "
+      f"longdouble eps {eq18.extended_eps:.1e})")
+print(f"round-off scale of the float64 dense form: {eq18.bound:.2e} nats")
+print(f"float64 dense off by {abs(eq18.dense - eq18.reference):.1e} nats ({eq18.ratio(eq18.dense):.1e} of the scale); "
+      f"chain rule off by {abs(crlb.mi_chain - eq18.reference):.1e} nats ({eq18.ratio(crlb.mi_chain):.1e})")
+
+# %% [markdown]
+# So the sixth-digit gap is the dense form's: the chain rule agrees with the extended-precision value several
+# orders of magnitude more closely (down to what the reference itself can resolve), which is why the package
+# evaluates Eq. 18 in square-root form.
+#
+# **Which reading of the process noise keeps the CRLB bounded?** The paper says of test case 1 (text on Fig. 4):
+# "Following the initial transient response, subsequent measurements serve to bound the expected error." Tables 3
+# and 5 print the same "$Q$ [km/s³] = $10^{-11}$", so the statement can test the readings of that number
+# (`wolf_jones.PROCESS_NOISE_READINGS_KM2_S3`) cheaply: `Case1Readings` runs test case 1's covariance recursion
+# (observer coasting on its initial DRO into the thrust-free window $[3P/4, 3P/2]$, target on its DRO, relative
+# position once a day at 100 m per axis, Table 3's priors) under each reading. Bounded means notebook 05's test,
+# fixed there before comparing: the window-end position RMS is at most the RMS after the 2nd measurement, for
+# observer and target. The coasting observer stands in for the $\alpha_h = 0$ plan (which enters the window from a
+# transfer); notebook 05 applies the same test to its solved plans.
+
+# %%
+readings = study.Case1Readings.of(em)
+for label, q_km, g, r in zip(readings.labels, readings.q_km2_s3, readings.growth, readings.rms_km):
+    print(f"{label:48s} q = {q_km:.2e} km^2/s^3: observer RMS {r[0, 1]:7.0f} km after the 2nd measurement, "
+          f"{r[0, -1]:7.0f} km at the window end; growth {g:.3f} ({'bounded' if g <= 1 else 'grows'})")
+
+# %% [markdown]
+# The literal reading, $10^{-11}$ km²/s³, lets the error grow by about thirty times over the window: the process
+# noise it adds in a day (a velocity sigma of about 1 m/s, $\sqrt{q\,\Delta t}$) outruns what a daily 100 m
+# position fix can remove. The adopted normalised reading and the two smaller readings are bounded. So the statement rejects the literal
+# reading but does not single out ours; the row in the closing table says so, and stays "consistent (tuned)"
+# because the reading was chosen with this very statement in view.
 
 # %% [markdown]
 # **Performance evaluation (CRLB).** Linearised about the true trajectories, the EKF covariance recursion
@@ -362,9 +411,15 @@ print(f"chain rule faster than dense from {timing.crossover_value} for the MI, f
 # baseline ... increases the navigation accuracy", Introduction) when over the whole range swept every step to a
 # longer baseline raises the MI and lowers the observer's in-plane terminal RMS, which falls by more than 1.5x from
 # the shortest to the longest baseline; the observer "on average" below the targets when its window-mean RMS is at
-# least 10 % lower than the targets' mean (notebook 06's criterion for the same sentence). The process-noise reading was chosen while
-# looking at the paper's result, so its row says so; so was the in-plane measure of the baseline rows (the total
-# RMS, which includes the unobservable z, failed first), so they are at best consistent (tuned).
+# least 10 % lower than the targets' mean (notebook 06's criterion for the same sentence); the chain rule when it
+# agrees with Eq. 18 in extended precision within the round-off scale of the float64 dense form, $n u
+# \kappa_2(\tilde S)/2$ (section 4); the process noise when, under the adopted reading, test case 1's CRLB is bounded
+# after the transient (notebook 05's test of the text on Fig. 4, section 4). The process-noise reading was chosen
+# while looking at the paper's result, and with that very statement in view, so its row is at best consistent
+# (tuned), and would read "differs" if the adopted reading let the CRLB grow; so was the in-plane measure of the
+# baseline rows (the total RMS, which includes the unobservable z, failed first), so they are at best consistent
+# (tuned). (Until 2026-11-26h the process-noise row compared our q with itself and the chain-rule row had no
+# criterion: neither could fail.)
 #
 # Two rows deserve a caution when you read their verdicts. The two baseline rows show the *same* shape in section
 # 6: the MI and the in-plane CRLB improve up to about 150 000 km and then both turn at the half-period baseline, so
@@ -383,9 +438,13 @@ table.add(claims.CLAIMS["eq11_scalar"].judge(
 table.add(claims.CLAIMS["eq18_dense"].judge(crlb.mi_dense, shown=f"{crlb.mi_dense:.4f} nats",
                                      note="no numerical MI values are printed in the paper"))
 table.add(claims.CLAIMS["eq18_chain_rule"].judge(
-    crlb.relative_difference, shown=f"rel. diff {crlb.relative_difference:.1e}",
-    note="same value at O(N) cost; square-root form (the dense log-determinant loses digits when the measurements "
-         "are far more precise than the prior)"))
+    eq18.ratio(crlb.mi_chain),
+    shown=(f"|chain - Eq. 18 in extended precision| {abs(crlb.mi_chain - eq18.reference):.1e} nats = "
+           f"{eq18.ratio(crlb.mi_chain):.1e} of the round-off scale {eq18.bound:.2f} nats"),
+    note=(f"scale n u kappa_2(S~) / 2 of the float64 dense form (n = {eq18.size}, kappa_2 = {eq18.condition:.1e}); "
+          f"the float64 dense Eq. 18 is off by {abs(eq18.dense - eq18.reference):.1e} nats (rel. diff. dense vs chain "
+          f"{crlb.relative_difference:.1e}: the dense log-determinant loses digits when the measurements are far "
+          "more precise than the prior); same value at O(N) cost, square-root form; until 2026-11-26h no criterion")))
 table.add(claims.CLAIMS["gradient"].judge(
     grad.error,
     shown=f"structured vs FD {grad.error:.1e}; structured vs dense Eq. 48 {grad.dense_error:.1e} (max rel.)",
@@ -397,8 +456,16 @@ table.add(claims.CLAIMS["eq44_linearisation"].judge(
          f"a trust region of {em.lu_to_km(scvx_defaults.eta0):,.0f}-{em.lu_to_km(scvx_defaults.eta_max):,.0f} km "
          "(notebook 05 compares linear and quadratic)"))
 table.add(claims.CLAIMS["process_noise"].judge(
-    win.q / 1e-11, shown=f"{win.q:.1e} LU^2/TU^3 = {cov.WOLF_JONES_PSD_KM2_S3:.2e} km^2/s^3",
-    note="judged on q in units of 1e-11 LU^2/TU^3"))
+    readings.growth[readings.adopted],
+    shown=(f"{win.q:.1e} LU^2/TU^3 = {cov.WOLF_JONES_PSD_KM2_S3:.2e} km^2/s^3: test case 1 window-end / 2nd-measurement "
+           f"RMS {readings.growth[readings.adopted]:.2f}"),
+    note=("the test is notebook 05's for Fig. 4, here with the observer coasting on its initial DRO (a stand-in for the "
+          "alpha_h = 0 plan); the other readings: " + ", ".join(
+              f"{q_km:.0e} km^2/s^3 {g:.2f} ({'bounded' if g <= 1 else 'grows'})"
+              for i, (q_km, g) in enumerate(zip(readings.q_km2_s3, readings.growth)) if i != readings.adopted)
+          + ": the statement rejects the literal reading but does not single out ours; notebook 06 sweeps the "
+            "readings through its plans; until 2026-11-26h judged on q in units of the adopted reading (could not "
+            "fail)")))
 table.add(claims.CLAIMS["window"].judge(
     max(abs(days[0] - 17.0), abs(days[-1] - 32.0)),
     shown=f"P_ref = {em.tu_to_days(win.P_ref):.2f} d, window {days[0]:.2f}-{days[-1]:.2f} d",

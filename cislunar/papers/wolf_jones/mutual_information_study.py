@@ -13,6 +13,10 @@ What is here:
   window start is that of 06's ballistic guess.
 * :func:`window_crlb`: the CRLB (EKF covariance recursion) along that window, split into total, in-plane and
   out-of-plane position RMS, with the per-measurement information gains (chain rule).
+* :class:`Eq18Precision`: Eq. 18 in extended precision and the round-off scale of its float64 dense form (the
+  reference the chain rule is judged against).
+* :class:`Case1Readings`: test case 1's CRLB under each reading of the printed process noise (is it bounded after
+  the transient, as the text of Fig. 4 says?).
 * :func:`gradient_check`, :func:`linearisation_check`: the gradient of Eqs. 44-52 against fourth-order central
   differences, and the range over which the first-order model of Eq. 44 holds.
 * :func:`baseline_study`: MI and terminal CRLB as an observer leads a target along the same DRO (Markley / Psiaki).
@@ -45,7 +49,9 @@ __all__ = [
     "OBSERVER_TF_X0",
     "TARGETS_X0",
     "BaselineCurve",
+    "Case1Readings",
     "Case2Window",
+    "Eq18Precision",
     "GradientCheck",
     "LinearisationCheck",
     "ScalarExample",
@@ -285,6 +291,147 @@ def window_crlb(window: Case2Window) -> WindowCRLB:
     z_cols = np.abs(lin.H[..., [6 * i + j for i in range(4) for j in (2, 5)]]).max()
     return WindowCRLB(window.days, sig(hist.posterior), sig(hist.prior), sig(hist.posterior, (0, 1)),
                       sig(hist.posterior, (2,)), np.asarray(gains), float(mi_dense), float(mi_chain), float(z_cols))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Eq. 18 in extended precision: the reference the chain rule is judged against
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def _logdet_extended(A) -> np.longdouble:
+    """``ln|A|`` of a symmetric positive-definite matrix by a Cholesky (LDL^T) sweep in ``np.longdouble``."""
+    A = np.array(A, dtype=np.longdouble)
+    total = np.longdouble(0)
+    for k in range(A.shape[0]):
+        p = A[k, k]
+        if not p > 0:
+            raise ValueError("the stacked innovation covariance is not positive definite in extended precision")
+        total += np.log(p)
+        A[k + 1:, k + 1:] -= np.outer(A[k + 1:, k] / p, A[k, k + 1:])
+    return total
+
+
+@dataclass(frozen=True)
+class Eq18Precision:
+    r"""Eq. 18 of a window evaluated densely in extended precision, and the round-off scale of the float64 dense form.
+
+    The reference is :math:`\tfrac12(\ln|\tilde S| - \ln|\tilde R|)` with :math:`\tilde S = \tilde H\tilde P
+    \tilde H^T + \tilde R` formed and factorised in ``np.longdouble`` (unit round-off ``extended_eps / 2``; on
+    platforms where it is float64 the reference is only as good as the dense form) from the same float64 stacked
+    matrices: an evaluation of Eq. 18 that shares nothing with the Kalman recursion but its inputs.
+
+    ``bound`` is the first-order round-off scale of the float64 dense form, :math:`\tfrac12\,n\,u\,\kappa_2(\tilde
+    S)` nats, with :math:`n` the dimension of :math:`\tilde S` and :math:`u = 2^{-53}`: a backward-stable formation
+    and Cholesky factorisation return the exact log-determinant of :math:`\tilde S + \Delta S` with
+    :math:`\|\Delta S\|_2 \lesssim u\|\tilde S\|_2`, and :math:`|\Delta\ln|\tilde S|| = |\mathrm{tr}(\tilde S^{-1}
+    \Delta S)| \le n\,\|\tilde S^{-1}\|_2\|\Delta S\|_2`; the MI is half the log-determinant.  The constant of the
+    backward error (a modest multiple of :math:`n` in the worst case) is taken as 1: an order-of-magnitude scale.
+
+    Attributes
+    ----------
+    reference : float
+        Eq. 18 in extended precision, nats.
+    dense : float
+        Eq. 18 in float64 (:func:`cislunar.sensing.information.mutual_information_dense`), nats.
+    condition : float
+        :math:`\kappa_2(\tilde S)` (float64 singular values).
+    size : int
+        Dimension of :math:`\tilde S` (measurements times measurement dimension).
+    extended_eps : float
+        Machine epsilon of ``np.longdouble``.
+    """
+
+    reference: float
+    dense: float
+    condition: float
+    size: int
+    extended_eps: float
+
+    @property
+    def bound(self) -> float:
+        r"""Round-off scale of the float64 dense Eq. 18, :math:`\tfrac12 n u \kappa_2(\tilde S)`, nats."""
+        return 0.5 * self.size * (np.finfo(np.float64).eps / 2) * self.condition
+
+    def ratio(self, value) -> float:
+        """``|value - reference| / bound`` for a value of Eq. 18 (nats): at most 1 when ``value`` is Eq. 18 to the
+        precision of the float64 dense form."""
+        v = validation.real(value, "value")
+        return abs(float(v) - self.reference) / self.bound
+
+    @classmethod
+    def of(cls, P0, F, Q, H, R) -> "Eq18Precision":
+        """Evaluate Eq. 18 of the window ``(P0, F, Q, H, R)`` (as :func:`cislunar.sensing.information.stacked_matrices`)
+        in extended precision and in float64."""
+        Pt, Ht, Rt = info.stacked_matrices(P0, F, Q, H, R)
+        S = Ht @ Pt @ Ht.T + Rt
+        S = 0.5 * (S + S.T)
+        L = np.longdouble
+        Hl = Ht.astype(L)
+        Sl = Hl @ Pt.astype(L) @ Hl.T + Rt.astype(L)
+        reference = 0.5 * (_logdet_extended(0.5 * (Sl + Sl.T)) - _logdet_extended(Rt))
+        return cls(float(reference), float(info.mutual_information_dense(P0, F, Q, H, R)),
+                   float(np.linalg.cond(S)), int(S.shape[0]), float(np.finfo(L).eps))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The printed process noise (Tables 3 and 5): which readings keep test case 1's CRLB bounded
+# ---------------------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Case1Readings:
+    """Test case 1's CRLB under each reading of the printed process noise "Q [km/s^3] = 1e-11" (Tables 3 and 5).
+
+    The observer coasts on its initial DRO (Table 2's row corrected, notebook 01) to the window ``[3P/4, 3P/2]``,
+    where the paper commands no thrust; the target flies its DRO; relative position every day, 100 m per axis;
+    Table 3 priors (the same statement, :func:`cislunar.papers.wolf_jones.scenarios.evaluate_crlb`, that notebook 05
+    applies to its solved plans).  The coasting observer is a stand-in for the alpha_h = 0 plan, whose window start
+    differs.
+
+    Attributes
+    ----------
+    labels : tuple of str
+        Keys of :data:`cislunar.papers.wolf_jones.scenarios.PROCESS_NOISE_READINGS_KM2_S3`, in its order.
+    q_km2_s3 : ndarray (n_readings,)
+        Acceleration PSD of each reading, km^2/s^3.
+    rms_km : ndarray (n_readings, 2, N)
+        Position RMS (CRLB) of observer (row 0) and target after each of the N measurements, km.
+    """
+
+    labels: tuple
+    q_km2_s3: np.ndarray
+    rms_km: np.ndarray
+
+    @staticmethod
+    def growth_of(rms_km) -> float:
+        """The Fig. 4 test (notebook 05's, fixed there before comparing): the largest, over the objects, window-end
+        position RMS over the RMS after the 2nd measurement.  At most 1: the measurements bound the error after the
+        initial transient.  ``rms_km``: (objects, N >= 2), km."""
+        r = validation.as_array(rms_km, "rms_km", ndim=(2,))
+        if r.shape[1] < 2 or not np.all(r[:, 1] > 0):
+            raise ValueError(f"rms_km must have at least two positive columns (objects, N >= 2); got shape {r.shape}")
+        return float(np.max(r[:, -1] / r[:, 1]))
+
+    @property
+    def growth(self) -> np.ndarray:
+        """:meth:`growth_of` of each reading."""
+        return np.array([self.growth_of(r) for r in self.rms_km])
+
+    @property
+    def adopted(self) -> int:
+        """Index of the adopted reading (1e-11 LU^2/TU^3)."""
+        return next(i for i, label in enumerate(self.labels) if "adopted" in label)
+
+    @classmethod
+    def of(cls, system: CR3BP = EARTH_MOON) -> "Case1Readings":
+        """Evaluate the CRLB of test case 1's coasting observer and its target under every reading."""
+        check_system(system)
+        sc = wj.test_case_1(system)
+        x_ws = propagate(system, sc.observer_x0, [0.0, sc.window[0]]).x[-1]
+        labels = tuple(wj.PROCESS_NOISE_READINGS_KM2_S3)
+        q = np.array([wj.PROCESS_NOISE_READINGS_KM2_S3[k] for k in labels])
+        rms = np.stack([wj.evaluate_crlb(sc, x_ws, q=cov.psd_to_nondimensional(qk, system)).rms_km for qk in q])
+        return cls(labels, q, rms)
 
 
 # ---------------------------------------------------------------------------------------------------------------

@@ -9,6 +9,7 @@ What is here:
 * :func:`iteration_summary`: what the iteration history says (accepted steps, the noise rule, multiplier updates,
   the largest-defect ratios that a superlinear rate would drive to zero, above the solver's round-off floor).
 * :func:`single_shooting`: the converged first-order-hold control re-flown from the initial state alone.
+* :class:`NodeDefects`: the node defects of a converged plan re-measured by an independent integrator (scipy DOP853).
 * :func:`blended_guess`, :func:`guess_study`: the same problem from random initial guesses.
 * :func:`printed_method_study`: the printed SCvx, fairly (issue 22 item 4): test case 1 with the information reward
   solved by every combination of the paper's ingredients (L1 exact penalty, linear MI model of Eq. 44) and ours
@@ -28,7 +29,9 @@ from dataclasses import dataclass, field
 
 import matplotlib.pyplot as plt
 import numpy as np
+from scipy.integrate import solve_ivp
 
+from cislunar.cr3bp.dynamics import check_system
 from cislunar.cr3bp.propagation import propagate
 from cislunar.guidance import discretization as D
 from cislunar.guidance import scvx
@@ -40,6 +43,7 @@ from cislunar.utils.montecarlo import map_tasks
 __all__ = [
     "GuessStudy",
     "IterationSummary",
+    "NodeDefects",
     "PRACTICAL_STOP",
     "PrintedMethodStudy",
     "VariantRun",
@@ -220,19 +224,102 @@ def single_shooting(problem: TransferProblem, u) -> ShootingCheck:
 
 
 @dataclass(frozen=True)
+class NodeDefects:
+    """Node defects of a first-order-hold plan measured by an integrator independent of the solver's.
+
+    Each interval is re-propagated from its node state ``x_k`` under the FOH acceleration (linear from ``u_k`` to
+    ``u_{k+1}``) with ``scipy.integrate.solve_ivp`` (DOP853) on the CR3BP vector field, and compared with ``x_{k+1}``:
+    the defect of Eq. 34 as the solver measures it (the 2-norm of the 6-vector, LU and LU/TU), but without heyoka,
+    the solver's discretisation or its bookkeeping.
+
+    Attributes
+    ----------
+    defects : ndarray (N-1,)
+        ``|x_{k+1} - phi(t_{k+1}; t_k, x_k, u)|`` with DOP853 at ``rtol = atol = rtol``.
+    integrator_spread : ndarray (N-1,)
+        Per interval, the distance between the end states of DOP853 at ``rtol`` and at the looser ``check_rtol``: an
+        estimate of the looser run's error, so an upper estimate of the measuring run's.
+    rtol, check_rtol : float
+    """
+
+    defects: np.ndarray
+    integrator_spread: np.ndarray
+    rtol: float
+    check_rtol: float
+
+    @property
+    def largest(self) -> float:
+        """Largest node defect (LU, LU/TU)."""
+        return float(np.max(self.defects))
+
+    @classmethod
+    def of(cls, system, t, x, u, *, rtol: float = 1e-13, check_rtol: float = 1e-12) -> "NodeDefects":
+        """Measure the node defects of the plan ``x`` (N, 6) with node accelerations ``u`` (N, 3, LU/TU^2, first-order
+        hold) at node times ``t`` (N,, TU, increasing)."""
+        check_system(system)
+        t = validation.time_grid(t, "t", increasing=True)
+        x = validation.as_array(x, "x", shape=(t.size, 6))
+        u = validation.as_array(u, "u", shape=(t.size, 3))
+        rtol = validation.in_range(rtol, "rtol", 1e-16, 1e-6)
+        check_rtol = validation.in_range(check_rtol, "check_rtol", 1e-16, 1e-6)
+        defects, spread = np.empty(t.size - 1), np.empty(t.size - 1)
+        for k in range(t.size - 1):
+            ends = [_foh_flight(system, x[k], u[k], u[k + 1], t[k], t[k + 1], tol) for tol in (rtol, check_rtol)]
+            defects[k] = np.linalg.norm(x[k + 1] - ends[0])
+            spread[k] = np.linalg.norm(ends[1] - ends[0])
+        return cls(defects, spread, float(rtol), float(check_rtol))
+
+
+def _foh_flight(system, x0, u0, u1, t0, t1, tol) -> np.ndarray:
+    """End state of one FOH interval by DOP853 (scipy), ``rtol = atol = tol``."""
+    du = (u1 - u0) / (t1 - t0)
+
+    def rhs(tau, y):
+        f = system.eom(y)
+        f[3:] += u0 + (tau - t0) * du
+        return f
+
+    sol = solve_ivp(rhs, (t0, t1), x0, method="DOP853", rtol=tol, atol=tol)
+    if not sol.success:
+        raise RuntimeError(f"solve_ivp failed on [{t0}, {t1}]: {sol.message}")
+    return sol.y[:, -1]
+
+
+@dataclass(frozen=True)
 class GuessStudy:
-    """Impulses (LU/TU) and iteration counts from random initial guesses; ``spread`` relative to a reference."""
+    """Impulses (LU/TU), iteration counts and converged plans (node states, LU and LU/TU) from random initial
+    guesses; ``spread`` relative to a reference."""
 
     impulses: np.ndarray
     iterations: tuple
     spread: float
+    plans: np.ndarray
+
+    def impulse_gap(self, reference_impulse: float) -> float:
+        """Largest ``|J_i - J_ref| / (1 + |J_ref|)`` over the runs, with ``J`` the impulse (LU/TU; at alpha_h = 0 and
+        closed defects the cost): in the units of the solver's relative cost tolerance."""
+        ref = validation.real(reference_impulse, "reference_impulse")
+        return float(np.max(np.abs(self.impulses - ref)) / (1.0 + abs(ref)))
+
+    def plan_distance(self, reference_x) -> float:
+        """Largest position distance, over the runs and the nodes, from the reference plan ``reference_x`` (N, 6), LU."""
+        ref = validation.as_array(reference_x, "reference_x", shape=self.plans.shape[1:])
+        return float(np.max(np.linalg.norm(self.plans[:, :, :3] - ref[:, :3], axis=-1)))
+
+    def same_optimum(self, reference_impulse: float, reference_x, *, cost_tol: float, distance: float) -> bool:
+        """Every run reached the reference optimum: :meth:`impulse_gap` at most ``cost_tol`` and
+        :meth:`plan_distance` at most ``distance`` (LU)."""
+        cost_tol = validation.positive(cost_tol, "cost_tol")
+        distance = validation.positive(distance, "distance")
+        return bool(self.impulse_gap(reference_impulse) <= cost_tol and self.plan_distance(reference_x) <= distance)
 
 
 def _solve_guess(task) -> tuple:
-    """One SCvx run from a given guess, for :func:`cislunar.utils.montecarlo.map_tasks`: (impulse, iterations)."""
+    """One SCvx run from a given guess, for :func:`cislunar.utils.montecarlo.map_tasks`: (impulse, iterations,
+    converged node states)."""
     problem, x_guess, u_guess, max_iter = task
     r = solve(problem, scvx.SCvxSettings(max_iter=max_iter), x_guess=x_guess, u_guess=u_guess)
-    return float(r.impulse), len(r.history)
+    return float(r.impulse), len(r.history), np.asarray(r.x)
 
 
 def blended_guess(problem: TransferProblem) -> np.ndarray:
@@ -267,7 +354,8 @@ def guess_study(problem: TransferProblem, n_guesses: int, rng: np.random.Generat
               max_iter) for _ in range(n)]
     runs = map_tasks(_solve_guess, tasks, executor=executor, progress=False, desc="initial guesses")
     impulses = np.array([r[0] for r in runs])
-    return GuessStudy(impulses, tuple(r[1] for r in runs), float((impulses.max() - impulses.min()) / ref))
+    return GuessStudy(impulses, tuple(r[1] for r in runs), float((impulses.max() - impulses.min()) / ref),
+                      np.stack([r[2] for r in runs]))
 
 
 # ---------------------------------------------------------------------------------------------------------------

@@ -142,3 +142,52 @@ def test_baseline_study_is_the_same_through_an_executor(short_window):
         assert np.all(a.obs_xy <= a.obs * (1 + 1e-12)) and np.all(a.obs_z <= a.obs * (1 + 1e-12))
     with pytest.raises(ValueError):
         S.baseline_study(short_window, 2, min_phase=0.2, max_phase=0.1)
+
+
+def test_eq18_precision_passes_the_chain_rule_and_fails_a_wrong_recursion():
+    """The chain rule agrees with Eq. 18 in extended precision within the dense form's round-off scale; a recursion
+    with the process noise doubled, or one measurement dropped, misses it by far more."""
+    toy = S.constant_velocity_toy(dt=0.5, n_times=4)
+    P0, F, Q, H, R = toy.arrays
+    ref = S.Eq18Precision.of(P0, F, Q, H, R)
+    assert ref.size == 4 and ref.condition >= 1 and ref.extended_eps <= np.finfo(float).eps
+    eps = np.finfo(float).eps
+    assert ref.bound == pytest.approx(0.5 * ref.size * (eps / 2) * np.linalg.cond(
+        (lambda Pt, Ht, Rt: Ht @ Pt @ Ht.T + Rt)(*info.stacked_matrices(P0, F, Q, H, R))), rel=1e-6)
+    assert ref.reference == pytest.approx(info.mutual_information_dense(P0, F, Q, H, R), rel=1e-12)
+    assert ref.ratio(info.mutual_information(P0, F, Q, H, R)) <= 1.0  # passes
+    assert ref.ratio(info.mutual_information(P0, F, 2 * Q, H, R)) > 1.0  # wrong process noise fails
+    assert ref.ratio(info.mutual_information(P0, F[:-1], Q[:-1], H[:-1], R[:-1])) > 1.0  # a dropped measurement
+    with pytest.raises(TypeError):
+        ref.ratio("1.0")
+
+
+def test_eq18_precision_bounds_the_dense_round_off_on_an_ill_conditioned_window():
+    """Measurements far more precise than the prior make S~ ill-conditioned: the float64 dense form then drifts
+    from the extended-precision reference, within the stated round-off scale, while the chain rule stays closer."""
+    toy = S.constant_velocity_toy(dt=1.0, n_times=6, psd=1e-6, r=1e-14)
+    P0, F, Q, H, R = toy.arrays
+    P0 = P0 * 1e6
+    ref = S.Eq18Precision.of(P0, F, Q, H, R)
+    assert ref.condition > 1e12
+    if np.finfo(np.longdouble).eps < np.finfo(float).eps:  # a real extended precision on this platform
+        chain = info.mutual_information(P0, F, Q, H, R)
+        assert ref.ratio(ref.dense) <= 1.0 and ref.ratio(chain) <= 1.0
+        assert abs(ref.dense - ref.reference) > 10 * abs(chain - ref.reference)  # the dense form is the one off
+
+
+def test_case1_readings_growth_judges_the_fig4_statement():
+    """Window end over the 2nd measurement, largest over the objects: at most 1 is bounded."""
+    assert S.Case1Readings.growth_of([[100.0, 50.0, 40.0], [90.0, 60.0, 30.0]]) == pytest.approx(0.8)  # bounded
+    assert S.Case1Readings.growth_of([[100.0, 50.0, 40.0], [90.0, 60.0, 66.0]]) == pytest.approx(1.1)  # one grows
+    with pytest.raises(ValueError):
+        S.Case1Readings.growth_of([[1.0], [2.0]])
+    r = S.Case1Readings.of(em)
+    assert r.rms_km.shape[:2] == (len(wj.PROCESS_NOISE_READINGS_KM2_S3), 2) and "adopted" in r.labels[r.adopted]
+    from cislunar.sensing import covariance as cov
+    assert cov.psd_to_nondimensional(r.q_km2_s3[r.adopted], em) == pytest.approx(wj.PROCESS_NOISE_PSD_ND, rel=1e-12)
+    literal = r.labels.index(next(k for k in r.labels if r.q_km2_s3[r.labels.index(k)] == 1e-11))
+    assert r.growth[literal] > 1.0 >= r.growth[r.adopted]  # the literal reading grows, the adopted one is bounded
+    # more process noise, more growth: the readings in order of q give growths in the same order
+    order = np.argsort(r.q_km2_s3)
+    assert np.all(np.diff(r.growth[order]) > 0)

@@ -94,6 +94,8 @@ def test_guess_study_draws_first_and_matches_through_an_executor(problem):
     assert np.array_equal(serial.impulses, pooled.impulses) and serial.iterations == pooled.iterations
     assert serial.spread == pytest.approx((serial.impulses.max() - serial.impulses.min()) / ref)
     assert serial.spread < 1e-6  # the same optimum from both guesses
+    assert serial.plans.shape == (2, problem.t.size, 6) and np.array_equal(serial.plans, pooled.plans)
+    assert np.allclose(serial.plans[:, 0], problem.x0) and np.allclose(serial.plans[:, -1], problem.x_final)
 
 
 def test_a_tighter_thrust_bound_reaches_the_problem(problem):
@@ -142,3 +144,50 @@ def test_printed_method_runs_at_other_penalty_weights():
     for bad in ([0.0], 5.0):
         with pytest.raises(ValueError, match="gammas"):
             S.printed_method_study(6, max_iter=1, labels=[], gammas=bad)
+
+
+def test_node_defects_are_measured_independently(problem):
+    """A plan flown by heyoka under a first-order-hold control has DOP853 defects at the integrators' round-off; the
+    same nodes with the control shifted by one node, or with one node moved by 1e-9, show the defect."""
+    from cislunar.guidance import discretization as D
+    from cislunar.papers.wolf_jones.claims.scvx import DEFECT_TOL, INTEGRATOR_ALLOWANCE
+
+    em, t = problem.system, problem.t
+    u = 0.3 * problem.u_max[:, None] * np.sin(np.arange(t.size)[:, None] + np.arange(3)[None, :])  # FOH, zero in window
+    x = D.propagate_foh(em, problem.x0, t, u)
+    d = S.NodeDefects.of(em, t, x, u)
+    assert d.defects.shape == (t.size - 1,) and d.largest < 1e-11  # passes the row's tolerance by far
+    assert d.largest <= DEFECT_TOL + INTEGRATOR_ALLOWANCE and np.all(d.integrator_spread < 1e-10)
+    shifted = S.NodeDefects.of(em, t, x, np.roll(u, 1, axis=0))  # the solver flying another control than it returns
+    assert shifted.largest > 1e3 * (DEFECT_TOL + INTEGRATOR_ALLOWANCE)
+    moved = x.copy()
+    moved[5, 0] += 1e-9  # one node off by 1e-9 LU: the interval ending there shows it, the next about as much
+    dm = S.NodeDefects.of(em, t, moved, u)
+    assert dm.defects[4] == pytest.approx(1e-9, rel=1e-2) and dm.largest > DEFECT_TOL + INTEGRATOR_ALLOWANCE
+    assert np.all(np.delete(dm.defects, [4, 5]) < 1e-11)
+    with pytest.raises(ValueError):
+        S.NodeDefects.of(em, t, x[:-1], u)
+
+
+def test_same_optimum_needs_both_the_cost_and_the_plan():
+    """Impulse within cost_tol (1 + |J|) and every node within the distance: a cost off by 1e-7 or a node 2 km away
+    fails."""
+    from cislunar.cr3bp.dynamics import EARTH_MOON as em
+
+    ref_x = np.zeros((5, 6))
+    ref_x[:, 0] = np.linspace(0.8, 0.9, 5)
+    plans = np.stack([ref_x, ref_x + 1e-9])
+    g = S.GuessStudy(np.array([1e-3, 1e-3 + 1e-9]), (3, 4), 1e-6, plans)
+    one_km = em.km_to_lu(1.0)
+    assert g.impulse_gap(1e-3) == pytest.approx(1e-9 / (1 + 1e-3))
+    assert g.plan_distance(ref_x) == pytest.approx(np.sqrt(3) * 1e-9)
+    assert g.same_optimum(1e-3, ref_x, cost_tol=1e-8, distance=one_km)
+    far = S.GuessStudy(np.array([1e-3, 1e-3 + 1e-7]), (3, 4), 1e-4, plans)  # impulse 1e-7 away
+    assert not far.same_optimum(1e-3, ref_x, cost_tol=1e-8, distance=one_km)
+    moved = plans.copy()
+    moved[1, 2, 1] += em.km_to_lu(2.0)  # one node of one plan 2 km away
+    other = S.GuessStudy(g.impulses, (3, 4), 1e-6, moved)
+    assert not other.same_optimum(1e-3, ref_x, cost_tol=1e-8, distance=one_km)
+    assert em.lu_to_km(other.plan_distance(ref_x)) == pytest.approx(2.0, rel=1e-3)
+    with pytest.raises(ValueError):
+        g.same_optimum(1e-3, ref_x, cost_tol=0.0, distance=one_km)

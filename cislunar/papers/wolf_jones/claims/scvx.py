@@ -1,9 +1,27 @@
 """Claims of the SCvx chapter (Wolf & Jones "Sequential Convex Programming for Trajectory Generation", Eqs. 24-36,
 42-43, Table 1), judged in notebook 03 on a minimum-impulse transfer with test case 1's boundary conditions.
 
-Declarations only.  Tolerances fixed before the run: converged node defects at most 1e-9 LU; the converged control,
-re-flown by single shooting, within 1 km of x_f; zero thrust in the window exactly (an imposed input, so a derived
-row, not evidence for the paper).
+Declarations only.  Tolerances fixed before the run: the converged control, re-flown by single shooting, within 1 km
+of x_f; zero thrust in the window exactly (an imposed input, so a derived row, not evidence for the paper).
+
+The converged defects (revised 2026-11-26h, after the full run had been seen; the tolerance is tightened, from 1e-9
+to 5.1e-10).  The old row read the solver's own largest defect against 1e-9 LU: it restated the solver's stopping
+test (defects <= ``defect_tol`` = 5e-10), so it could not fail unless the solver lied to itself.  It now measures
+the defects independently (:class:`~cislunar.papers.wolf_jones.scvx_study.NodeDefects`): every interval of the
+converged FOH plan re-propagated from its node by scipy's DOP853 at ``rtol = atol = 1e-13`` (no heyoka, no
+discretisation, no bookkeeping of the solver), compared with the next node.  The tolerance is the solver's claim,
+``defect_tol``, plus ``INTEGRATOR_ALLOWANCE`` = 1e-11 for the error of the two integrators over one interval (DOP853
+at 1e-13: ~1e-13 over a node interval, estimated in the row from a second run at 1e-12; heyoka's Taylor integrator
+at 1e-15 less): so the row fails if the discretisation, the FOH control the solver flies, or its defect bookkeeping
+were wrong by more than the allowance.
+
+Same optimum from different initial guesses (revised 2026-11-26h, after the impulse spread, 1e-11 relative, had
+been seen, before any plan distance was computed; the row had no criterion).  "The same optimum" means: every run
+from a random guess converges (a run that does not raises and stops the notebook) to an impulse within the solver's
+own cost tolerance of the section-2 run, ``|J_i - J| <= tol (1 + |J|)`` with ``tol`` = ``SCvxSettings.tol`` = 1e-8
+(the solver cannot resolve costs closer than its stopping test), and to a plan whose node positions all lie within
+``GUESS_DISTANCE_KM`` = 1 km of the section-2 plan's (the accuracy asked of a plan's single-shooting re-flight in the
+row above it: two plans closer than that are one plan for this chapter).
 
 The superlinear rate (revised 2026-11-26g, after the run's ratios had been seen; the row failed before and fails
 after, so nothing is tuned).  The paper's words (Sequential Convex Programming section): SCvx is "an SCP approach with
@@ -32,7 +50,16 @@ and 3e-5 gives the same verdicts.
 
 from __future__ import annotations
 
+from cislunar.guidance.scvx import SCvxSettings
 from cislunar.publish.claims import AtMost, Claim, Equals, Holds
+
+#: The solver's defect tolerance (LU, LU/TU) and relative cost tolerance, package defaults (module docstring).
+DEFECT_TOL = SCvxSettings().defect_tol
+COST_TOL = SCvxSettings().tol
+#: Allowance for the integrators' error over one node interval when the defects are re-measured (module docstring).
+INTEGRATOR_ALLOWANCE = 1e-11
+#: Largest node-position distance (km) between two plans that count as the same optimum (module docstring).
+GUESS_DISTANCE_KM = 1.0
 
 #: ``|cost - reference optimum|`` (non-dimensional) within which a run "reaches the optimum" (module docstring).
 OPTIMUM_TOL = 1e-6
@@ -45,8 +72,10 @@ CLAIMS = {
     "defects": Claim(
         "SCvx converges with defects driven to zero (Eqs. 30, 42), at alpha_h = 0 (no information reward), package "
         "default (augmented Lagrangian)",
-        "yes (method)", AtMost(1e-9),
-        source="Eqs. 30, 42", reason="defects remain (largest node defect, LU)"),
+        "yes (method)", AtMost(DEFECT_TOL + INTEGRATOR_ALLOWANCE),
+        source="Eqs. 30, 42",
+        reason="defects remain: re-measured by an independent integrator, the largest node defect exceeds the "
+               "solver's tolerance plus the integrators' allowance (LU, LU/TU)"),
     "superlinear": Claim(
         "global convergence and superlinear rate (Mao et al. 2018, cited)", "stated, not shown",
         Holds(f"the ratios of successive largest defects tend to zero: over the last {SUPERLINEAR_TAIL} accepted "
@@ -70,7 +99,13 @@ CLAIMS = {
         "minimum impulse, test case 1 boundary conditions", "not reported (alpha_h = 0 not shown)",
         kind="not in paper", reason="corrected x_S(t0) (notebook 01) to printed x_S(tf), two periods"),
     "initial_guess": Claim(
-        "same optimum from different initial guesses", "-", kind="beyond paper"),
+        "same optimum from different initial guesses", "-",
+        Holds(f"every run from a random guess converges to an impulse within the solver's cost tolerance "
+              f"{COST_TOL:g} (1 + |J|) of the section-2 run, with every node within {GUESS_DISTANCE_KM:g} km of its "
+              "plan"),
+        kind="beyond paper",
+        reason="a random guess converges to another plan (a different local optimum, or a run stopped short of the "
+               "optimum)"),
     "window_thrust": Claim(
         "zero thrust in the observation window [3P/4, 3P/2] (imposed)", "a_max = 0 there (test case 1)", Equals(0.0),
         kind="derived", source="Table 3", reason="thrust in the window (an imposed input; LU/TU^2)"),
