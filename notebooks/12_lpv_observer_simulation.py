@@ -14,8 +14,9 @@
 # **What you will learn.** How the LPV observers designed in notebook 11 behave on the *nonlinear* CR3BP when
 # they only see the two angles $\theta_1$ (at the Earth) and $\theta_2$ (at the Moon) with 0.1 deg noise; how the
 # scheduling parameters $\rho$ are recovered from those angles by triangulation, and why the estimate must be used
-# instead near the Earth-Moon line ($|\sin\theta_3|<0.04$); what accuracy the LMIs actually *guarantee* for this
-# noise, and whether the simulated observers meet it; why they miss it even at the sampling interval where the H2
+# instead near the Earth-Moon line ($|\sin\theta_3|<0.04$); whether the simulated observers "rapidly converge and
+# maintain accurate estimates" by the paper's own yardstick (its error bound $\gamma$); what accuracy the LMIs
+# actually *guarantee* for this noise, and why the observers miss it even at the sampling interval where the H2
 # design allows exactly the paper's 0.1 deg (the error of the triangulated $\rho$, which the LMIs do not see), and
 # what a robust design that treats that error as an input certifies (Section 6, beyond the paper); whether, with no
 # range information anywhere in the loop, the observers converge and stay converged (Section 7); and how an
@@ -140,19 +141,35 @@ sim = obs.simulate_fig3(sc, od, dt, periods, sigma, rng, initial_error=e0_scale 
 print(readout.measurements(sim, sc))
 
 # %% [markdown]
-# ## 4 · The accuracy the LMIs guarantee (the criterion for Fig. 3's claim, fixed before looking)
+# ## 4 · "Rapidly converge and maintain accurate estimates": the paper's yardstick, and what the LMIs guarantee
 #
-# The paper claims the observers "rapidly converge and maintain accurate estimates". We judge "accurate" by the
-# bound each theorem guarantees for the simulated noise (`lpv.guaranteed_error_rms`): the error is linear in the
-# normalised noise $\kappa\,\delta\theta$, so
+# The paper (§IV-B, after Fig. 3): "despite large initial state estimation errors, the observers rapidly converge
+# and maintain accurate estimates with 360 arcseconds (0.1°) of noise". Its designs are built for "a user-specified
+# bound on the estimation error", $\gamma = 0.0013$ LU (500 km), and 0.1 deg is the noise it finds allowable for that
+# bound with H2 (0.08 deg with H-infinity, which therefore flies 1.25 times its allowance: its error "is expected to
+# be larger", the paper says). So, from the paper's own words and digits (`claims.observer_simulation` records the
+# reasoning):
+# * **accurate**: the RMS position error after the first 10 % of the run (the chapter's settling window) at most the
+#   accuracy the paper designs for at 0.1 deg: $\gamma$ = 500 km for H2, $1.25\gamma$ = 625 km for H-infinity
+#   (`obs.Fig3Accuracy.paper_level`; the error is linear in the noise);
+# * **rapidly**: the error first below that level within 5 % of the orbit period, the one timescale Fig. 3 draws
+#   (fixed before the first runs), and settled there: its RMS from 5 to 10 % of the period at most the level (an
+#   error that only passes through the level on its way down has not converged).
+#
+# Both are judged at the two sampling intervals this chapter flies (here and in Section 6). The levels do not depend
+# on our sampling interval. The theorems' own guarantee for the simulated noise (`lpv.guaranteed_error_rms`) does,
+# and it holds only where its assumptions do; it is printed below as a **diagnostic**, not as the paper's claim:
+# the error is linear in the normalised noise $\kappa\,\delta\theta$, so
 # * H2: steady-state RMS position error $\le \gamma\,\kappa\,\sigma\sqrt{\Delta t}$ (white noise of intensity
-#   $\sigma^2\Delta t$);
+#   $\sigma^2\Delta t$; at this notebook's 12.5 min the 0.1 deg noise is a quarter of the H2 allowance, so the
+#   guarantee is well below $\gamma$);
 # * H-infinity: time-RMS position error $\le \gamma\,\kappa\,\mathrm{RMS}(\delta\theta)$ (L2 gain), up to the decay
 #   of the initial error.
 #
-# Both assume $\rho$ is known exactly; as a diagnostic the same runs are repeated scheduling on the true $\rho$.
-# "Converge rapidly": the error first falls below the bound within 5 % of the orbit period. "Stay accurate": the
-# RMS error after that (first crossing plus 2 % of the period) is below the bound.
+# Both assume $\rho$ is known exactly, which the paper's set-up does not give (it triangulates $\rho$ from the noisy
+# angles); the same runs are therefore repeated scheduling on the true $\rho$, where the guarantee applies. The
+# lines below: each guarantee, when the error first falls below it, the RMS after that (first crossing plus 2 % of
+# the period) and the RMS on the true $\rho$.
 
 # %%
 with open_executor(workers, SCHEDULER) as executor:
@@ -163,9 +180,10 @@ print(readout.convergence(cv, sim))
 # **What sets the convergence time.** The criterion "within 5 % of a period" was fixed before the runs, but whether
 # it can be met depends on an input the paper does not state: the initial error. The error decays no faster than
 # the slowest closed-loop pole of $A(\rho)+LC(\rho)$ along the orbit allows, so falling from the initial error to
-# the guarantee takes about $\ln(e_0/\text{bound})/|\mathrm{Re}\,\lambda|_{\min}$. Below: that prediction, a run
-# with no noise and exact $\rho$ (so neither noise nor triangulation can be blamed), and a sweep of the initial error
-# (the same direction, scaled) on the noisy runs.
+# the paper's level takes about $\ln(e_0/\text{level})/|\mathrm{Re}\,\lambda|_{\min}$: the method's own prediction.
+# Below: that prediction, an H2 run with no noise and exact $\rho$ (so neither noise nor triangulation can be
+# blamed), and a sweep of the initial error (the same direction, scaled) on the noisy H2 runs, all against the
+# paper's level.
 
 # %%
 print(readout.convergence_time(cv, sim))
@@ -176,8 +194,9 @@ print(readout.convergence_time(cv, sim))
 # (a), (b): truth (thick grey) and estimate (blue) over the whole orbit; the first 0.3 TU of the estimate (the
 # convergence transient from the 10,900 km initial position error) is drawn in orange, and the insets magnify its first
 # 0.1 TU. (c)-(e): position error of each observer on a common scale, thin at each sample and thick as a running
-# RMS over 0.1 TU, with the design's guaranteed RMS (dashed; the EKF has none), the first sample below it
-# (triangle), $\gamma$ (dotted) and the first 5 % of the period (grey), the window of the convergence criterion.
+# RMS over 0.1 TU, with the design's guaranteed RMS (dashed; the EKF has none) and the first sample below it
+# (triangle), $\gamma$ (dotted: the paper's accuracy level for H2; H-infinity's is 1.25 times it) and the first 5 %
+# of the period (grey), the window of the convergence criterion.
 # The paper draws the errors of both observers in one panel; here each gets its own, because the H-infinity
 # error, several times the H2 error after convergence (the medians are in the table), would hide the H2 trace.
 
@@ -188,23 +207,22 @@ _ = plotting.save_figure(fig, "12_fig3_observers", output_dir=out)
 
 # %% [markdown]
 # **Reading the result.** Panels (c) and (d) show the two ways the observers miss the criterion (the numbers are
-# printed in Section 4 and in the table). The H2 error falls slowly from the initial 10,900 km and first reaches
-# its guarantee only after about a fifth of the period, as its slowest closed-loop pole predicts (Section 4);
-# afterwards its running RMS stays near the guarantee with bumps
-# well above it. The H-infinity error drops below its own, larger guarantee almost at once, but its running RMS then
-# hovers above that guarantee for most of the orbit. Both LPV observers have a burst of error where the spacecraft
-# crosses the Earth-Moon line ($y = 0$, printed below): there the triangulated $\rho$ is singular and $\rho(\hat x)$
-# is used instead. The guarantee assumes exact $\rho$ (the diagnostic runs on the true $\rho$ show what it buys),
-# whereas here $\rho$ comes from noisy angles (its error enters $A(\rho)$, $b(\rho)$ and $d(\rho)$, and is
-# amplified near the Earth-Moon line), and the noise is held between samples (white noise only in the intensity
-# sense). The EKF, which uses both
-# angles as measurements and the full nonlinear model, is the yardstick: it has no burst at the line.
+# printed in Section 4 and, for both intervals, in the table after Section 6; full-run numbers here). The H2 error
+# falls slowly from the initial 10,900 km and reaches the paper's 500 km only after about a seventh of the period
+# (14.6 %; its slowest closed-loop pole predicts 12.9 %, Section 4), so not "rapidly" from this start; afterwards
+# it is accurate by the paper's level (RMS 279 km after the first 10 % of the run), though 2.4 times its own
+# guarantee (116 km), with bumps well above it. The H-infinity error drops below its level (625 km) almost at once
+# but does not stay there (RMS 698 km over 5-10 % of the period), and its running RMS then hovers above the level,
+# and above its guarantee, for most of the orbit (RMS 1,355 km). Both LPV observers have a burst of error where the
+# spacecraft crosses the Earth-Moon line ($y = 0$, printed below): there the triangulated $\rho$ is singular and
+# $\rho(\hat x)$ is used instead. The guarantee assumes exact $\rho$ (the diagnostic runs on the true $\rho$ show
+# what it buys), whereas here $\rho$ comes from noisy angles (its error enters $A(\rho)$, $b(\rho)$ and $d(\rho)$,
+# and is amplified near the Earth-Moon line), and the noise is held between samples (white noise only in the
+# intensity sense). The EKF, which uses both angles as measurements and the full nonlinear model, is the yardstick:
+# it has no burst at the line.
 
 # %%
 print(readout.line_crossings(lc, sim))
-
-# %%
-_ = table.add(*readout.converges(cv, sim).judged(CLAIMS))
 
 # %% [markdown]
 # ## 6 · Fig. 3 where the paper's H2 number holds, with every guarantee drawn
@@ -246,21 +264,39 @@ print(readout.robust_designs(rd, sc.model.system))
 # **Fig. 3 at 233 min.** The same truth and noisy angles feed three observers of each kind: the nominal design on
 # the triangulated $\hat\rho$ (the paper's set-up), the nominal design on the true $\rho$ (what its LMI certifies)
 # and the robust design on $\hat\rho$; each from the large initial error of Section 3 and from one a hundred times
-# smaller (about 109 km), so that the steady error and the transient can be told apart. The criteria were fixed
-# before the runs (`claims.observer_simulation`): the RMS error after the first 10 % of the run against each
-# design's guarantee.
+# smaller (about 109 km), so that the steady error and the transient can be told apart. Printed: the RMS error
+# after the first 10 % of the run against each design's guarantee (diagnostics, beyond the paper). Then the two
+# rows of the paper's claim, "rapidly converge and maintain accurate estimates", judged at both intervals against
+# the paper's level (Section 4), from the large start.
 
 # %%
 ws = rb.simulate_window(sc, od, rd, periods, np.random.default_rng(SEED + 1))
 r = readout.window(ws, rd, od, sc.model.system)
 print(r)
 _ = plotting.save_figure(figures.fig3_window(ws, sc.model.system), "12_fig3_233min", output_dir=out)
+tu_min = sc.model.system.time_unit_s / 60.0
+at_dt, at_233 = f"{sim.dt * tu_min:.1f} min", f"{ws.dt * tu_min:.0f} min"
+acc = obs.Fig3Accuracy.measure(
+    {at_dt: (sim.t, {n: sim.runs[n].position_error for n in od.designs}),
+     at_233: (ws.t, {n: ws.errors[("nominal", n, "large")] for n in od.designs})}, cv.level, sim.period,
+    reference={at_dt: (sim.t, {n: sim.exact[n].position_error for n in od.designs}),
+               at_233: (ws.t, {n: ws.errors[("nominal, exact rho", n, "large")] for n in od.designs})})
+_ = table.add(*readout.converges(cv, sim, sc.model.system, acc=acc).judged(CLAIMS))
 _ = table.add(*r.judged(CLAIMS))
 
 # %% [markdown]
 # **Reading the result.** With the true $\rho$ the nominal observers stay inside their guarantees: the LMIs are
 # right about what they certify. With the triangulated $\hat\rho$ the same gains exceed them from either start, so
-# the shortfall is the scheduling error, not the transient. The robust designs hold their guarantee, but it is
+# the shortfall is the scheduling error, not the transient. Against the paper's own level the picture is the same
+# here, since at this interval the H2 level *is* its guarantee (500 km) and the H-infinity level (625 km) is close to
+# its guarantee: neither observer is accurate at 233 min with the triangulated $\rho$ (full run: H2 642 km, H-infinity
+# 1,499 km), while both are on the true $\rho$ (239 and 488 km). So, by the paper's yardstick (full run), the H2
+# observer is accurate at 12.5 min but does not settle "rapidly" from our 10,900 km start at either interval (at
+# 12.5 min the sweep of Section 4 settles within 5 % of the period from starts up to 3,262 km; the paper states
+# none), and it is not accurate at 233 min; the H-infinity observer drops below its level at once but does not stay
+# there, and is accurate at neither interval. Accuracy holds at both intervals where $\rho$ is exact (the "same
+# with rho from the truth" row), i.e. where the theorems' assumptions hold: the triangulated $\rho$ is what the
+# paper's set-up adds and what its claim does not survive. The robust designs hold their guarantee, but it is
 # about ten times the paper's 500 km: with $\theta_1$ and $\theta_2$ at 0.1 deg every 233 min, accounting for the
 # error of the scheduling parameters, the LMIs certify several thousand kilometres, and the simulated error lies
 # well inside that (the bound is loose: one quadratic Lyapunov function over the widened box, and an RMS gravity
@@ -285,9 +321,9 @@ _ = table.add(*r.judged(CLAIMS))
 #
 # The paper's sentence after Fig. 3 makes two claims: "The results in Fig.3 confirm that the H2 and H-infinity
 # observers can function without range sensors. *Additionally*, despite large initial state estimation errors, the
-# observers rapidly converge and maintain accurate estimates". The second, accuracy, is judged by the rows above
-# against each design's guarantee. The first is what is specific to dropping the range sensors: with no range
-# information anywhere in the loop (the gains' columns for $r_{13}^2$, $r_{23}^2$ are zero, and $\rho$ is
+# observers rapidly converge and maintain accurate estimates". The second, accuracy, is judged by the H2 and
+# H-infinity rows above against the paper's own level. The first is what is specific to dropping the range sensors:
+# with no range information anywhere in the loop (the gains' columns for $r_{13}^2$, $r_{23}^2$ are zero, and $\rho$ is
 # triangulated from $\theta_1$, $\theta_2$ alone) does the observer still *work*, i.e. converge from the large
 # initial error and stay there rather than lose the spacecraft? The criterion, fixed before this statistic was
 # looked at (`claims.observer_simulation` records what had been seen): for both observers at both sampling
@@ -297,8 +333,6 @@ _ = table.add(*r.judged(CLAIMS))
 # the true $\rho$ (what a range sensor would add to the scheduling) are printed beside them.
 
 # %%
-tu_min = sc.model.system.time_unit_s / 60.0
-at_dt, at_233 = f"{sim.dt * tu_min:.1f} min", f"{ws.dt * tu_min:.0f} min"
 err = {at_dt: (sim.t, {n: sim.runs[n].position_error for n in od.designs}),
        at_233: (ws.t, {n: ws.errors[("nominal", n, "large")] for n in od.designs})}
 ref = {at_dt: (sim.t, {n: sim.exact[n].position_error for n in od.designs}),
@@ -314,9 +348,9 @@ where = (f"; holds at {', '.join(held)}" if held else "") + (
     "error")
 _ = table.add(CLAIMS["no_range"].judge(
     rf.holds, shown=rf.shown(),
-    note=f"only theta1, theta2 measured; initial error {sim.initial_error * km:,.0f} km; accuracy against the LMI "
-         "guarantees is the separate claim of the rows above (Fig. 3's 'Additionally'); the gain columns are zero by "
-         "construction here (notebook 11's free optimum drops the range sensors)",
+    note=f"only theta1, theta2 measured; initial error {sim.initial_error * km:,.0f} km; accuracy (the paper's "
+         "level gamma) is the separate claim of the H2 / Hinf rows (Fig. 3's 'Additionally'); the gain columns are "
+         "zero by construction here (notebook 11's free optimum drops the range sensors)",
     reason=(rf.why(km) + ": rho triangulated from the angles near the Earth-Moon line" + where) if not rf.holds else ""))
 
 # %% [markdown]
@@ -356,8 +390,10 @@ table.display()
 #    worse, and why can a *noisier* sensor make the error reach its guarantee *sooner*? Worked solution:
 #    `exercise_12_noise(factor=2.0)`.
 # 2. **Start closer.** Set `E0_SCALE = 0.1` (an initial error of about 1,090 km). Using the slowest closed-loop pole
-#    printed in Section 4, predict how much earlier the H2 error first falls below its guarantee, and whether the
-#    `h2_converges` row can now pass its 5 % criterion. Worked solution: `exercise_12_initial_error(scale=0.1)`.
+#    printed in Section 4, predict how much earlier the H2 error first falls below a fixed level (the shift,
+#    $\ln(1/0.1)/$decay, does not depend on the level; the worked solution uses the guarantee), and whether the
+#    `h2_converges` row's 5 % part can then be met at 12.5 min. Worked solution:
+#    `exercise_12_initial_error(scale=0.1)`.
 # 3. **Sample twice as often.** Set `DT` to half its value. Predict the H2 allowance per sample printed in
 #    Section 2 (it scales like $1/\sqrt{\Delta t}$), the H2 guarantee (like $\sqrt{\Delta t}$) and the H-infinity
 #    allowance (unchanged: it bounds the noise energy, not a per-sample spread). Worked solution:

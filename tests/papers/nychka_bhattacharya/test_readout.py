@@ -56,6 +56,13 @@ def test_notebook_12_rows_cover_every_claim():
     assert readout.scheduling_error(se).text and readout.robust_designs(rd).text.count("\n") == 2
     assert "no_range" not in win.rows  # measured by obs.RangeFree (tests/.../test_observer_simulation.py)
     assert win.rows["fig3_233"].value == all(ws.holds("nominal", n, "large") for n in ("h2", "hinf"))
+    # the accuracy rows are judged by the Fig3Accuracy given (default: the simulation's own interval)
+    acc = obs.Fig3Accuracy.measure({"x": (sim.t, {n: sim.runs[n].position_error for n in cv.level}),
+                                    "y": (ws.t, {n: ws.errors[("nominal", n, "large")] for n in cv.level})},
+                                   cv.level, sim.period)
+    both = readout.converges(cv, sim, acc=acc)
+    assert [both.rows[f"{n}_converges"].value for n in ("h2", "hinf")] == [acc.holds("h2"), acc.holds("hinf")]
+    assert "x: below 500 km" in both.rows["h2_converges"].shown and "y: below 625 km" in both.rows["hinf_converges"].shown
     keys = [k for p in parts for k in p.rows] + ["no_range"]  # the range-free row comes from obs.RangeFree
     assert sorted(keys) == sorted(CLAIMS_12)  # every declared row, once
     assert all(v.status for p in parts for v in p.judged(CLAIMS_12))
