@@ -182,7 +182,8 @@ def sensitivity(study, reading, gamma, pole_radius):
 
 def fig3_observers(sim, conv, crossings, system, gamma, sigma_deg):
     """Fig. 3 analogue: (a), (b) truth and estimate of each LPV observer with a magnified start; (c)-(e) position
-    error of H2, H-infinity and the EKF against the guarantees (see notebook 12).
+    error of H2, H-infinity and the EKF against the guarantees and the paper's accuracy level of each observer
+    (``conv.level``; see notebook 12).
 
     ``sim``, ``conv`` and ``crossings`` are the :class:`Fig3Runs`, :class:`Convergence` and :class:`LineCrossings`
     of one run; ``system`` converts LU to km; ``gamma`` (LU) and ``sigma_deg`` (deg) are labelled.
@@ -242,7 +243,7 @@ def fig3_observers(sim, conv, crossings, system, gamma, sigma_deg):
             a.axhline(conv.bound[n] * KM, color="k", ls="--", lw=1.0, zorder=4)
             if np.isfinite(conv.first[n]):
                 a.plot(conv.first[n], conv.bound[n] * KM, "v", color="k", ms=6, zorder=5)
-        a.axhline(gamma * KM, color="k", ls=":", lw=0.8, zorder=2)
+        a.axhline(conv.level.get(n, gamma) * KM, color="k", ls=":", lw=0.8, zorder=2)
         a.set_xlabel("t [TU]")
         a.set_title(title, fontsize=10)
     ax_err[0].set_ylabel("position error [km]")
@@ -251,7 +252,8 @@ def fig3_observers(sim, conv, crossings, system, gamma, sigma_deg):
            Line2D([], [], color="0.4", lw=1.6, label="running RMS over 0.1 TU"),
            Line2D([], [], color="k", ls="--", lw=1.0, label=r"guaranteed RMS (LMI, exact $\rho$)"),
            Line2D([], [], color="k", ls="", marker="v", label="first below the guarantee"),
-           Line2D([], [], color="k", ls=":", lw=0.8, label=r"$\gamma$ = 0.0013 LU"),
+           Line2D([], [], color="k", ls=":", lw=0.8,
+                  label=r"paper's accuracy level: $\gamma$ = 0.0013 LU (H$_\infty$: $\gamma \cdot 0.1/0.08$; EKF: $\gamma$)"),
            Patch(color="0.85", label="first 5 % of the period")]
     bottom.legend(handles=key, loc="outside lower center", ncol=3, fontsize=8)
     bottom.suptitle("Position error (colour: observer)", fontsize=11)
