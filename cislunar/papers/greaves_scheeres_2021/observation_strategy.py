@@ -330,6 +330,29 @@ class StrategyStudy:
         """(orbit, cadence) cells where most runs diverged."""
         return [(name, cad) for name, cad, div, *_ in self.rows if div > 0.5]
 
+    def cells_diverged_before(self, t_limit_h: dict) -> list:
+        """(orbit, cadence) cells where most runs (> 50 %) diverged *before* a time, per orbit.
+
+        A run counts when it diverged (:class:`tracking.TrialSummary`) and its first epoch above the NEES 99.9 %
+        quantile is earlier than ``t_limit_h[orbit]`` hours after the start of the track (epoch ``k`` lies ``k``
+        cadences after the start, :func:`tracking.make_scenario`); a numerical failure, whose epoch is not
+        recorded, counts as early.  With ``t_limit_h`` the time of the first perilune this reads the paper's "leads
+        to filter divergence before periapsis".
+        """
+        def early(run, cad, limit):
+            k = run.first_inconsistent_epoch
+            return run.diverged and (k < 0 or k * cad < limit)
+
+        return [(name, cad) for (name, cad), runs in self.runs.items()
+                if np.mean([early(r, cad, t_limit_h[name]) for r in runs]) > 0.5]
+
+    def orbits_diverging_before(self, t_limit_h: dict) -> list:
+        """Orbits on which most runs diverged before ``t_limit_h[orbit]`` hours in every cadence cell
+        (:meth:`cells_diverged_before`): the paper's "every strategy leads to filter divergence before periapsis"."""
+        cells = set(self.cells_diverged_before(t_limit_h))
+        names = dict.fromkeys(name for name, _ in self.runs)
+        return [n for n in names if all((n, cad) in cells for name, cad in self.runs if name == n)]
+
     def diverged_fraction(self, orbit_name: str, cadences) -> float:
         """Fraction of diverged runs of one orbit over the given cadences together."""
         return float(np.mean([r.diverged for c in cadences for r in self.runs[orbit_name, c]]))
@@ -545,6 +568,18 @@ class RegimeMap:
         """Angles-only diverged fractions of one orbit at the paper's hand-off, over cadence and noise."""
         return [self.cells[orbit_name, c, sg, "angles", self.paper_handoff] for c in self.cadences
                 for sg in self.sigmas]
+
+    def noise_readings(self, orbit_name) -> dict:
+        """Per angle noise (rad), the angles-only diverged fractions of one orbit at the paper's hand-off, one per
+        cadence of the map (in the order of :attr:`cadences`)."""
+        return {sg: [self.cells[orbit_name, c, sg, "angles", self.paper_handoff] for c in self.cadences]
+                for sg in self.sigmas}
+
+    def diverging_noises(self, orbit_name) -> list:
+        """The angle noises (rad) of the map at which most angles-only runs (> 50 %) of one orbit diverge at the
+        paper's hand-off at *every* cadence of the map: the paper's "every strategy [1 min-12 h] leads to filter
+        divergence", stated at its one, unstated noise (Table 3 missing), read at each noise of the sweep."""
+        return [sg for sg, fr in self.noise_readings(orbit_name).items() if min(fr) > 0.5]
 
     def onset_km(self, orbit_name):
         """Smallest hand-off (km) over noise and cadence at which most angles-only runs diverge (None: none)."""

@@ -1,6 +1,7 @@
 """Chapter 09 studies: Monte Carlo aggregation, seeding, the regime-map analysis and the stable-candidate
 comparison (small sizes and synthetic cells; invariants, not snapshots)."""
 
+import dataclasses
 from concurrent.futures import ThreadPoolExecutor
 
 import matplotlib.pyplot as plt
@@ -272,3 +273,44 @@ def test_filter_axes_study_bad_input(nrho):
         obs.filter_axes_study(em, orbits_, [12.0], Q, n_runs=1, seed=0, axes={"a": ({}, 0.0)})
     with pytest.raises(ValueError, match="n_runs"):
         obs.filter_axes_study(em, orbits_, [12.0], Q, n_runs=0, seed=0)
+
+
+def _early(diverged, first_epoch):
+    return dataclasses.replace(_summary(diverged), first_inconsistent_epoch=first_epoch)
+
+
+def test_divergence_before_perilune_counts_only_early_onsets():
+    """The angles-only L2 row: most runs of a cell diverge *before* the orbit's perilune, at every cadence."""
+    limit = {"a": 10.0, "b": 10.0}  # hours after the start
+    runs = {("a", 2.0): (_early(True, 4), _early(True, 0), _early(False, -1)),  # 8 h, 0 h: 2 of 3 early
+            ("a", 6.0): (_early(True, 1), _early(True, -1), _early(True, 2)),  # 6 h, failure, 12 h: 2 of 3 early
+            ("b", 2.0): (_early(True, 5), _early(True, 6), _early(True, 0)),  # 10 h is not before 10 h: 1 of 3
+            ("b", 6.0): (_early(True, 0), _early(True, 0), _early(False, -1))}
+    st = obs.StrategyStudy(runs, rates=False)
+    assert st.cells_diverged_before(limit) == [("a", 2.0), ("a", 6.0), ("b", 6.0)]
+    assert st.orbits_diverging_before(limit) == ["a"]  # b fails at 2 h though every run there diverged
+    assert st.diverged_cells() == list(runs)  # by the plain rule every cell diverged
+    assert st.orbits_diverging_before({"a": 100.0, "b": 100.0}) == ["a", "b"]
+    assert st.cells_diverged_before({"a": 1.0, "b": 1.0}) == [("b", 6.0)]  # only b at 6 h has two 0-h onsets
+    assert st.orbits_diverging_before({"a": 1.0, "b": 1.0}) == []
+    half = obs.StrategyStudy({("c", 2.0): (_early(True, 0), _early(False, -1))}, rates=False)
+    assert half.cells_diverged_before({"c": 10.0}) == [] and half.orbits_diverging_before({"c": 10.0}) == []
+
+
+def test_noise_readings_ask_for_every_cadence_at_one_noise():
+    """The hand-off rows: some noise of the map makes most angles-only runs diverge at every cadence at the paper's
+    hand-off; divergence at different cadences under different noises does not count."""
+    cells = {}
+    for c in (2.0, 12.0):
+        for sg in (1e-6, 1e-5):
+            for h in (1.0, 100.0):
+                cells["o", c, sg, "angles", h] = 1.0 if h == 100.0 else 0.0
+    cells["o", 12.0, 1e-6, "angles", 1.0] = 0.8  # 12 h diverges at 1 urad, 2 h at 10 urad: never both
+    cells["o", 2.0, 1e-5, "angles", 1.0] = 0.9
+    rm = obs.RegimeMap(cells, {}, ("angles",), ("o",), (2.0, 12.0), (1e-6, 1e-5), (1.0, 100.0), 10)
+    assert rm.noise_readings("o") == {1e-6: [0.0, 0.8], 1e-5: [0.9, 0.0]}
+    assert rm.diverging_noises("o") == []
+    cells["o", 2.0, 1e-6, "angles", 1.0] = 0.6  # now 1 urad diverges at both cadences
+    assert rm.diverging_noises("o") == [1e-6]
+    cells["o", 2.0, 1e-6, "angles", 1.0] = 0.5  # exactly half is not "most"
+    assert rm.diverging_noises("o") == []
