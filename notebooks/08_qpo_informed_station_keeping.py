@@ -19,7 +19,7 @@
 # over the full surface of maneuvers, each with its own covariance analysis. Eq. 25 as printed needs a reading: read
 # as an angle, its answer depends on how finely the set is sampled; read as a projection, it does not, and it finds
 # the paper's valley at the price of fuel (section 5b). Whether $\mathbf u^*$ "significantly improves" range
-# knowledge is tested against baselines a poor pick fails, the best maneuver of its slice and uninformed random
+# knowledge is tested against baselines a poor pick fails, the edge of its slice's valley and uninformed random
 # picks (section 5c), not against doing nothing, which every maneuver beats. Beyond the paper (its own future work),
 # a full-filter Monte Carlo with maneuver execution errors tells us how much of the predicted range information
 # survives.
@@ -102,6 +102,7 @@ from cislunar.papers.greaves_scheeres_2023 import station_keeping as sk
 from cislunar.papers.greaves_scheeres_2023 import station_keeping_study as study
 from cislunar.papers.greaves_scheeres_2023.claims.informed_station_keeping import (
     CLAIMS,
+    CONSISTENT,
     PROJECTION_VALLEY_PHASES,
     QUARTER_TURN_PHASES,
 )
@@ -374,11 +375,12 @@ print(f"tracking from {T_BURN_H - PRE_ARC_H:.0f} h: sqrt(J_rho) of u* with both 
 # maneuvers and covariance analyses. The table gives medians over the slices: the percentile of $\mathbf u^*$ in
 # its slice, its $\sqrt{J_\rho}$ at $t_f$, its fuel, the share of maneuvers using more fuel, and the best
 # $\sqrt{J_\rho}$ of the slice (a property of the set, which should settle as the grid is refined). Then:
-# $\sqrt{J_\rho}$ of $\mathbf u^*$ over the slice's best (median over slices), the percentage of slices where
+# $\sqrt{J_\rho}$ of $\mathbf u^*$ over the slice's best and over the edge of the slice's valley, its
+# 25th-percentile $\sqrt{J_\rho}$ (medians over slices; section 5c), the percentage of slices where
 # $\mathbf u^*$ uses at most the slice's median fuel, the percentage of `N_RANDOM` uninformed picks per slice (target
 # ring angles uniform on $[0, 2\pi)$, stream `[SEED, 21]`; section 5c) that $\mathbf u^*$ beats, and the percentage
 # of slices where $\mathbf u^*$ is off the fuel peak (outside the most expensive quarter of its slice's maneuvers).
-# The closing table uses the u*/best, beats-random and off-fuel-peak columns.
+# The closing table uses the u*/valley edge, beats-random and off-fuel-peak columns.
 
 # %%
 t_grid = np.linspace(*T_ARRIVAL_H, N_GRID_SLICES) * HR
@@ -497,10 +499,14 @@ raised_counts = np.array([len(v[2]) for v in raised_by_n.values()])
 # choice.
 # Two comparisons that a poor choice does fail:
 #
-# - **Against the best maneuver of its slice:** $\sqrt{J_\rho}$ of $\mathbf u^*$ over the slice's best,
-#   the median over the slices; "in the valley" read as within 50 % of its floor (at most 1.5). The verdicts below do
-#   not hang on the 50 %: the angle reading's ratio grows far beyond any such bound as the grid is refined, the
-#   projection reading's stays within a few percent of 1.
+# - **Against the valley of its slice:** the paper's words are "fall in the valley of range uncertainty", so the
+#   yardstick is the surface itself, not a factor of ours. The valley of a slice is its best quartile of maneuvers
+#   (the chapter's one reading of the word, that of the valley rows), and its *edge* the slice's 25th-percentile
+#   $\sqrt{J_\rho}$ (`study.valley_edge_ratio`). The row divides $\sqrt{J_\rho}$ of $\mathbf u^*$ by that edge
+#   and asks for the median over the slices to be at most 1, at every ring-angle grid. Printed next to it: the
+#   ratio to the slice's best, and where the edge sits above the best (until 2026-11-26 the row asked for
+#   $\mathbf u^*$ within 1.5 times the best, a number of ours; in the full run the edge is tighter than that in 32
+#   of the 40 slices).
 # - **Against an uninformed pick:** the station keeping the informed choice replaces picks a point of the torus
 #   without regard to information. `study.random_pick_study` draws `N_RANDOM` target ring angles uniformly on
 #   $[0, 2\pi)$ (stream `[SEED, 20]`; the same angles for every arrival slice; continuous, so the baseline does not
@@ -517,22 +523,28 @@ rand = study.random_pick_study(em, torus, t_arr, T_BURN_H * HR, T_FINAL_H * HR, 
 print(f"{N_RANDOM} random picks per slice: sqrt(J_rho) {rand.range_sigma_km.min() * 1e3:.1f}-"
       f"{rand.range_sigma_km.max() * 1e3:.0f} m (median {np.median(rand.range_sigma_km) * 1e3:.1f} m), fuel "
       f"{rand.fuel_m_s.min():.2f}-{rand.fuel_m_s.max():.2f} m/s")
-vs_best, vs_rand = {}, {}
+edge_best = np.percentile(S.range_sigma_km, study.VALLEY_PERCENT, axis=1) / S.best_range_sigma_km  # same maneuvers
+print(f"valley edge ({study.VALLEY_PERCENT:.0f}th-percentile sqrt(J_rho) of a slice) / slice best: median "
+      f"{np.median(edge_best):.2f} ({edge_best.min():.2f}-{edge_best.max():.2f} over the slices)")
+vs_best, vs_edge, vs_rand = {}, {}, {}
 for name, surf in (("angle", S), ("projection", S_proj)):
     vs_best[name] = float(np.median(surf.informed_range_sigma_km / surf.best_range_sigma_km))
+    vs_edge[name] = float(np.median(study.valley_edge_ratio(surf)))
     vs_rand[name] = rand.beaten_percent(surf)
-    print(f"{name} reading: u* / slice best {vs_best[name]:.2f} (median over slices); u* beats {vs_rand[name]:.0f} % "
-          f"of the random picks; at every grid of section 5b ({'/'.join(str(n) for n in N_GRID)} ring angles): "
-          f"u* / best {'/'.join(f'{v:.2f}' for v in grid.series(0.0, name, 'ratio_best'))}, beats "
+    print(f"{name} reading: u* / valley edge {vs_edge[name]:.2f}, u* / slice best {vs_best[name]:.2f} (medians over "
+          f"slices); u* beats {vs_rand[name]:.0f} % of the random picks; at every grid of section 5b "
+          f"({'/'.join(str(n) for n in N_GRID)} ring angles): u* / valley edge "
+          f"{'/'.join(f'{v:.2f}' for v in grid.series(0.0, name, 'ratio_valley'))}, u* / best "
+          f"{'/'.join(f'{v:.2f}' for v in grid.series(0.0, name, 'ratio_best'))}, beats "
           f"{'/'.join(f'{v:.0f}' for v in grid.series(0.0, name, 'beats_random'))} % of random picks")
 print(f"for scale: random picks better than doing nothing ({S.range_sigma_km[0, 0] * 1e3:.0f} m): "
       f"{np.mean(rand.range_sigma_km < S.range_sigma_km[0, 0]) * 100:.0f} %")
 
 # %% [markdown]
 # **Reading.** The angle reading's $\mathbf u^*$ beats about a quarter of the random picks on the coarsest grid
-# (16 ring angles, full run) and almost none on the finer ones (it tends to no maneuver), and its distance from the
-# slice's best grows with the grid; the projection reading's $\mathbf u^*$ is within a few percent of the slice's
-# best and beats about nine
+# (16 ring angles, full run) and almost none on the finer ones (it tends to no maneuver), and it sits ever farther
+# above its slice's valley as the grid is refined; the projection reading's $\mathbf u^*$ is within a few percent of
+# the slice's best, below the valley's edge, and beats about nine
 # random picks in ten or more, on every grid. So "significantly improves" holds in a form that could have failed
 # for the projection reading (tuned, since that reading was chosen looking at the paper's Fig. 4), not for the
 # angle reading.
@@ -726,22 +738,36 @@ _ = plotting.save_figure(figures.monte_carlo_range_errors(mcs), "08_monte_carlo_
 #   *tuned*; the note of each row gives the least share of maneuvers costing more than $\mathbf u^*$, which shows
 #   how far the verdict is from the quartile.
 # - **The second burn's local peak.** The paper says the second burn raises $\sqrt{J_\rho}$ at one point of the
-#   $\mathbf u^*$ line; the criterion asks for a ratio (both burns over first burn only) above 1 in some slice.
+#   $\mathbf u^*$ line; the criterion asks for a ratio (both burns over first burn only) above 1 in some slice. The
+#   paper's line is the line of its Fig. 4, which the chapter identifies with the projection reading, so the row is
+#   judged on that reading's $\mathbf u^*$ (until 2026-11-26 on the angle reading's); the angle reading's ratio is
+#   measured as well and printed in the row, with its own verdict.
 #   The raised point itself is tested on the projection line: exactly one slice whose $\sqrt{J_\rho}$ exceeds both
 #   neighbours' by more than 10 %, at every arrival sampling of `N_RAISED` (how many points are raised depends on
 #   the sampling, which the paper does not give; until 2026-11-26 only the `N_SURF` slices of section 3 were
 #   counted).
 # - **"Significantly improves"**, against baselines that can fail (section 5c): $\sqrt{J_\rho}$ of
-#   $\mathbf u^*$ at most 1.5 times the slice's best (median over slices), and $\mathbf u^*$ better than at least
+#   $\mathbf u^*$ at most the edge of its slice's valley, the slice's 25th-percentile $\sqrt{J_\rho}$ (median over
+#   slices; until 2026-11-26: at most 1.5 times the slice's best, a number of ours, where the paper's words "in the
+#   valley" give the surface's own yardstick), and $\mathbf u^*$ better than at least
 #   75 % of uninformed picks (ring angles uniform on $[0, 2\pi)$, seeded); both at every ring-angle grid of section
 #   5b as well (the worst grid is compared). Against doing nothing every maneuver passes, so that comparison is
 #   printed in section 5c but is not a row.
-# - **The full-filter rows** are beyond the paper (its future work) and carry no criterion: they report what the
-#   filter achieves.
+# - **The full-filter rows** are beyond the paper (its future work). The NEES row, the 10x-smaller-errors row and
+#   the no-maneuver row ask whether the filter is consistent at $t_f$: the two-sided chi-square tail probability
+#   of each policy's mean NEES (12 states times the runs that did not fail, `study.nees_p_value`) must be at least
+#   0.05, i.e. every mean NEES inside its 95 % band (10.5-13.6 for 40 runs), fixed by the run count and the state
+#   dimension alone (until 2026-11-26 these rows carried no criterion and could not fail). Without a maneuver the
+#   filter is expected to fail it, and does (section 7): the paper's covariance analysis assumes a filter "that does
+#   not diverge". The RMS row compares policies and only reports.
 #
 # The cell first gathers what the rows compare: `fuel_test` applies the Fig. 5 criterion to one reading (the
-# baseline surface and every grid of section 5b); `worst_best` and `worst_rand` take the least favourable of the baseline surface and the
-# grids for the two "improves" comparisons of section 5c; `raised` lists the raised slices of the projection line
+# baseline surface and every grid of section 5b); `worst_edge` (the ratio to the valley's edge) and
+# `worst_rand` take the least favourable of the baseline surface and the grids for the two "improves" comparisons
+# of section 5c; `second_raises` applies `study.second_burn_raises` to the ratio of each reading (the projection
+# reading's is judged, the angle reading's printed with its own verdict); `p_exec`, `p_small` and `p_none` are the
+# smallest chi-square tail probabilities of the mean NEES over the policies of the three full-filter rows that carry
+# the consistency criterion (`mcs.p_value`, runs that did not fail only); `raised` lists the raised slices of the projection line
 # on the surface of section 3, each with its neighbours, the phases picked there and the second burn's ratio, and
 # `raised_reason` says at which samplings of `N_RAISED` the count is not 1; the quarter-turn row is built only
 # when the sweep of section 6 has agent phases 1/4 or 3/4, and the projection row at phase 0 or 1/2 takes the worst
@@ -766,7 +792,13 @@ def fuel_test(reading, stats):
 
 
 fuel_ok = {"angle": fuel_test("angle", st), "projection": fuel_test("projection", st_proj)}
-worst_best = {name: max(vs_best[name], *grid.series(0.0, name, "ratio_best")) for name in vs_best}
+worst_edge = {name: max(vs_edge[name], *grid.series(0.0, name, "ratio_valley")) for name in vs_edge}
+second_raises = {"angle": study.second_burn_raises(second_effect),
+                 "projection": study.second_burn_raises(second_effect_proj)}
+# the full-filter rows: the smallest chi-square tail probability of the mean NEES over the row's policies
+p_exec = min(mcs.p_value(INF, "exec"), mcs.p_value(INFP, "exec"))
+p_small = min(mcs.p_value(pol, "small") for pol in (INF, INFP, UNI))
+p_none = mcs.p_value(NONE, "perfect")
 worst_rand = {name: min(vs_rand[name], *grid.series(0.0, name, "beats_random")) for name in vs_rand}
 raised = st_proj.raised_slices
 raised_txt = "; ".join(f"{S_proj.t_arrival_hours[j]:+.1f} h: {S_proj.informed_range_sigma_km[j] * 1e3:.1f} m vs "
@@ -841,11 +873,16 @@ table.add(
              f"{'/'.join(f'{v:.2f}' for v in fuel_ok['projection'][2])} m/s with {grids} ring angles (settles with the "
              f"grid), at most {S.fuel_m_s.max():.2f} m/s in the set: well below the peak, near the middle of the "
              f"distribution (at or below the slice median fuel in {st_proj.below_median_fuel * 100:.0f} % of slices)"),
-    CLAIMS["second_burn_peak"].judge(bool(second_effect.max() > 1),
-        shown=f"ratio both burns / first only {second_effect.min():.3f}-{second_effect.max():.3f}",
-        note=f"Tracking 24 h before the first burn: {second_effect_pre.min():.2f}-{second_effect_pre.max():.2f} (raised "
-             f"by > 10 % in {np.sum(second_effect_pre > 1.1)} of {S.t_arrival.size} slices); projection reading: "
-             f"{second_effect_proj.min():.4f}-{second_effect_proj.max():.4f}, including its raised point (next row)"),
+    CLAIMS["second_burn_peak"].judge(second_raises["projection"],
+        shown=f"ratio both burns / first only {second_effect_proj.min():.4f}-{second_effect_proj.max():.4f} "
+              f"(projection reading; angle reading {second_effect.min():.3f}-{second_effect.max():.3f})",
+        note=f"the second burn raises sqrt(J_rho) of u* in some slice: projection reading (adopted for Fig. 4, the "
+             f"status) {'yes' if second_raises['projection'] else 'no'}, angle reading "
+             f"{'yes' if second_raises['angle'] else 'no'}" + (", the same verdict under both readings" if
+             second_raises["angle"] == second_raises["projection"] else ", the readings disagree") +
+             f"; the projection line's raised point (next row) included. Tracking 24 h before the first burn (angle "
+             f"reading): {second_effect_pre.min():.2f}-{second_effect_pre.max():.2f} (raised by > 10 % in "
+             f"{np.sum(second_effect_pre > 1.1)} of {S.t_arrival.size} slices)"),
     CLAIMS["raised_point_projection"].judge(raised_counts,
         shown=f"{'/'.join(str(c) for c in raised_counts)} raised point(s) with {raised_ns} arrival slices",
         reason=raised_reason,
@@ -853,16 +890,21 @@ table.add(
              else "") + f"; angle reading: {len(st.raised_slices)} raised slice(s). The point is raised because u* "
              "jumps to another ring angle there, not by the second burn (ratio well below 1: without it the same "
              "maneuver is far worse)"),
-    CLAIMS["vs_best_angle"].judge(worst_best["angle"],
-        shown=f"{worst_best['angle']:.2f} (u* {np.median(S.informed_range_sigma_km) * 1e3:.1f} m vs best "
+    CLAIMS["vs_best_angle"].judge(worst_edge["angle"],
+        shown=f"{worst_edge['angle']:.2f} (worst grid; u* {np.median(S.informed_range_sigma_km) * 1e3:.1f} m vs best "
               f"{np.median(S.best_range_sigma_km) * 1e3:.1f} m, median over slices)",
-        note=f"{vs_best['angle']:.2f} on the {N_SURF}-angle surface; {series('angle', 'ratio_best', '{:.2f}')} with {grids} "
-             f"ring angles, growing as the grid is refined. Doing nothing: {none_km * 1e3:.0f} m (every maneuver beats it)"),
-    CLAIMS["vs_best_projection"].judge(worst_best["projection"],
-        shown=f"{worst_best['projection']:.2f} (u* {np.median(S_proj.informed_range_sigma_km) * 1e3:.1f} m vs best "
-              f"{np.median(S.best_range_sigma_km) * 1e3:.1f} m, median over slices)",
-        note=f"{vs_best['projection']:.2f} on the {N_SURF}-angle surface; {series('projection', 'ratio_best', '{:.2f}')} "
-             f"with {grids} ring angles (grid-independent)"),
+        note=f"{vs_edge['angle']:.2f} on the {N_SURF}-angle surface (u* / slice best {vs_best['angle']:.2f}; the valley's "
+             f"edge lies a median {np.median(edge_best):.2f} times above the best); u* / valley edge "
+             f"{series('angle', 'ratio_valley', '{:.2f}')} with {grids} ring angles, growing as the grid is refined "
+             f"(u* / best {series('angle', 'ratio_best', '{:.2f}')}). Doing nothing: {none_km * 1e3:.0f} m (every "
+             "maneuver beats it)"),
+    CLAIMS["vs_best_projection"].judge(worst_edge["projection"],
+        shown=f"{worst_edge['projection']:.2f} (worst grid; u* {np.median(S_proj.informed_range_sigma_km) * 1e3:.1f} m "
+              f"vs best {np.median(S.best_range_sigma_km) * 1e3:.1f} m, median over slices)",
+        note=f"{vs_edge['projection']:.2f} on the {N_SURF}-angle surface (u* / slice best {vs_best['projection']:.2f}; "
+             f"the valley's edge lies a median {np.median(edge_best):.2f} times above the best); u* / valley edge "
+             f"{series('projection', 'ratio_valley', '{:.2f}')} with {grids} ring angles (u* / best "
+             f"{series('projection', 'ratio_best', '{:.2f}')}; grid-independent)"),
     CLAIMS["vs_random_angle"].judge(worst_rand["angle"],
         shown=f"{worst_rand['angle']:.0f} % (worst grid)",
         note=f"{vs_rand['angle']:.0f} % of {N_RANDOM} random picks per slice on the {N_SURF}-angle surface (stream "
@@ -872,14 +914,17 @@ table.add(
         shown=f"{worst_rand['projection']:.0f} % (worst grid)",
         note=f"{vs_rand['projection']:.0f} % of {N_RANDOM} random picks per slice on the {N_SURF}-angle surface; "
              f"{series('projection', 'beats_random', '{:.0f}')} % with {grids} ring angles"),
-    CLAIMS["filter_nees"].judge(ia["nees"], shown=f"{ia['nees']:.2f} / {ipa['nees']:.2f} (band {lo:.1f}-{hi:.1f})",
-        note=f"iterated EKF, {N_TRIALS} runs; perfect burns: {ip['nees']:.2f} / {ipp['nees']:.2f}"),
-    CLAIMS["filter_no_maneuver"].judge(nm["nees"], shown=f"{nm['nees']:.1f}; {nm['rms'] / 1e3:.1f} vs {nm['fsig'] / 1e3:.1f} km",
-        note="range nearly unobservable without a maneuver: the iterated EKF diverges (NEES far above the band, error "
-             f"larger than the prior's {mcs.prior_range_m / 1e3:.1f} km range 1-sigma)"),
-    CLAIMS["filter_small_errors"].judge(isml["rms"], shown=f"{isml['rms']:.0f} / {ispm['rms']:.0f} / {usml['rms']:.0f} m",
+    CLAIMS["filter_nees"].judge(p_exec, shown=f"{ia['nees']:.2f} / {ipa['nees']:.2f} (band {lo:.1f}-{hi:.1f})",
+        note=f"{CONSISTENT}; tail probability {mcs.p_value(INF, 'exec'):.2f} / {mcs.p_value(INFP, 'exec'):.2f}; iterated "
+             f"EKF, {N_TRIALS} runs; perfect burns: {ip['nees']:.2f} / {ipp['nees']:.2f}"),
+    CLAIMS["filter_no_maneuver"].judge(p_none, shown=f"{nm['nees']:.1f}; {nm['rms'] / 1e3:.1f} vs {nm['fsig'] / 1e3:.1f} km",
+        note=f"{CONSISTENT}; tail probability {p_none:.2g}" + (" (below the float range)" if p_none == 0 else "") +
+             f" (band {lo:.1f}-{hi:.1f}); prior range 1-sigma "
+             f"{mcs.prior_range_m / 1e3:.1f} km"),
+    CLAIMS["filter_small_errors"].judge(p_small, shown=f"{isml['rms']:.0f} / {ispm['rms']:.0f} / {usml['rms']:.0f} m",
         note=f"{EXEC_ABS_M_S * 1e2:g} mm/s + {EXEC_REL * 10:g} % per axis; NEES {isml['nees']:.1f} / {ispm['nees']:.1f} / "
-             f"{usml['nees']:.1f}"),
+             f"{usml['nees']:.1f} (band {lo:.1f}-{hi:.1f}); {CONSISTENT}; tail probability "
+             + " / ".join(f"{mcs.p_value(pol, 'small'):.2f}" for pol in (INF, INFP, UNI))),
     CLAIMS["filter_rms"].judge(ia["rms"], shown=f"{ia['rms']:.0f} / {ipa['rms']:.0f} / {ua['rms']:.0f} / {nm['rms']:.0f} m",
         note=f"execution errors {EXEC_ABS_M_S * 1e3:.0f} mm/s + {EXEC_REL * 100:.0f} % per axis; perfect burns: informed "
              f"{ip['rms']:.1f} / {ipp['rms']:.1f} m (covariance analysis {ip['ca']:.1f} / {ipp['ca']:.1f} m), uninformed "

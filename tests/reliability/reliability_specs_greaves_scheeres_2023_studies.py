@@ -10,7 +10,7 @@ surface, tiny policy, tracking-arc, grid and Monte Carlo studies) are built once
 baseline call costs about a second or less, except ``member_study`` (2 s: it converges a 30-km torus) and the three
 notebook-08 exercises (about 4 s each: they converge the paper's 215-km torus).  The result objects' methods that
 take arguments (``SliceStatistics.format``, ``GridStudy.series``, ``PolicyStudy.*``, ``TrackingArcStudy.*``,
-``MonteCarloStudy.ratio``) are swept too.  Figure calls close the figure they draw.
+``MonteCarloStudy.ratio``, ``MonteCarloStudy.p_value``) are swept too.  Figure calls close the figure they draw.
 """
 
 from __future__ import annotations
@@ -171,6 +171,12 @@ def specs(S, lazy):
                dict(agent_phase="real", reading="choice", key="choice")))
     s.append(S("MonteCarloStudy.ratio", lazy(lambda: _mcs().ratio), dict(policy=sks.POLICIES[1], level="exec"),
                dict(policy="choice", level="choice")))
+    s.append(S("MonteCarloStudy.p_value", lazy(lambda: _mcs().p_value), dict(policy=sks.POLICIES[1], level="exec"),
+               dict(policy="choice", level="choice")))
+    s.append(S("valley_edge_ratio", sks.valley_edge_ratio, dict(surface=surface), dict(surface="instance")))
+    s.append(S("second_burn_raises", sks.second_burn_raises, dict(ratio=np.array([0.5, 1.2])), dict(ratio="vec")))
+    s.append(S("nees_p_value", sks.nees_p_value, dict(mean_nees=12.0, n_runs=40, dim=12),
+               dict(mean_nees="nonneg", n_runs="int1", dim="int1")))
     s.append(S("grid_resolution_study", sks.grid_resolution_study,
                dict(system=em, torus=torus, n_grid=(3, 4), t_arrival=T_ARRIVAL, t_burn=T_BURN, t_final=T_FINAL,
                     agent_phases=(0.0,), executor=None),

@@ -4,13 +4,16 @@ Each function runs one study over :func:`cislunar.papers.greaves_scheeres_2023.s
 and returns a frozen result object:
 
 * :func:`slice_statistics`: where :math:`\mathbf u^*` ranks within each arrival slice (range uncertainty, fuel);
+* :func:`valley_edge_ratio`: :math:`\sqrt{J_\rho}` of :math:`\mathbf u^*` against the edge of its slice's valley;
+* :func:`second_burn_raises`: whether the second burn raises :math:`\sqrt{J_\rho}` of :math:`\mathbf u^*` somewhere;
 * :func:`grid_resolution_study`: both readings of Eq. 25 as the ring-angle grid is refined;
 * :func:`scenario_sweep`: the unstated scenario inputs (tracking start, burn lead, agent phase, read-out time);
 * :func:`offset_study`: an agent that has drifted off the torus;
 * :func:`member_study`: torus members matching 215 km under other readings of "average range";
 * :func:`random_pick_study`: uninformed station-keeping maneuvers (target ring angle drawn uniformly at random), the
   baseline that :math:`\mathbf u^*` is judged against;
-* :func:`filter_monte_carlo`: the iterated-EKF Monte Carlo with execution errors (beyond the paper).
+* :func:`filter_monte_carlo`: the iterated-EKF Monte Carlo with execution errors (beyond the paper), and
+  :func:`nees_p_value`, the chi-square consistency test of its mean NEES.
 
 The sweeps (:func:`grid_resolution_study`, :func:`scenario_sweep`, :func:`offset_study`) and the Monte Carlo take
 ``executor=`` (from :func:`cislunar.utils.executors.open_executor`; ``None`` runs serially): one task per surface
@@ -43,6 +46,7 @@ __all__ = [
     "POLICIES",
     "FUEL_PEAK_QUARTER",
     "RAISED_FRACTION",
+    "VALLEY_PERCENT",
     "GridRow",
     "GridStudy",
     "MonteCarloStudy",
@@ -54,10 +58,13 @@ __all__ = [
     "format_sweep",
     "grid_resolution_study",
     "member_study",
+    "nees_p_value",
     "offset_study",
     "random_pick_study",
     "scenario_sweep",
+    "second_burn_raises",
     "slice_statistics",
+    "valley_edge_ratio",
 ]
 
 
@@ -198,6 +205,35 @@ def slice_statistics(surface) -> SliceStatistics:
                            _raised(S.informed_range_sigma_km))
 
 
+#: The valley of a slice (Fig. 4): its best quartile of maneuvers by :math:`\sqrt{J_\rho}` at :math:`t_f`, the
+#: chapter's one reading of "in the valley" (the valley rows' percentile of u* at most this).
+VALLEY_PERCENT = 25.0
+
+
+def valley_edge_ratio(surface) -> np.ndarray:
+    """:math:`\\sqrt{J_\\rho}` of :math:`\\mathbf u^*` over the edge of its slice's valley, per arrival slice.
+
+    The edge is the :data:`VALLEY_PERCENT`-th percentile (linear interpolation) of the slice's :math:`\\sqrt{J_\\rho}`
+    at :math:`t_f` over all its ring angles: a ratio at most 1 puts :math:`\\mathbf u^*` in the valley, a ratio of
+    ``r`` means it is ``r`` times as uncertain as the valley's edge.  Dimensionless, shape ``(n_t,)``.
+    """
+    S = _surface(surface)
+    return S.informed_range_sigma_km / np.percentile(S.range_sigma_km, VALLEY_PERCENT, axis=1)
+
+
+def second_burn_raises(ratio) -> bool:
+    """Whether the second burn raises :math:`\\sqrt{J_\\rho}` of :math:`\\mathbf u^*` in some slice.
+
+    ``ratio``: per arrival slice, :math:`\\sqrt{J_\\rho}` of :math:`\\mathbf u^*` with both burns over the same with
+    its first burn only (:func:`station_keeping.first_burn_only_range_sigma_km`), positive.  True when some ratio
+    exceeds 1 (the paper's "small local peak ... induced by the secondary maneuver", Sec. 5).
+    """
+    r = _vector(ratio, "ratio")
+    if np.any(r <= 0):
+        raise ValueError(f"ratio must be positive (a ratio of two range sigmas); got {ratio!r:.80}")
+    return bool(np.any(r > 1.0))
+
+
 # ---------------------------------------------------------------------------------------------------------------
 # Eq. 25 readings against the grid resolution
 # ---------------------------------------------------------------------------------------------------------------
@@ -213,7 +249,8 @@ class GridRow:
     :math:`\\mathbf u^*` is outside the most expensive quarter of the slice's maneuvers
     (:attr:`SliceStatistics.outside_fuel_peak_share`); ``beats_random``: percent of random picks
     (:func:`random_pick_study` on the same slices) with a larger :math:`\\sqrt{J_\\rho}` than :math:`\\mathbf u^*`
-    (NaN when the study drew none).
+    (NaN when the study drew none); ``ratio_valley``: median over slices of :func:`valley_edge_ratio` (at most 1:
+    :math:`\\mathbf u^*` within its slice's valley).
     """
 
     agent_phase: float
@@ -228,10 +265,11 @@ class GridRow:
     below_median_share: float = float("nan")
     beats_random: float = float("nan")
     outside_peak_share: float = float("nan")
+    ratio_valley: float = float("nan")
 
 
 _GRID_KEYS = ("percentile", "sigma_m", "fuel_m_s", "more_fuel_percent", "best_m", "ratio_best", "below_median_share",
-              "beats_random", "outside_peak_share")
+              "beats_random", "outside_peak_share", "ratio_valley")
 
 
 @dataclass(frozen=True)
@@ -246,10 +284,12 @@ class GridStudy:
     def format(self) -> str:
         """The study as a text table, one line per row."""
         lines = [("agent phase | ring angles | reading    | percentile of u* % | sqrt(J) of u* m | fuel of u* m/s | "
-                 "more fuel % | best of slice m | u*/best | <= median fuel % | beats random % | off fuel peak %")]
+                 "more fuel % | best of slice m | u*/best | u*/valley edge | <= median fuel % | beats random % | "
+                 "off fuel peak %")]
         lines += [f" {g.agent_phase:10.2f} | {g.n:11d} | {g.reading:10s} | {g.percentile:18.1f} | {g.sigma_m:15.1f} | "
                   f"{g.fuel_m_s:14.3f} | {g.more_fuel_percent:11.1f} | {g.best_m:15.1f} | {g.ratio_best:7.2f} | "
-                  f"{g.below_median_share:16.0f} | {g.beats_random:14.0f} | {g.outside_peak_share:15.0f}"
+                  f"{g.ratio_valley:14.2f} | {g.below_median_share:16.0f} | {g.beats_random:14.0f} | "
+                  f"{g.outside_peak_share:15.0f}"
                   for g in self.rows]
         return "\n".join(lines)
 
@@ -287,7 +327,8 @@ def _grid_task(task):
                              float(np.median(r.best_range_sigma_km) * 1e3),
                              float(np.median(r.informed_range_sigma_km / r.best_range_sigma_km)),
                              float(np.mean(r.informed_fuel_m_s <= np.median(r.fuel_m_s, axis=1)) * 100),
-                             outside_peak_share=_outside_peak_share(r.informed_fuel_percentile)),
+                             outside_peak_share=_outside_peak_share(r.informed_fuel_percentile),
+                             ratio_valley=float(np.median(valley_edge_ratio(r)))),
                      r.informed_range_sigma_km))
     return rows
 
@@ -552,6 +593,20 @@ def execution_levels(exec_abs_m_s: float, exec_rel: float) -> dict:
     return {"perfect": (0.0, 0.0), "small": (exec_abs_m_s / 10, exec_rel / 10), "exec": (exec_abs_m_s, exec_rel)}
 
 
+def nees_p_value(mean_nees: float, n_runs: int, dim: int = 12) -> float:
+    """Two-sided chi-square tail probability of a mean NEES over ``n_runs`` runs of a ``dim``-state filter.
+
+    For a consistent filter ``n_runs * mean_nees`` is chi-square with ``dim * n_runs`` degrees of freedom; the value
+    returned is ``2 * min(cdf, sf)`` of it (at most 1).  It is at least 0.05 exactly when ``mean_nees`` lies inside
+    the 95 % band of :attr:`MonteCarloStudy.band` (``chi2.ppf([0.025, 0.975], dim * n_runs) / n_runs``), so the
+    band's test becomes one number whose threshold does not depend on the run count.
+    """
+    m = validation.positive(mean_nees, "mean_nees", allow_zero=True)
+    n = validation.integer(n_runs, "n_runs", minimum=1)
+    k = validation.integer(dim, "dim", minimum=1) * n
+    return float(min(1.0, 2 * min(chi2.cdf(n * m, k), chi2.sf(n * m, k))))
+
+
 @dataclass(frozen=True)
 class MonteCarloStudy:
     """Summary of the filter runs per (policy, execution level).
@@ -594,6 +649,16 @@ class MonteCarloStudy:
                   f"{s['rms']:17.1f} | {s['fsig']:14.1f} | {s['ca']:15.1f}" for (pol, tag), s in self.summary.items()]
         lines.append(f"range 1-sigma of the prior at the start of tracking: {self.prior_range_m:.0f} m")
         return "\n".join(lines)
+
+    def p_value(self, policy: str, level: str = "perfect") -> float:
+        """:func:`nees_p_value` of the mean NEES of ``policy`` at ``level`` over its runs that did not fail (12-state
+        SSAT filter): at least 0.05 when the mean NEES is inside its 95 % band."""
+        validation.choice(policy, "policy", POLICIES)
+        validation.choice(level, "level", tuple(self.levels))
+        if (policy, level) not in self.summary:
+            raise ValueError(f"level must be 'perfect' for {policy!r} (no burn to execute); got {level!r}")
+        s = self.summary[(policy, level)]
+        return nees_p_value(s["nees"], self.n_trials - s["failed"])
 
     def ratio(self, policy: str, level: str = "perfect") -> float:
         """RMS range error of ``policy`` over that of the uninformed choice."""

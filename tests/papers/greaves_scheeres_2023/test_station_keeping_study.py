@@ -95,6 +95,13 @@ def test_filter_monte_carlo_structure(surface):
     assert mcs.prior_range_m == pytest.approx(20e3 * np.sqrt(2), rel=1e-9)
     assert mcs.ratio(uni) == pytest.approx(1.0)
     assert "filter runs" in mcs.format()
+    s = mcs.summary[(infp, "exec")]
+    assert mcs.p_value(infp, "exec") == pytest.approx(study.nees_p_value(s["nees"], 1 - s["failed"]))
+    with pytest.raises(ValueError, match="perfect"):
+        mcs.p_value(none, "exec")
+    # failed runs do not count: 3 trials with 1 failed is a mean over 2 runs
+    two = replace(mcs, n_trials=3, summary={**mcs.summary, (infp, "exec"): {**s, "nees": 14.0, "failed": 1}})
+    assert two.p_value(infp, "exec") == pytest.approx(study.nees_p_value(14.0, 2))
 
 
 def test_sweeps_on_an_executor_match_the_serial_run(torus, surface):
@@ -278,3 +285,73 @@ def test_raised_point_claim_needs_one_point_at_every_sampling():
     assert claim.judge(np.array([1, 1, 1]), reason="r").status == "consistent (tuned)"
     for counts in ([0, 1, 1], [1, 2, 1], [0, 0, 0]):
         assert claim.judge(np.array(counts), reason="r").status == "differs"
+
+
+def test_valley_edge_ratio_against_the_slice_quartile_known_answer(surface):
+    """u* / the slice's 25th-percentile sqrt(J_rho): at most 1 inside the valley, above 1 outside it."""
+    S = surface  # 3 slices x 6 ring angles
+    sig = np.tile(np.array([1.0, 2.0, 3.0, 4.0, 5.0, 100.0]), (3, 1))  # 25th percentile (linear): 2.25
+    inside = replace(S, range_sigma_km=sig, informed=np.array([0, 1, 0]))
+    outside = replace(S, range_sigma_km=sig, informed=np.array([2, 3, 5]))
+    assert np.allclose(study.valley_edge_ratio(inside), [1 / 2.25, 2 / 2.25, 1 / 2.25])
+    assert np.allclose(study.valley_edge_ratio(outside), [3 / 2.25, 4 / 2.25, 100 / 2.25])
+    assert np.all(study.valley_edge_ratio(inside) <= 1) and np.all(study.valley_edge_ratio(outside) > 1)
+    assert np.allclose(study.valley_edge_ratio(S),
+                       S.informed_range_sigma_km / np.percentile(S.range_sigma_km, 25, axis=1))
+    # the claim flips on it: the projection row passes inside, differs outside
+    from cislunar.papers.greaves_scheeres_2023.claims.informed_station_keeping import CLAIMS
+
+    claim = CLAIMS["vs_best_projection"]
+    assert claim.judge(float(np.median(study.valley_edge_ratio(inside)))).status == "consistent (tuned)"
+    assert claim.judge(float(np.median(study.valley_edge_ratio(outside)))).status == "differs"
+
+
+def test_grid_study_valley_column_is_the_median_edge_ratio(torus):
+    t_grid = np.array([-6.0, 0.5, 7.0]) * HR  # three slices: a median, not a mean
+    g = study.grid_resolution_study(em, torus, (6,), t_grid, -18 * HR, 12 * HR, agent_phases=(0.0,))
+    s6 = sk.station_keeping_surface(em, torus, 2 * np.pi * np.arange(6) / 6, t_grid, -18 * HR, 12 * HR,
+                                    progress=False)
+    for reading in ("angle", "projection"):
+        r = s6.reselect(reading)
+        edge = np.percentile(r.range_sigma_km, 25, axis=1)
+        assert g.series(0.0, reading, "ratio_valley")[0] == pytest.approx(
+            np.median(r.informed_range_sigma_km / edge))
+    assert "u*/valley edge" in g.format()
+
+
+def test_second_burn_raises_only_above_one():
+    assert study.second_burn_raises(np.array([0.2, 1.01, 0.5]))
+    assert not study.second_burn_raises(np.array([0.2, 0.9, 1.0]))  # equal is not raised
+    assert not study.second_burn_raises([0.0007, 0.0003])
+    with pytest.raises(ValueError, match="ratio"):
+        study.second_burn_raises(np.array([0.5, -1.0]))
+    from cislunar.papers.greaves_scheeres_2023.claims.informed_station_keeping import CLAIMS
+
+    claim = CLAIMS["second_burn_peak"]
+    assert claim.judge(study.second_burn_raises([1.2])).status == "consistent (tuned)"
+    assert claim.judge(study.second_burn_raises([0.9])).status == "differs"
+
+
+def test_nees_p_value_is_the_two_sided_chi_square_band():
+    from scipy.stats import chi2
+
+    for n, dim in ((40, 12), (2, 12), (5, 3)):
+        lo, hi = chi2.ppf([0.025, 0.975], dim * n) / n
+        assert study.nees_p_value(lo, n, dim) == pytest.approx(0.05)
+        assert study.nees_p_value(hi, n, dim) == pytest.approx(0.05)
+        assert study.nees_p_value(lo * 1.01, n, dim) > 0.05 and study.nees_p_value(hi * 0.99, n, dim) > 0.05
+        assert study.nees_p_value(lo * 0.99, n, dim) < 0.05 and study.nees_p_value(hi * 1.01, n, dim) < 0.05
+    # the 40-run band of the 12-state filter is 10.5-13.6: 11.8 passes, 14 and 103 fail
+    assert study.nees_p_value(11.8, 40) > 0.05 > study.nees_p_value(14.0, 40) > study.nees_p_value(103.0, 40)
+    # an independent check: simulated means of chi-square(12) draws land inside the band 95 % of the time
+    rng = np.random.default_rng(3)
+    means = rng.chisquare(12, size=(4000, 40)).mean(axis=1)
+    share = np.mean([study.nees_p_value(m, 40) >= 0.05 for m in means])
+    assert 0.93 < share < 0.97
+    from cislunar.papers.greaves_scheeres_2023.claims.informed_station_keeping import CLAIMS
+
+    for key in ("filter_nees", "filter_small_errors", "filter_no_maneuver"):
+        assert CLAIMS[key].judge(study.nees_p_value(11.8, 40)).status == "beyond paper"
+        assert CLAIMS[key].judge(study.nees_p_value(14.0, 40)).status == "differs"
+    with pytest.raises(ValueError, match="mean_nees"):
+        study.nees_p_value(-1.0, 40)
