@@ -430,9 +430,10 @@ print(demo.fig13_report())
 # paper detects with $z$ and not with the metric.
 #
 # **The statements behind Figs. 10-11, on many runs.** $N$ quiet-policy runs with a burn and $N$ without (sizes
-# printed) are filtered with both tunings at $f = 0.1$ (the same data for both). Criteria fixed before running:
-# *Fig. 10* holds if at most 10 % of the runs are NEES-inconsistent, forward and smoothed, with and without a
-# burn, widened by two binomial standard errors of a fraction of $N$ runs (14.2 % for 200), and the constant tuning's
+# printed) are filtered with both tunings at $f = 0.1$ (the same data for both). Criteria (the Fig. 10 limit revised
+# on 2026-11-26, see below): *Fig. 10* ("both the forwards and smoothed filters produce consistent, but less
+# certain, solutions") holds if at most 10 % of the runs are NEES-inconsistent, forward and smoothed, with and
+# without a burn (the chapter's rule for "consistent", as in the Figs. 12-13 rows), and the constant tuning's
 # mean forward 3-sigma position bound is larger than the window tuning's;
 # *Fig. 11* holds if in at least 90 % of the burn runs the smoothed control's spike contrast at the burn
 # (`detection.control_spike_contrast`: mean norm within 6 h of the burn over the mean elsewhere) is at least 2 and
@@ -452,9 +453,12 @@ spike, fig10_ok, fig11_h1, fig11_h0 = spike_study.cells, spike_study.fig10_ok, s
 # are inconsistent, inside the 10 % of notebook 09's rule. *How these runs were drawn.* A first draw (seed
 # `[SEED, 41]`, an earlier full run) gave 10.5 % smoothed: above 10 % by a quarter of one binomial standard
 # error of 200 runs (2.1 points). The row's limit was then widened to 10 % plus two such errors (14.2 %), with
-# 10.5 % in view, which the status rule does not allow on the same runs. So the runs were drawn once more with a new
-# seed (`[SEED, 42]`) after that limit was declared (commit of 2026-11-26 04:27), and the row judges only the new
-# runs, whatever they gave. The row is "consistent (tuned)", because the constant weight is the window weight at $f = 0.1$. The smoothed
+# 10.5 % in view, and the runs were drawn once more with a new seed (`[SEED, 42]`, commit of 2026-11-26 04:27),
+# which the row judges. A referee's pass (2026-11-26, later) put the limit back to the chapter's 10 %: a widening
+# decided after seeing 10.5 % is a choice made while looking, and no other consistency row of the chapter widens
+# its 10 %. The new draw passes the 10 % rule too (full run: at most 8.0 % in any cell). But it is a second draw,
+# made after the first had missed this very limit, so the row says so: it is "consistent (tuned)", because the
+# constant weight is the window weight at $f = 0.1$ and because the judged runs are the redraw. The smoothed
 # spike of Fig. 11 appears without a burn in 2 % of the runs only, but with a burn it stands out (contrast at least
 # 2 and above the forward one) in about two runs out of three (64 %; the first draw: 74 %): in the others the
 # smoother, which may fit control everywhere, does not concentrate the burn in the 12 hours around it. With the
@@ -509,6 +513,20 @@ print(train.tables_report(F_C))
 # **Figs. 14-15 and 18-19 analogues** at $f = 0.1$: histograms (left of each pair) and kernel density estimates
 # (right) of $z$ without (blue) and with (red) a maneuver; the dotted line is $z_{lim}$, where the two PDFs cross.
 # Rows are the three orbits, the left pair the active policy (m/s), the right pair the quiet policy (mm/s).
+#
+# **How the thresholds are judged.** The paper prints $z_{lim}$ = 0.4106 m/s (active) and 17.22 mm/s (quiet), each
+# from its own 500 + 3000 runs: a Monte Carlo estimate with a sampling error the paper does not print, like ours. At
+# $f_c$ (the predictions) the tolerance is therefore half a unit of the paper's last printed digit plus two standard
+# errors of the *difference*: our bootstrap error and the paper's in quadrature. The paper's is estimated from ours:
+# our relative error at the paper's value, scaled to its sample sizes (equal to ours in the full run; a kernel
+# density threshold's spread falls as $n^{-2/5}$,
+# `detection_studies.paper_threshold_standard_error`). The rule follows from the sample sizes and the printed
+# digits, not from our $z_{lim}$. (Until a referee's pass on 2026-11-26 the tolerance used our error alone.) In the
+# full run the predictions lie far outside it either way: active 613.88 mm/s against 410.6, with standard errors of
+# 13.68 (ours) and 9.15 (the paper's, estimated) mm/s, combined 16.46, a difference of 12.4 combined standard
+# errors (tolerance 33.0 mm/s); quiet 22.24 against 17.22 mm/s, errors 0.50 and 0.39, combined 0.63, 7.9 standard
+# errors (tolerance 1.27 mm/s). Under the old rule they were 14.9 and 10.0 of our errors off. At $f = 0.1$
+# the thresholds are judged within the 25 % band of the threshold reading (tuned), far wider than either error.
 #
 # ## 3b · Is the window-tuned OCBE consistent? (beyond the paper's figures)
 #
@@ -609,21 +627,24 @@ print(train.accuracy_report(F_C))
 
 # %% [markdown]
 # **How the accuracies are judged.** Table 7 prints whole percent, so the paper's 100 % means at least 99.5 % and
-# its 97 % lies in [96.5, 97.5] %. The tolerance of each accuracy row is that half point plus two binomial standard
-# errors of an accuracy over our 200 test runs, taken at the end of the paper's interval nearer one half (where the
-# error is largest): 0.5 + 2 x 0.5 = 1.5 points at 100 %, 0.5 + 2 x 1.3 = 3.1 points at 97 %. A rule with a floor of
-# one point per standard error gave a 2-point tolerance at 100 % that neither the printed digits nor 200 runs
-# support; under it a 98.0 % sat exactly on the edge. That change was made after the 98.0 % was seen, but it made
-# the row stricter (98.0 % now differs), so it cannot have tuned the row in the paper's favour. The normal
+# its 97 % lies in [96.5, 97.5] %. The paper's accuracies are counts over its own 100 + 100 test runs, Monte Carlo
+# estimates like ours. The tolerance of each accuracy row is that half point plus two standard errors of the
+# difference: the binomial errors of an accuracy over our 200 test runs and over the paper's 200, in quadrature,
+# each taken at the end of the paper's interval nearer one half (where the error is largest): 0.5 + 2 x 0.71 = 1.9
+# points at 100 %, 0.5 + 2 x 1.84 = 4.2 points at 97 %. History: a rule with a floor of one point per standard
+# error gave a 2-point tolerance at 100 % that neither the printed digits nor 200 runs support; under it a 98.0 %
+# sat exactly on the edge. It was replaced (after the 98.0 % was seen, but stricter) by half a point plus two of
+# our binomial errors alone, 1.5 points at 100 %, which left out the paper's own sampling error; a referee's pass
+# (2026-11-26, later) added it, a widening fixed by the two sample sizes and the printed digits, not by our counts,
+# under which 98.0 % still differs (by 0.1 point). The normal
 # approximation behind a binomial standard error is poor next to 100 %, so each accuracy row also carries two exact
 # tests in its note: the binomial probability of at least our number of errors if the true accuracy sat at the
 # edge of the paper's printed interval, and Fisher's exact test of our counts against the paper's own 100 + 100 test
-# runs. For 196 of 200 against 100 % (full run, $f_c$, active) the row misses by 0.5 points: $-2.0$ points against a
-# 1.5-point tolerance. The exact binomial probability is 1.9 %, below the 2.3 % one-sided level of two standard
-# errors, so the exact test agrees with the row; and even with the paper's own binomial error added to ours (a
-# tolerance of 0.5 + 2 x 0.71 = 1.9 points) 98.0 % would still differ, by 0.1 point. Fisher's test gives p = 0.12: the
-# paper's own 200 runs could not tell 98 % from 100 % either. The status is the declared rule's; the row says by how
-# much it misses.
+# runs. For 196 of 200 against 100 % (full run, $f_c$, active) the row misses by 0.1 point: $-2.0$ points against a
+# 1.9-point tolerance. The exact binomial probability of so many errors at 99.5 % accuracy is 1.9 %, below the
+# 2.3 % one-sided level of two standard errors, so that test agrees with the row. Fisher's test of our counts
+# against the paper's gives p = 0.12: the paper's own 200 runs could not tell 98 % from 100 %, and the row's miss is
+# narrow. The status is the declared rule's; the row says by how much it misses.
 #
 # **The two stable candidates, side by side** (both tunings): detection accuracy, the expected error of the test
 # with its bootstrap standard error (a finer measure than 200 test runs) and the worst consistency cell.
@@ -684,8 +705,10 @@ print(f"smoothed NEES mean {nees_h.mean():.0f} (6 if consistent); residual norms
 # **Is $z$ of a given burn independent of the tuning?** One would expect $z$ of a 0.5 m/s burn to be about 0.5 m/s
 # whatever the window weight. We fly the same $N$ randomly pointed 0.5 m/s burns (sizes printed) through the quiet
 # tuning at every factor of the grid. The paper's value is one run, so the tolerance of the comparison is fixed
-# from our single-run spread: agreement when 0.4761 m/s (printed to $5\times10^{-5}$, negligible) lies within two
-# single-run standard deviations of our mean. The paper's "about 30 sigma" has one significant digit: agreement
+# from our single-run spread: agreement when 0.4761 m/s lies within half its last printed digit ($5\times10^{-5}$)
+# plus two standard errors of the difference between one run and our mean of $n$ runs, $sd\sqrt{1 + 1/n}$ ($sd$ the
+# single-run standard deviation; until 2026-11-26 two $sd$, which left out our mean's own error, 0.8 % of the
+# tolerance at 64 runs). The paper's "about 30 sigma" has one significant digit: agreement
 # when our level rounds to 30, i.e. lies in [25, 35). The level is (mean $z$ of the 0.5 m/s burns $-$ mean of the
 # quiet H1 training runs) / their standard deviation, both at the same tuning.
 

@@ -2,6 +2,8 @@
 draws, pooled Monte Carlo runs and policy studies, pooled filtering of trial sets, the direction trials, and the
 binomial standard error of a fraction (detection_studies).  Contributed by the owner of those functions; the
 functions' older specs live in ``reliability_specs_detection.py`` and ``reliability_specs_greaves_scheeres_2021_studies.py``.
+``HealthRuns.from_filter`` (the per-run Fig. 22 reading) and the standard errors of a difference from the paper's
+Monte Carlo numbers (notebook 10's closing table) are swept here too.
 
 Every argument is swept (``executor`` is checked by ``map_tasks``).  The items of ``jobs`` and ``sets`` are swept
 through one-job wrappers (labels ``<function>.job`` / ``.set``), whose refusals name ``jobs[0] seed``,
@@ -26,6 +28,11 @@ MODULES = []  # the modules are covered by the two plugins above; these specs ad
 @functools.lru_cache(maxsize=None)
 def _inputs():
     return detection.draw_trials([np.random.default_rng(k) for k in range(2)], _setup(), detection.QUIET_POLICY)
+
+
+@functools.lru_cache(maxsize=None)
+def _filtered():
+    return detection.filter_trials(_setup(), _inputs())
 
 
 def _one_job(fn, container, fields):
@@ -83,4 +90,21 @@ def specs(Spec, lazy):
                     burn_offset_hours="real")))
     s.append(S("fraction_standard_error", ds.fraction_standard_error, dict(fraction=0.1, n=200),
                dict(fraction="range:0:1", n="int1")))
+    # the standard errors of a difference from the paper's Monte Carlo numbers (notebook 10's closing table)
+    s.append(S("accuracy_comparison_standard_error", ds.accuracy_comparison_standard_error,
+               dict(paper=0.97, n=200, n_paper=200), dict(paper="range:0:1", n="int1", n_paper="int1")))
+    s.append(S("paper_threshold_standard_error", ds.paper_threshold_standard_error,
+               dict(se=0.0137, z_lim=0.614, paper=0.4106, n_h0=500, n_h1=3000),
+               dict(se="nonneg", z_lim="pos", paper="pos", n_h0="int1", n_h1="int1")))
+    s.append(S("threshold_comparison_standard_error", ds.threshold_comparison_standard_error,
+               dict(se=0.0137, z_lim=0.614, paper=0.4106, n_h0=500, n_h1=3000),
+               dict(se="nonneg", z_lim="pos", paper="pos", n_h0="int1", n_h1="int1")))
+    s.append(S("one_run_comparison_standard_error", ds.one_run_comparison_standard_error, dict(sd=0.03, n=64),
+               dict(sd="nonneg", n="int1")))
+    # the per-run reading of Fig. 22 (notebook 10, Section 6): trials, their batched OCBE, the residual test's options
+    s.append(S("HealthRuns.from_filter", ds.HealthRuns.from_filter,
+               dict(setup=lazy(_setup), inputs=lazy(_inputs), result=lazy(_filtered), horizon_hours=24.0,
+                    tail_probability=0.00135),
+               dict(setup="instance", inputs="iterable", result="instance", horizon_hours="pos",
+                    tail_probability="range:0:0.5")))
     return s

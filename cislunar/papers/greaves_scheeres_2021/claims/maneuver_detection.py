@@ -6,22 +6,55 @@ Declarations only.  Every criterion was fixed before the Monte Carlo it judges. 
 weight run side by side: ``f = 0.1`` was chosen with the paper's thresholds in view, so agreement there is
 "consistent (tuned)"; ``f_c`` follows from the paper's consistency claim by a rule fixed before the tuning map, so
 agreement there is "reproduced".  Monte Carlo tolerances are standard errors passed at judging: bootstrap standard
-errors of the threshold and of the expected error, binomial standard errors of a test accuracy
-(:func:`cislunar.papers.greaves_scheeres_2021.detection_studies.accuracy_standard_error`, on top of half a printed
-point) and of a fraction of inconsistent runs (Fig. 10), single-run spreads of z.
+errors of the threshold (with the paper's own, estimated, in quadrature) and of the expected error, binomial
+standard errors of a test accuracy (ours and the paper's in quadrature,
+:func:`cislunar.papers.greaves_scheeres_2021.detection_studies.accuracy_comparison_standard_error`, on top of half a
+printed point) and of a share of runs (Fig. 22), single-run spreads of z.
 
 Two limits were changed after their runs had been seen, and how each is then judged (checked 2026-11-26):
 
-* Fig. 10: the limit "10 % plus two binomial standard errors" was declared (2026-11-26 04:27) after runs drawn with
-  the seed ``[SEED, 41]`` had shown 10.5 % inconsistent smoothed runs; notebook 10 therefore judges fresh runs drawn
-  afterwards with the seed ``[SEED, 42]`` (once, whatever they gave).
+* Fig. 10 ("Both the forwards and smoothed filters produce consistent, but less certain, solutions", caption of
+  Fig. 10, one run with a 50 mm/s maneuver): the limit "10 % plus two binomial standard errors" (14.2 % for 200
+  runs) was declared (2026-11-26 04:27) after runs drawn with the seed ``[SEED, 41]`` had shown 10.5 % inconsistent
+  smoothed runs; notebook 10 then judged fresh runs drawn afterwards with the seed ``[SEED, 42]``.  A referee
+  (session h, 2026-11-26) found the widening out of line with the chapter's rule for "consistent" (at most 10 % of
+  the runs inconsistent: the Figs. 12-13 rows, notebook 09) and decided with 10.5 % in view.  The row now uses that
+  rule unwidened, in every cell (with and without a burn, forward and smoothed; the paper's figure is the burn case
+  alone, so the scope is wider than its words), plus the "less certain" half (a larger mean forward 3-sigma bound).
+  That tightens the criterion.  The row stays "consistent (tuned)", and its tuned reason now says both choices: the
+  constant weight is the window weight at f = 0.1, and the judged runs are a second draw, made after the first had
+  failed this limit (a redraw after a miss is a choice made while looking).
 * Table 7 accuracy: the tolerance "half a printed point plus two binomial standard errors" replaced (same commit) a
-  one-point floor under which 98.0 % sat exactly on the edge; the change made the row stricter (it now differs).  The
+  one-point floor under which 98.0 % sat exactly on the edge; the change made the row stricter (it now differs; the
+  paper's own binomial error, added in session h below, leaves it differing by 0.1 point instead of 0.5).  The
   row's note adds exact tests (:func:`detection_studies.accuracy_exact_text`): 4 errors in 200 have a binomial
   probability of 1.9 % at 99.5 % accuracy, but against the paper's own 200 test runs (200/200) Fisher's exact test
   gives p = 0.12: the paper's sample cannot separate 98 % from 100 %.  The status stays the declared rule's.
 
 The joint search and the race grid (issue 23) had their criteria declared 2026-11-26 before they ran.
+
+Comparisons with a number of the paper that is itself a Monte Carlo estimate (revised 2026-11-26, session h, a
+referee's finding; the values had been seen, the statuses did not change):
+
+* Eq. 35 thresholds at f_c ("For the active case presented here zlim = 0.4106 m/s"; "zlim = 17.22 mm/s", from the
+  paper's 500 runs without and 3000 with a maneuver).  The rows compared our z_lim with the paper's within two of
+  *our* bootstrap standard errors, as if the paper's number were exact.  The paper's z_lim has a sampling error of
+  its own (unprinted), and printed digits.  The tolerance is now half a unit of the paper's last printed digit
+  (:func:`cislunar.publish.claims.printed_tolerance`: 5e-5 m/s, 5e-6 m/s) plus two standard errors of the
+  difference: ours and the paper's in quadrature, the paper's estimated from our bootstrap at its sample sizes (our
+  relative standard error at the paper's value,
+  :func:`cislunar.papers.greaves_scheeres_2021.detection_studies.paper_threshold_standard_error`).  The rule follows
+  from the sample sizes and the printed digits alone, not from our z_lim; it widens the tolerance (by 20-30 % at the
+  full run's sizes),
+  and the rows differed by 10-15 of our standard errors, so the change could not turn them.
+* Table 7 accuracies: the same reasoning: the paper's accuracies are counts over its own 100 + 100 test runs, so the
+  binomial error of the paper's 200 runs joins ours in quadrature (``accuracy_comparison_standard_error``).  The
+  f_c active row (98.0 % against 100 %) then misses by 0.1 point instead of 0.5 (the notebook had already printed
+  this reading); the other three pass either way.
+* Fig. 22's z of the 0.5 m/s burn (0.4761 m/s, one run): the paper's one run spreads by a single-run standard
+  deviation and our mean by that over the square root of our runs; the tolerance is half the printed digit plus two
+  standard errors of the difference, ``sd * sqrt(1 + 1/n)`` (``one_run_comparison_standard_error``), instead of two
+  single-run standard deviations.  A widening by 0.8 % at 64 runs; both rows pass either way.
 
 Two criteria were revised on 2026-11-26 (session g, a referee's findings), after the values they judge had been seen:
 
@@ -72,10 +105,13 @@ from cislunar.publish.claims import (
     Equals,
     Holds,
     Within,
+    printed_tolerance,
 )
 
-#: Thresholds printed with Eq. 35, m/s.
+#: Thresholds printed with Eq. 35, m/s ("zlim = 0.4106 m/s", "zlim = 17.22 mm/s"), and as printed (in m/s: the
+#: printed digits give half a unit of the last one, 5e-5 and 5e-6 m/s, to the z_lim tolerance).
 PAPER_ZLIM = {"active": 0.4106, "quiet": 0.01722}
+PAPER_ZLIM_PRINTED = {"active": "0.4106", "quiet": "0.01722"}
 #: Detection accuracies of Table 7 (9:2 NRHO).
 PAPER_ACCURACY = {"active": 1.00, "quiet": 0.97}
 #: Control integral of the 0.5 m/s burn of Fig. 22, m/s.
@@ -85,10 +121,11 @@ _STABLE = _ORBITS[1:]
 _POLICIES = ("active", "quiet")
 _TUNED_F = "f = 0.1 chosen with the paper's thresholds in view"
 _OUTER = "; outer-band candidate (notebook 09), reduced Monte Carlo"
-#: Table 7 prints whole percent: half a point of the paper's value, plus two binomial standard errors of our test
-#: accuracy at the end of the paper's printed interval nearer one half (detection_studies.accuracy_standard_error).
-#: Fixed on 2026-11-26 in place of a rule with a one-point floor per standard error (a 2-point tolerance at 100 %
-#: that the printed digits and 200 test runs do not support).
+#: Table 7 prints whole percent: half a point of the paper's value, plus two standard errors of the difference, the
+#: binomial errors of our test accuracy and of the paper's (its 200 test runs) in quadrature, each at the end of the
+#: paper's printed interval nearer one half (detection_studies.accuracy_comparison_standard_error).  Fixed on
+#: 2026-11-26 in place of a rule with a one-point floor per standard error (a 2-point tolerance at 100 % that the
+#: printed digits and 200 test runs do not support); the paper's error added later that day (session h).
 _ACC_DIGITS = 0.005
 #: "Marginally better" (Table 8): the paper's largest accuracy gap between Tables 7 and 8 (quiet, 194/200 against
 #: 200/200), as a fraction, and the same gap in the expected error FP + MD (accuracy over 100 + 100 tests is
@@ -102,8 +139,9 @@ STABLE_MARGIN = 2 * STABLE_MARGIN_POINTS
 HEALTH_PLAUSIBLE_FLOOR = 0.05
 HEALTH_NEES_DIVERGED = 20.0
 HEALTH_RESIDUAL_BENIGN = 3.0
-_ACC_SOURCE = ("Table 7 (tolerance: half a printed point plus two binomial standard errors over our test runs at "
-               "the end of the paper's printed interval)")
+_ACC_SOURCE = ("Table 7 (tolerance: half a printed point plus two standard errors of the difference, the binomial "
+               "errors of our test runs and of the paper's 200 in quadrature, each at the end of the paper's printed "
+               "interval)")
 
 CLAIMS = {
     "magnitude bounds": Claim("Eq. 5 magnitude stays within mean +- 3 sd (both policies)", "by construction",
@@ -124,11 +162,18 @@ CLAIMS = {
         "Monte Carlo sizes (H0 / H1 / tests per hypothesis)", "500 / 3000 / 100", Equals("500 / 3000 / 100"),
         kind="derived", source="Maneuver Detection",
         reason="quick mode shrinks every Monte Carlo; the full run uses the paper's sizes"),
+    # revised 2026-11-26 (session h, a referee): the limit "10 % + 2 binomial standard errors" (14.2 % for 200 runs)
+    # was declared after 10.5 % had been seen; the row now uses the chapter's rule for consistent (at most 10 %, as
+    # the Figs. 12-13 rows and notebook 09), a tightening; the redraw after the first draw is declared in tuned
     "fig10": Claim(
         "Fig. 10: constant tuning consistent but less certain", "consistent, less certain (one run)",
-        Holds("at most 10 % inconsistent runs in every cell (H0/H1, forward/smoothed), widened by two binomial "
-              "standard errors of the cell's runs, and a larger mean forward 3-sigma bound than the window tuning"),
-        tuned="the constant weight is the window weight at f = 0.1, " + _TUNED_F, source="Fig. 10"),
+        Holds("at most 10 % inconsistent runs in every cell (H0/H1, forward/smoothed), the chapter's rule for "
+              "consistent, and a larger mean forward 3-sigma bound than the window tuning"),
+        tuned="the constant weight is the window weight at f = 0.1, " + _TUNED_F + "; and the runs judged are a "
+              "second draw (seed [SEED, 42]), made after a first draw ([SEED, 41]) had shown 10.5 % inconsistent "
+              "smoothed burn runs, above this limit",
+        source="Fig. 10 ('both the forwards and smoothed filters produce consistent, but less certain, solutions')",
+        reason="more than 10 % inconsistent runs in some cell, or a bound not larger than the window tuning's"),
     "fig11": Claim(
         "Fig. 11: constant tuning, control spike at the burn in the smoothed control only",
         "spike only in the smoothed system", AtLeast(0.9),
@@ -155,10 +200,14 @@ CLAIMS = {
         f"z_lim, 9:2 NRHO, {p}, f = 0.1 (Eq. 35)", f"{PAPER_ZLIM[p] * 1e3:.2f} mm/s",
         Within(PAPER_ZLIM[p], 0.25, relative=True), tuned=_TUNED_F, source="Eq. 35 text (z_lim in m/s)",
         reason="outside 25 % of the paper's threshold") for p in _POLICIES},
+    # revised 2026-11-26 (session h, a referee): the tolerance was two of OUR bootstrap standard errors only; the
+    # paper's z_lim is a Monte Carlo estimate too, so the difference now carries both errors (see the docstring)
     **{f"z_lim f_c, {p}": Claim(
         f"z_lim, 9:2 NRHO, {p}, f_c (prediction)", f"{PAPER_ZLIM[p] * 1e3:.2f} mm/s",
-        Within(PAPER_ZLIM[p], 0.0, n_sigma=2), source="Eq. 35 text (z_lim in m/s; bootstrap standard errors, the "
-        "paper's digits are finer)") for p in _POLICIES},
+        Within(PAPER_ZLIM[p], printed_tolerance(PAPER_ZLIM_PRINTED[p]), n_sigma=2),
+        source="Eq. 35 text (z_lim in m/s; tolerance: half the paper's last printed digit plus two standard errors "
+        "of the difference, our bootstrap standard error and the paper's, estimated for its 500 + 3000 runs, in "
+        "quadrature: detection_studies.threshold_comparison_standard_error)") for p in _POLICIES},
     **{f"z_lim, {o}, {p}": Claim(
         f"z_lim, {o}, {p}", "not given", kind="not in paper",
         reason="the paper omits the stable-NRHO plots and values" + (_OUTER if o == _ORBITS[2] else ""))
@@ -210,8 +259,10 @@ CLAIMS = {
         tuned="the regime was chosen because the active pattern appears there", source="Fig. 20"),
     **{f"health z, {tag}": Claim(
         f"Health metric: z for a 0.5 m/s burn, quiet tuning, {tag}", "0.4761 m/s (one run)",
-        Within(PAPER_Z_HEALTH, 0.0, n_sigma=2), tuned=_TUNED_F if tag == "f = 0.1" else "",
-        source="Fig. 22 text (standard error: the single-run standard deviation; the paper's digits are finer)")
+        Within(PAPER_Z_HEALTH, printed_tolerance("0.4761"), n_sigma=2), tuned=_TUNED_F if tag == "f = 0.1" else "",
+        source="Fig. 22 text (tolerance: half the paper's last printed digit plus two standard errors of the "
+        "difference between the paper's one run and our mean, sd x sqrt(1 + 1/n) with sd the single-run standard "
+        "deviation: detection_studies.one_run_comparison_standard_error)")
        for tag in ("f = 0.1", "f_c")},
     **{f"health sigma, {tag}": Claim(
         f"Health metric: sigma level in the quiet H1 distribution, {tag}", "about 30 sigma", Between(25.0, 35.0),
