@@ -23,7 +23,22 @@ utils        argument validation, Monte Carlo through any executor, progress out
 ``tests/architecture/test_import_rules.py`` holds these rules against the source.
 """
 
-from cislunar.cr3bp.dynamics import CR3BP, EARTH_MOON
-
 __all__ = ["CR3BP", "EARTH_MOON"]
 __version__ = "0.1.0"
+
+
+def __getattr__(name):
+    """``cislunar.CR3BP`` and ``cislunar.EARTH_MOON``, imported on first use (PEP 562).
+
+    Importing ``cislunar`` alone (as the notebook runner, each of its child processes and the book builder do)
+    then costs nothing: the dynamics module pulls in ``scipy.optimize``, about a second and a half.
+    """
+    if name in __all__:
+        from cislunar.cr3bp import dynamics
+
+        return getattr(dynamics, name)
+    raise AttributeError(f"module 'cislunar' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted([*globals(), *__all__])
