@@ -35,7 +35,7 @@ QUICK = False  # quick mode: every None below picks its smaller quick-mode value
 SEED = 0  # seed of the notebook's random generator (the Monte Carlo check of section 1)
 OUTPUT_DIR = ""  # folder for the figures (empty: build-scratch/ by hand, the build under the runner)
 MC_SAMPLES = None  # Monte Carlo samples for the Eq. 11 check [-] (None: 20000 quick, 200000 full)
-RANGE_SIGMA_KM = None  # range noise standard deviation [km] (None: Table 5's 0.1 km = 100 m)
+RANGE_SIGMA_KM = None  # range noise standard deviation [km] (None: Table 5's 0.1 km, i.e. 100 m)
 N_BASELINES = None  # observer phase offsets in the baseline study of section 6 [-] (None: 5 quick, 10 full)
 BASELINE_MAX_PHASE = None  # longest observer lead in section 6, fraction of the DRO period [-] (None: 0.5)
 TIMING_SIZES = None  # measurement times per window in section 7 [-] (None: [5, 9, 17] quick, up to 65 full)

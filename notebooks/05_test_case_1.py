@@ -37,10 +37,10 @@ SEED = 0  # seed of the random perturbation starts of the multi-start (Section 3
 OUTPUT_DIR = ""
 N_NODES = None  # Sundman-spaced nodes over the two periods; the paper does not give its N (None: 18 quick, 40 full)
 N_NODES_ALT = None  # node count of the second grid of the mesh check, Section 5 (None: 20 quick, 28 full)
-SIGMA = 1.0  # Sundman exponent of the node spacing dt = r_m^sigma dtau (notebook 04)
+SIGMA = 1.0  # Sundman exponent of the node spacing, dt / dtau equal to r_m^sigma (notebook 04)
 ALPHAS = None  # homotopy weights alpha_h, increasing in [0, 1], must contain 5e-3 (None: [0, 5e-3, 1e-2] quick, 9 full)
 PENALTY_ITER = None  # iterations granted to the paper's exact-penalty SCvx in Section 4 (None: 5 quick, 80 full)
-PENALTY_ITER_LONG = None  # the same at gamma = 1e3 with a larger limit (None: 10 quick, 300 full)
+PENALTY_ITER_LONG = None  # the same at gamma 1e3 with a larger limit (None: 10 quick, 300 full)
 PENALTY_GAMMAS = None  # exact-penalty weights gamma swept, unstated in the paper (None: [1e1, 1e3, 1e5] quick, 1e1-1e5 full)
 BUDGETS_EXTRA_MPS = None  # impulse budgets above the baseline's, Section 8, m/s (None: [5] quick, [1, 5, 20] full)
 BUDGET_RTOL = 0.02  # a budget counts as met within this relative tolerance (fixed before solving)

@@ -42,7 +42,7 @@ PRE_ARC_SWEEP_H = None  # tracking arcs swept, whole hours (None: 24 quick; 6, 1
 RING_ANGLES_DEG = None  # agent's initial ring angles on the QPO, deg, with 0 (None: 0, 90 quick; 0, 45, 90, 135 full)
 TIMING_REPEAT = None  # runs of the true minimiser timed, best kept (None: 1)
 WORKERS = 1  # local processes for the sweeps (1: serial)
-SCHEDULER = ""  # address of a Dask scheduler to run the sweeps on ("" = none; then WORKERS applies)
+SCHEDULER = ""  # address of a Dask scheduler to run the sweeps on ("" for none; then WORKERS applies)
 
 # %% [markdown]
 # **Changing the chapter.** Every size and setting of this chapter is a parameter of the cell above. A parameter

@@ -33,7 +33,7 @@
 QUICK = False  # quick mode: coarser surface, fewer sweep points, fewer Monte Carlo trials (the default sizes below)
 SEED = 0  # root seed: Monte Carlo streams [SEED, k], offset directions [SEED, 8], random picks [SEED, 20] and [SEED, 21]
 OUTPUT_DIR = ""  # folder for the figures (empty: build-scratch/ by hand, the build under the runner)
-N_SURF = None  # ring angles = arrival times of the station-keeping surface (None: 14 quick, 40 full; paper: not given)
+N_SURF = None  # ring angles, i.e. arrival times, of the station-keeping surface (None: 14 quick, 40 full; paper: not given)
 N_SWEEP = None  # arrival times in the sweep over the unstated scenario inputs (None: 3 quick, 16 full)
 N_GRID = None  # ring-angle counts of the resolution study of section 5b (None: 10, 20 quick; 16 ... 640 full)
 N_GRID_SLICES = None  # arrival times in the resolution study (None: 3 quick, 5 full)
@@ -43,7 +43,7 @@ N_TRIALS = None  # Monte Carlo trials per policy and execution-error level (None
 N_RANDOM = None  # uninformed picks per arrival slice, ring angles uniform on [0, 2 pi) (None: 16 quick, 64 full)
 MEMBER_CHECK = None  # re-solve the torus for two other readings of "average range" (None: False quick, True full)
 WORKERS = None  # local processes for the sweeps and the Monte Carlo, 1 runs serially (None: 1 quick, 2 full)
-SCHEDULER = ""  # address of a Dask scheduler to run them on ("" = none; then WORKERS applies)
+SCHEDULER = ""  # address of a Dask scheduler to run them on ("" for none; then WORKERS applies)
 MEAN_RANGE_KM = None  # mean agent-target range that selects the torus member, km (None: 215.0, the paper's number)
 T_BURN_H = None  # first burn, hours from the target's apoapsis (None: -24.0)
 T_ARRIVAL_H = None  # window of arrival times (second burn), hours from apoapsis (None: (-12.0, 12.0))

@@ -48,7 +48,7 @@ MAX_RESETS = None  # a run needing more resets than this counts as diverged (Non
 N_VARIANT = None  # runs per burn size of the measurement-set study (Section 6), each seen through three measurement
 #                   sets and filtered with two reset rules (None: 1 quick, 12 full)
 WORKERS = 1  # local processes for the delay and reset-rule studies (1: serial)
-SCHEDULER = ""  # address of a Dask scheduler to run those studies on ("" = none; then WORKERS applies)
+SCHEDULER = ""  # address of a Dask scheduler to run those studies on ("" for none; then WORKERS applies)
 
 # %% [markdown]
 # **Changing the chapter.** Every size and setting is a parameter of the cell above. A parameter left at `None` is

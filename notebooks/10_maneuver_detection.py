@@ -75,7 +75,7 @@ N_RACE = None  # (no-burn runs for calibration and validation, runs per burn siz
 N_BOOT = None  # bootstrap resamples for the standard errors of z_lim and of FP + MD (None: 4 quick, 40 full)
 BATCH = None  # trials the batched OCBE filters together, epoch by epoch (None: 8); results depend on it
 WORKERS = None  # local processes for the Monte Carlo, 1 runs serially (None: 1 quick, 2 full)
-SCHEDULER = ""  # address of a Dask scheduler to run the Monte Carlo on ("" = none; then WORKERS applies)
+SCHEDULER = ""  # address of a Dask scheduler to run the Monte Carlo on ("" for none; then WORKERS applies)
 
 # %% [markdown]
 # **Changing the chapter.** Every size and setting is a parameter of the cell above. A parameter left at `None` is

@@ -48,7 +48,7 @@ QUICK = False
 SEED = 0  # seed of the verification samples and of the angle noise
 OUTPUT_DIR = ""
 PERIODS = None  # orbit periods simulated (None: 0.5 quick, 1.0 full)
-DT = None  # measurement interval, TU; 0.002 TU = 12.5 min (None: 0.004 quick, 0.002 full)
+DT = None  # measurement interval, TU; 0.002 TU is 12.5 min (None: 0.004 quick, 0.002 full)
 NOISE_DEG = None  # standard deviation of the angle noise on theta1 and theta2, deg (None: the paper's 0.1)
 E0_SCALE = None  # multiplier of the initial estimate error (None: 1, i.e. about 10,900 km and 14 m/s)
 N_ORBIT = None  # samples along one period of the orbit that bound rho (None: 600 quick, 4000 full)

@@ -107,3 +107,20 @@ def test_the_checker_catches_each_break(tmp_path, body, message):
     good.write_text(BASE + "# %%\nn = N if N is not None else (10 if QUICK else 100)\n"
                     "from x import open_executor\nwith open_executor(WORKERS, SCHEDULER) as ex:\n    pass\n")
     check_source(good)
+
+
+@pytest.mark.parametrize("source", SOURCES, ids=[p.stem for p in SOURCES])
+def test_papermill_lists_every_parameter_with_its_default_and_help(source, caplog):
+    """``papermill --help-notebook`` (papermill's own reading of the parameters cell) names every parameter.
+
+    papermill drops, with an "Unable to parse line" warning in every run's log, any parameter line holding more than
+    one ``=``, so a help comment must not contain one (it used to: ``0.002 TU = 12.5 min``).
+    """
+    from papermill.translators import PythonTranslator
+
+    cell = next(c for c in jupytext.read(source).cells if "parameters" in c.metadata.get("tags", []))
+    with caplog.at_level("WARNING", logger="papermill"):
+        listed = {p.name: p for p in PythonTranslator.inspect(cell)}
+    assert not [r.getMessage() for r in caplog.records if "Unable to parse" in r.getMessage()]
+    assert set(listed) == set(_split(source)[0])
+    assert all(p.help for name, p in listed.items() if name not in COMMON), "every parameter explains itself"
