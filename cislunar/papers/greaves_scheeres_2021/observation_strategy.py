@@ -761,6 +761,7 @@ class FilterAxesStudy:
         Names of the axes (keys of :data:`FILTER_AXES` or the caller's).
     orbit_names : tuple of str
     cadences : tuple of float
+        Cadences, hours, increasing (the table's and the figure's order; the draws follow the caller's order).
     n_runs : int
         Runs per cell (at cadences of 0.1 h and more; ``n_runs_one_minute`` below).
     n_runs_one_minute : int
@@ -780,6 +781,15 @@ class FilterAxesStudy:
     sigma_angle_rad: float
 
     MODELS = ("angles", "angles+rates")
+
+    def runs_at(self, cadence: float) -> int:
+        """Runs per cell at ``cadence`` (hours): ``n_runs_one_minute`` under 0.1 h, else ``n_runs``."""
+        return self.n_runs_one_minute if cadence < 0.1 else self.n_runs
+
+    @property
+    def total_runs(self) -> int:
+        """Filter runs in the study (every axis, orbit, cadence and model)."""
+        return len(self.axes) * len(self.orbit_names) * len(self.MODELS) * sum(self.runs_at(c) for c in self.cadences)
 
     def contrast_holds(self, axis, orbit_name, cadence) -> bool:
         """The paper's contrast in one cell: most angles-only runs diverge, at most 10 % of the runs with rates do
@@ -832,7 +842,8 @@ def filter_axes_study(system: CR3BP, orbits_: dict, cadences, control_weight: fl
     system : CR3BP
     orbits_ : dict of str -> PeriodicOrbit
     cadences : sequence of float
-        Measurement cadences, hours.
+        Measurement cadences, hours.  Their order fixes the draws (index ``ic`` in the seed below), so a cadence
+        appended to the list leaves every earlier cell's runs as they were; the study lists them increasing.
     control_weight : float
         The chapter's OCBE control weight, LU^2/TU^3 (each axis multiplies it by its factor).
     n_runs : int
@@ -893,8 +904,8 @@ def filter_axes_study(system: CR3BP, orbits_: dict, cadences, control_weight: fl
         a += n_parts
         cells[key] = float(np.mean([r.diverged for r in runs]))
         onsets[key] = [_onset_class(r, t, t_peri) for r in runs if r.diverged]
-    return FilterAxesStudy(cells, onsets, tuple(axes), tuple(orbits_), tuple(cadences), n_runs, n_one,
-                           handoff_scale, sigma_angle_rad)
+    return FilterAxesStudy(cells, onsets, tuple(axes), tuple(orbits_), tuple(sorted(float(c) for c in cadences)),
+                           n_runs, n_one, handoff_scale, sigma_angle_rad)
 
 
 def figure_filter_axes(study: FilterAxesStudy):
@@ -913,8 +924,10 @@ def figure_filter_axes(study: FilterAxesStudy):
             ax.axhspan(-5, 10, color="0.9", zorder=0)
             ax.axhline(50, color="0.6", lw=0.8, ls=":")
             ax.set(xscale="log", ylim=(-5, 105), title=f"{o}, {m}, hand-off {10 * study.handoff:g} km")
+            ax.set_xticks(study.cadences, [cadence_label(c) for c in study.cadences])  # the cadences run, by name
+            ax.xaxis.set_minor_locator(ticker.NullLocator())
             if io == n_orb - 1:
-                ax.set_xlabel("cadence [h]")
+                ax.set_xlabel("measurement cadence [min, h: as ticked]")
             if jm == 0:
                 ax.set_ylabel("diverged runs [%]")
     fig.legend(loc="lower center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, 0.0))

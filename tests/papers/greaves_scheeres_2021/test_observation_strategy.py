@@ -14,6 +14,7 @@ from cislunar.estimation import ocbe
 from cislunar.papers.greaves_scheeres_2021 import observation_strategy as obs
 from cislunar.papers.greaves_scheeres_2021 import tracking
 from cislunar.papers.greaves_scheeres_2021.claims.observation_strategy import CLAIMS
+from cislunar.publish import plotting
 from cislunar.utils.montecarlo import trial_rng
 
 Q = 1e-20 * em.time_unit_s**3 / em.length_unit_km**2
@@ -238,6 +239,49 @@ def test_filter_axes_study_filters_the_same_draws_with_each_axis_options_and_wei
     angles_calls = calls[:6]  # the angles-only cell: three axes, two one-run tasks each
     assert [c[2] for c in angles_calls[0:2]] == [c[2] for c in angles_calls[2:4]] == [c[2] for c in angles_calls[4:6]]
     assert [(c[0] / Q, c[1]) for c in angles_calls[::2]] == [(1.0, True), (1.0, False), (100.0, True)]
+
+
+def test_an_appended_cadence_leaves_the_earlier_cells_draws_and_the_study_lists_cadences_increasing(nrho, monkeypatch):
+    """A cell's draws follow its cadence's place in the caller's list (notebook 09 appends the minute cadences so
+    that the hour cells keep theirs); the study lists its cadences increasing, whatever the caller's order."""
+    calls = []
+    real = tracking.filter_trials
+
+    def spy(rngs, scenario, control_weight, **kw):
+        calls.append(tuple(r.bit_generator.state["state"]["state"] for r in rngs))
+        return real(rngs, scenario, control_weight, **kw)
+
+    monkeypatch.setattr(tracking, "filter_trials", spy)
+    axes = {"baseline": ({}, 1.0)}
+
+    def study(cadences):
+        calls.clear()
+        st = obs.filter_axes_study(em, {"9:2 NRHO": nrho}, cadences, Q, n_runs=2, n_runs_one_minute=1, seed=5,
+                                   axes=axes, handoff_scale=300.0, progress=False)
+        return st, list(calls)
+
+    one, one_calls = study([12.0])
+    two, two_calls = study([12.0, 24.0])
+    assert two.cadences == (12.0, 24.0) and two_calls[:2] == one_calls  # the 12-h cells: the same draws
+    assert all(two.cells[k] == one.cells[k] for k in one.cells)
+    swapped, swapped_calls = study([24.0, 12.0])
+    assert swapped.cadences == (12.0, 24.0)  # listed increasing
+    assert swapped_calls[2:] != one_calls  # the 12-h cell moved to index 1: other draws (why the notebook appends)
+
+
+def test_filter_axes_run_counts_and_the_cadence_ticks_by_name():
+    cells = {(a, "9:2 NRHO", c, m): 0.0 for a in ("baseline", "x") for c in (1 / 60, 2.0)
+             for m in ("angles", "angles+rates")}
+    st = obs.FilterAxesStudy(cells, {k: [] for k in cells}, ("baseline", "x"), ("9:2 NRHO",), (1 / 60, 2.0), 10, 4,
+                             1.0, 1e-5)
+    assert (st.runs_at(1 / 60), st.runs_at(0.1), st.runs_at(2.0)) == (4, 10, 10)
+    assert st.total_runs == 2 * 1 * 2 * (4 + 10)
+    fig = obs.figure_filter_axes(st)
+    ax = next(a for a in fig.axes if a.lines)
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["1 min", "2 h"]
+    assert list(ax.get_xticks()) == [1 / 60, 2.0]
+    assert plotting.axis_label_problems(fig) == []  # save_figure's rule: the x label still carries a unit
+    plt.close(fig)
 
 
 def test_filter_axes_contrast_and_claim_on_synthetic_cells():
