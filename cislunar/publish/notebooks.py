@@ -744,10 +744,9 @@ def _skip_iri_grammar() -> None:
 
 
 def _child(spec_path: str) -> int:
-    """Run one notebook as the command line's child process (``--child SPEC``); writes the result JSON."""
+    """Run one notebook as the command line's child process (``--child SPEC``, which :func:`main` hands here after
+    :func:`_skip_iri_grammar`); writes the result JSON."""
     import logging
-
-    _skip_iri_grammar()
 
     spec = json.loads(Path(spec_path).read_text())
     logging.basicConfig(level=logging.INFO if spec.get("log_output") else logging.WARNING, stream=sys.stdout,

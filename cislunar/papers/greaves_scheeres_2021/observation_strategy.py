@@ -81,6 +81,12 @@ def filled(claim, **fields):
     return dataclasses.replace(claim, quantity=quantity)
 
 
+def _runs_at_cadence(cadence_h: float, n_runs: int, n_runs_one_minute: int) -> int:
+    """Runs per cell at ``cadence_h`` (hours): ``n_runs_one_minute`` under 0.1 h (the 1-min cadence, about 9450
+    updates per period), else ``n_runs``."""
+    return n_runs_one_minute if cadence_h < 0.1 else n_runs
+
+
 def cadence_label(cadence_h: float) -> str:
     """'10 min' or '2 h'."""
     cadence_h = validation.positive(cadence_h, "cadence_h")
@@ -445,7 +451,7 @@ def strategy_study(system: CR3BP, orbits_: dict, cadences, control_weight: float
                                          sigma_angle_rad=sigma_angle_rad)
             keys.append((name, cad))
             sets.append((scn, [((seed, k, j, int(rates)), i, handoff_scale)
-                               for i in range(n_one if cad < 0.1 else n_runs)]))
+                               for i in range(_runs_at_cadence(cad, n_runs, n_one))]))
     runs = _run_sets(sets, control_weight, executor, f"{'angles+rates' if rates else 'angles'} {observers}")
     return StrategyStudy(dict(zip(keys, runs)), rates)
 
@@ -784,12 +790,17 @@ class FilterAxesStudy:
 
     def runs_at(self, cadence: float) -> int:
         """Runs per cell at ``cadence`` (hours): ``n_runs_one_minute`` under 0.1 h, else ``n_runs``."""
-        return self.n_runs_one_minute if cadence < 0.1 else self.n_runs
+        return _runs_at_cadence(cadence, self.n_runs, self.n_runs_one_minute)
 
     @property
     def total_runs(self) -> int:
         """Filter runs in the study (every axis, orbit, cadence and model)."""
         return len(self.axes) * len(self.orbit_names) * len(self.MODELS) * sum(self.runs_at(c) for c in self.cadences)
+
+    def worst_cadence(self, axis: str, orbit_name: str, model: str) -> float:
+        """The cadence (hours) at which ``axis`` has most diverged runs for ``orbit_name`` and ``model`` (ties: the
+        shortest cadence)."""
+        return max(self.cadences, key=lambda c: self.cells[axis, orbit_name, c, model])
 
     def contrast_holds(self, axis, orbit_name, cadence) -> bool:
         """The paper's contrast in one cell: most angles-only runs diverge, at most 10 % of the runs with rates do
@@ -890,7 +901,7 @@ def filter_axes_study(system: CR3BP, orbits_: dict, cadences, control_weight: fl
             for im, rates in enumerate((False, True)):
                 scn = tracking.make_scenario(system, orb, cad, start="apoapsis", rates=rates,
                                              sigma_angle_rad=sigma_angle_rad)
-                n = n_one if cad < 0.1 else n_runs
+                n = _runs_at_cadence(cad, n_runs, n_one)
                 draws = [((seed, 23, io, ic, im), i, handoff_scale) for i in range(n)]
                 for name, (options, factor) in axes.items():
                     keys.append(((name, oname, cad, FilterAxesStudy.MODELS[im]), scn.t, orb.period / 2))

@@ -275,6 +275,9 @@ def test_filter_axes_run_counts_and_the_cadence_ticks_by_name():
     st = obs.FilterAxesStudy(cells, {k: [] for k in cells}, ("baseline", "x"), ("9:2 NRHO",), (1 / 60, 2.0), 10, 4,
                              1.0, 1e-5)
     assert (st.runs_at(1 / 60), st.runs_at(0.1), st.runs_at(2.0)) == (4, 10, 10)
+    st.cells["x", "9:2 NRHO", 2.0, "angles+rates"] = 0.3
+    assert st.worst_cadence("x", "9:2 NRHO", "angles+rates") == 2.0
+    assert st.worst_cadence("baseline", "9:2 NRHO", "angles+rates") == 1 / 60  # a tie: the shortest cadence
     assert st.total_runs == 2 * 1 * 2 * (4 + 10)
     fig = obs.figure_filter_axes(st)
     ax = next(a for a in fig.axes if a.lines)
